@@ -1,0 +1,126 @@
+// The compute-backend interface. Three implementations: cpu (plain multithreaded C++,
+// the reference and test oracle), opencl and vulkan. GPU work is explicit: the caller
+// creates device buffers, uploads, dispatches kernels on buffers and downloads; each
+// dispatch returns when its results are ready.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "fvp/accel/kernel_types.h"
+
+namespace fvp::accel {
+
+enum class BackendKind { kCpu, kOpenCl, kVulkan };
+
+/// "cpu", "opencl" or "vulkan".
+std::string_view toString(BackendKind kind);
+/// Parses "cpu" | "opencl" | "vulkan"; nullopt for anything else ("auto" included).
+std::optional<BackendKind> parseBackendKind(std::string_view name);
+
+/// A backend call failed: the message names the API call, the source file and line,
+/// and for kernel builds the compiler's log.
+class BackendError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// A backend the user asked for cannot run here (not built in, no driver, no device,
+/// missing device feature). Never silently replaced by another backend.
+class BackendUnavailable : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Memory owned by one backend. Not copyable; freed when destroyed.
+class DeviceBuffer {
+ public:
+  virtual ~DeviceBuffer() = default;
+  DeviceBuffer(const DeviceBuffer&) = delete;
+  DeviceBuffer& operator=(const DeviceBuffer&) = delete;
+  std::size_t sizeBytes() const { return size_bytes_; }
+
+ protected:
+  explicit DeviceBuffer(std::size_t size_bytes) : size_bytes_(size_bytes) {}
+
+ private:
+  std::size_t size_bytes_;
+};
+
+class Backend {
+ public:
+  virtual ~Backend() = default;
+  Backend(const Backend&) = delete;
+  Backend& operator=(const Backend&) = delete;
+
+  virtual BackendKind kind() const = 0;
+  /// The device the kernels run on, e.g. "cpu (2 threads)", "pthread-..." (PoCL), "llvmpipe ...".
+  virtual std::string deviceName() const = 0;
+
+  virtual std::unique_ptr<DeviceBuffer> createBuffer(std::size_t size_bytes) = 0;
+  /// Copies size_bytes from host memory into buf at offset_bytes. Throws std::out_of_range
+  /// if the range does not fit the buffer.
+  void upload(DeviceBuffer& buf, const void* src, std::size_t size_bytes,
+              std::size_t offset_bytes = 0);
+  void download(const DeviceBuffer& buf, void* dst, std::size_t size_bytes,
+                std::size_t offset_bytes = 0);
+
+  /// Kernel: batched voxel ray traversal (kernels/fvp_dda.h, fvp_traverse_ray).
+  /// rays: params.ray_count Ray; occupancy, field: voxelCount(params.grid) float;
+  /// results: params.ray_count RayResult. Throws std::out_of_range for short buffers.
+  void traverseRays(const TraverseParams& params, const DeviceBuffer& rays,
+                    const DeviceBuffer& occupancy, const DeviceBuffer& field,
+                    DeviceBuffer& results);
+
+  // Typed conveniences over upload/download.
+  template <typename T>
+  std::unique_ptr<DeviceBuffer> createBufferFrom(const std::vector<T>& host) {
+    auto buf = createBuffer(host.size() * sizeof(T));
+    if (!host.empty()) upload(*buf, host.data(), host.size() * sizeof(T));
+    return buf;
+  }
+  template <typename T>
+  std::vector<T> downloadAll(const DeviceBuffer& buf) {
+    std::vector<T> host(buf.sizeBytes() / sizeof(T));
+    if (!host.empty()) download(buf, host.data(), host.size() * sizeof(T));
+    return host;
+  }
+
+ protected:
+  Backend() = default;
+  // Implementations: arguments are validated by the public twins above; size_bytes > 0.
+  virtual void uploadBytes(DeviceBuffer& buf, const void* src, std::size_t size_bytes,
+                           std::size_t offset_bytes) = 0;
+  virtual void downloadBytes(const DeviceBuffer& buf, void* dst, std::size_t size_bytes,
+                             std::size_t offset_bytes) = 0;
+  // ray_count > 0.
+  virtual void dispatchTraverseRays(const TraverseParams& params, const DeviceBuffer& rays,
+                                    const DeviceBuffer& occupancy, const DeviceBuffer& field,
+                                    DeviceBuffer& results) = 0;
+};
+
+struct BackendInfo {
+  BackendKind kind;
+  bool available = false;
+  bool is_gpu = false;
+  std::string device;  ///< device name when available
+  std::string reason;  ///< why not, when unavailable
+};
+
+/// Tries every backend that was built in (cheap: creates and drops a context).
+std::vector<BackendInfo> probeBackends();
+
+/// Creates the named backend or throws BackendUnavailable saying what is missing.
+std::unique_ptr<Backend> createBackend(BackendKind kind);
+
+/// "cpu" | "opencl" | "vulkan" | "auto". auto picks a GPU device (OpenCL first, then
+/// Vulkan) when one exists, else the CPU reference. Throws std::invalid_argument for an
+/// unknown name and BackendUnavailable for an explicitly named backend that cannot run.
+std::unique_ptr<Backend> createBackend(std::string_view name);
+
+}  // namespace fvp::accel

@@ -1,0 +1,151 @@
+#include "fvp/accel/backend.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "backends.h"
+
+namespace fvp::accel {
+
+std::string_view toString(BackendKind kind) {
+  switch (kind) {
+    case BackendKind::kCpu: return "cpu";
+    case BackendKind::kOpenCl: return "opencl";
+    case BackendKind::kVulkan: return "vulkan";
+  }
+  return "unknown";
+}
+
+std::optional<BackendKind> parseBackendKind(std::string_view name) {
+  if (name == "cpu") return BackendKind::kCpu;
+  if (name == "opencl") return BackendKind::kOpenCl;
+  if (name == "vulkan") return BackendKind::kVulkan;
+  return std::nullopt;
+}
+
+GridParams makeGridParams(std::array<int, 3> dims, std::array<float, 3> origin_m,
+                          float voxel_size_m) {
+  for (int d : dims)
+    if (d <= 0) throw std::invalid_argument("grid dimensions must be positive");
+  if (!(voxel_size_m > 0.0f) || !std::isfinite(voxel_size_m))
+    throw std::invalid_argument("voxel_size_m must be a positive finite number");
+  if (std::int64_t{dims[0]} * dims[1] * dims[2] >= (std::int64_t{1} << 31))
+    throw std::invalid_argument("dense grids hold fewer than 2^31 voxels");
+  GridParams g{};
+  g.dim_x = dims[0];
+  g.dim_y = dims[1];
+  g.dim_z = dims[2];
+  g.origin_x_m = origin_m[0];
+  g.origin_y_m = origin_m[1];
+  g.origin_z_m = origin_m[2];
+  g.voxel_size_m = voxel_size_m;
+  g.fixed_per_m = static_cast<float>(static_cast<double>(FVP_DDA_ONE) / voxel_size_m);
+  return g;
+}
+
+namespace {
+void checkRange(const DeviceBuffer& buf, std::size_t size_bytes, std::size_t offset_bytes,
+                const char* what) {
+  if (offset_bytes > buf.sizeBytes() || size_bytes > buf.sizeBytes() - offset_bytes) {
+    std::ostringstream msg;
+    msg << what << ": range [" << offset_bytes << ", " << offset_bytes + size_bytes
+        << ") lies outside a buffer of " << buf.sizeBytes() << " bytes";
+    throw std::out_of_range(msg.str());
+  }
+}
+}  // namespace
+
+void Backend::upload(DeviceBuffer& buf, const void* src, std::size_t size_bytes,
+                     std::size_t offset_bytes) {
+  checkRange(buf, size_bytes, offset_bytes, "upload");
+  if (size_bytes) uploadBytes(buf, src, size_bytes, offset_bytes);
+}
+
+void Backend::download(const DeviceBuffer& buf, void* dst, std::size_t size_bytes,
+                       std::size_t offset_bytes) {
+  checkRange(buf, size_bytes, offset_bytes, "download");
+  if (size_bytes) downloadBytes(buf, dst, size_bytes, offset_bytes);
+}
+
+void Backend::traverseRays(const TraverseParams& params, const DeviceBuffer& rays,
+                           const DeviceBuffer& occupancy, const DeviceBuffer& field,
+                           DeviceBuffer& results) {
+  const std::size_t n = params.ray_count;
+  const auto voxels = static_cast<std::size_t>(voxelCount(params.grid));
+  checkRange(rays, n * sizeof(Ray), 0, "traverseRays: rays");
+  checkRange(occupancy, voxels * sizeof(float), 0, "traverseRays: occupancy");
+  checkRange(field, voxels * sizeof(float), 0, "traverseRays: field");
+  checkRange(results, n * sizeof(RayResult), 0, "traverseRays: results");
+  if (n) dispatchTraverseRays(params, rays, occupancy, field, results);
+}
+
+std::unique_ptr<Backend> createBackend(BackendKind kind) {
+  switch (kind) {
+    case BackendKind::kCpu: return detail::createCpuBackend();
+    case BackendKind::kOpenCl:
+#ifdef FVP_WITH_OPENCL
+      return detail::createOpenClBackend();
+#else
+      throw BackendUnavailable("opencl: this build has no OpenCL backend (FVP_WITH_OPENCL=OFF)");
+#endif
+    case BackendKind::kVulkan:
+#ifdef FVP_WITH_VULKAN
+      return detail::createVulkanBackend();
+#else
+      throw BackendUnavailable("vulkan: this build has no Vulkan backend (FVP_WITH_VULKAN=OFF)");
+#endif
+  }
+  throw std::invalid_argument("unknown backend kind");
+}
+
+namespace {
+bool isGpu(const Backend& backend) {
+#ifdef FVP_WITH_OPENCL
+  if (backend.kind() == BackendKind::kOpenCl) return detail::openClDeviceIsGpu(backend);
+#endif
+#ifdef FVP_WITH_VULKAN
+  if (backend.kind() == BackendKind::kVulkan) return detail::vulkanDeviceIsGpu(backend);
+#endif
+  return false;
+}
+}  // namespace
+
+std::vector<BackendInfo> probeBackends() {
+  std::vector<BackendInfo> infos;
+  for (BackendKind kind : {BackendKind::kCpu, BackendKind::kOpenCl, BackendKind::kVulkan}) {
+    BackendInfo info;
+    info.kind = kind;
+    try {
+      auto backend = createBackend(kind);
+      info.available = true;
+      info.is_gpu = isGpu(*backend);
+      info.device = backend->deviceName();
+    } catch (const std::exception& e) {
+      info.reason = e.what();
+    }
+    infos.push_back(std::move(info));
+  }
+  return infos;
+}
+
+std::unique_ptr<Backend> createBackend(std::string_view name) {
+  if (name == "auto") {
+    for (BackendKind kind : {BackendKind::kOpenCl, BackendKind::kVulkan}) {
+      try {
+        auto backend = createBackend(kind);
+        if (isGpu(*backend)) return backend;
+      } catch (const BackendUnavailable&) {
+        // auto means "best available": an absent GPU backend is expected here.
+      }
+    }
+    return detail::createCpuBackend();
+  }
+  auto kind = parseBackendKind(name);
+  if (!kind) {
+    throw std::invalid_argument("unknown backend '" + std::string(name) +
+                                "': expected cpu, opencl, vulkan or auto");
+  }
+  return createBackend(*kind);
+}
+
+}  // namespace fvp::accel

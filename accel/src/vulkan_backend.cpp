@@ -1,0 +1,348 @@
+// Vulkan backend: GLSL compute shaders from shaders/, compiled to SPIR-V at build time and
+// embedded. Prefers a discrete or integrated GPU; falls back to a CPU implementation
+// (Mesa lavapipe here). Every dispatch is recorded into a command buffer, submitted and
+// waited for with a fence, so results are ready when the call returns.
+#include <vulkan/vulkan_raii.hpp>
+
+#include <algorithm>
+#include <cstring>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "backends.h"
+#include "check.h"
+#include "embedded/spirv_ray_traverse.h"
+
+namespace fvp::accel::detail {
+namespace {
+
+template <typename F>
+auto vkChecked(F&& f, const char* call, const char* file, int line) -> decltype(f()) {
+  try {
+    return f();
+  } catch (const vk::Error& e) {
+    throwBackendError("Vulkan", call, e.what(), file, line);
+  }
+}
+#define FVP_VK(expr) vkChecked([&]() { return expr; }, #expr, __FILE__, __LINE__)
+
+constexpr uint32_t kPreferredWorkGroupSize = 64;
+
+bool deviceIsGpu(vk::PhysicalDeviceType type) {
+  return type == vk::PhysicalDeviceType::eDiscreteGpu ||
+         type == vk::PhysicalDeviceType::eIntegratedGpu;
+}
+
+int deviceRank(vk::PhysicalDeviceType type) {
+  switch (type) {
+    case vk::PhysicalDeviceType::eDiscreteGpu: return 0;
+    case vk::PhysicalDeviceType::eIntegratedGpu: return 1;
+    case vk::PhysicalDeviceType::eVirtualGpu: return 2;
+    case vk::PhysicalDeviceType::eCpu: return 3;
+    default: return 4;
+  }
+}
+
+class VkBuffer final : public DeviceBuffer {
+ public:
+  VkBuffer(std::size_t size_bytes, vk::raii::Buffer buffer, vk::raii::DeviceMemory memory,
+           void* mapped)
+      : DeviceBuffer(size_bytes),
+        buffer_(std::move(buffer)),
+        memory_(std::move(memory)),
+        mapped_(static_cast<std::byte*>(mapped)) {}
+  ~VkBuffer() override {
+    if (mapped_) memory_.unmapMemory();
+  }
+  vk::Buffer get() const { return *buffer_; }
+  std::byte* mapped() const { return mapped_; }  // null when not host visible
+
+ private:
+  vk::raii::Buffer buffer_;
+  vk::raii::DeviceMemory memory_;
+  std::byte* mapped_;
+};
+
+const VkBuffer& vkBuf(const DeviceBuffer& b) { return static_cast<const VkBuffer&>(b); }
+
+// One compute pipeline: storage buffers at bindings 0..n-1 of set 0, push constants,
+// work-group size as specialisation constant 0.
+struct ComputePipeline {
+  vk::raii::DescriptorSetLayout set_layout{nullptr};
+  vk::raii::PipelineLayout layout{nullptr};
+  vk::raii::ShaderModule module{nullptr};
+  vk::raii::Pipeline pipeline{nullptr};
+  uint32_t buffer_count = 0;
+  uint32_t push_constant_bytes = 0;
+};
+
+class VulkanBackend final : public Backend {
+ public:
+  VulkanBackend() {
+    vk::ApplicationInfo app("fvp", 1, "fvp", 1, VK_API_VERSION_1_1);
+    try {
+      instance_ = vk::raii::Instance(context_, vk::InstanceCreateInfo({}, &app));
+    } catch (const vk::Error& e) {
+      throw BackendUnavailable(std::string("vulkan: cannot create an instance (") + e.what() +
+                               "); install a driver such as mesa-vulkan-drivers");
+    }
+    pickDevice();
+    createDevice();
+    ray_traverse_ = createPipeline(kSpirv_ray_traverse, sizeof(kSpirv_ray_traverse), 4,
+                                   sizeof(TraversePushConstants));
+  }
+
+  BackendKind kind() const override { return BackendKind::kVulkan; }
+  std::string deviceName() const override { return device_name_; }
+  bool isGpu() const { return is_gpu_; }
+
+  std::unique_ptr<DeviceBuffer> createBuffer(std::size_t size_bytes) override {
+    // Vulkan rejects zero-sized buffers; an empty buffer still owns a few bytes.
+    const vk::DeviceSize bytes = std::max<std::size_t>(size_bytes, 4);
+    auto usage = vk::BufferUsageFlagBits::eStorageBuffer | vk::BufferUsageFlagBits::eTransferSrc |
+                 vk::BufferUsageFlagBits::eTransferDst;
+    vk::raii::Buffer buffer =
+        FVP_VK(vk::raii::Buffer(device_, vk::BufferCreateInfo({}, bytes, usage)));
+    const vk::MemoryRequirements req = buffer.getMemoryRequirements();
+    // Unified memory (integrated GPUs, lavapipe) is mapped directly; discrete GPUs get
+    // device-local memory filled through staging copies.
+    using M = vk::MemoryPropertyFlagBits;
+    std::optional<uint32_t> type = findMemoryType(req, M::eDeviceLocal | M::eHostVisible | M::eHostCoherent);
+    if (!type) type = findMemoryType(req, M::eDeviceLocal);
+    if (!type) type = findMemoryType(req, M::eHostVisible | M::eHostCoherent);
+    if (!type) throw BackendError("vulkan: no memory type for a storage buffer");
+    vk::raii::DeviceMemory memory =
+        FVP_VK(vk::raii::DeviceMemory(device_, vk::MemoryAllocateInfo(req.size, *type)));
+    FVP_VK(buffer.bindMemory(*memory, 0));
+    const auto flags = memory_props_.memoryTypes[*type].propertyFlags;
+    void* mapped = nullptr;
+    if ((flags & M::eHostVisible) && (flags & M::eHostCoherent))
+      mapped = FVP_VK(memory.mapMemory(0, VK_WHOLE_SIZE));
+    return std::make_unique<VkBuffer>(size_bytes, std::move(buffer), std::move(memory), mapped);
+  }
+
+ protected:
+  void uploadBytes(DeviceBuffer& buf, const void* src, std::size_t size_bytes,
+                   std::size_t offset_bytes) override {
+    const VkBuffer& dst = vkBuf(buf);
+    if (dst.mapped()) {
+      std::memcpy(dst.mapped() + offset_bytes, src, size_bytes);
+      return;
+    }
+    auto staging = createBuffer(size_bytes);
+    std::memcpy(vkBuf(*staging).mapped(), src, size_bytes);
+    submit([&](const vk::raii::CommandBuffer& cmd) {
+      cmd.copyBuffer(vkBuf(*staging).get(), dst.get(), vk::BufferCopy(0, offset_bytes, size_bytes));
+    });
+  }
+
+  void downloadBytes(const DeviceBuffer& buf, void* dst, std::size_t size_bytes,
+                     std::size_t offset_bytes) override {
+    const VkBuffer& src = vkBuf(buf);
+    if (src.mapped()) {
+      std::memcpy(dst, src.mapped() + offset_bytes, size_bytes);
+      return;
+    }
+    auto staging = createBuffer(size_bytes);
+    submit([&](const vk::raii::CommandBuffer& cmd) {
+      cmd.copyBuffer(src.get(), vkBuf(*staging).get(), vk::BufferCopy(offset_bytes, 0, size_bytes));
+    });
+    std::memcpy(dst, vkBuf(*staging).mapped(), size_bytes);
+  }
+
+  void dispatchTraverseRays(const TraverseParams& params, const DeviceBuffer& rays,
+                            const DeviceBuffer& occupancy, const DeviceBuffer& field,
+                            DeviceBuffer& results) override {
+    TraversePushConstants push{params, 0};
+    dispatch1D(ray_traverse_, {&rays, &occupancy, &field, &results}, params.ray_count,
+               [&](uint32_t first) {
+                 push.first_ray = first;
+                 return std::vector<std::byte>(reinterpret_cast<const std::byte*>(&push),
+                                               reinterpret_cast<const std::byte*>(&push) + sizeof(push));
+               });
+  }
+
+ private:
+  struct TraversePushConstants {
+    TraverseParams params;
+    uint32_t first_ray;
+  };
+
+  void pickDevice() {
+    std::vector<vk::raii::PhysicalDevice> devices;
+    try {
+      devices = vk::raii::PhysicalDevices(instance_);
+    } catch (const vk::Error& e) {
+      throw BackendUnavailable(std::string("vulkan: cannot list devices (") + e.what() + ")");
+    }
+    std::optional<std::size_t> best;
+    std::string rejected;
+    for (std::size_t i = 0; i < devices.size(); ++i) {
+      const auto props = devices[i].getProperties();
+      if (!devices[i].getFeatures().shaderInt64) {
+        rejected += std::string(" ") + props.deviceName.data() + " (no shaderInt64);";
+        continue;
+      }
+      if (!computeQueueFamily(devices[i])) {
+        rejected += std::string(" ") + props.deviceName.data() + " (no compute queue);";
+        continue;
+      }
+      if (!best || deviceRank(props.deviceType) < deviceRank(devices[*best].getProperties().deviceType))
+        best = i;
+    }
+    if (!best)
+      throw BackendUnavailable("vulkan: no usable device among " + std::to_string(devices.size()) +
+                               ":" + rejected + " (mesa-vulkan-drivers provides lavapipe)");
+    physical_ = std::move(devices[*best]);
+    const auto props = physical_.getProperties();
+    is_gpu_ = deviceIsGpu(props.deviceType);
+    device_name_ = std::string(props.deviceName.data()) + " (Vulkan " +
+                   std::to_string(VK_API_VERSION_MAJOR(props.apiVersion)) + "." +
+                   std::to_string(VK_API_VERSION_MINOR(props.apiVersion)) + ")";
+    limits_ = props.limits;
+    memory_props_ = physical_.getMemoryProperties();
+    queue_family_ = *computeQueueFamily(physical_);
+  }
+
+  static std::optional<uint32_t> computeQueueFamily(const vk::raii::PhysicalDevice& device) {
+    const auto families = device.getQueueFamilyProperties();
+    for (uint32_t i = 0; i < families.size(); ++i)
+      if (families[i].queueFlags & vk::QueueFlagBits::eCompute) return i;
+    return std::nullopt;
+  }
+
+  void createDevice() {
+    const float priority = 1.0f;
+    vk::DeviceQueueCreateInfo queue_info({}, queue_family_, 1, &priority);
+    vk::PhysicalDeviceFeatures features;
+    features.shaderInt64 = VK_TRUE;  // the exact DDA walks in 64-bit integers
+    device_ = FVP_VK(vk::raii::Device(physical_, vk::DeviceCreateInfo({}, queue_info, {}, {}, &features)));
+    queue_ = FVP_VK(vk::raii::Queue(device_, queue_family_, 0));
+    command_pool_ = FVP_VK(vk::raii::CommandPool(
+        device_, vk::CommandPoolCreateInfo(vk::CommandPoolCreateFlagBits::eResetCommandBuffer,
+                                           queue_family_)));
+    vk::raii::CommandBuffers buffers = FVP_VK(vk::raii::CommandBuffers(
+        device_, vk::CommandBufferAllocateInfo(*command_pool_, vk::CommandBufferLevel::ePrimary, 1)));
+    command_buffer_ = std::move(buffers.front());
+    fence_ = FVP_VK(vk::raii::Fence(device_, vk::FenceCreateInfo()));
+    vk::DescriptorPoolSize pool_size(vk::DescriptorType::eStorageBuffer, 16);
+    descriptor_pool_ = FVP_VK(vk::raii::DescriptorPool(
+        device_, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 4,
+                                              pool_size)));
+    work_group_size_ = std::min({kPreferredWorkGroupSize, limits_.maxComputeWorkGroupSize[0],
+                                 limits_.maxComputeWorkGroupInvocations});
+  }
+
+  std::optional<uint32_t> findMemoryType(const vk::MemoryRequirements& req,
+                                         vk::MemoryPropertyFlags wanted) const {
+    for (uint32_t i = 0; i < memory_props_.memoryTypeCount; ++i)
+      if ((req.memoryTypeBits & (1u << i)) &&
+          (memory_props_.memoryTypes[i].propertyFlags & wanted) == wanted)
+        return i;
+    return std::nullopt;
+  }
+
+  ComputePipeline createPipeline(const uint32_t* spirv, std::size_t spirv_bytes,
+                                 uint32_t buffer_count, uint32_t push_constant_bytes) {
+    ComputePipeline p;
+    p.buffer_count = buffer_count;
+    p.push_constant_bytes = push_constant_bytes;
+    std::vector<vk::DescriptorSetLayoutBinding> bindings;
+    for (uint32_t b = 0; b < buffer_count; ++b)
+      bindings.emplace_back(b, vk::DescriptorType::eStorageBuffer, 1,
+                            vk::ShaderStageFlagBits::eCompute);
+    p.set_layout = FVP_VK(vk::raii::DescriptorSetLayout(
+        device_, vk::DescriptorSetLayoutCreateInfo({}, bindings)));
+    vk::PushConstantRange push(vk::ShaderStageFlagBits::eCompute, 0, push_constant_bytes);
+    vk::DescriptorSetLayout set_layout = *p.set_layout;
+    p.layout = FVP_VK(vk::raii::PipelineLayout(
+        device_, vk::PipelineLayoutCreateInfo({}, set_layout, push)));
+    p.module = FVP_VK(vk::raii::ShaderModule(
+        device_, vk::ShaderModuleCreateInfo({}, spirv_bytes, spirv)));
+    vk::SpecializationMapEntry entry(0, 0, sizeof(uint32_t));
+    vk::SpecializationInfo spec(1, &entry, sizeof(uint32_t), &work_group_size_);
+    vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, *p.module,
+                                            "main", &spec);
+    p.pipeline = FVP_VK(vk::raii::Pipeline(
+        device_, nullptr, vk::ComputePipelineCreateInfo({}, stage, *p.layout)));
+    return p;
+  }
+
+  template <typename Record>
+  void submit(Record&& record) {
+    const vk::raii::CommandBuffer& cmd = command_buffer_;
+    FVP_VK(cmd.reset());
+    FVP_VK(cmd.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit)));
+    record(cmd);
+    // Make shader and transfer writes visible to the host reads that follow the fence.
+    vk::MemoryBarrier to_host(vk::AccessFlagBits::eShaderWrite | vk::AccessFlagBits::eTransferWrite,
+                              vk::AccessFlagBits::eHostRead);
+    cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader | vk::PipelineStageFlagBits::eTransfer,
+                        vk::PipelineStageFlagBits::eHost, {}, to_host, {}, {});
+    FVP_VK(cmd.end());
+    vk::CommandBuffer handle = *cmd;
+    FVP_VK(queue_.submit(vk::SubmitInfo({}, {}, handle), *fence_));
+    const vk::Result waited = FVP_VK(device_.waitForFences(*fence_, VK_TRUE, UINT64_MAX));
+    if (waited != vk::Result::eSuccess)
+      throw BackendError("vulkan: waitForFences returned " + vk::to_string(waited));
+    FVP_VK(device_.resetFences(*fence_));
+  }
+
+  // Records one pipeline over `items` work items, chunked so that no dispatch exceeds
+  // the device's work-group count limit; push(first_item) gives each chunk's constants.
+  template <typename PushFn>
+  void dispatch1D(const ComputePipeline& p, std::initializer_list<const DeviceBuffer*> buffers,
+                  uint32_t items, PushFn&& push) {
+    vk::raii::DescriptorSets sets = FVP_VK(vk::raii::DescriptorSets(
+        device_, vk::DescriptorSetAllocateInfo(*descriptor_pool_, *p.set_layout)));
+    vk::raii::DescriptorSet& set = sets.front();
+    std::vector<vk::DescriptorBufferInfo> infos;
+    for (const DeviceBuffer* b : buffers) infos.emplace_back(vkBuf(*b).get(), 0, VK_WHOLE_SIZE);
+    std::vector<vk::WriteDescriptorSet> writes;
+    for (uint32_t i = 0; i < infos.size(); ++i)
+      writes.emplace_back(*set, i, 0, 1, vk::DescriptorType::eStorageBuffer, nullptr, &infos[i]);
+    device_.updateDescriptorSets(writes, {});
+
+    const uint64_t max_groups = limits_.maxComputeWorkGroupCount[0];
+    const uint64_t chunk = max_groups * work_group_size_;
+    submit([&](const vk::raii::CommandBuffer& cmd) {
+      cmd.bindPipeline(vk::PipelineBindPoint::eCompute, *p.pipeline);
+      cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *p.layout, 0, *set, {});
+      for (uint64_t first = 0; first < items; first += chunk) {
+        const uint64_t n = std::min<uint64_t>(chunk, items - first);
+        const std::vector<std::byte> constants = push(static_cast<uint32_t>(first));
+        cmd.pushConstants<std::byte>(*p.layout, vk::ShaderStageFlagBits::eCompute, 0, constants);
+        cmd.dispatch(static_cast<uint32_t>((n + work_group_size_ - 1) / work_group_size_), 1, 1);
+      }
+    });
+  }
+
+  vk::raii::Context context_;
+  vk::raii::Instance instance_{nullptr};
+  vk::raii::PhysicalDevice physical_{nullptr};
+  vk::PhysicalDeviceLimits limits_;
+  vk::PhysicalDeviceMemoryProperties memory_props_;
+  uint32_t queue_family_ = 0;
+  bool is_gpu_ = false;
+  std::string device_name_;
+  vk::raii::Device device_{nullptr};
+  vk::raii::Queue queue_{nullptr};
+  vk::raii::CommandPool command_pool_{nullptr};
+  vk::raii::CommandBuffer command_buffer_{nullptr};
+  vk::raii::Fence fence_{nullptr};
+  vk::raii::DescriptorPool descriptor_pool_{nullptr};
+  uint32_t work_group_size_ = 1;
+  ComputePipeline ray_traverse_;
+};
+
+}  // namespace
+
+std::unique_ptr<Backend> createVulkanBackend() { return std::make_unique<VulkanBackend>(); }
+
+bool vulkanDeviceIsGpu(const Backend& backend) {
+  return static_cast<const VulkanBackend&>(backend).isGpu();
+}
+
+}  // namespace fvp::accel::detail

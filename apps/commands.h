@@ -1,0 +1,12 @@
+// Each `fvp` subcommand registers itself on the CLI11 app; the handlers only parse
+// options and call the library.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace fvp::apps {
+
+void addBackendsCommand(CLI::App& app);
+void addTraverseCommand(CLI::App& app);
+
+}  // namespace fvp::apps
