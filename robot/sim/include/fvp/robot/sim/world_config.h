@@ -1,0 +1,61 @@
+// Parameters of world generation (DESIGN.md section 8). Every field is a documented YAML
+// key of the same name; the defaults reproduce the paper's protocol. The keys, their units
+// and ranges are listed in robot/sim/config/world_default.yaml and docs/simulation.md.
+//
+// API CONTRACT: the fields below are the minimum; more may be added (documented).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace fvp::robot::sim {
+
+struct WorldConfig {
+  // Cluster
+  int min_fruitlets = 3;
+  int max_fruitlets = 6;
+  double min_radius_m = 0.003;     ///< r ~ U(min_radius_m, max_radius_m)
+  double max_radius_m = 0.008;
+  double min_elongation = 0.85;    ///< e ~ U(min_elongation, max_elongation)
+  double max_elongation = 1.15;
+  double cluster_spread_m = 0.03;  ///< fruitlet centres within this of the cluster centre
+  double min_gap_m = 0.001;        ///< fruitlets at least this far apart (surface to surface)
+  // Leaves
+  int leaf_count = 30;
+  double min_leaf_length_m = 0.04, max_leaf_length_m = 0.08;
+  double min_leaf_width_m = 0.02, max_leaf_width_m = 0.04;
+  double leaf_region_m = 0.15;     ///< leaves placed within this of the cluster centre
+  double max_leaf_curl_per_m = 6.0;  ///< curled leaves: z = c x^2, |c| ~ U(0, this); half are flat
+  /// Fraction of the leaves placed between the start view and the cluster (the rest fill the
+  /// leaf region uniformly), so the cluster starts substantially occluded.
+  double front_leaf_fraction = 0.3;
+  // AprilTag
+  int tag_id = 0;
+  double tag_size_m = 0.03;
+  double min_tag_distance_m = 0.05;  ///< tag centre to cluster centre, ~ U(min, max)
+  double max_tag_distance_m = 0.08;
+  double max_tag_tilt_deg = 15.0;    ///< random tilt of the tag away from facing the start view
+  // Tree
+  double trunk_radius_m = 0.05;
+  double trunk_height_m = 2.0;
+  double cluster_height_m = 1.0;     ///< height of the fruiting branch above the trunk base
+  double branch_radius_m = 0.01;     ///< the fruiting branch
+  int extra_branch_count = 3;        ///< further branches (background clutter)
+  // Start view
+  double start_view_distance_m = 0.3;
+
+  /// Reads a YAML file; missing keys keep their defaults; unknown keys, wrong types and
+  /// out-of-range values throw std::invalid_argument naming the file and the key.
+  static WorldConfig fromYamlFile(const std::filesystem::path& path);
+  /// Throws std::invalid_argument naming the first bad key and its expected range.
+  void validate(const std::string& source = "world config") const;
+  /// Every YAML key, in declaration order (the same names as the fields).
+  static const std::vector<std::string>& keyNames();
+  /// The config as a JSON object text {key: value, ...} (for ground truth and results).
+  std::string toJson() const;
+
+  bool operator==(const WorldConfig&) const = default;
+};
+
+}  // namespace fvp::robot::sim

@@ -1,0 +1,183 @@
+// Every backend against the cpu reference. In CI (CI=true) or with
+// FVP_REQUIRE_ALL_BACKENDS=1 an unavailable backend fails instead of skipping.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <random>
+#include <string>
+
+#include "fvp/accel/backend.h"
+#include "fvp/accel/ray_workload.h"
+
+namespace fvp::accel {
+namespace {
+
+// Sums run in the same order on every backend with contraction disabled, so they agree
+// to the bit today; the tolerance allows a device that rounds float adds differently.
+constexpr float kFieldSumRelativeTolerance = 1e-5f;
+
+bool allBackendsRequired() {
+  const char* ci = std::getenv("CI");
+  const char* req = std::getenv("FVP_REQUIRE_ALL_BACKENDS");
+  return (ci && std::string(ci) == "true") || (req && std::string(req) == "1");
+}
+
+std::uint64_t freshSeed() {
+  if (const char* s = std::getenv("FVP_TEST_SEED")) return std::stoull(s);
+  return std::random_device{}();
+}
+
+class BackendTest : public ::testing::TestWithParam<BackendKind> {
+ protected:
+  void SetUp() override {
+    try {
+      backend_ = createBackend(GetParam());
+    } catch (const BackendUnavailable& e) {
+      if (allBackendsRequired()) FAIL() << "required backend unavailable: " << e.what();
+      GTEST_SKIP() << e.what();
+    }
+    cpu_ = createBackend(BackendKind::kCpu);
+  }
+
+  void expectSameAsCpu(const DenseGrid& grid, const std::vector<Ray>& rays,
+                       const std::string& context) {
+    const auto got = traverseOnBackend(*backend_, grid, rays);
+    const auto want = traverseOnBackend(*cpu_, grid, rays);
+    ASSERT_EQ(got.size(), want.size());
+    for (std::size_t i = 0; i < got.size(); ++i) {
+      ASSERT_EQ(got[i].status, want[i].status) << context << ", ray " << i;
+      ASSERT_EQ(got[i].steps, want[i].steps) << context << ", ray " << i;
+      ASSERT_EQ(got[i].stop_voxel, want[i].stop_voxel) << context << ", ray " << i;
+      ASSERT_NEAR(got[i].field_sum, want[i].field_sum,
+                  kFieldSumRelativeTolerance * std::max(1.0f, std::abs(want[i].field_sum)))
+          << context << ", ray " << i;
+    }
+  }
+
+  std::unique_ptr<Backend> backend_;
+  std::unique_ptr<Backend> cpu_;
+};
+
+TEST_P(BackendTest, ReportsItsKindAndDevice) {
+  EXPECT_EQ(backend_->kind(), GetParam());
+  EXPECT_FALSE(backend_->deviceName().empty());
+}
+
+TEST_P(BackendTest, UploadDownloadRoundTripsAndChecksRanges) {
+  std::vector<float> data(1000);
+  for (std::size_t i = 0; i < data.size(); ++i) data[i] = static_cast<float>(i) * 0.5f;
+  auto buf = backend_->createBufferFrom(data);
+  EXPECT_EQ(backend_->downloadAll<float>(*buf), data);
+  const float patch[2] = {-1.0f, -2.0f};
+  backend_->upload(*buf, patch, sizeof(patch), 10 * sizeof(float));
+  float back[3];
+  backend_->download(*buf, back, sizeof(back), 9 * sizeof(float));
+  EXPECT_EQ(back[0], 4.5f);
+  EXPECT_EQ(back[1], -1.0f);
+  EXPECT_EQ(back[2], -2.0f);
+  EXPECT_THROW(backend_->upload(*buf, patch, sizeof(patch), 999 * sizeof(float)), std::out_of_range);
+  EXPECT_THROW(backend_->download(*buf, back, 4001), std::out_of_range);
+}
+
+TEST_P(BackendTest, TraverseRejectsShortBuffers) {
+  const DenseGrid grid = makeCanopyGrid(16, 0.01f, 1);
+  auto occupancy = backend_->createBufferFrom(grid.occupancy);
+  auto field = backend_->createBuffer(8);  // far too small for 16^3 floats
+  auto rays = backend_->createBuffer(sizeof(Ray));
+  auto results = backend_->createBuffer(sizeof(RayResult));
+  TraverseParams params{grid.params, kDefaultOccupiedThreshold, 1};
+  EXPECT_THROW(backend_->traverseRays(params, *rays, *occupancy, *field, *results),
+               std::out_of_range);
+}
+
+TEST_P(BackendTest, EmptyBatchIsANoOp) {
+  const DenseGrid grid = makeCanopyGrid(16, 0.01f, 1);
+  EXPECT_TRUE(traverseOnBackend(*backend_, grid, {}).empty());
+}
+
+TEST_P(BackendTest, MatchesCpuOnFixedWorkload) {
+  const DenseGrid grid = makeCanopyGrid(64, 0.002f, 5);
+  expectSameAsCpu(grid, makeRandomRays(grid.params, {20000, 0.5f}, 6), "fixed seed 5/6");
+}
+
+TEST_P(BackendTest, MatchesCpuOnFreshRandomWorkloads) {
+  for (int round = 0; round < 3; ++round) {
+    const std::uint64_t seed = freshSeed();
+    std::mt19937_64 rng(seed);
+    const int side = 8 + static_cast<int>(rng() % 90);
+    const float voxel = 0.001f * (1 + static_cast<int>(rng() % 10));
+    const DenseGrid grid = makeCanopyGrid(side, voxel, seed);
+    const auto rays = makeRandomRays(grid.params, {5000, 0.5f}, seed + 1);
+    SCOPED_TRACE("seed " + std::to_string(seed) + " (rerun with FVP_TEST_SEED=" +
+                 std::to_string(seed) + ")");
+    expectSameAsCpu(grid, rays, "seed " + std::to_string(seed));
+    if (HasFatalFailure()) return;
+  }
+}
+
+TEST_P(BackendTest, MatchesCpuOnBoundaryCases) {
+  // Axis-aligned, diagonal-through-corners, zero-length, outside, NaN and far rays.
+  const float v = 1.0f / 64.0f;
+  DenseGrid grid = makeCanopyGrid(16, v, 3);
+  const float lo = grid.params.origin_x_m, hi = lo + 16 * v;
+  const float nan = std::nanf("");
+  std::vector<Ray> rays = {
+      makeRay({lo + 2.5f * v, 0, 0}, {hi - 0.5f * v, 0, 0}),
+      makeRay({0, hi - 0.5f * v, 0}, {0, lo + 0.5f * v, 0}),
+      makeRay({0, 0, lo + 0.5f * v}, {0, 0, hi - 0.5f * v}),
+      makeRay({lo + 2.5f * v, lo + 2.5f * v, lo + 2.5f * v}, {hi - 2.5f * v, hi - 2.5f * v, hi - 2.5f * v}),
+      makeRay({lo - 2 * v, lo - 2 * v, 0.5f * v}, {hi, hi, 0.5f * v}),
+      makeRay({0.3f * v, 0.3f * v, 0.3f * v}, {0.3f * v, 0.3f * v, 0.3f * v}),
+      makeRay({lo - 1.0f, 0, 0}, {lo - 2.0f, 0, 0}),
+      makeRay({nan, 0, 0}, {0, 0, 0}),
+      makeRay({0, 0, 0}, {0, 0, 1000.0f}),
+      makeRay({lo, lo, lo}, {hi, hi, hi}),
+  };
+  expectSameAsCpu(grid, rays, "boundary cases");
+}
+
+std::string backendName(const ::testing::TestParamInfo<BackendKind>& info) {
+  return std::string(toString(info.param));
+}
+
+INSTANTIATE_TEST_SUITE_P(AllBackends, BackendTest,
+                         ::testing::Values(BackendKind::kCpu, BackendKind::kOpenCl,
+                                           BackendKind::kVulkan),
+                         backendName);
+
+TEST(BackendFactory, NamesAndErrors) {
+  EXPECT_EQ(parseBackendKind("opencl"), BackendKind::kOpenCl);
+  EXPECT_FALSE(parseBackendKind("auto").has_value());
+  EXPECT_FALSE(parseBackendKind("cuda").has_value());
+  try {
+    createBackend("cuda");
+    FAIL() << "an unknown backend name must throw";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("cuda"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("expected cpu, opencl, vulkan or auto"), std::string::npos);
+  }
+  // auto always yields a working backend: a GPU where there is one, else the reference.
+  auto backend = createBackend("auto");
+  ASSERT_TRUE(backend);
+  EXPECT_FALSE(backend->deviceName().empty());
+}
+
+TEST(BackendFactory, ProbeListsEveryBackend) {
+  const auto infos = probeBackends();
+  ASSERT_EQ(infos.size(), 3u);
+  EXPECT_EQ(infos[0].kind, BackendKind::kCpu);
+  EXPECT_TRUE(infos[0].available);
+  for (const auto& info : infos) {
+    if (info.available) {
+      EXPECT_FALSE(info.device.empty());
+    } else {
+      EXPECT_FALSE(info.reason.empty()) << toString(info.kind) << " must say why it is unavailable";
+    }
+    if (allBackendsRequired()) {
+      EXPECT_TRUE(info.available) << toString(info.kind) << ": " << info.reason;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace fvp::accel

@@ -1,0 +1,15 @@
+# cmake -P script: runs one fvp command line and checks its exit code and output.
+#   CMD         the command (a CMake list)
+#   EXPECT_EXIT "zero" or "nonzero"
+#   EXPECT_OUT  regex that stdout+stderr must match (optional)
+execute_process(COMMAND ${CMD} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+set(all "${out}${err}")
+message("${all}")
+if(EXPECT_EXIT STREQUAL "zero" AND NOT rc EQUAL 0)
+  message(FATAL_ERROR "expected exit 0, got ${rc}")
+elseif(EXPECT_EXIT STREQUAL "nonzero" AND rc EQUAL 0)
+  message(FATAL_ERROR "expected a non-zero exit, got 0")
+endif()
+if(DEFINED EXPECT_OUT AND NOT all MATCHES "${EXPECT_OUT}")
+  message(FATAL_ERROR "output does not match: ${EXPECT_OUT}")
+endif()
