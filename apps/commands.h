@@ -7,6 +7,8 @@
 namespace fvp::apps {
 
 void addBackendsCommand(CLI::App& app);
+void addCaptureCommand(CLI::App& app);
 void addTraverseCommand(CLI::App& app);
+void addMapCommand(CLI::App& app);
 
 }  // namespace fvp::apps

@@ -8,7 +8,9 @@ int main(int argc, char** argv) {
   CLI::App app{"fvp: apple-fruitlet sizing with next-best-view planning"};
   app.require_subcommand(1);
   fvp::apps::addBackendsCommand(app);
+  fvp::apps::addCaptureCommand(app);
   fvp::apps::addTraverseCommand(app);
+  fvp::apps::addMapCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

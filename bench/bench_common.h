@@ -5,6 +5,9 @@
 #include <omp.h>
 
 #include <cstdint>
+#include <memory>
+
+#include "fvp/accel/backend.h"
 
 namespace fvp::bench {
 
@@ -17,6 +20,16 @@ inline void setThroughput(benchmark::State& state, std::uint64_t steps_per_itera
       static_cast<double>(rays_per_iteration) * state.iterations(), benchmark::Counter::kIsRate);
   state.counters["steps_per_ray"] =
       static_cast<double>(steps_per_iteration) / static_cast<double>(rays_per_iteration);
+}
+
+/// The backend, or null after marking the benchmark skipped with the reason it is unavailable.
+inline std::unique_ptr<accel::Backend> backendOrSkip(benchmark::State& state, accel::BackendKind kind) {
+  try {
+    return accel::createBackend(kind);
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+    return nullptr;
+  }
 }
 
 /// Limits OpenMP to `threads` (0: leave as is) for one benchmark, restoring it after.

@@ -93,13 +93,8 @@ std::uint64_t octomapTraverse(octomap::OcTree& tree, const Ray& ray, octomap::Ke
 
 void BM_RayTraverseGrid(benchmark::State& state, BackendKind kind, int threads) {
   const auto n = static_cast<std::size_t>(state.range(0));
-  std::unique_ptr<Backend> backend;
-  try {
-    backend = accel::createBackend(kind);
-  } catch (const std::exception& e) {
-    state.SkipWithError(e.what());
-    return;
-  }
+  auto backend = backendOrSkip(state, kind);
+  if (!backend) return;
   OmpThreadsScope omp_threads(threads);
   Workload& w = workload();
   const auto& rays = w.raysFor(n);

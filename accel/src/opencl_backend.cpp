@@ -7,6 +7,7 @@
 #include <CL/opencl.hpp>
 
 #include <algorithm>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -15,6 +16,9 @@
 #include "check.h"
 
 extern const char kOpenClSource_ray_traverse[];
+extern const char kOpenClSource_scan_integrate[];
+extern const char kOpenClSource_roi_distance[];
+extern const char kOpenClSource_frontier[];
 
 namespace fvp::accel::detail {
 namespace {
@@ -117,10 +121,11 @@ class OpenClBackend final : public Backend {
                    FVP_CL(s.platform.getInfo<CL_PLATFORM_NAME>()) + ")";
     context_ = FVP_CL(cl::Context(device_));
     queue_ = FVP_CL(cl::CommandQueue(context_, device_));
-    program_ = FVP_CL(cl::Program(context_, std::string(kOpenClSource_ray_traverse)));
-    FVP_CL(program_.build(std::vector<cl::Device>{device_}, "-cl-std=CL1.2"));
-    ray_traverse_ = FVP_CL(cl::Kernel(program_, "fvp_ray_traverse"));
-    ray_traverse_local_ = workGroupSize(ray_traverse_);
+    ray_traverse_ = buildKernel(kOpenClSource_ray_traverse, "fvp_ray_traverse");
+    scan_mark_ = buildKernel(kOpenClSource_scan_integrate, "fvp_scan_mark");
+    scan_update_ = buildKernel(kOpenClSource_scan_integrate, "fvp_scan_update");
+    roi_distance_ = buildKernel(kOpenClSource_roi_distance, "fvp_roi_distance_pass");
+    frontier_ = buildKernel(kOpenClSource_frontier, "fvp_extract_frontiers");
   }
 
   BackendKind kind() const override { return BackendKind::kOpenCl; }
@@ -144,15 +149,72 @@ class OpenClBackend final : public Backend {
   void dispatchTraverseRays(const TraverseParams& params, const DeviceBuffer& rays,
                             const DeviceBuffer& occupancy, const DeviceBuffer& field,
                             DeviceBuffer& results) override {
-    FVP_CL(ray_traverse_.setArg(0, params));
-    FVP_CL(ray_traverse_.setArg(1, clBuf(rays)));
-    FVP_CL(ray_traverse_.setArg(2, clBuf(occupancy)));
-    FVP_CL(ray_traverse_.setArg(3, clBuf(field)));
-    FVP_CL(ray_traverse_.setArg(4, clBuf(results)));
-    enqueue1D(ray_traverse_, params.ray_count, ray_traverse_local_);
+    run(ray_traverse_, params.ray_count, params, clBuf(rays), clBuf(occupancy), clBuf(field),
+        clBuf(results));
+  }
+
+ public:
+  // Three byte planes: free | hit | roi (plain byte stores; see fvp_map_kernels.h).
+  std::size_t scanMarkBytes(std::size_t slot_count) const override { return 3 * slot_count; }
+
+ protected:
+  void dispatchScanMark(const ScanParams& params, const DeviceBuffer& points,
+                        const DeviceBuffer& brick_table, DeviceBuffer& marks, DeviceBuffer& missing,
+                        std::uint32_t slot_count, std::uint32_t brick_count) override {
+    run(scan_mark_, params.point_count, params, clBuf(points), clBuf(brick_table), clBuf(marks),
+        clBuf(missing), cl_uint{slot_count}, static_cast<cl_int>(brick_count));
+  }
+
+  void dispatchScanUpdate(const UpdateParams& params, DeviceBuffer& marks, DeviceBuffer& occupancy,
+                          DeviceBuffer& roi, DeviceBuffer& updated) override {
+    run(scan_update_, params.slot_count / kUpdateChunkSlots, params, clBuf(marks), clBuf(occupancy),
+        clBuf(roi), clBuf(updated));
+  }
+
+  void dispatchRoiDistancePass(const EdtParams& params, int axis, const DeviceBuffer& brick_coords,
+                               const DeviceBuffer& brick_table, const DeviceBuffer& roi,
+                               const DeviceBuffer& sq_in, DeviceBuffer& sq_out,
+                               DeviceBuffer& distance_vox) override {
+    run(roi_distance_, params.slot_count, params, cl_int{axis}, clBuf(brick_coords),
+        clBuf(brick_table), clBuf(roi), clBuf(sq_in), clBuf(sq_out), clBuf(distance_vox));
+  }
+
+  void dispatchExtractFrontiers(const FrontierParams& params, const DeviceBuffer& brick_coords,
+                                const DeviceBuffer& brick_table, const DeviceBuffer& occupancy,
+                                const DeviceBuffer& roi, DeviceBuffer& out,
+                                DeviceBuffer& count) override {
+    run(frontier_, params.slot_count, params, clBuf(brick_coords), clBuf(brick_table),
+        clBuf(occupancy), clBuf(roi), clBuf(out), clBuf(count));
   }
 
  private:
+  struct Kernel {
+    cl::Kernel kernel;
+    std::size_t local = 1;
+  };
+
+  // Builds one embedded source (programs are cached per source) and takes one kernel.
+  Kernel buildKernel(const char* source, const char* name) {
+    auto it = programs_.find(source);
+    if (it == programs_.end()) {
+      cl::Program program = FVP_CL(cl::Program(context_, std::string(source)));
+      FVP_CL(program.build(std::vector<cl::Device>{device_}, "-cl-std=CL1.2"));
+      it = programs_.emplace(source, std::move(program)).first;
+    }
+    Kernel k;
+    k.kernel = FVP_CL(cl::Kernel(it->second, name));
+    k.local = workGroupSize(k.kernel);
+    return k;
+  }
+
+  // Sets the arguments in order and runs the kernel over `items` work items.
+  template <typename... Args>
+  void run(Kernel& k, std::size_t items, const Args&... args) {
+    cl_uint index = 0;
+    (FVP_CL(k.kernel.setArg(index++, args)), ...);
+    enqueue1D(k.kernel, items, k.local);
+  }
+
   // Largest multiple of the preferred multiple not above 64 and the kernel's limit:
   // queried per kernel and device, never assumed.
   std::size_t workGroupSize(const cl::Kernel& kernel) const {
@@ -177,9 +239,8 @@ class OpenClBackend final : public Backend {
   std::string device_name_;
   cl::Context context_;
   cl::CommandQueue queue_;
-  cl::Program program_;
-  cl::Kernel ray_traverse_;
-  std::size_t ray_traverse_local_ = 1;
+  std::map<const char*, cl::Program> programs_;
+  Kernel ray_traverse_, scan_mark_, scan_update_, roi_distance_, frontier_;
 };
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <vulkan/vulkan_raii.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <optional>
 #include <sstream>
@@ -13,7 +14,10 @@
 
 #include "backends.h"
 #include "check.h"
+#include "embedded/spirv_frontier.h"
 #include "embedded/spirv_ray_traverse.h"
+#include "embedded/spirv_roi_distance.h"
+#include "embedded/spirv_scan_integrate.h"
 
 namespace fvp::accel::detail {
 namespace {
@@ -92,6 +96,16 @@ class VulkanBackend final : public Backend {
     createDevice();
     ray_traverse_ = createPipeline(kSpirv_ray_traverse, sizeof(kSpirv_ray_traverse), 4,
                                    sizeof(TraversePushConstants));
+    scan_mark_ = createPipeline(kSpirv_scan_integrate, sizeof(kSpirv_scan_integrate), 7,
+                                sizeof(ScanPushConstants), /*mode=*/0);
+    scan_update_ = createPipeline(kSpirv_scan_integrate, sizeof(kSpirv_scan_integrate), 7,
+                                  sizeof(ScanPushConstants), /*mode=*/1);
+    roi_distance_ = createPipeline(kSpirv_roi_distance, sizeof(kSpirv_roi_distance), 6,
+                                   sizeof(EdtPushConstants));
+    frontier_ = createPipeline(kSpirv_frontier, sizeof(kSpirv_frontier), 6,
+                               sizeof(FrontierPushConstants));
+    // Bound where a pass does not use a binding: every binding needs a valid buffer.
+    unused_ = createBuffer(16);
   }
 
   BackendKind kind() const override { return BackendKind::kVulkan; }
@@ -156,19 +170,84 @@ class VulkanBackend final : public Backend {
                             const DeviceBuffer& occupancy, const DeviceBuffer& field,
                             DeviceBuffer& results) override {
     TraversePushConstants push{params, 0};
-    dispatch1D(ray_traverse_, {&rays, &occupancy, &field, &results}, params.ray_count,
-               [&](uint32_t first) {
-                 push.first_ray = first;
-                 return std::vector<std::byte>(reinterpret_cast<const std::byte*>(&push),
-                                               reinterpret_cast<const std::byte*>(&push) + sizeof(push));
-               });
+    dispatch1D(ray_traverse_, {&rays, &occupancy, &field, &results}, params.ray_count, push,
+               push.first_ray);
+  }
+
+ public:
+  // Packed marks: a byte lane per slot in uint words (atomicOr), see shaders/fvp_map.glsl.
+  std::size_t scanMarkBytes(std::size_t slot_count) const override {
+    return (slot_count + 3) / 4 * 4;
+  }
+
+ protected:
+  void dispatchScanMark(const ScanParams& params, const DeviceBuffer& points,
+                        const DeviceBuffer& brick_table, DeviceBuffer& marks, DeviceBuffer& missing,
+                        std::uint32_t slot_count, std::uint32_t brick_count) override {
+    ScanPushConstants push{};
+    push.scan = params;
+    push.slot_count = slot_count;
+    push.brick_count = static_cast<int32_t>(brick_count);
+    dispatch1D(scan_mark_, {&points, &brick_table, &marks, &missing, unused_.get(), unused_.get(), unused_.get()},
+               params.point_count, push, push.first_item);
+  }
+
+  void dispatchScanUpdate(const UpdateParams& params, DeviceBuffer& marks, DeviceBuffer& occupancy,
+                          DeviceBuffer& roi, DeviceBuffer& updated) override {
+    ScanPushConstants push{};
+    push.update = params;
+    push.slot_count = params.slot_count;
+    dispatch1D(scan_update_, {unused_.get(), unused_.get(), &marks, unused_.get(), &occupancy,
+                              params.has_roi ? &roi : unused_.get(), &updated},
+               params.slot_count / kUpdateChunkSlots, push, push.first_item);
+  }
+
+  void dispatchRoiDistancePass(const EdtParams& params, int axis, const DeviceBuffer& brick_coords,
+                               const DeviceBuffer& brick_table, const DeviceBuffer& roi,
+                               const DeviceBuffer& sq_in, DeviceBuffer& sq_out,
+                               DeviceBuffer& distance_vox) override {
+    EdtPushConstants push{params, axis, 0};
+    dispatch1D(roi_distance_,
+               {&brick_coords, &brick_table, axis == 0 ? &roi : unused_.get(),
+                axis > 0 ? &sq_in : unused_.get(), axis < 2 ? &sq_out : unused_.get(),
+                axis == 2 ? &distance_vox : unused_.get()},
+               params.slot_count, push, push.first_item);
+  }
+
+  void dispatchExtractFrontiers(const FrontierParams& params, const DeviceBuffer& brick_coords,
+                                const DeviceBuffer& brick_table, const DeviceBuffer& occupancy,
+                                const DeviceBuffer& roi, DeviceBuffer& out,
+                                DeviceBuffer& count) override {
+    FrontierPushConstants push{params, 0};
+    dispatch1D(frontier_, {&brick_coords, &brick_table, &occupancy, &roi, &out, &count},
+               params.slot_count, push, push.first_item);
   }
 
  private:
+  // Push-constant blocks: the kernel parameters plus the first work item of a chunk.
   struct TraversePushConstants {
     TraverseParams params;
     uint32_t first_ray;
   };
+  struct ScanPushConstants {
+    ScanParams scan;
+    UpdateParams update;
+    uint32_t slot_count;
+    int32_t brick_count;
+    uint32_t first_item;
+  };
+  struct EdtPushConstants {
+    EdtParams edt;
+    int32_t axis;
+    uint32_t first_item;
+  };
+  struct FrontierPushConstants {
+    FrontierParams frontier;
+    uint32_t first_item;
+  };
+  static_assert(sizeof(ScanPushConstants) == 116 && sizeof(EdtPushConstants) == 80 &&
+                    sizeof(FrontierPushConstants) == 80,
+                "must match the shaders' push-constant blocks");
 
   void pickDevice() {
     std::vector<vk::raii::PhysicalDevice> devices;
@@ -245,7 +324,8 @@ class VulkanBackend final : public Backend {
   }
 
   ComputePipeline createPipeline(const uint32_t* spirv, std::size_t spirv_bytes,
-                                 uint32_t buffer_count, uint32_t push_constant_bytes) {
+                                 uint32_t buffer_count, uint32_t push_constant_bytes,
+                                 int32_t mode = 0) {
     ComputePipeline p;
     p.buffer_count = buffer_count;
     p.push_constant_bytes = push_constant_bytes;
@@ -261,8 +341,13 @@ class VulkanBackend final : public Backend {
         device_, vk::PipelineLayoutCreateInfo({}, set_layout, push)));
     p.module = FVP_VK(vk::raii::ShaderModule(
         device_, vk::ShaderModuleCreateInfo({}, spirv_bytes, spirv)));
-    vk::SpecializationMapEntry entry(0, 0, sizeof(uint32_t));
-    vk::SpecializationInfo spec(1, &entry, sizeof(uint32_t), &work_group_size_);
+    // Specialisation constants: 0 = work-group size, 1 = kernel mode (shaders with several passes).
+    const std::array<uint32_t, 2> spec_values{work_group_size_, static_cast<uint32_t>(mode)};
+    const std::array<vk::SpecializationMapEntry, 2> entries{
+        vk::SpecializationMapEntry(0, 0, sizeof(uint32_t)),
+        vk::SpecializationMapEntry(1, sizeof(uint32_t), sizeof(uint32_t))};
+    vk::SpecializationInfo spec(static_cast<uint32_t>(entries.size()), entries.data(),
+                                sizeof(spec_values), spec_values.data());
     vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, *p.module,
                                             "main", &spec);
     p.pipeline = FVP_VK(vk::raii::Pipeline(
@@ -291,10 +376,10 @@ class VulkanBackend final : public Backend {
   }
 
   // Records one pipeline over `items` work items, chunked so that no dispatch exceeds
-  // the device's work-group count limit; push(first_item) gives each chunk's constants.
-  template <typename PushFn>
+  // the device's work-group count limit; `first` (a member of `push`) is set per chunk.
+  template <typename Push>
   void dispatch1D(const ComputePipeline& p, std::initializer_list<const DeviceBuffer*> buffers,
-                  uint32_t items, PushFn&& push) {
+                  uint32_t items, Push& push, uint32_t& first) {
     vk::raii::DescriptorSets sets = FVP_VK(vk::raii::DescriptorSets(
         device_, vk::DescriptorSetAllocateInfo(*descriptor_pool_, *p.set_layout)));
     vk::raii::DescriptorSet& set = sets.front();
@@ -310,10 +395,10 @@ class VulkanBackend final : public Backend {
     submit([&](const vk::raii::CommandBuffer& cmd) {
       cmd.bindPipeline(vk::PipelineBindPoint::eCompute, *p.pipeline);
       cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *p.layout, 0, *set, {});
-      for (uint64_t first = 0; first < items; first += chunk) {
-        const uint64_t n = std::min<uint64_t>(chunk, items - first);
-        const std::vector<std::byte> constants = push(static_cast<uint32_t>(first));
-        cmd.pushConstants<std::byte>(*p.layout, vk::ShaderStageFlagBits::eCompute, 0, constants);
+      for (uint64_t start = 0; start < items; start += chunk) {
+        const uint64_t n = std::min<uint64_t>(chunk, items - start);
+        first = static_cast<uint32_t>(start);
+        cmd.pushConstants<Push>(*p.layout, vk::ShaderStageFlagBits::eCompute, 0, push);
         cmd.dispatch(static_cast<uint32_t>((n + work_group_size_ - 1) / work_group_size_), 1, 1);
       }
     });
@@ -334,7 +419,8 @@ class VulkanBackend final : public Backend {
   vk::raii::Fence fence_{nullptr};
   vk::raii::DescriptorPool descriptor_pool_{nullptr};
   uint32_t work_group_size_ = 1;
-  ComputePipeline ray_traverse_;
+  ComputePipeline ray_traverse_, scan_mark_, scan_update_, roi_distance_, frontier_;
+  std::unique_ptr<DeviceBuffer> unused_;
 };
 
 }  // namespace

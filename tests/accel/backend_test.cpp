@@ -2,6 +2,8 @@
 // FVP_REQUIRE_ALL_BACKENDS=1 an unavailable backend fails instead of skipping.
 #include <gtest/gtest.h>
 
+#include "backend_test_support.h"
+
 #include <cstdlib>
 #include <random>
 #include <string>
@@ -16,24 +18,13 @@ namespace {
 // to the bit today; the tolerance allows a device that rounds float adds differently.
 constexpr float kFieldSumRelativeTolerance = 1e-5f;
 
-bool allBackendsRequired() {
-  const char* ci = std::getenv("CI");
-  const char* req = std::getenv("FVP_REQUIRE_ALL_BACKENDS");
-  return (ci && std::string(ci) == "true") || (req && std::string(req) == "1");
-}
-
-std::uint64_t freshSeed() {
-  if (const char* s = std::getenv("FVP_TEST_SEED")) return std::stoull(s);
-  return std::random_device{}();
-}
-
 class BackendTest : public ::testing::TestWithParam<BackendKind> {
  protected:
   void SetUp() override {
     try {
       backend_ = createBackend(GetParam());
     } catch (const BackendUnavailable& e) {
-      if (allBackendsRequired()) FAIL() << "required backend unavailable: " << e.what();
+      if (fvp::testing::allBackendsRequired()) FAIL() << "required backend unavailable: " << e.what();
       GTEST_SKIP() << e.what();
     }
     cpu_ = createBackend(BackendKind::kCpu);
@@ -102,14 +93,13 @@ TEST_P(BackendTest, MatchesCpuOnFixedWorkload) {
 
 TEST_P(BackendTest, MatchesCpuOnFreshRandomWorkloads) {
   for (int round = 0; round < 3; ++round) {
-    const std::uint64_t seed = freshSeed();
+    const std::uint64_t seed = fvp::testing::freshSeed();
     std::mt19937_64 rng(seed);
     const int side = 8 + static_cast<int>(rng() % 90);
     const float voxel = 0.001f * (1 + static_cast<int>(rng() % 10));
     const DenseGrid grid = makeCanopyGrid(side, voxel, seed);
     const auto rays = makeRandomRays(grid.params, {5000, 0.5f}, seed + 1);
-    SCOPED_TRACE("seed " + std::to_string(seed) + " (rerun with FVP_TEST_SEED=" +
-                 std::to_string(seed) + ")");
+    SCOPED_TRACE(fvp::testing::replayHint(seed));
     expectSameAsCpu(grid, rays, "seed " + std::to_string(seed));
     if (HasFatalFailure()) return;
   }
@@ -173,7 +163,7 @@ TEST(BackendFactory, ProbeListsEveryBackend) {
     } else {
       EXPECT_FALSE(info.reason.empty()) << toString(info.kind) << " must say why it is unavailable";
     }
-    if (allBackendsRequired()) {
+    if (fvp::testing::allBackendsRequired()) {
       EXPECT_TRUE(info.available) << toString(info.kind) << ": " << info.reason;
     }
   }

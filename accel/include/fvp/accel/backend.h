@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -77,6 +78,33 @@ class Backend {
                     const DeviceBuffer& occupancy, const DeviceBuffer& field,
                     DeviceBuffer& results);
 
+  // ---- Map kernels over bricked storage (kernels/fvp_map_kernels.h) ----
+  // Slots: brick * 512 + local voxel. brick_table: int per brick of the grid (kNoBrick where
+  // unallocated); brick_coords: 3 int (brick grid coordinates) per allocated brick.
+
+  /// Bytes of the scan mark buffer for slot_count slots (its layout is the backend's own).
+  /// Mark buffers must start zeroed; the update pass leaves them zeroed.
+  virtual std::size_t scanMarkBytes(std::size_t slot_count) const = 0;
+  /// Mark pass: params.point_count ScanPoint. missing: brick_count + 1 uint; voxels in
+  /// unallocated bricks set missing[brick] and missing[brick_count] to 1.
+  void scanMark(const ScanParams& params, const DeviceBuffer& points, const DeviceBuffer& brick_table,
+                DeviceBuffer& marks, DeviceBuffer& missing, std::uint32_t slot_count,
+                std::uint32_t brick_count);
+  /// Update pass over params.slot_count slots (a multiple of kBrickVoxels); roi is read and
+  /// written only when params.has_roi. Adds the number of updated voxels to updated[0].
+  void scanUpdate(const UpdateParams& params, DeviceBuffer& marks, DeviceBuffer& occupancy,
+                  DeviceBuffer& roi, DeviceBuffer& updated);
+  /// One pass (axis 0, 1, 2) of the ROI distance field. Axis 0 reads roi and writes
+  /// sq_out; axis 1 reads sq_in, writes sq_out; axis 2 reads sq_in, writes distance_vox.
+  void roiDistancePass(const EdtParams& params, int axis, const DeviceBuffer& brick_coords,
+                       const DeviceBuffer& brick_table, const DeviceBuffer& roi,
+                       const DeviceBuffer& sq_in, DeviceBuffer& sq_out, DeviceBuffer& distance_vox);
+  /// Appends every frontier voxel to out (up to params.capacity entries, in any order);
+  /// count[0] receives the total number found (may exceed the capacity).
+  void extractFrontiers(const FrontierParams& params, const DeviceBuffer& brick_coords,
+                        const DeviceBuffer& brick_table, const DeviceBuffer& occupancy,
+                        const DeviceBuffer& roi, DeviceBuffer& out, DeviceBuffer& count);
+
   // Typed conveniences over upload/download.
   template <typename T>
   std::unique_ptr<DeviceBuffer> createBufferFrom(const std::vector<T>& host) {
@@ -102,6 +130,25 @@ class Backend {
   virtual void dispatchTraverseRays(const TraverseParams& params, const DeviceBuffer& rays,
                                     const DeviceBuffer& occupancy, const DeviceBuffer& field,
                                     DeviceBuffer& results) = 0;
+  // point_count > 0.
+  virtual void dispatchScanMark(const ScanParams& params, const DeviceBuffer& points,
+                                const DeviceBuffer& brick_table, DeviceBuffer& marks,
+                                DeviceBuffer& missing, std::uint32_t slot_count,
+                                std::uint32_t brick_count) = 0;
+  // slot_count > 0.
+  virtual void dispatchScanUpdate(const UpdateParams& params, DeviceBuffer& marks,
+                                  DeviceBuffer& occupancy, DeviceBuffer& roi,
+                                  DeviceBuffer& updated) = 0;
+  virtual void dispatchRoiDistancePass(const EdtParams& params, int axis,
+                                       const DeviceBuffer& brick_coords,
+                                       const DeviceBuffer& brick_table, const DeviceBuffer& roi,
+                                       const DeviceBuffer& sq_in, DeviceBuffer& sq_out,
+                                       DeviceBuffer& distance_vox) = 0;
+  virtual void dispatchExtractFrontiers(const FrontierParams& params,
+                                        const DeviceBuffer& brick_coords,
+                                        const DeviceBuffer& brick_table,
+                                        const DeviceBuffer& occupancy, const DeviceBuffer& roi,
+                                        DeviceBuffer& out, DeviceBuffer& count) = 0;
 };
 
 struct BackendInfo {

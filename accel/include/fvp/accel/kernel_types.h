@@ -8,6 +8,7 @@
 
 extern "C" {
 #include "fvp_dda.h"
+#include "fvp_map_kernels.h"
 }
 
 namespace fvp::accel {
@@ -17,13 +18,34 @@ using Ray = fvp_ray;
 using RayResult = fvp_ray_result;
 using TraverseParams = fvp_traverse_params;
 
+// Map kernels (kernels/fvp_map_kernels.h).
+using ScanPoint = fvp_scan_point;
+using BrickedGridParams = fvp_bricked_grid;
+using ScanParams = fvp_scan_params;
+using UpdateParams = fvp_update_params;
+using EdtParams = fvp_edt_params;
+using FrontierParams = fvp_frontier_params;
+using Frontier = fvp_frontier;
+
+inline constexpr int kBrickEdge = FVP_BRICK_EDGE;
+inline constexpr int kBrickVoxels = FVP_BRICK_VOXELS;
+inline constexpr int kNoBrick = FVP_NO_BRICK;
+inline constexpr std::uint32_t kUpdateChunkSlots = 64;  // slots per update work item
+
+static_assert(sizeof(ScanPoint) == 16, "must match FvpScanPoint");
+static_assert(sizeof(BrickedGridParams) == 64, "must match FvpBrickedGrid");
+static_assert(sizeof(ScanParams) == 80, "must match the scan_integrate push constants");
+static_assert(sizeof(UpdateParams) == 24, "must match FvpUpdateParams");
+static_assert(sizeof(EdtParams) == 72, "must match FvpEdtParams");
+static_assert(sizeof(FrontierParams) == 76, "must match FvpFrontierParams");
+static_assert(sizeof(Frontier) == 32, "must match FvpFrontier");
 static_assert(sizeof(GridParams) == 32, "must match FvpGridParams in shaders/fvp_dda.glsl");
 static_assert(sizeof(Ray) == 32, "must match FvpRay (two vec4)");
 static_assert(sizeof(RayResult) == 16, "must match FvpRayResult");
 static_assert(sizeof(TraverseParams) == 40, "must match the ray_traverse push constants");
 
 /// Geometry of a dense grid whose voxel (0,0,0) has its lower corner at origin_m.
-/// Throws std::invalid_argument for non-positive sizes or a grid of 2^31 voxels or more.
+/// Throws std::invalid_argument for non-positive sizes or more than 16384 voxels per axis.
 GridParams makeGridParams(std::array<int, 3> dims, std::array<float, 3> origin_m,
                           float voxel_size_m);
 

@@ -22,11 +22,11 @@ namespace fvp::robot::sim {
 
 /// An ellipsoid fruitlet with semi-axes (r, r, e*r) along the columns of R_world_fruitlet.
 struct Fruitlet {
-  int index = 0;                   ///< 0-based; object id is host::kFirstFruitletId + index
+  int index = 0;  ///< 0-based; object id is host::kFirstFruitletId + index
   Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
   Eigen::Matrix3d R_world_fruitlet = Eigen::Matrix3d::Identity();
-  double radius_m = 0.0;           ///< r: equatorial semi-axis
-  double elongation = 1.0;         ///< e: the third semi-axis is e * r
+  double radius_m = 0.0;                          ///< r: equatorial semi-axis
+  double elongation = 1.0;                        ///< e: the third semi-axis is e * r
   Eigen::Vector3d rgb = Eigen::Vector3d::Ones();  ///< linear colour in [0, 1]
   /// Ground-truth size: the equatorial diameter 2r, in millimetres (what calipers read).
   double gtSizeMm() const { return 2000.0 * radius_m; }
@@ -40,9 +40,9 @@ struct Fruitlet {
 struct Leaf {
   int index = 0;
   Eigen::Isometry3d T_world_leaf = Eigen::Isometry3d::Identity();  ///< leaf plane z = 0
-  double half_length_m = 0.0;  ///< along the leaf's x axis
-  double half_width_m = 0.0;   ///< along the leaf's y axis
-  double curl_per_m = 0.0;     ///< z = curl * x^2 (0: flat)
+  double half_length_m = 0.0;                                      ///< along the leaf's x axis
+  double half_width_m = 0.0;                                       ///< along the leaf's y axis
+  double curl_per_m = 0.0;                                         ///< z = curl * x^2 (0: flat)
 };
 
 /// A cylinder segment of bark (trunk or branch), rendered with hemispherical end caps.
@@ -78,8 +78,8 @@ class World {
   /// and leaf indices must be 0..n-1 in order. The start view looks at the fruitlets'
   /// centroid from config.start_view_distance_m along -y (camera y = world -z).
   static World fromParts(std::vector<Fruitlet> fruitlets, std::vector<Leaf> leaves,
-                         std::vector<BranchSegment> branches,
-                         std::optional<AprilTagPlacement> tag, const WorldConfig& config = {});
+                         std::vector<BranchSegment> branches, std::optional<AprilTagPlacement> tag,
+                         const WorldConfig& config = {});
 
   std::uint64_t seed() const { return seed_; }
   const WorldConfig& config() const { return config_; }
@@ -91,7 +91,9 @@ class World {
   const AprilTagPlacement& tag() const { return tag_; }
   /// Centroid of the fruitlet centres.
   Eigen::Vector3d clusterCenter_m() const;
-  /// The start view: left-camera pose looking at the cluster from config().start_view.
+  /// The start view: left-camera pose (OpenCV optical frame) at start_view_distance_m from
+  /// the cluster centre on the tag's side, looking at the cluster centre, image "down" as
+  /// close to world -z as possible.
   Eigen::Isometry3d startCameraPose() const { return T_world_start_camera_; }
 
   /// Ground truth as JSON text (seed, config, fruitlets with centre / size, tag pose).

@@ -15,9 +15,9 @@ struct WorldConfig {
   // Cluster
   int min_fruitlets = 3;
   int max_fruitlets = 6;
-  double min_radius_m = 0.003;     ///< r ~ U(min_radius_m, max_radius_m)
+  double min_radius_m = 0.003;  ///< r ~ U(min_radius_m, max_radius_m)
   double max_radius_m = 0.008;
-  double min_elongation = 0.85;    ///< e ~ U(min_elongation, max_elongation)
+  double min_elongation = 0.85;  ///< e ~ U(min_elongation, max_elongation)
   double max_elongation = 1.15;
   double cluster_spread_m = 0.03;  ///< fruitlet centres within this of the cluster centre
   double min_gap_m = 0.001;        ///< fruitlets at least this far apart (surface to surface)
@@ -25,7 +25,7 @@ struct WorldConfig {
   int leaf_count = 30;
   double min_leaf_length_m = 0.04, max_leaf_length_m = 0.08;
   double min_leaf_width_m = 0.02, max_leaf_width_m = 0.04;
-  double leaf_region_m = 0.15;     ///< leaves placed within this of the cluster centre
+  double leaf_region_m = 0.15;       ///< leaves placed within this of the cluster centre
   double max_leaf_curl_per_m = 6.0;  ///< curled leaves: z = c x^2, |c| ~ U(0, this); half are flat
   /// Fraction of the leaves placed between the start view and the cluster (the rest fill the
   /// leaf region uniformly), so the cluster starts substantially occluded.
@@ -33,15 +33,21 @@ struct WorldConfig {
   // AprilTag
   int tag_id = 0;
   double tag_size_m = 0.03;
-  double min_tag_distance_m = 0.05;  ///< tag centre to cluster centre, ~ U(min, max)
-  double max_tag_distance_m = 0.08;
-  double max_tag_tilt_deg = 15.0;    ///< random tilt of the tag away from facing the start view
+  /// Tag centre to cluster centre, ~ U(min, max). A grower hangs the tag at a consistent
+  /// spot beside the cluster, so the Cluster Region placed from it can be tight.
+  double min_tag_distance_m = 0.065;
+  double max_tag_distance_m = 0.075;
+  double max_tag_tilt_deg = 5.0;  ///< random tilt of the tag away from facing the start view
+  /// Side of the cluster the tag hangs on, along the fruiting branch: +1 right of it as the
+  /// start view sees it, -1 left, 0 either side at random (the Cluster Region placed from the
+  /// tag must then be about twice as large).
+  int tag_side = 1;
   // Tree
   double trunk_radius_m = 0.05;
   double trunk_height_m = 2.0;
-  double cluster_height_m = 1.0;     ///< height of the fruiting branch above the trunk base
-  double branch_radius_m = 0.01;     ///< the fruiting branch
-  int extra_branch_count = 3;        ///< further branches (background clutter)
+  double cluster_height_m = 1.0;  ///< height of the fruiting branch above the trunk base
+  double branch_radius_m = 0.01;  ///< the fruiting branch
+  int extra_branch_count = 3;     ///< further branches (background clutter)
   // Start view
   double start_view_distance_m = 0.3;
 

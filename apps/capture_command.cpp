@@ -1,0 +1,171 @@
+// `fvp capture`: render one view of a simulated world, run the perception chain on it and
+// write it in the capture format (docs/capture-format.md).
+#include <Eigen/Geometry>
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "commands.h"
+#include "fvp/host/perception/capture.h"
+#include "fvp/host/perception/occlusion_statistic.h"
+#include "fvp/host/perception/perception_pipeline.h"
+#include "fvp/robot/sim/stereo_renderer.h"
+#include "fvp/robot/sim/world.h"
+
+namespace fvp::apps {
+namespace {
+
+// "x,y,z,qx,qy,qz,qw" -> the left camera's optical-frame pose in the world.
+Eigen::Isometry3d parsePose(const std::string& text) {
+  std::vector<double> v;
+  std::stringstream ss(text);
+  for (std::string item; std::getline(ss, item, ',');) {
+    try {
+      std::size_t used = 0;
+      v.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw std::invalid_argument("--pose: '" + item + "' is not a number");
+    }
+  }
+  if (v.size() != 7)
+    throw std::invalid_argument("--pose: expected 7 comma-separated numbers x,y,z,qx,qy,qz,qw");
+  Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
+  if (!(q.norm() > 1e-9)) throw std::invalid_argument("--pose: the quaternion is zero");
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = q.normalized().toRotationMatrix();
+  T.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
+  return T;
+}
+
+std::string vec(const Eigen::Vector3d& p) {
+  std::ostringstream os;
+  os << std::fixed << std::setprecision(4) << "(" << p.x() << ", " << p.y() << ", " << p.z() << ")";
+  return os.str();
+}
+
+}  // namespace
+
+void addCaptureCommand(CLI::App& app) {
+  struct Options {
+    std::uint64_t seed = 1;
+    std::string world_file;
+    std::string pose;
+    std::string out;
+  };
+  auto opt = std::make_shared<Options>();
+  auto* cmd = app.add_subcommand(
+      "capture",
+      "Render one view of a simulated world (default: the start view), run the "
+      "perception chain and write it in the capture format (docs/capture-format.md)");
+  cmd->add_option("--seed", opt->seed, "world seed")->required();
+  cmd->add_option("--world", opt->world_file, "world config YAML (default: built-in defaults)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--pose", opt->pose,
+                  "left camera pose in the world, x,y,z,qx,qy,qz,qw (optical frame: x right, "
+                  "y down, z forward; default: the world's start view)");
+  cmd->add_option("--out", opt->out, "capture directory (created)")->required();
+  cmd->callback([opt] {
+    const robot::sim::WorldConfig world_config =
+        opt->world_file.empty() ? robot::sim::WorldConfig{}
+                                : robot::sim::WorldConfig::fromYamlFile(opt->world_file);
+    const auto world = robot::sim::World::generate(world_config, opt->seed);
+    const Eigen::Isometry3d T_world_camera =
+        opt->pose.empty() ? world.startCameraPose() : parsePose(opt->pose);
+
+    robot::sim::StereoRenderer renderer(world);
+    const host::StereoFrame frame = renderer.render(T_world_camera);
+    const double render_s = renderer.lastRenderSeconds();
+    robot::sim::RenderOptions no_leaves;  // ids only: for the occlusion statistic
+    no_leaves.with_leaves = false;
+    no_leaves.images = false;
+    const host::StereoFrame bare = renderer.render(T_world_camera, no_leaves);
+    const double bare_render_s = renderer.lastRenderSeconds();
+
+    host::PerceptionConfig config;
+    config.tag.tag_id = world.tag().tag_id;
+    config.tag.tag_size_m = world.tag().tag_size_m;
+    const host::PerceptionPipeline pipeline(config);
+    const host::PerceptionResult result = pipeline.process(frame);
+    const host::PerceptionStats& st = result.clouds.stats;
+
+    host::Capture capture;
+    capture.left_bgr = frame.left_bgr;
+    capture.right_bgr = frame.right_bgr;
+    capture.intrinsics = frame.intrinsics;
+    capture.T_world_camera = frame.T_world_camera;
+    capture.disparity_px = result.disparity.disparity_px;
+    capture.fruitlet_mask = result.fruitlet_mask;
+    capture.roi_points_m = result.clouds.roi_points_m;
+    capture.other_points_m = result.clouds.other_points_m;
+    capture.has_clouds = true;
+    capture.ground_truth_json = world.groundTruthJson();
+    host::writeCapture(opt->out, capture);
+
+    const auto occlusion = host::OcclusionStatistic::compute(frame.gt_object_id, bare.gt_object_id);
+    const auto& K = frame.intrinsics;
+    const cv::Rect fine = result.disparity.fine_rect;
+    std::cout << std::fixed << std::setprecision(1);
+    std::cout << "world          seed " << world.seed() << ": " << world.fruitlets().size()
+              << " fruitlets, " << world.leaves().size() << " leaves, tag36h11 id "
+              << world.tag().tag_id << "\n"
+              << "camera         " << K.width_px << "x" << K.height_px << " at "
+              << vec(T_world_camera.translation()) << (opt->pose.empty() ? " (start view)" : "")
+              << "\n"
+              << "render         " << render_s * 1e3 << " ms per pair (+ " << bare_render_s * 1e3
+              << " ms for the leafless render of the occlusion statistic)\n";
+    if (result.tag) {
+      const auto& tag = *result.tag;
+      const Eigen::Isometry3d& gt = world.tag().T_world_tag;
+      std::cout << std::setprecision(2) << "tag            detected id " << tag.tag_id
+                << " (hamming " << tag.hamming << ", margin " << tag.decision_margin
+                << "), error vs ground truth "
+                << (tag.T_world_tag.translation() - gt.translation()).norm() * 1e3 << " mm, "
+                << Eigen::AngleAxisd(tag.T_world_tag.linear().transpose() * gt.linear()).angle() *
+                       180.0 / M_PI
+                << " deg, in " << st.tag_s * 1e3 << " ms\n";
+    } else {
+      std::cout << "tag            NOT detected (id " << config.tag.tag_id
+                << "): no Cluster Region; full resolution only around segmented fruitlets\n";
+    }
+    if (result.region)
+      std::cout << std::setprecision(3) << "cluster region centre "
+                << vec(result.region->center_m()) << ", radius " << result.region->radius_m()
+                << " m; true cluster centre "
+                << (world.clusterCenter_m() - result.region->center_m()).norm() * 1e3
+                << " mm from it\n";
+    std::cout << std::setprecision(1) << "SGBM           " << st.sgbm_s * 1e3
+              << " ms (full resolution " << fine.width << "x" << fine.height << " px at (" << fine.x
+              << ", " << fine.y << "), 1/" << result.disparity.coarse_scale
+              << " resolution elsewhere)\n"
+              << "segmentation   " << cv::countNonZero(result.fruitlet_mask) << " fruitlet px in "
+              << st.segmentation_s * 1e3 << " ms\n"
+              << "points         " << st.roi_points << " ROI, " << st.other_points << " other\n"
+              << "disparities    " << st.fine_samples << " full-res + " << st.coarse_samples
+              << " coarse samples; dropped " << st.droppedDisparities() << ": SGBM invalid "
+              << st.sgbm_invalid << ", saturated (too near) " << st.saturated
+              << ", blind left band " << st.blind_band << ", non-finite " << st.nonfinite
+              << ", zero/negative " << st.nonpositive << ", out of range " << st.out_of_range
+              << "\n";
+    std::cout << std::setprecision(3)
+              << "occlusion      visible fraction of each fruitlet's "
+                 "silhouette vs a render without leaves:\n";
+    for (const auto& f : occlusion.fruitlets())
+      std::cout << "  fruitlet " << f.object_id - host::kFirstFruitletId << "   "
+                << (f.unoccluded_px > 0 ? std::to_string(f.visible_fraction).substr(0, 5)
+                                        : std::string("out of view"))
+                << "  (" << f.visible_px << " of " << f.unoccluded_px << " px)\n";
+    std::cout << "  mean         " << occlusion.meanVisibleFraction() << " over "
+              << occlusion.fruitletsInView() << " fruitlets in view\n"
+              << "capture        " << opt->out << "\n";
+  });
+}
+
+}  // namespace fvp::apps

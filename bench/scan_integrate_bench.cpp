@@ -1,0 +1,206 @@
+// BM_ScanIntegrate: one simulated frame (the start view of world seed 1, rendered and run
+// through the perception chain: its ROI + non-ROI clouds) into a fresh coarse (1 cm) +
+// fine (1 mm, Cluster Region) map pair: the grid engine on every backend and the octomap
+// engine, same data, same run. items_per_second = points.
+// BM_ScanIntegrateFineBox: RVP's case, one 1 mm map over the whole observation box, for
+// the grid engine (bricks allocated as rays reach them) and OctoMap's OcTree.
+#include <benchmark/benchmark.h>
+#include <octomap/OcTree.h>
+
+#include <memory>
+#include <string>
+
+#include "bench_common.h"
+#include "fvp/accel/backend.h"
+#include "fvp/host/map/grid_map_engine.h"
+#include "fvp/host/map/octomap_map_engine.h"
+#include "fvp/host/perception/perception_pipeline.h"
+#include "fvp/robot/sim/stereo_renderer.h"
+#include "fvp/robot/sim/world.h"
+
+namespace fvp::bench {
+namespace {
+
+using accel::BackendKind;
+using host::map::GridMapEngine;
+using host::map::MapConfig;
+using host::map::OctomapMapEngine;
+
+constexpr std::uint64_t kWorldSeed = 1;
+constexpr double kObservationHalfExtentM = 0.6;  // around the cluster: camera and canopy
+
+struct Frame {
+  Eigen::Vector3d sensor_m;
+  std::vector<Eigen::Vector3f> roi_m, other_m;
+  host::ClusterRegion region;
+  MapConfig config;
+  std::size_t points() const { return roi_m.size() + other_m.size(); }
+};
+
+const Frame& frame() {
+  static const Frame f = [] {
+    const auto world = robot::sim::World::generate(robot::sim::WorldConfig{}, kWorldSeed);
+    const robot::sim::StereoRenderer renderer(world);
+    const host::StereoFrame stereo = renderer.render(world.startCameraPose());
+    const host::PerceptionResult perceived = host::PerceptionPipeline().process(stereo);
+    if (!perceived.region) throw std::runtime_error("benchmark frame: no Cluster Region (tag not seen)");
+    Frame out;
+    out.sensor_m = perceived.clouds.sensor_origin_m;
+    out.roi_m = perceived.clouds.roi_points_m;
+    out.other_m = perceived.clouds.other_points_m;
+    out.region = *perceived.region;
+    const Eigen::Vector3d c = world.clusterCenter_m();
+    out.config.observation_min_m = c.array() - kObservationHalfExtentM;
+    out.config.observation_max_m = c.array() + kObservationHalfExtentM;
+    return out;
+  }();
+  return f;
+}
+
+// Reference result (cpu grid engine) to check every run against.
+const host::map::ScanStats& reference() {
+  static const host::map::ScanStats stats = [] {
+    auto cpu = accel::createBackend(BackendKind::kCpu);
+    GridMapEngine map(frame().config, frame().region, *cpu);
+    return map.integrate(frame().sensor_m, frame().roi_m, frame().other_m);
+  }();
+  return stats;
+}
+
+void BM_ScanIntegrateGrid(benchmark::State& state, BackendKind kind) {
+  auto backend = backendOrSkip(state, kind);
+  if (!backend) return;
+  const Frame& f = frame();
+  host::map::ScanStats stats;
+  std::size_t map_bytes = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto map = std::make_unique<GridMapEngine>(f.config, f.region, *backend);
+    state.ResumeTiming();
+    stats = map->integrate(f.sensor_m, f.roi_m, f.other_m);
+    state.PauseTiming();
+    map_bytes = map->coarse().deviceBytes() + map->fine().deviceBytes();
+    map.reset();
+    state.ResumeTiming();
+  }
+  if (stats.coarse_voxels_updated != reference().coarse_voxels_updated ||
+      stats.fine_voxels_updated != reference().fine_voxels_updated) {
+    state.SkipWithError("voxel updates differ from the cpu reference");
+    return;
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(f.points()) * state.iterations());
+  state.counters["points"] = static_cast<double>(f.points());
+  state.counters["voxel_updates"] = static_cast<double>(stats.coarse_voxels_updated + stats.fine_voxels_updated);
+  state.counters["map_MB"] = map_bytes / 1e6;
+  state.SetLabel(backend->deviceName());
+}
+
+void BM_ScanIntegrateOctomap(benchmark::State& state) {
+  const Frame& f = frame();
+  host::map::ScanStats stats;
+  std::size_t map_bytes = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto map = std::make_unique<OctomapMapEngine>(f.config, f.region);
+    state.ResumeTiming();
+    stats = map->integrate(f.sensor_m, f.roi_m, f.other_m);
+    state.PauseTiming();
+    map_bytes = map->coarseTree().memoryUsage() + map->fineTree().memoryUsage();
+    map.reset();
+    state.ResumeTiming();
+  }
+  // Same semantics: the voxel updates agree with the grid engine's to within near-ties.
+  const double want = static_cast<double>(reference().fine_voxels_updated + reference().coarse_voxels_updated);
+  const double got = static_cast<double>(stats.fine_voxels_updated + stats.coarse_voxels_updated);
+  if (std::abs(got - want) > 1e-3 * want) {
+    state.SkipWithError("octomap engine's voxel updates differ from the grid engine's by > 0.1 %");
+    return;
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(f.points()) * state.iterations());
+  state.counters["points"] = static_cast<double>(f.points());
+  state.counters["voxel_updates"] = got;
+  state.counters["map_MB"] = map_bytes / 1e6;
+  state.SetLabel("OcTree 1 cm + RoiOcTree 1 mm, key sets built on all cores (OpenMP)");
+}
+
+// RVP's case: one 1 mm occupancy + ROI map over the whole observation box.
+host::map::GridGeometry fineBoxGeometry() {
+  MapConfig box = frame().config;
+  box.coarse_voxel_size_m = 0.001;
+  return host::map::coarseGridGeometry(box);
+}
+
+void BM_ScanIntegrateFineBoxGrid(benchmark::State& state, BackendKind kind) {
+  auto backend = backendOrSkip(state, kind);
+  if (!backend) return;
+  const Frame& f = frame();
+  host::map::ScanStats prep;
+  const auto points = host::map::prepareScanPoints(f.sensor_m, f.roi_m, f.other_m,
+                                                   f.config.sensor_max_range_m, prep);
+  auto buffer = backend->createBufferFrom(points);
+  const host::map::OccupancyModel model;
+  std::size_t updated = 0, bricks = 0, bytes = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto grid = std::make_unique<host::map::BrickedVoxelGrid>(
+        *backend, fineBoxGeometry(), true, std::nullopt, host::map::BrickedVoxelGrid::Allocation::kOnTouch);
+    state.ResumeTiming();
+    updated = grid->integrate(*buffer, static_cast<std::uint32_t>(points.size()), f.sensor_m.cast<float>(), model);
+    state.PauseTiming();
+    bricks = grid->allocatedBricks();
+    bytes = grid->deviceBytes();
+    grid.reset();
+    state.ResumeTiming();
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(points.size()) * state.iterations());
+  state.counters["voxel_updates"] = static_cast<double>(updated);
+  state.counters["bricks"] = static_cast<double>(bricks);
+  state.counters["map_MB"] = bytes / 1e6;
+  state.SetLabel(backend->deviceName());
+}
+
+void BM_ScanIntegrateFineBoxOctomap(benchmark::State& state) {
+  const Frame& f = frame();
+  octomap::Pointcloud cloud;
+  for (const auto* c : {&f.roi_m, &f.other_m})
+    for (const auto& p : *c) cloud.push_back(p.x(), p.y(), p.z());
+  const octomap::point3d origin(f.sensor_m.x(), f.sensor_m.y(), f.sensor_m.z());
+  std::size_t leaves = 0, bytes = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto tree = std::make_unique<octomap::OcTree>(0.001);
+    state.ResumeTiming();
+    tree->insertPointCloud(cloud, origin, f.config.sensor_max_range_m);
+    state.PauseTiming();
+    leaves = tree->getNumLeafNodes();
+    bytes = tree->memoryUsage();
+    tree.reset();
+    state.ResumeTiming();
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(cloud.size()) * state.iterations());
+  state.counters["leaves"] = static_cast<double>(leaves);
+  state.counters["map_MB"] = bytes / 1e6;
+  state.SetLabel("octomap::OcTree 1 mm insertPointCloud (no ROI), 1 thread");
+}
+
+void registerAll() {
+  for (BackendKind kind : {BackendKind::kCpu, BackendKind::kOpenCl, BackendKind::kVulkan}) {
+    const std::string b(accel::toString(kind));
+    benchmark::RegisterBenchmark(("BM_ScanIntegrate/grid/" + b).c_str(), BM_ScanIntegrateGrid, kind)
+        ->Unit(benchmark::kMillisecond)->UseRealTime();
+  }
+  benchmark::RegisterBenchmark("BM_ScanIntegrate/octomap/cpu", BM_ScanIntegrateOctomap)
+      ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+  for (BackendKind kind : {BackendKind::kCpu, BackendKind::kOpenCl, BackendKind::kVulkan}) {
+    const std::string b(accel::toString(kind));
+    benchmark::RegisterBenchmark(("BM_ScanIntegrateFineBox/grid/" + b).c_str(), BM_ScanIntegrateFineBoxGrid, kind)
+        ->Unit(benchmark::kMillisecond)->UseRealTime();
+  }
+  benchmark::RegisterBenchmark("BM_ScanIntegrateFineBox/octomap/cpu", BM_ScanIntegrateFineBoxOctomap)
+      ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+}
+
+const bool registered = (registerAll(), true);
+
+}  // namespace
+}  // namespace fvp::bench

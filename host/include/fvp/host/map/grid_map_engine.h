@@ -1,0 +1,54 @@
+// The "grid" map engine: coarse and fine maps as bricked voxel storage on a compute backend
+// (cpu, opencl or vulkan), integrated by the scan kernels. Default for FVP: the planner's
+// information-gain kernel reads these buffers directly.
+#pragma once
+
+#include <memory>
+
+#include "fvp/accel/backend.h"
+#include "fvp/host/map/bricked_voxel_grid.h"
+#include "fvp/host/map/map_engine.h"
+
+namespace fvp::host::map {
+
+/// Grids of at most this many voxels get every brick up front; larger ones (RVP's 1 mm map
+/// of the whole observation box) allocate bricks as scans reach them.
+inline constexpr std::int64_t kDefaultUpFrontVoxelLimit = 64LL << 20;
+
+class GridMapEngine final : public MapEngine {
+ public:
+  GridMapEngine(const MapConfig& config, const ClusterRegion& region, accel::Backend& backend);
+
+  std::string_view engineName() const override { return "grid"; }
+  ScanStats integrate(const Eigen::Vector3d& sensor_origin_m,
+                      const std::vector<Eigen::Vector3f>& roi_points_m,
+                      const std::vector<Eigen::Vector3f>& other_points_m) override;
+  VoxelClass coarseClass(const Eigen::Vector3d& p_m) const override;
+  VoxelState fineState(const Eigen::Vector3d& p_m) const override;
+  void exportCoarse(const std::filesystem::path& bt_path) const override;
+  void exportFine(const std::filesystem::path& ot_path) const override;
+
+  accel::Backend& backend() const { return backend_; }
+  BrickedVoxelGrid& coarse() { return *coarse_; }
+  BrickedVoxelGrid& fine() { return *fine_; }
+  const BrickedVoxelGrid& coarse() const { return *coarse_; }
+  const BrickedVoxelGrid& fine() const { return *fine_; }
+
+  /// Paper Eq. 1's d_i over the fine grid, metres, capped at max_d_m (dense, x fastest).
+  std::vector<float> roiDistance_m(double max_d_m);
+  /// ROI and exploration frontiers of the fine map, sorted by grid index.
+  std::vector<FrontierVoxel> frontiers();
+
+ private:
+  accel::Backend& backend_;
+  std::unique_ptr<BrickedVoxelGrid> coarse_, fine_;
+};
+
+/// Turns two clouds into kernel scan points: non-finite points are skipped and counted,
+/// points beyond max_range_m cut the ray at that range with no hit (counted).
+std::vector<accel::ScanPoint> prepareScanPoints(const Eigen::Vector3d& sensor_origin_m,
+                                                const std::vector<Eigen::Vector3f>& roi_points_m,
+                                                const std::vector<Eigen::Vector3f>& other_points_m,
+                                                double max_range_m, ScanStats& stats);
+
+}  // namespace fvp::host::map

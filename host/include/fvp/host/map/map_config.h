@@ -1,0 +1,32 @@
+// Geometry and sensor model of the coarse and fine maps (DESIGN.md section 5, issue 4).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+
+#include "fvp/host/map/occupancy_model.h"
+
+namespace fvp::host::map {
+
+inline constexpr double kDefaultCoarseVoxelSizeM = 0.01;
+inline constexpr double kDefaultFineVoxelSizeM = 0.001;
+inline constexpr double kDefaultSensorMaxRangeM = 1.0;
+
+struct MapConfig {
+  /// Coarse map: whole observation space. The box is snapped outward to whole voxels of
+  /// the OctoMap key lattice (voxel k covers [k, k+1) * voxel size).
+  double coarse_voxel_size_m = kDefaultCoarseVoxelSizeM;
+  Eigen::Vector3d observation_min_m{-1.0, -1.0, 0.0};
+  Eigen::Vector3d observation_max_m{1.0, 1.0, 2.0};
+  /// Fine map: occupancy + ROI, only inside the Cluster Region sphere.
+  double fine_voxel_size_m = kDefaultFineVoxelSizeM;
+  /// Points farther than this from the sensor: the ray is cut at this range and its end
+  /// is not a hit (OctoMap's maxrange).
+  double sensor_max_range_m = kDefaultSensorMaxRangeM;
+  OccupancyModel model;
+
+  /// Throws std::invalid_argument naming `source`.field and the expected range.
+  void validate(const std::string& source = "map config") const;
+};
+
+}  // namespace fvp::host::map

@@ -1,0 +1,70 @@
+// The coarse + fine map pair behind one interface, with two engines of identical semantics:
+// "grid" (flat bricked storage the compute kernels read; default for FVP) and "octomap"
+// (octomap::OcTree coarse + an ROI octree fine; the papers' reference, default for RVP).
+//
+// Semantics (OctoMap's, DESIGN.md section 5): log-odds hit/miss with clamping; occupied
+// when p > occupied_prob; unknown = never updated. One scan updates each voxel once: the
+// union of voxels crossed by the rays, minus the end-point voxels, is free; end-point
+// voxels are hits. ROI (fine map only): a second log-odds per voxel, a hit where any ROI
+// point ends, a miss where only other points end. Rays update the fine map only inside
+// the Cluster Region sphere (voxel centres within the radius).
+#pragma once
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <memory>
+#include <string_view>
+#include <vector>
+
+#include "fvp/host/map/map_config.h"
+#include "fvp/host/map/scan_stats.h"
+#include "fvp/host/map/voxel_state.h"
+#include "fvp/host/perception/cluster_region.h"
+
+namespace fvp::accel {
+class Backend;
+}
+
+namespace fvp::host::map {
+
+class MapEngine {
+ public:
+  virtual ~MapEngine() = default;
+  MapEngine(const MapEngine&) = delete;
+  MapEngine& operator=(const MapEngine&) = delete;
+
+  /// "grid" or "octomap".
+  virtual std::string_view engineName() const = 0;
+  const MapConfig& config() const { return config_; }
+  const ClusterRegion& region() const { return region_; }
+
+  /// Integrates one view: rays from sensor_origin_m to every point (world frame).
+  virtual ScanStats integrate(const Eigen::Vector3d& sensor_origin_m,
+                              const std::vector<Eigen::Vector3f>& roi_points_m,
+                              const std::vector<Eigen::Vector3f>& other_points_m) = 0;
+
+  /// State of the coarse voxel containing p (unknown outside the observation box).
+  virtual VoxelClass coarseClass(const Eigen::Vector3d& p_m) const = 0;
+  /// State of the fine voxel containing p (unknown outside the Cluster Region).
+  virtual VoxelState fineState(const Eigen::Vector3d& p_m) const = 0;
+
+  /// Coarse map as an OctoMap binary tree (.bt) that OctoMap's tools read.
+  virtual void exportCoarse(const std::filesystem::path& bt_path) const = 0;
+  /// Fine map as an OctoMap .ot file (occupancy + ROI; format in docs/maps.md).
+  virtual void exportFine(const std::filesystem::path& ot_path) const = 0;
+
+ protected:
+  MapEngine(const MapConfig& config, const ClusterRegion& region)
+      : config_(config), region_(region) {}
+
+ private:
+  MapConfig config_;
+  ClusterRegion region_;
+};
+
+/// engine: "grid" (needs a compute backend) or "octomap" (backend ignored, may be null).
+/// Throws std::invalid_argument for an unknown engine name or a bad config.
+std::unique_ptr<MapEngine> createMapEngine(std::string_view engine, const MapConfig& config,
+                                           const ClusterRegion& region, accel::Backend* backend);
+
+}  // namespace fvp::host::map

@@ -1,0 +1,80 @@
+// The "octomap" map engine (DESIGN.md section 5): the papers' reference. Coarse map: an
+// octomap::OcTree at coarse_voxel_size_m over the observation box; fine map: a RoiOcTree
+// (occupancy + ROI log-odds) at fine_voxel_size_m over the Cluster Region.
+//
+// One scan is integrated as OctoMap's insertPointCloud does (computeUpdate, then one
+// updateNode per key): the keys of computeRayKeys(origin, end) of every ray form the free
+// set, the end points' keys the occupied set, free minus occupied is updated as a miss and
+// occupied as a hit, each key once. Differences from a plain insertPointCloud, all required
+// by the map contract (map_engine.h):
+// - Only voxels of the grids (coarseGridGeometry / fineGridGeometry lattices, OctoMap key =
+//   lattice index + 32768) are updated; the fine map only voxels whose centre lies in the
+//   Cluster Region (fvp_region_contains, the test the grid engine uses). OctoMap's own bbx
+//   limit is not used: it drops every ray whose end point lies outside the box.
+// - Each ray is first clipped to the map's box (and, fine, to the Cluster Region sphere),
+//   grown by two voxels, so a 1 mm map walks only the voxels it may update. The clipped
+//   segment lies on the same line, but computeRayKeys starts from the clipped point in
+//   float, so crossings that nearly tie may be ordered differently: a voxel touched only at
+//   a corner can differ. The grid engine agreement target is >= 99.9 %, not 100 %.
+// - NaN / infinite points are skipped and counted; points beyond sensor_max_range_m are cut
+//   there as OctoMap's maxrange does (free up to the cut, the cut voxel itself not updated,
+//   no hit) and counted.
+// - ROI (fine map): +hit where any ROI point ends, +miss where only other points end,
+//   unchanged in free voxels; clamped like occupancy.
+//
+// Voxel classes: occupied when log-odds > logOdds(occupied_prob) (strict, the grid engine's
+// rule; OctoMap's isNodeOccupied uses >=, which differs only at exactly 0), free when
+// updated but not occupied, unknown when never updated; ROI when ROI log-odds > 0.
+#pragma once
+
+#include <octomap/OcTree.h>
+
+#include <array>
+#include <memory>
+
+#include "fvp/host/map/grid_geometry.h"
+#include "fvp/host/map/map_engine.h"
+#include "fvp/host/map/roi_octree.h"
+
+namespace fvp::host::map {
+
+class OctomapMapEngine : public MapEngine {
+ public:
+  /// Throws std::invalid_argument for a bad config or grids outside OctoMap's key range.
+  OctomapMapEngine(const MapConfig& config, const ClusterRegion& region);
+  ~OctomapMapEngine() override;
+
+  std::string_view engineName() const override { return "octomap"; }
+
+  ScanStats integrate(const Eigen::Vector3d& sensor_origin_m,
+                      const std::vector<Eigen::Vector3f>& roi_points_m,
+                      const std::vector<Eigen::Vector3f>& other_points_m) override;
+
+  VoxelClass coarseClass(const Eigen::Vector3d& p_m) const override;
+  VoxelState fineState(const Eigen::Vector3d& p_m) const override;
+  /// The same by grid index (coarseGrid() / fineGrid()); unknown outside the grid/region.
+  VoxelClass coarseClassAt(const std::array<int, 3>& index) const;
+  VoxelState fineStateAt(const std::array<int, 3>& index) const;
+
+  /// .bt (octomap::OcTree) and .ot (ColorOcTree, ROI in the colour): octomap_io.h.
+  void exportCoarse(const std::filesystem::path& bt_path) const override;
+  void exportFine(const std::filesystem::path& ot_path) const override;
+
+  const octomap::OcTree& coarseTree() const { return *coarse_; }
+  const RoiOcTree& fineTree() const { return *fine_; }
+  const GridGeometry& coarseGrid() const { return coarse_grid_; }
+  const GridGeometry& fineGrid() const { return fine_grid_; }
+  /// OctoMap key of a grid voxel (lattice index + the tree's key offset, 32768).
+  octomap::OcTreeKey coarseKey(const std::array<int, 3>& index) const;
+  octomap::OcTreeKey fineKey(const std::array<int, 3>& index) const;
+
+ private:
+  GridGeometry coarse_grid_;
+  GridGeometry fine_grid_;
+  fvp_region fine_region_{};
+  int key_offset_ = 0;  ///< OctoMap key of lattice index 0 (tree_max_val)
+  std::unique_ptr<octomap::OcTree> coarse_;
+  std::unique_ptr<RoiOcTree> fine_;
+};
+
+}  // namespace fvp::host::map

@@ -1,0 +1,56 @@
+// AprilTag (tag36h11) detection with libapriltag on the left image and tag pose with
+// libapriltag's estimate_tag_pose (homography + orthogonal iteration). Frames: see
+// tag_detection.h.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <memory>
+#include <mutex>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <vector>
+
+#include "fvp/host/core/stereo_intrinsics.h"
+#include "fvp/host/perception/tag_detection.h"
+
+namespace fvp::host {
+
+inline constexpr int kDefaultTagId = 0;
+inline constexpr double kDefaultTagSizeM = 0.03;  ///< black border edge, as libapriltag's tagsize
+inline constexpr float kDefaultQuadDecimate = 1.0f;  ///< full resolution: best corner accuracy
+inline constexpr int kDefaultMaxHamming = 1;
+
+struct AprilTagDetectorConfig {
+  int tag_id = kDefaultTagId;  ///< the cluster's tag; -1: accept any id (detect() returns the best)
+  double tag_size_m = kDefaultTagSizeM;
+  float quad_decimate = kDefaultQuadDecimate;
+  float quad_sigma = 0.0f;
+  bool refine_edges = true;
+  int max_hamming = kDefaultMaxHamming;
+  int threads = 0;  ///< 0: std::thread::hardware_concurrency()
+  void validate() const;
+};
+
+class AprilTagDetector {
+ public:
+  explicit AprilTagDetector(AprilTagDetectorConfig config = {});
+  ~AprilTagDetector();
+  AprilTagDetector(const AprilTagDetector&) = delete;
+  AprilTagDetector& operator=(const AprilTagDetector&) = delete;
+  const AprilTagDetectorConfig& config() const { return config_; }
+
+  /// Every tag36h11 tag in the image (CV_8UC3 BGR or CV_8UC1), with poses.
+  std::vector<TagDetection> detectAll(const cv::Mat& image, const StereoIntrinsics& intrinsics,
+                                      const Eigen::Isometry3d& T_world_camera) const;
+  /// The configured tag (highest decision margin if seen more than once); nullopt if absent.
+  std::optional<TagDetection> detect(const cv::Mat& image, const StereoIntrinsics& intrinsics,
+                                     const Eigen::Isometry3d& T_world_camera) const;
+
+ private:
+  struct Impl;
+  AprilTagDetectorConfig config_;
+  std::unique_ptr<Impl> impl_;
+  mutable std::mutex mutex_;  ///< libapriltag's detector is not re-entrant
+};
+
+}  // namespace fvp::host

@@ -1,0 +1,47 @@
+// The capture format: one stereo view on disk (docs/capture-format.md), written by
+// `fvp capture` and readable from a real robot's exported data.
+//
+//   DIR/left.png, right.png    rectified 8-bit BGR (or grey) pair        required
+//   DIR/camera.yaml            intrinsics, baseline, T_world_camera       required
+//   DIR/disparity.png          16-bit, disparity * disparity_scale, 0 invalid   optional
+//   DIR/mask.png               8-bit fruitlet mask (nonzero = fruitlet)   optional
+//   DIR/roi.ply, other.ply     binary little-endian PLY, float x y z, world frame  optional
+//   DIR/ground_truth.json      the simulated world's ground truth (sim only)  optional
+#pragma once
+
+#include <Eigen/Geometry>
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "fvp/host/core/stereo_intrinsics.h"
+
+namespace fvp::host {
+
+inline constexpr double kDefaultDisparityScale = 16.0;  ///< OpenCV's fixed point (1/16 px)
+
+struct Capture {
+  cv::Mat left_bgr;  ///< CV_8UC3 (a grey PNG is read as CV_8UC3 too)
+  cv::Mat right_bgr;
+  StereoIntrinsics intrinsics;
+  Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();
+  cv::Mat disparity_px;                         ///< CV_32F, 0 = invalid; empty if absent
+  cv::Mat fruitlet_mask;                        ///< CV_8U, 255 = fruitlet; empty if absent
+  std::vector<Eigen::Vector3f> roi_points_m;    ///< world frame; empty if absent
+  std::vector<Eigen::Vector3f> other_points_m;  ///< world frame
+  bool has_clouds = false;                      ///< roi.ply and other.ply present
+  std::string ground_truth_json;                ///< empty if absent
+  double disparity_scale = kDefaultDisparityScale;
+};
+
+/// Creates dir if needed and writes every present part; each file is written to a temporary
+/// name and renamed, so no file is ever half-written. Throws std::runtime_error (naming the
+/// file) on I/O failure and std::invalid_argument for inconsistent sizes.
+void writeCapture(const std::filesystem::path& dir, const Capture& capture);
+
+/// Reads and validates a capture; throws std::runtime_error whose message names the file,
+/// the field and what was expected.
+Capture readCapture(const std::filesystem::path& dir);
+
+}  // namespace fvp::host

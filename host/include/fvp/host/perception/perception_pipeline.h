@@ -1,0 +1,60 @@
+// The perception chain of one view (paper, "Perception"; DESIGN.md §1 step 1):
+// HSV segmentation -> AprilTag -> Cluster Region -> SGBM (full resolution over the band
+// covering the Cluster Region and the segmented fruitlets, reduced resolution elsewhere)
+// -> ROI and non-ROI world-frame clouds.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <optional>
+
+#include "fvp/host/perception/apriltag_detector.h"
+#include "fvp/host/perception/cloud_projector.h"
+#include "fvp/host/perception/cluster_region.h"
+#include "fvp/host/perception/fruitlet_segmenter.h"
+#include "fvp/host/perception/labeled_clouds.h"
+#include "fvp/host/perception/stereo_frame.h"
+#include "fvp/host/perception/stereo_matcher.h"
+
+namespace fvp::host {
+
+inline constexpr int kDefaultBandMarginPx = 16;
+
+struct PerceptionConfig {
+  SegmentationConfig segmentation;
+  StereoMatcherConfig stereo;
+  AprilTagDetectorConfig tag;
+  ClusterRegionConfig region;
+  ProjectionConfig projection;
+  int band_margin_px = kDefaultBandMarginPx;  ///< added around the fine rectangle
+  /// Ablation switch (DESIGN.md §8): use the frame's exact gt_depth_m instead of SGBM.
+  bool use_exact_depth = false;
+  void validate() const;
+};
+
+struct PerceptionResult {
+  cv::Mat fruitlet_mask;      ///< CV_8U, 255 = fruitlet
+  DisparityResult disparity;  ///< full-size CV_32F map, fine rect, coarse scale
+  LabeledClouds clouds;       ///< stats: all counts and timings of this view
+  std::optional<TagDetection> tag;
+  std::optional<ClusterRegion> region;  ///< the one used (given or from the tag)
+};
+
+class PerceptionPipeline {
+ public:
+  explicit PerceptionPipeline(PerceptionConfig config = {});
+  const PerceptionConfig& config() const { return config_; }
+
+  /// known_region: the Cluster Region from an earlier view (the tag is then still detected
+  /// and reported, but the given region is used).
+  PerceptionResult process(const StereoFrame& frame,
+                           const std::optional<ClusterRegion>& known_region = std::nullopt) const;
+
+ private:
+  PerceptionConfig config_;
+  FruitletSegmenter segmenter_;
+  StereoMatcher matcher_;
+  AprilTagDetector tag_detector_;
+  CloudProjector projector_;
+};
+
+}  // namespace fvp::host

@@ -1,0 +1,94 @@
+// Disparity by OpenCV StereoSGBM (DESIGN.md §8 reference configuration), computed where it is
+// needed: a full-resolution pass over the requested fine rectangle (the Cluster Region's image
+// band) and a cheaper reduced-resolution pass for everything else (the coarse map). Both are
+// split into row strips with overlap and run on all cores (OpenCV's MODE_SGBM is
+// single-threaded). Pitfalls handled (DESIGN.md §10): saturated disparities at the top of the
+// search range (objects nearer than ~0.17 m) are rejected, and the left band where SGBM has no
+// match is marked invalid; both are counted.
+#pragma once
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+
+#include "fvp/host/perception/perception_stats.h"
+
+namespace fvp::host {
+
+inline constexpr int kDefaultNumDisparities = 320;
+inline constexpr int kDefaultBlockSize = 3;
+inline constexpr int kDefaultP1 = 216;  ///< 8 * channels * block^2 for BGR input
+inline constexpr int kDefaultP2 = 864;  ///< 32 * channels * block^2
+inline constexpr int kDefaultDisp12MaxDiff = 1;
+inline constexpr int kDefaultPreFilterCap = 63;
+inline constexpr int kDefaultUniquenessRatio = 10;
+inline constexpr int kDefaultSpeckleWindowSize = 100;
+inline constexpr int kDefaultSpeckleRange = 2;
+inline constexpr int kDefaultSgbmMode = cv::StereoSGBM::MODE_SGBM;
+/// Disparities >= num_disparities - margin are saturated (SGBM clamps near objects there).
+inline constexpr int kDefaultSaturationMarginPx = 2;
+inline constexpr int kDefaultCoarseScale = 2;      ///< coarse pass at 1/2 resolution
+inline constexpr int kDefaultStripOverlapPx = 24;  ///< rows for SGBM's top-down paths to settle
+
+/// OpenCV StereoSGBM parameters at full resolution.
+struct SgbmConfig {
+  int min_disparity = 0;
+  int num_disparities = kDefaultNumDisparities;  ///< multiple of 16
+  int block_size = kDefaultBlockSize;            ///< odd
+  int p1 = kDefaultP1;
+  int p2 = kDefaultP2;
+  int disp12_max_diff = kDefaultDisp12MaxDiff;
+  int pre_filter_cap = kDefaultPreFilterCap;
+  int uniqueness_ratio = kDefaultUniquenessRatio;
+  int speckle_window_size = kDefaultSpeckleWindowSize;
+  int speckle_range = kDefaultSpeckleRange;
+  int mode = kDefaultSgbmMode;
+  int saturation_margin_px = kDefaultSaturationMarginPx;
+
+  /// The same matcher for images downscaled by `scale`: the disparity range shrinks (rounded
+  /// up to a multiple of 16), the speckle window by scale^2.
+  SgbmConfig scaled(int scale) const;
+  void validate() const;  ///< throws std::invalid_argument naming the field
+};
+
+struct StereoMatcherConfig {
+  SgbmConfig sgbm;
+  int coarse_scale = kDefaultCoarseScale;  ///< 1: the whole image at full resolution
+  bool coarse_pass = true;                 ///< false: no disparity outside the fine rect
+  int strip_overlap_px = kDefaultStripOverlapPx;
+  int threads = 0;  ///< 0: std::thread::hardware_concurrency()
+  void validate() const;
+};
+
+/// A full-size disparity map assembled from the fine and the coarse pass.
+struct DisparityResult {
+  /// CV_32F, pixels of the full-resolution left image; 0 = no valid disparity.
+  cv::Mat disparity_px;
+  /// Where disparity_px comes from the full-resolution pass (possibly empty).
+  cv::Rect fine_rect;
+  /// Outside fine_rect each coarse pixel is replicated over a coarse_scale^2 block (nearest
+  /// upsampling); the block whose top-left is (u, v), u and v multiples of coarse_scale, is
+  /// one sample centred at (u + (s-1)/2, v + (s-1)/2).
+  int coarse_scale = 1;
+  PerceptionStats stats;  ///< disparity-stage counts and sgbm_s
+};
+
+class StereoMatcher {
+ public:
+  explicit StereoMatcher(StereoMatcherConfig config = {});
+  const StereoMatcherConfig& config() const { return config_; }
+
+  /// left/right: rectified CV_8UC3 (or CV_8UC1) images of equal size. fine_rect: the region
+  /// wanted at full resolution (clipped to the image; empty: none). With coarse_scale 1 the
+  /// whole image is computed at full resolution.
+  DisparityResult compute(const cv::Mat& left, const cv::Mat& right, cv::Rect fine_rect) const;
+
+  /// One plain SGBM call on a (sub)image pair: CV_32F pixels, 0 where invalid, saturated
+  /// or blind (the counts are added to stats when given).
+  static cv::Mat runSgbm(const cv::Mat& left, const cv::Mat& right, const SgbmConfig& config,
+                         PerceptionStats* stats = nullptr);
+
+ private:
+  StereoMatcherConfig config_;
+};
+
+}  // namespace fvp::host

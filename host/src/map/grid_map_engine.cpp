@@ -1,0 +1,141 @@
+#include "fvp/host/map/grid_map_engine.h"
+
+#include <octomap/OcTree.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "fvp/host/map/octomap_io.h"
+#include "fvp/host/map/roi_octree.h"
+
+namespace fvp::host::map {
+namespace {
+
+VoxelClass classify(float logodds, float occupied_logodds) {
+  if (std::isnan(logodds)) return VoxelClass::kUnknown;
+  return logodds > occupied_logodds ? VoxelClass::kOccupied : VoxelClass::kFree;
+}
+
+BrickedVoxelGrid::Allocation allocationFor(const GridGeometry& g) {
+  return g.voxelCount() <= kDefaultUpFrontVoxelLimit ? BrickedVoxelGrid::Allocation::kUpFront
+                                                     : BrickedVoxelGrid::Allocation::kOnTouch;
+}
+
+}  // namespace
+
+std::vector<accel::ScanPoint> prepareScanPoints(const Eigen::Vector3d& sensor_origin_m,
+                                                const std::vector<Eigen::Vector3f>& roi_points_m,
+                                                const std::vector<Eigen::Vector3f>& other_points_m,
+                                                double max_range_m, ScanStats& stats) {
+  std::vector<accel::ScanPoint> points;
+  points.reserve(roi_points_m.size() + other_points_m.size());
+  auto add = [&](const std::vector<Eigen::Vector3f>& cloud, unsigned flags) {
+    for (const Eigen::Vector3f& p : cloud) {
+      ++stats.points;
+      if (!p.allFinite()) {
+        ++stats.skipped_invalid;
+        continue;
+      }
+      const Eigen::Vector3d d = p.cast<double>() - sensor_origin_m;
+      const double range = d.norm();
+      if (range > max_range_m) {
+        ++stats.truncated;
+        const Eigen::Vector3d end = sensor_origin_m + d * (max_range_m / range);
+        points.push_back({static_cast<float>(end.x()), static_cast<float>(end.y()),
+                          static_cast<float>(end.z()), 0u});
+        continue;
+      }
+      points.push_back({p.x(), p.y(), p.z(), FVP_POINT_HIT | flags});
+    }
+  };
+  add(roi_points_m, FVP_POINT_ROI);
+  add(other_points_m, 0u);
+  return points;
+}
+
+GridMapEngine::GridMapEngine(const MapConfig& config, const ClusterRegion& region,
+                             accel::Backend& backend)
+    : MapEngine(config, region), backend_(backend) {
+  config.validate();
+  const GridGeometry coarse = coarseGridGeometry(config);
+  const GridGeometry fine = fineGridGeometry(config, region);
+  coarse_ = std::make_unique<BrickedVoxelGrid>(backend, coarse, /*with_roi=*/false, std::nullopt,
+                                               allocationFor(coarse));
+  fine_ = std::make_unique<BrickedVoxelGrid>(backend, fine, /*with_roi=*/true,
+                                             regionInGrid(fine, region), allocationFor(fine));
+}
+
+ScanStats GridMapEngine::integrate(const Eigen::Vector3d& sensor_origin_m,
+                                   const std::vector<Eigen::Vector3f>& roi_points_m,
+                                   const std::vector<Eigen::Vector3f>& other_points_m) {
+  const auto t0 = std::chrono::steady_clock::now();
+  ScanStats stats;
+  const auto points = prepareScanPoints(sensor_origin_m, roi_points_m, other_points_m,
+                                        config().sensor_max_range_m, stats);
+  if (!points.empty() && sensor_origin_m.allFinite()) {
+    auto buffer = backend_.createBufferFrom(points);
+    const Eigen::Vector3f sensor = sensor_origin_m.cast<float>();
+    const auto n = static_cast<std::uint32_t>(points.size());
+    stats.coarse_voxels_updated = coarse_->integrate(*buffer, n, sensor, config().model);
+    stats.fine_voxels_updated = fine_->integrate(*buffer, n, sensor, config().model);
+  }
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return stats;
+}
+
+VoxelClass GridMapEngine::coarseClass(const Eigen::Vector3d& p_m) const {
+  std::array<int, 3> index;
+  if (!coarse_->geometry().gridIndex(p_m, index)) return VoxelClass::kUnknown;
+  return classify(coarse_->occupancyAt(index), config().model.occupiedLogOdds());
+}
+
+VoxelState GridMapEngine::fineState(const Eigen::Vector3d& p_m) const {
+  std::array<int, 3> index;
+  if (!fine_->geometry().gridIndex(p_m, index)) return {};
+  VoxelState s;
+  s.occupancy = classify(fine_->occupancyAt(index), config().model.occupiedLogOdds());
+  s.roi = s.occupancy != VoxelClass::kUnknown && fine_->roiAt(index) > 0.0f;
+  return s;
+}
+
+// Exports build the same OctoMap trees the octomap engine holds and write them with its
+// writers (octomap_io.h), so both engines produce interchangeable files.
+void GridMapEngine::exportCoarse(const std::filesystem::path& bt_path) const {
+  octomap::OcTree tree(config().coarse_voxel_size_m);
+  tree.setOccupancyThres(config().model.occupied_prob);
+  coarse_->forEachVoxel([&](const std::array<int, 3>& index, float occupancy, float) {
+    if (std::isnan(occupancy)) return;
+    const Eigen::Vector3d c = coarse_->geometry().voxelCenter_m(index);
+    tree.setNodeValue(octomap::point3d(c.x(), c.y(), c.z()), occupancy, /*lazy_eval=*/true);
+  });
+  tree.updateInnerOccupancy();
+  writeCoarseBt(tree, bt_path);
+}
+
+void GridMapEngine::exportFine(const std::filesystem::path& ot_path) const {
+  RoiOcTree tree(config().fine_voxel_size_m);
+  tree.setOccupancyThres(config().model.occupied_prob);
+  fine_->forEachVoxel([&](const std::array<int, 3>& index, float occupancy, float roi) {
+    if (std::isnan(occupancy)) return;
+    const Eigen::Vector3d c = fine_->geometry().voxelCenter_m(index);
+    RoiOcTreeNode* node =
+        tree.setNodeValue(octomap::point3d(c.x(), c.y(), c.z()), occupancy, /*lazy_eval=*/true);
+    node->setRoiLogOdds(std::isnan(roi) ? 0.0f : roi);
+  });
+  tree.updateInnerOccupancy();
+  writeFineOt(tree, ot_path);
+}
+
+std::vector<float> GridMapEngine::roiDistance_m(double max_d_m) {
+  const double voxel = fine_->geometry().voxel_size_m;
+  const int radius_vox = std::max(1, static_cast<int>(std::ceil(max_d_m / voxel)));
+  std::vector<float> d = fine_->roiDistanceVox(radius_vox);
+  for (float& v : d) v = static_cast<float>(std::min(v * voxel, max_d_m));
+  return d;
+}
+
+std::vector<FrontierVoxel> GridMapEngine::frontiers() {
+  return fine_->extractFrontiers(config().model.occupiedLogOdds());
+}
+
+}  // namespace fvp::host::map

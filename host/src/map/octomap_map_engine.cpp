@@ -1,0 +1,335 @@
+#include "fvp/host/map/octomap_map_engine.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "fvp/host/map/octomap_io.h"
+
+namespace fvp::host::map {
+namespace {
+
+// Rays are clipped to the map's box / sphere grown by this many voxels, so the clipped
+// segment's first and last voxels lie outside the updatable set: the start voxel
+// (included by computeRayKeys) and the cut end voxel (excluded by it) never matter.
+constexpr double kClipMarginVoxels = 2.0;
+
+struct PreparedRay {
+  octomap::point3d end;  ///< the point, or the max-range cut (float, as OctoMap computes it)
+  bool hit = false;      ///< end is a measured point (not cut at max range)
+  bool roi = false;
+};
+
+struct Interval {
+  double t0 = 0.0, t1 = 1.0;
+  bool empty() const { return !(t0 <= t1); }
+};
+
+// Segment o + t d, t in [0, 1], against an axis-aligned box (slab method).
+Interval clipToBox(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::Vector3d& lo,
+                   const Eigen::Vector3d& hi, Interval in) {
+  for (int a = 0; a < 3; ++a) {
+    if (d[a] == 0.0) {
+      if (o[a] < lo[a] || o[a] > hi[a]) return {1.0, 0.0};
+      continue;
+    }
+    double ta = (lo[a] - o[a]) / d[a];
+    double tb = (hi[a] - o[a]) / d[a];
+    if (ta > tb) std::swap(ta, tb);
+    in.t0 = std::max(in.t0, ta);
+    in.t1 = std::min(in.t1, tb);
+  }
+  return in;
+}
+
+// Segment o + t d against a sphere.
+Interval clipToSphere(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::Vector3d& c,
+                      double r, Interval in) {
+  const double a = d.squaredNorm();
+  if (a == 0.0) return (o - c).squaredNorm() <= r * r ? in : Interval{1.0, 0.0};
+  const Eigen::Vector3d f = o - c;
+  const double b = f.dot(d);
+  const double disc = b * b - a * (f.squaredNorm() - r * r);
+  if (disc < 0.0) return {1.0, 0.0};
+  const double s = std::sqrt(disc);
+  in.t0 = std::max(in.t0, (-b - s) / a);
+  in.t1 = std::min(in.t1, (-b + s) / a);
+  return in;
+}
+
+bool inGrid(const GridGeometry& g, int key_offset, const octomap::OcTreeKey& key,
+            std::array<int, 3>& index) {
+  for (int a = 0; a < 3; ++a) {
+    const std::int64_t i = std::int64_t{key[a]} - key_offset - g.first_voxel[a];
+    if (i < 0 || i >= g.dims[a]) return false;
+    index[a] = static_cast<int>(i);
+  }
+  return true;
+}
+
+VoxelClass classify(float log_odds, float occupied_log_odds) {
+  return log_odds > occupied_log_odds ? VoxelClass::kOccupied : VoxelClass::kFree;
+}
+
+template <typename Tree>
+void setSensorModel(Tree& tree, const OccupancyModel& model) {
+  tree.setProbHit(model.prob_hit);
+  tree.setProbMiss(model.prob_miss);
+  tree.setClampingThresMin(model.clamp_min);
+  tree.setClampingThresMax(model.clamp_max);
+  tree.setOccupancyThres(model.occupied_prob);
+}
+
+// The key sets of one scan (OctoMap's computeUpdate), per map.
+struct ScanKeys {
+  octomap::KeySet coarse_free, coarse_hit;
+  octomap::KeySet fine_free, fine_roi_hit, fine_other_hit;
+
+  void merge(const ScanKeys& o) {
+    coarse_free.insert(o.coarse_free.begin(), o.coarse_free.end());
+    coarse_hit.insert(o.coarse_hit.begin(), o.coarse_hit.end());
+    fine_free.insert(o.fine_free.begin(), o.fine_free.end());
+    fine_roi_hit.insert(o.fine_roi_hit.begin(), o.fine_roi_hit.end());
+    fine_other_hit.insert(o.fine_other_hit.begin(), o.fine_other_hit.end());
+  }
+};
+
+}  // namespace
+
+OctomapMapEngine::OctomapMapEngine(const MapConfig& config, const ClusterRegion& region)
+    : MapEngine(config, region) {
+  config.validate("octomap engine config");
+  if (!(region.radius_m() > 0.0) || !region.center_m().allFinite()) {
+    throw std::invalid_argument(
+        "octomap engine: the Cluster Region needs a finite centre and a "
+        "positive radius");
+  }
+  coarse_grid_ = coarseGridGeometry(config);
+  fine_grid_ = fineGridGeometry(config, region);
+  fine_region_ = regionInGrid(fine_grid_, region);
+
+  coarse_ = std::make_unique<octomap::OcTree>(config.coarse_voxel_size_m);
+  fine_ = std::make_unique<RoiOcTree>(config.fine_voxel_size_m);
+  setSensorModel(*coarse_, config.model);
+  setSensorModel(*fine_, config.model);
+  key_offset_ = coarse_->coordToKey(0.0);  // tree_max_val: the key of lattice index 0
+
+  // Keys are 16 bit: the whole grid must lie within OctoMap's +-32768 voxels.
+  for (const GridGeometry* g : {&coarse_grid_, &fine_grid_}) {
+    for (int a = 0; a < 3; ++a) {
+      const std::int64_t lo = g->first_voxel[a] + key_offset_;
+      const std::int64_t hi = lo + g->dims[a] - 1;
+      if (lo < 0 || hi > std::numeric_limits<octomap::key_type>::max()) {
+        throw std::invalid_argument(
+            std::string("octomap engine: the ") + (g == &coarse_grid_ ? "coarse" : "fine") +
+            " grid lies outside OctoMap's key range (+-32768 voxels around the origin)");
+      }
+    }
+  }
+}
+
+OctomapMapEngine::~OctomapMapEngine() = default;
+
+octomap::OcTreeKey OctomapMapEngine::coarseKey(const std::array<int, 3>& index) const {
+  octomap::OcTreeKey key;
+  for (int a = 0; a < 3; ++a) {
+    key[a] = static_cast<octomap::key_type>(coarse_grid_.first_voxel[a] + index[a] + key_offset_);
+  }
+  return key;
+}
+
+octomap::OcTreeKey OctomapMapEngine::fineKey(const std::array<int, 3>& index) const {
+  octomap::OcTreeKey key;
+  for (int a = 0; a < 3; ++a) {
+    key[a] = static_cast<octomap::key_type>(fine_grid_.first_voxel[a] + index[a] + key_offset_);
+  }
+  return key;
+}
+
+ScanStats OctomapMapEngine::integrate(const Eigen::Vector3d& sensor_origin_m,
+                                      const std::vector<Eigen::Vector3f>& roi_points_m,
+                                      const std::vector<Eigen::Vector3f>& other_points_m) {
+  const auto start = std::chrono::steady_clock::now();
+  if (!sensor_origin_m.allFinite()) {
+    throw std::invalid_argument("octomap engine: the sensor origin is not finite");
+  }
+  ScanStats stats;
+  stats.points = roi_points_m.size() + other_points_m.size();
+
+  // 1. Validate and cut the rays (OctoMap's maxrange: the cut end lies on the ray at
+  //    exactly max range, computed in float as computeUpdate does).
+  const octomap::point3d origin(static_cast<float>(sensor_origin_m.x()),
+                                static_cast<float>(sensor_origin_m.y()),
+                                static_cast<float>(sensor_origin_m.z()));
+  const double max_range = config().sensor_max_range_m;
+  std::vector<PreparedRay> rays;
+  rays.reserve(stats.points);
+  auto prepare = [&](const std::vector<Eigen::Vector3f>& points, bool roi) {
+    for (const Eigen::Vector3f& p : points) {
+      if (!p.allFinite()) {
+        ++stats.skipped_invalid;
+        continue;
+      }
+      const octomap::point3d end(p.x(), p.y(), p.z());
+      if ((end - origin).norm() <= max_range) {
+        rays.push_back({end, true, roi});
+      } else {
+        ++stats.truncated;
+        const octomap::point3d direction = (end - origin).normalized();
+        rays.push_back({origin + direction * static_cast<float>(max_range), false, roi});
+      }
+    }
+  };
+  prepare(roi_points_m, true);
+  prepare(other_points_m, false);
+
+  // 2. Key sets (computeUpdate), one per thread, merged.
+  const double cs = coarse_grid_.voxel_size_m, fs = fine_grid_.voxel_size_m;
+  Eigen::Vector3d coarse_lo, coarse_hi, fine_lo, fine_hi;
+  for (int a = 0; a < 3; ++a) {
+    coarse_lo[a] = (coarse_grid_.first_voxel[a] - kClipMarginVoxels) * cs;
+    coarse_hi[a] = (coarse_grid_.first_voxel[a] + coarse_grid_.dims[a] + kClipMarginVoxels) * cs;
+    fine_lo[a] = (fine_grid_.first_voxel[a] - kClipMarginVoxels) * fs;
+    fine_hi[a] = (fine_grid_.first_voxel[a] + fine_grid_.dims[a] + kClipMarginVoxels) * fs;
+  }
+  const Eigen::Vector3d& region_center = region().center_m();
+  const double region_clip_radius = region().radius_m() + kClipMarginVoxels * fs;
+
+  const octomap::OcTree& coarse = *coarse_;
+  const RoiOcTree& fine = *fine_;
+  const GridGeometry& coarse_grid = coarse_grid_;
+  const GridGeometry& fine_grid = fine_grid_;
+  const fvp_region fine_region = fine_region_;
+  const int key_offset = key_offset_;
+  auto inFineRegion = [&](const octomap::OcTreeKey& key) {
+    std::array<int, 3> i;
+    return inGrid(fine_grid, key_offset, key, i) &&
+           fvp_region_contains(&fine_region, i[0], i[1], i[2]);
+  };
+  auto inCoarseGrid = [&](const octomap::OcTreeKey& key) {
+    std::array<int, 3> i;
+    return inGrid(coarse_grid, key_offset, key, i);
+  };
+  // computeRayKeys on the part of the ray inside `clip`, keeping the keys `keep` accepts.
+  auto addFreeKeys = [](const auto& tree, const octomap::point3d& o, const octomap::point3d& e,
+                        const Interval& clip, octomap::KeyRay& key_ray, const auto& keep,
+                        octomap::KeySet& out) {
+    if (clip.empty()) return;
+    const Eigen::Vector3d od(o.x(), o.y(), o.z());
+    const Eigen::Vector3d dd = Eigen::Vector3d(e.x(), e.y(), e.z()) - od;
+    auto at = [&](double t) {
+      const Eigen::Vector3d p = od + t * dd;
+      return octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()),
+                              static_cast<float>(p.z()));
+    };
+    const octomap::point3d a = clip.t0 > 0.0 ? at(clip.t0) : o;
+    const octomap::point3d b = clip.t1 < 1.0 ? at(clip.t1) : e;
+    if (!tree.computeRayKeys(a, b, key_ray)) return;
+    for (const octomap::OcTreeKey& key : key_ray) {
+      if (keep(key)) out.insert(key);
+    }
+  };
+
+  // The ray as OctoMap sees it: float end points (clipping is done in double from them).
+  const Eigen::Vector3d of(origin.x(), origin.y(), origin.z());
+  ScanKeys keys;
+  const auto ray_count = static_cast<std::int64_t>(rays.size());
+#pragma omp parallel
+  {
+    ScanKeys local;
+    octomap::KeyRay key_ray;
+#pragma omp for schedule(dynamic, 1024)
+    for (std::int64_t r = 0; r < ray_count; ++r) {
+      const PreparedRay& ray = rays[static_cast<std::size_t>(r)];
+      const Eigen::Vector3d dd = Eigen::Vector3d(ray.end.x(), ray.end.y(), ray.end.z()) - of;
+      addFreeKeys(coarse, origin, ray.end, clipToBox(of, dd, coarse_lo, coarse_hi, {}), key_ray,
+                  inCoarseGrid, local.coarse_free);
+      const Interval fine_clip = clipToSphere(of, dd, region_center, region_clip_radius,
+                                              clipToBox(of, dd, fine_lo, fine_hi, {}));
+      addFreeKeys(fine, origin, ray.end, fine_clip, key_ray, inFineRegion, local.fine_free);
+      if (ray.hit) {
+        octomap::OcTreeKey key;
+        if (coarse.coordToKeyChecked(ray.end, key) && inCoarseGrid(key)) {
+          local.coarse_hit.insert(key);
+        }
+        if (fine.coordToKeyChecked(ray.end, key) && inFineRegion(key)) {
+          (ray.roi ? local.fine_roi_hit : local.fine_other_hit).insert(key);
+        }
+      }
+    }
+#pragma omp critical(fvp_octomap_engine_merge)
+    keys.merge(local);
+  }
+
+  // 3. Free minus occupied (occupied wins), then one update per key, as insertPointCloud.
+  for (const auto& key : keys.coarse_hit) keys.coarse_free.erase(key);
+  for (const auto& key : keys.fine_roi_hit) {
+    keys.fine_free.erase(key);
+    keys.fine_other_hit.erase(key);  // any ROI end point makes the voxel an ROI hit
+  }
+  for (const auto& key : keys.fine_other_hit) keys.fine_free.erase(key);
+
+  for (const auto& key : keys.coarse_free) coarse_->updateNode(key, false);
+  for (const auto& key : keys.coarse_hit) coarse_->updateNode(key, true);
+  for (const auto& key : keys.fine_free) {
+    fine_->updateNodeAndRoi(key, false, RoiOcTree::RoiUpdate::kNone);
+  }
+  for (const auto& key : keys.fine_roi_hit) {
+    fine_->updateNodeAndRoi(key, true, RoiOcTree::RoiUpdate::kHit);
+  }
+  for (const auto& key : keys.fine_other_hit) {
+    fine_->updateNodeAndRoi(key, true, RoiOcTree::RoiUpdate::kMiss);
+  }
+
+  stats.coarse_voxels_updated = keys.coarse_free.size() + keys.coarse_hit.size();
+  stats.fine_voxels_updated =
+      keys.fine_free.size() + keys.fine_roi_hit.size() + keys.fine_other_hit.size();
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return stats;
+}
+
+VoxelClass OctomapMapEngine::coarseClassAt(const std::array<int, 3>& index) const {
+  for (int a = 0; a < 3; ++a) {
+    if (index[a] < 0 || index[a] >= coarse_grid_.dims[a]) return VoxelClass::kUnknown;
+  }
+  const octomap::OcTreeNode* node = coarse_->search(coarseKey(index));
+  if (node == nullptr) return VoxelClass::kUnknown;
+  return classify(node->getLogOdds(), config().model.occupiedLogOdds());
+}
+
+VoxelState OctomapMapEngine::fineStateAt(const std::array<int, 3>& index) const {
+  for (int a = 0; a < 3; ++a) {
+    if (index[a] < 0 || index[a] >= fine_grid_.dims[a]) return {};
+  }
+  if (!fvp_region_contains(&fine_region_, index[0], index[1], index[2])) return {};
+  const RoiOcTreeNode* node = fine_->search(fineKey(index));
+  if (node == nullptr) return {};
+  return {classify(node->getLogOdds(), config().model.occupiedLogOdds()), node->isRoi()};
+}
+
+VoxelClass OctomapMapEngine::coarseClass(const Eigen::Vector3d& p_m) const {
+  std::array<int, 3> index;
+  if (!coarse_grid_.gridIndex(p_m, index)) return VoxelClass::kUnknown;
+  return coarseClassAt(index);
+}
+
+VoxelState OctomapMapEngine::fineState(const Eigen::Vector3d& p_m) const {
+  std::array<int, 3> index;
+  if (!fine_grid_.gridIndex(p_m, index)) return {};
+  return fineStateAt(index);
+}
+
+void OctomapMapEngine::exportCoarse(const std::filesystem::path& bt_path) const {
+  writeCoarseBt(*coarse_, bt_path);
+}
+
+void OctomapMapEngine::exportFine(const std::filesystem::path& ot_path) const {
+  writeFineOt(*fine_, ot_path);
+}
+
+}  // namespace fvp::host::map

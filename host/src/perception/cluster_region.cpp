@@ -1,0 +1,56 @@
+#include "fvp/host/perception/cluster_region.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace fvp::host {
+
+void ClusterRegionConfig::validate() const {
+  if (!(radius_m > 0.0) || !std::isfinite(radius_m))
+    throw std::invalid_argument("cluster region config: radius_m: expected a positive radius");
+  if (!center_offset_tag_m.allFinite())
+    throw std::invalid_argument("cluster region config: center_offset_tag_m: expected finite");
+}
+
+ClusterRegion ClusterRegion::fromTag(const Eigen::Isometry3d& T_world_tag,
+                                     const ClusterRegionConfig& config) {
+  config.validate();
+  return ClusterRegion(T_world_tag * config.center_offset_tag_m, config.radius_m);
+}
+
+namespace {
+
+// Exact image interval of a sphere along one axis: the tangent planes through the camera's
+// other image axis, x = k z, satisfy (c_x - k c_z)^2 = r^2 (1 + k^2). False when the sphere
+// reaches the camera plane (the interval is unbounded).
+bool tangentInterval(double c_x, double c_z, double r, double& k_min, double& k_max) {
+  const double a = c_z * c_z - r * r;
+  if (!(c_z > 0.0) || !(a > 0.0)) return false;
+  const double disc = r * std::sqrt(std::max(0.0, c_x * c_x + a));
+  k_min = (c_x * c_z - disc) / a;
+  k_max = (c_x * c_z + disc) / a;
+  return true;
+}
+
+}  // namespace
+
+cv::Rect ClusterRegion::imageBounds(const StereoIntrinsics& K,
+                                    const Eigen::Isometry3d& T_world_camera) const {
+  const cv::Rect image(0, 0, K.width_px, K.height_px);
+  const Eigen::Vector3d c = T_world_camera.inverse() * center_m_;
+  if (c.z() + radius_m_ <= 0.0) return {};  // entirely behind the camera
+  double kx0, kx1, ky0, ky1;
+  if (!tangentInterval(c.x(), c.z(), radius_m_, kx0, kx1) ||
+      !tangentInterval(c.y(), c.z(), radius_m_, ky0, ky1))
+    return image;  // the sphere reaches the camera plane: it may fill the view
+  const double lim = 1e6;
+  auto px = [&](double k, double f, double c0) { return std::clamp(f * k + c0, -lim, lim); };
+  const int x0 = static_cast<int>(std::floor(px(kx0, K.fx_px, K.cx_px)));
+  const int x1 = static_cast<int>(std::ceil(px(kx1, K.fx_px, K.cx_px))) + 1;
+  const int y0 = static_cast<int>(std::floor(px(ky0, K.fy_px, K.cy_px)));
+  const int y1 = static_cast<int>(std::ceil(px(ky1, K.fy_px, K.cy_px))) + 1;
+  return cv::Rect(cv::Point(x0, y0), cv::Point(x1, y1)) & image;
+}
+
+}  // namespace fvp::host

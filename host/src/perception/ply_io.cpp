@@ -1,0 +1,122 @@
+#include "fvp/host/perception/ply_io.h"
+
+#include <bit>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "fvp/host/core/atomic_file.h"
+
+namespace fvp::host {
+
+static_assert(std::endian::native == std::endian::little,
+              "PLY I/O writes the host's floats as binary_little_endian");
+
+void writePlyPoints(const std::filesystem::path& path, const std::vector<Eigen::Vector3f>& points) {
+  std::string header =
+      "ply\nformat binary_little_endian 1.0\ncomment fvp capture, world frame, metres\n"
+      "element vertex " +
+      std::to_string(points.size()) +
+      "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+  std::string bytes = header;
+  const std::size_t offset = bytes.size();
+  bytes.resize(offset + points.size() * 3 * sizeof(float));
+  char* dst = bytes.data() + offset;
+  for (const auto& p : points) {
+    std::memcpy(dst, p.data(), 3 * sizeof(float));
+    dst += 3 * sizeof(float);
+  }
+  writeFileAtomically(path, "point cloud (PLY)", bytes);
+}
+
+std::vector<Eigen::Vector3f> readPlyPoints(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  auto fail = [&](const std::string& field, const std::string& expected) -> void {
+    throw std::runtime_error(name + ": " + field + ": expected " + expected);
+  };
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(name + ": cannot open");
+  std::string line;
+  std::getline(in, line);
+  if (line != "ply") fail("magic", "'ply' on the first line");
+  std::size_t vertices = 0;
+  bool have_vertex = false, in_vertex = false, format_ok = false;
+  int prop_index = 0, x_index = -1, y_index = -1, z_index = -1;
+  std::vector<int> prop_sizes;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::istringstream ls(line);
+    std::string word;
+    ls >> word;
+    if (word == "end_header") break;
+    if (word == "comment" || word == "obj_info" || word.empty()) continue;
+    if (word == "format") {
+      std::string fmt, version;
+      ls >> fmt >> version;
+      if (fmt != "binary_little_endian") fail("format", "binary_little_endian, got '" + fmt + "'");
+      format_ok = true;
+    } else if (word == "element") {
+      std::string el;
+      long long n = -1;
+      ls >> el >> n;
+      in_vertex = el == "vertex";
+      if (in_vertex) {
+        if (have_vertex) fail("element vertex", "a single vertex element");
+        if (n < 0) fail("element vertex", "a non-negative count");
+        if (prop_index != 0 || !prop_sizes.empty()) fail("element vertex", "the first element");
+        vertices = static_cast<std::size_t>(n);
+        have_vertex = true;
+      }
+    } else if (word == "property" && in_vertex) {
+      std::string type, prop;
+      ls >> type >> prop;
+      int size = 0;
+      if (type == "float" || type == "float32" || type == "int" || type == "int32" ||
+          type == "uint" || type == "uint32")
+        size = 4;
+      else if (type == "double" || type == "float64")
+        size = 8;
+      else if (type == "uchar" || type == "uint8" || type == "char" || type == "int8")
+        size = 1;
+      else if (type == "short" || type == "ushort" || type == "int16" || type == "uint16")
+        size = 2;
+      else
+        fail("property " + prop, "a scalar type, got '" + type + "'");
+      const bool is_float = type == "float" || type == "float32";
+      if (prop == "x" || prop == "y" || prop == "z") {
+        if (!is_float) fail("property " + prop, "type float, got '" + type + "'");
+        (prop == "x" ? x_index : prop == "y" ? y_index : z_index) = prop_index;
+      }
+      prop_sizes.push_back(size);
+      ++prop_index;
+    }
+  }
+  if (line != "end_header") fail("header", "an 'end_header' line");
+  if (!format_ok) fail("format", "a 'format binary_little_endian 1.0' line");
+  if (!have_vertex) fail("element vertex", "a vertex element");
+  if (x_index < 0 || y_index < 0 || z_index < 0)
+    fail("vertex properties", "float properties x, y and z");
+  std::vector<int> offsets(prop_sizes.size());
+  int stride = 0;
+  for (std::size_t i = 0; i < prop_sizes.size(); ++i) {
+    offsets[i] = stride;
+    stride += prop_sizes[i];
+  }
+  std::vector<char> data(vertices * stride);
+  in.read(data.data(), static_cast<std::streamsize>(data.size()));
+  if (static_cast<std::size_t>(in.gcount()) != data.size())
+    fail("vertex data", std::to_string(vertices) + " vertices of " + std::to_string(stride) +
+                            " bytes, the file is truncated");
+  std::vector<Eigen::Vector3f> points(vertices);
+  for (std::size_t i = 0; i < vertices; ++i) {
+    const char* rec = data.data() + i * stride;
+    std::memcpy(&points[i].x(), rec + offsets[x_index], 4);
+    std::memcpy(&points[i].y(), rec + offsets[y_index], 4);
+    std::memcpy(&points[i].z(), rec + offsets[z_index], 4);
+  }
+  return points;
+}
+
+}  // namespace fvp::host

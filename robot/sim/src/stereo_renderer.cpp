@@ -1,0 +1,467 @@
+#include "fvp/robot/sim/stereo_renderer.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <exception>
+#include <numbers>
+#include <stdexcept>
+
+#include "fvp/accel/embree_check.h"
+#include "fvp/robot/sim/tag_image.h"
+#include "procedural_texture.h"
+#include "scene_primitive.h"
+
+namespace fvp::robot::sim {
+namespace {
+
+using detail::Primitive;
+using detail::PrimitiveKind;
+
+// Texture feature sizes: at 0.3 m one pixel spans 0.27 mm, so speckle of ~0.5 mm gives
+// StereoSGBM's 3x3 blocks something to lock on to without aliasing at 4 samples per pixel.
+constexpr double kFruitSpeckleM = 0.0005;
+constexpr double kLeafNoiseM = 0.0006;
+constexpr double kLeafVeinSpacingM = 0.007;
+constexpr double kBarkNoiseM = 0.0012;
+constexpr double kPaperNoiseM = 0.0008;
+// Albedos (linear): leaves a mid green, bark a greyish brown (low saturation, see the
+// palette note in world.cpp), the tag's print and paper.
+const Eigen::Vector3d kLeafRgb(0.070, 0.260, 0.027);      // sRGB ~(0.30, 0.55, 0.18)
+const Eigen::Vector3d kLeafVeinRgb(0.170, 0.340, 0.060);  // lighter, yellower green
+const Eigen::Vector3d kBarkRgb(0.150, 0.095, 0.060);      // sRGB ~(0.42, 0.34, 0.27)
+const Eigen::Vector3d kPlateBackRgb(0.25, 0.25, 0.25);
+constexpr double kTagWhite = 0.85;
+constexpr double kTagBlack = 0.04;
+// Distinct seeds per texture family keep their noise patterns uncorrelated.
+constexpr std::uint64_t kFruitSeed = 0x1f2e3d4cULL, kLeafSeed = 0x5b6a7988ULL,
+                        kBarkSeed = 0x9cabbac9ULL, kPaperSeed = 0xd8e7f601ULL;
+constexpr float kRayTNear = 1e-4f;  // ignore hits within 0.1 mm of the camera centre
+// Shadow rays end this short of the shaded point (float hit positions are ~1e-7 m exact).
+constexpr double kShadowRayGapM = 1e-5;
+
+double linearToSrgb(double v) {
+  v = std::clamp(v, 0.0, 1.0);
+  return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+}
+
+// Embree's intersect context, extended: the user-geometry callback reads the render's
+// options from it (Embree hands back the pointer we passed).
+struct SceneContext {
+  RTCIntersectContext embree;
+  bool with_leaves = true;
+};
+
+struct Hit {
+  int primitive = -1;  ///< index into primitives, -1 for a miss
+  double t = 0.0;      ///< ray parameter for the (unnormalised) direction passed in
+};
+
+}  // namespace
+
+struct StereoRenderer::Impl {
+  World world;
+  RenderConfig config;
+  std::vector<Primitive> primitives;
+  cv::Mat tag_cells;        ///< CV_8U tag image (total_width^2 cells), empty without a tag
+  double tag_cell_m = 0.0;  ///< edge of one tag cell
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  std::atomic<double> last_seconds{0.0};
+
+  Impl(const World& w, const RenderConfig& c) : world(w), config(c) {}
+  ~Impl() {
+    if (scene != nullptr) rtcReleaseScene(scene);
+    if (device != nullptr) rtcReleaseDevice(device);
+  }
+
+  void build();
+  static void boundsCallback(const RTCBoundsFunctionArguments* args);
+  static void intersectCallback(const RTCIntersectFunctionNArguments* args);
+  static void occludedCallback(const RTCOccludedFunctionNArguments* args);
+
+  Hit trace(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, bool with_leaves) const;
+  Eigen::Vector3d albedo(const Primitive& prim, const detail::SurfacePoint& surface,
+                         const Eigen::Vector3d& dir) const;
+  bool lit(const Eigen::Vector3d& p, const Eigen::Vector3d& flash, bool with_leaves) const;
+  Eigen::Vector3d radiance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
+                           const Eigen::Vector3d& flash, bool with_leaves) const;
+  int threadCount() const { return config.threads > 0 ? config.threads : omp_get_max_threads(); }
+};
+
+void StereoRenderer::Impl::build() {
+  for (const Fruitlet& f : world.fruitlets()) {
+    primitives.push_back(detail::makeEllipsoid(f, host::kFirstFruitletId + f.index));
+  }
+  for (std::size_t i = 0; i < world.branches().size(); ++i) {
+    primitives.push_back(
+        detail::makeCapsule(world.branches()[i], static_cast<int>(i), host::kTreeId));
+  }
+  for (const Leaf& leaf : world.leaves()) {
+    primitives.push_back(detail::makeLeaf(leaf, host::kFirstLeafId + leaf.index));
+  }
+  if (world.hasTag()) {
+    primitives.push_back(detail::makePlate(world.tag(), host::kTagId));
+    tag_cells = tag36h11Image(world.tag().tag_id);
+    tag_cell_m = world.tag().tag_size_m / tag36h11WidthAtBorder();
+  }
+
+  device = FVP_RTC(nullptr, rtcNewDevice(nullptr));
+  FVP_RTC(device, rtcSetDeviceErrorFunction(device, accel::detail::embreeErrorCallback, nullptr));
+  scene = FVP_RTC(device, rtcNewScene(device));
+  FVP_RTC(device, rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH));
+  if (!primitives.empty()) {
+    RTCGeometry geometry = FVP_RTC(device, rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER));
+    FVP_RTC(device, rtcSetGeometryUserPrimitiveCount(geometry,
+                                                     static_cast<unsigned int>(primitives.size())));
+    FVP_RTC(device, rtcSetGeometryUserData(geometry, this));
+    FVP_RTC(device, rtcSetGeometryBoundsFunction(geometry, &Impl::boundsCallback, nullptr));
+    FVP_RTC(device, rtcSetGeometryIntersectFunction(geometry, &Impl::intersectCallback));
+    FVP_RTC(device, rtcSetGeometryOccludedFunction(geometry, &Impl::occludedCallback));
+    FVP_RTC(device, rtcCommitGeometry(geometry));
+    FVP_RTC(device, rtcAttachGeometry(scene, geometry));
+    FVP_RTC(device, rtcReleaseGeometry(geometry));
+  }
+  FVP_RTC(device, rtcCommitScene(scene));
+}
+
+void StereoRenderer::Impl::boundsCallback(const RTCBoundsFunctionArguments* args) {
+  const auto* self = static_cast<const Impl*>(args->geometryUserPtr);
+  const auto box = detail::bounds(self->primitives[args->primID]);
+  RTCBounds* out = args->bounds_o;
+  out->lower_x = static_cast<float>(box[0].x());
+  out->lower_y = static_cast<float>(box[0].y());
+  out->lower_z = static_cast<float>(box[0].z());
+  out->upper_x = static_cast<float>(box[1].x());
+  out->upper_y = static_cast<float>(box[1].y());
+  out->upper_z = static_cast<float>(box[1].z());
+}
+
+void StereoRenderer::Impl::intersectCallback(const RTCIntersectFunctionNArguments* args) {
+  const auto* self = static_cast<const Impl*>(args->geometryUserPtr);
+  const Primitive& prim = self->primitives[args->primID];
+  const auto* context = reinterpret_cast<const SceneContext*>(args->context);
+  if (prim.kind == PrimitiveKind::kLeaf && !context->with_leaves) return;
+  RTCRayN* rays = RTCRayHitN_RayN(args->rayhit, args->N);
+  RTCHitN* hits = RTCRayHitN_HitN(args->rayhit, args->N);
+  for (unsigned int i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const Eigen::Vector3d origin(RTCRayN_org_x(rays, args->N, i), RTCRayN_org_y(rays, args->N, i),
+                                 RTCRayN_org_z(rays, args->N, i));
+    const Eigen::Vector3d dir(RTCRayN_dir_x(rays, args->N, i), RTCRayN_dir_y(rays, args->N, i),
+                              RTCRayN_dir_z(rays, args->N, i));
+    const double scale = dir.norm();
+    float& tfar = RTCRayN_tfar(rays, args->N, i);
+    // Intersect with the unit direction in double; t along dir is t_unit / |dir|.
+    const double t_unit =
+        detail::intersect(prim, origin, dir / scale, RTCRayN_tnear(rays, args->N, i) * scale,
+                          static_cast<double>(tfar) * scale);
+    if (t_unit < 0.0) continue;
+    tfar = static_cast<float>(t_unit / scale);
+    RTCHitN_geomID(hits, args->N, i) = args->geomID;
+    RTCHitN_primID(hits, args->N, i) = args->primID;
+    RTCHitN_instID(hits, args->N, i, 0) = args->context->instID[0];
+    RTCHitN_u(hits, args->N, i) = 0.0f;
+    RTCHitN_v(hits, args->N, i) = 0.0f;
+    // Ng is unused: shading recomputes the exact normal from the primitive.
+    RTCHitN_Ng_x(hits, args->N, i) = 0.0f;
+    RTCHitN_Ng_y(hits, args->N, i) = 0.0f;
+    RTCHitN_Ng_z(hits, args->N, i) = 1.0f;
+  }
+}
+
+void StereoRenderer::Impl::occludedCallback(const RTCOccludedFunctionNArguments* args) {
+  const auto* self = static_cast<const Impl*>(args->geometryUserPtr);
+  const Primitive& prim = self->primitives[args->primID];
+  const auto* context = reinterpret_cast<const SceneContext*>(args->context);
+  if (prim.kind == PrimitiveKind::kLeaf && !context->with_leaves) return;
+  for (unsigned int i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const Eigen::Vector3d origin(RTCRayN_org_x(args->ray, args->N, i),
+                                 RTCRayN_org_y(args->ray, args->N, i),
+                                 RTCRayN_org_z(args->ray, args->N, i));
+    const Eigen::Vector3d dir(RTCRayN_dir_x(args->ray, args->N, i),
+                              RTCRayN_dir_y(args->ray, args->N, i),
+                              RTCRayN_dir_z(args->ray, args->N, i));
+    const double scale = dir.norm();
+    float& tfar = RTCRayN_tfar(args->ray, args->N, i);
+    if (detail::intersect(prim, origin, dir / scale, RTCRayN_tnear(args->ray, args->N, i) * scale,
+                          static_cast<double>(tfar) * scale) >= 0.0) {
+      tfar = -std::numeric_limits<float>::infinity();  // Embree's "occluded" mark
+    }
+  }
+}
+
+Hit StereoRenderer::Impl::trace(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
+                                bool with_leaves) const {
+  SceneContext context;
+  rtcInitIntersectContext(&context.embree);
+  context.with_leaves = with_leaves;
+  RTCRayHit rayhit;
+  std::memset(&rayhit, 0, sizeof(rayhit));
+  rayhit.ray.org_x = static_cast<float>(origin.x());
+  rayhit.ray.org_y = static_cast<float>(origin.y());
+  rayhit.ray.org_z = static_cast<float>(origin.z());
+  rayhit.ray.dir_x = static_cast<float>(dir.x());
+  rayhit.ray.dir_y = static_cast<float>(dir.y());
+  rayhit.ray.dir_z = static_cast<float>(dir.z());
+  rayhit.ray.tnear = kRayTNear;
+  rayhit.ray.tfar = std::numeric_limits<float>::infinity();
+  rayhit.ray.mask = 0xFFFFFFFFu;
+  rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(scene, &context.embree, &rayhit);
+  if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return {};
+  return {static_cast<int>(rayhit.hit.primID), static_cast<double>(rayhit.ray.tfar)};
+}
+
+Eigen::Vector3d StereoRenderer::Impl::albedo(const Primitive& prim,
+                                             const detail::SurfacePoint& surface,
+                                             const Eigen::Vector3d& dir) const {
+  const Eigen::Vector3d& p = surface.p_local;
+  switch (prim.kind) {
+    case PrimitiveKind::kEllipsoid: {
+      // Speckle in value only: hue and saturation stay the palette's.
+      const std::uint64_t seed = detail::hashCombine(kFruitSeed, prim.source_index);
+      const double fine = detail::fractalNoise(p / kFruitSpeckleM, seed, 2);
+      const double coarse = detail::valueNoise(p / (4.0 * kFruitSpeckleM), seed + 1);
+      const double value = 0.6 + 0.45 * (0.65 * fine + 0.35 * coarse);
+      return value * world.fruitlets()[prim.source_index].rgb;
+    }
+    case PrimitiveKind::kLeaf: {
+      const std::uint64_t seed = detail::hashCombine(kLeafSeed, prim.source_index);
+      // Midrib along x and lateral veins slanting towards the tip.
+      const double midrib = std::exp(-std::pow(p.y() / 0.0005, 2));
+      const double phase = (p.x() - 1.2 * std::abs(p.y())) / kLeafVeinSpacingM;
+      const double lateral = std::exp(-std::pow((phase - std::round(phase)) / 0.07, 2)) *
+                             std::clamp(std::abs(p.y()) / 0.002, 0.0, 1.0);
+      const double vein = std::clamp(std::max(midrib, 0.7 * lateral), 0.0, 1.0);
+      const double noise = detail::fractalNoise(p / kLeafNoiseM, seed, 3);
+      const double tint = 0.85 + 0.3 * detail::unitFromHash(seed);  // leaf-to-leaf variation
+      const Eigen::Vector3d base = (1.0 - vein) * kLeafRgb + vein * kLeafVeinRgb;
+      return tint * (0.55 + 0.9 * noise) * base;
+    }
+    case PrimitiveKind::kCapsule: {
+      // Stretched along the branch like bark fissures: noise coordinates in a frame whose
+      // first axis follows the branch.
+      const Eigen::Vector3d axis = (prim.b_m - prim.a_m).normalized();
+      const Eigen::Vector3d u = axis.unitOrthogonal();
+      const Eigen::Vector3d w = axis.cross(u);
+      const Eigen::Vector3d rel = p - prim.a_m;  // capsules' local frame is the world frame
+      const Eigen::Vector3d q(rel.dot(axis) / (3.0 * kBarkNoiseM), rel.dot(u) / kBarkNoiseM,
+                              rel.dot(w) / kBarkNoiseM);
+      const double noise =
+          detail::fractalNoise(q, detail::hashCombine(kBarkSeed, prim.source_index), 4);
+      return (0.35 + 1.3 * noise) * kBarkRgb;
+    }
+    case PrimitiveKind::kPlate: {
+      const double paper = 0.94 + 0.12 * detail::valueNoise(p / kPaperNoiseM, kPaperSeed);
+      // The printed face looks along +z of the tag frame (into the plate).
+      const double facing = prim.T_local_world.linear().row(2).dot(dir);
+      if (facing <= 0.0) return paper * kPlateBackRgb;
+      const int cells = tag_cells.cols;
+      const int col = static_cast<int>(std::floor(p.x() / tag_cell_m + 0.5 * cells));
+      const int row = static_cast<int>(std::floor(p.y() / tag_cell_m + 0.5 * cells));
+      const bool white = col < 0 || row < 0 || col >= cells || row >= cells ||
+                         tag_cells.at<std::uint8_t>(row, col) != 0;
+      return Eigen::Vector3d::Constant(paper * (white ? kTagWhite : kTagBlack));
+    }
+  }
+  return Eigen::Vector3d::Zero();
+}
+
+bool StereoRenderer::Impl::lit(const Eigen::Vector3d& p, const Eigen::Vector3d& flash,
+                               bool with_leaves) const {
+  SceneContext context;
+  rtcInitIntersectContext(&context.embree);
+  context.with_leaves = with_leaves;
+  const Eigen::Vector3d to_point = p - flash;
+  RTCRay ray;
+  std::memset(&ray, 0, sizeof(ray));
+  ray.org_x = static_cast<float>(flash.x());
+  ray.org_y = static_cast<float>(flash.y());
+  ray.org_z = static_cast<float>(flash.z());
+  ray.dir_x = static_cast<float>(to_point.x());
+  ray.dir_y = static_cast<float>(to_point.y());
+  ray.dir_z = static_cast<float>(to_point.z());
+  ray.tnear = 0.0f;
+  // Stop short of the shaded surface itself.
+  ray.tfar = static_cast<float>(1.0 - kShadowRayGapM / to_point.norm());
+  ray.mask = 0xFFFFFFFFu;
+  rtcOccluded1(scene, &context.embree, &ray);
+  return ray.tfar >= 0.0f;
+}
+
+Eigen::Vector3d StereoRenderer::Impl::radiance(const Eigen::Vector3d& origin,
+                                               const Eigen::Vector3d& dir,
+                                               const Eigen::Vector3d& flash,
+                                               bool with_leaves) const {
+  const Hit hit = trace(origin, dir, with_leaves);
+  if (hit.primitive < 0) return Eigen::Vector3d::Zero();  // night sky: the flash reaches nothing
+  const Primitive& prim = primitives[hit.primitive];
+  const Eigen::Vector3d p = origin + hit.t * dir;
+  const detail::SurfacePoint surface = detail::surfaceAt(prim, p);
+  if (!lit(p, flash, with_leaves)) return Eigen::Vector3d::Zero();
+  // Lambert's cosine and the flash's inverse-square falloff.
+  const Eigen::Vector3d to_light = flash - p;
+  const double distance2 = to_light.squaredNorm();
+  const double cosine = std::abs(surface.normal_world.dot(to_light)) / std::sqrt(distance2);
+  const double irradiance =
+      config.flash_power * kFlashFullScaleDistanceM * kFlashFullScaleDistanceM / distance2;
+  return (cosine * irradiance) * albedo(prim, surface, dir);
+}
+
+StereoRenderer::StereoRenderer(const World& world, const RenderConfig& config)
+    : impl_(std::make_unique<Impl>(world, config)) {
+  const host::StereoIntrinsics& in = config.intrinsics;
+  if (in.width_px <= 0 || in.height_px <= 0 || !(in.fx_px > 0.0) || !(in.fy_px > 0.0)) {
+    throw std::invalid_argument("StereoRenderer: intrinsics need positive size and focal length");
+  }
+  if (config.samples_per_pixel < 1 || config.threads < 0) {
+    throw std::invalid_argument("StereoRenderer: samples_per_pixel must be >= 1, threads >= 0");
+  }
+  if (!(config.noise_sigma >= 0.0) || !(config.flash_power >= 0.0)) {
+    throw std::invalid_argument("StereoRenderer: noise_sigma and flash_power must be >= 0");
+  }
+  impl_->build();
+}
+
+StereoRenderer::~StereoRenderer() = default;
+
+double StereoRenderer::lastRenderSeconds() const {
+  return impl_->last_seconds.load();
+}
+
+const RenderConfig& StereoRenderer::config() const {
+  return impl_->config;
+}
+
+host::StereoFrame StereoRenderer::render(const Eigen::Isometry3d& T_world_camera,
+                                         const RenderOptions& options) const {
+  const auto start = std::chrono::steady_clock::now();
+  const Impl& im = *impl_;
+  const host::StereoIntrinsics& in = im.config.intrinsics;
+  host::StereoFrame frame;
+  frame.intrinsics = in;
+  frame.T_world_camera = T_world_camera;
+  const int width = in.width_px, height = in.height_px;
+  if (options.images) {
+    frame.left_bgr.create(height, width, CV_8UC3);
+    frame.right_bgr.create(height, width, CV_8UC3);
+  }
+  if (options.ground_truth) {
+    frame.gt_depth_m = cv::Mat::zeros(height, width, CV_32F);
+    frame.gt_object_id = cv::Mat::zeros(height, width, CV_32S);
+  }
+  const Eigen::Matrix3d R = T_world_camera.linear();
+  const std::array<Eigen::Vector3d, 2> eyes = {
+      T_world_camera.translation(), T_world_camera.translation() + in.baseline_m * R.col(0)};
+  // One flash for the simultaneous exposure of both cameras, at the rig's centre.
+  const Eigen::Vector3d flash = T_world_camera.translation() + 0.5 * in.baseline_m * R.col(0);
+  // Noise differs per view: mix the seed with the pose's bits.
+  std::uint64_t view_seed = detail::mix64(im.config.noise_seed);
+  for (int i = 0; i < 16; ++i) {
+    std::uint64_t bits = 0;
+    const double value = T_world_camera.matrix().data()[i];
+    std::memcpy(&bits, &value, sizeof(bits));
+    view_seed = detail::hashCombine(view_seed, bits);
+  }
+  const int spp = im.config.samples_per_pixel;
+  const int strata_x = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(spp))));
+  const int strata_y = (spp + strata_x - 1) / strata_x;
+  const auto rayDir = [&](double u, double v) {
+    return Eigen::Vector3d(
+        R * Eigen::Vector3d((u - in.cx_px) / in.fx_px, (v - in.cy_px) / in.fy_px, 1.0));
+  };
+
+  // Exceptions must not leave an OpenMP region: keep the first, rethrow after the loop.
+  // Embree's error state is per thread, so each row checks its own.
+  std::exception_ptr error;
+#pragma omp parallel for schedule(dynamic, 2) num_threads(im.threadCount())
+  for (int row = 0; row < height; ++row) {
+    try {
+      for (int col = 0; col < width; ++col) {
+        const std::uint64_t pixel_seed =
+            detail::hashCombine(view_seed, static_cast<std::uint64_t>(row) * width + col);
+        if (options.ground_truth) {
+          const Hit hit = im.trace(eyes[0], rayDir(col, row), options.with_leaves);
+          if (hit.primitive >= 0) {
+            // The direction has unit z in the camera frame, so t is the z-depth.
+            frame.gt_depth_m.at<float>(row, col) = static_cast<float>(hit.t);
+            frame.gt_object_id.at<std::int32_t>(row, col) = im.primitives[hit.primitive].object_id;
+          }
+        }
+        if (!options.images) continue;
+        for (int camera = 0; camera < 2; ++camera) {
+          Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+          for (int s = 0; s < spp; ++s) {
+            double du = 0.0, dv = 0.0;  // one sample: the pixel centre
+            if (spp > 1) {
+              const std::uint64_t h = detail::hashCombine(pixel_seed, 2 * s + camera);
+              const double jx = detail::unitFromHash(h);
+              const double jy = detail::unitFromHash(detail::mix64(h));
+              du = ((s % strata_x) + jx) / strata_x - 0.5;
+              dv = ((s / strata_x) + jy) / strata_y - 0.5;
+            }
+            sum +=
+                im.radiance(eyes[camera], rayDir(col + du, row + dv), flash, options.with_leaves);
+          }
+          const Eigen::Vector3d linear = sum / spp;
+          cv::Vec3b& out = (camera == 0 ? frame.left_bgr : frame.right_bgr).at<cv::Vec3b>(row, col);
+          for (int channel = 0; channel < 3; ++channel) {
+            double noise = 0.0;
+            if (im.config.noise_sigma > 0.0) {
+              // Box-Muller from two hashed uniforms.
+              const std::uint64_t h = detail::hashCombine(pixel_seed, 0x100 + 4 * camera + channel);
+              const double u1 = 1.0 - detail::unitFromHash(h);
+              const double u2 = detail::unitFromHash(detail::mix64(h));
+              noise = im.config.noise_sigma * std::sqrt(-2.0 * std::log(u1)) *
+                      std::cos(2.0 * std::numbers::pi * u2);
+            }
+            const double value = 255.0 * linearToSrgb(linear[channel]) + noise;
+            out[2 - channel] = static_cast<std::uint8_t>(std::clamp(std::lround(value), 0L, 255L));
+          }
+        }
+      }
+      accel::detail::checkEmbree(im.device, "rtcIntersect1", __FILE__, __LINE__);
+    } catch (...) {
+#pragma omp critical(fvp_render_error)
+      if (!error) error = std::current_exception();
+    }
+  }
+  if (error) std::rethrow_exception(error);
+  impl_->last_seconds.store(
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  return frame;
+}
+
+std::vector<FruitletVisibility> StereoRenderer::fruitletVisibility(
+    const Eigen::Isometry3d& T_world_camera) const {
+  RenderOptions gt_only;
+  gt_only.images = false;
+  const cv::Mat with_leaves = render(T_world_camera, gt_only).gt_object_id;
+  gt_only.with_leaves = false;
+  const cv::Mat without_leaves = render(T_world_camera, gt_only).gt_object_id;
+  std::vector<FruitletVisibility> result(impl_->world.fruitlets().size());
+  for (std::size_t i = 0; i < result.size(); ++i) result[i].index = static_cast<int>(i);
+  const auto count = [&](const cv::Mat& ids, long FruitletVisibility::*field) {
+    for (int row = 0; row < ids.rows; ++row) {
+      for (int col = 0; col < ids.cols; ++col) {
+        const int id = ids.at<std::int32_t>(row, col);
+        if (host::isFruitletId(id) &&
+            id - host::kFirstFruitletId < static_cast<int>(result.size())) {
+          ++(result[id - host::kFirstFruitletId].*field);
+        }
+      }
+    }
+  };
+  count(with_leaves, &FruitletVisibility::visible_px);
+  count(without_leaves, &FruitletVisibility::unoccluded_px);
+  return result;
+}
+
+}  // namespace fvp::robot::sim

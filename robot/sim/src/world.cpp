@@ -1,0 +1,464 @@
+#include "fvp/robot/sim/world.h"
+
+#include "fvp/robot/sim/camera_views.h"
+
+#include <array>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <random>
+#include <stdexcept>
+
+#include "fvp/host/perception/stereo_frame.h"
+
+namespace fvp::robot::sim {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kDegToRad = kPi / 180.0;
+
+// Tree layout (not worth a config key each): the fruiting branch's length, where along it
+// the cluster hangs, its heading jitter around +-x and its upward slope.
+constexpr double kFruitingBranchLengthM = 0.55;
+constexpr double kMinClusterAlongBranchM = 0.2;
+constexpr double kMaxClusterAlongBranchM = 0.35;
+constexpr double kMaxBranchYawDeg = 20.0;
+constexpr double kMinBranchElevationDeg = 5.0;
+constexpr double kMaxBranchElevationDeg = 20.0;
+// The tag plate hangs this far in front of the fruiting branch's surface.
+constexpr double kTagStandoffM = 0.004;
+// Leaves keep this far from the start camera and this margin around the tag's silhouette.
+constexpr double kLeafCameraClearanceM = 0.05;
+constexpr double kTagSightMarginM = 0.01;
+// Rejection-sampling budgets.
+constexpr int kClusterAttempts = 2000;
+constexpr int kPlacementAttempts = 500;
+
+// The fruitlet palette, in sRGB (what the camera outputs). Six saturated hues chosen so an
+// HSV threshold separates them from everything else in the scene: leaves are green (hue
+// ~95-130 deg, saturation <= 0.7), bark is a greyish brown (saturation <= 0.45), the tag is
+// black and white, the background black. Fruitlet hues avoid the 70-170 deg green band and
+// have saturation >= 0.9. See docs/simulation.md.
+constexpr std::array<std::array<double, 3>, 6> kPaletteSrgb = {{
+    {0.90, 0.06, 0.06},  // red, hue ~0 deg
+    {1.00, 0.50, 0.02},  // orange, ~30 deg
+    {0.95, 0.85, 0.05},  // yellow, ~53 deg
+    {0.03, 0.80, 0.90},  // cyan, ~186 deg
+    {0.10, 0.30, 0.95},  // blue, ~226 deg
+    {0.88, 0.05, 0.80},  // magenta, ~305 deg
+}};
+
+double srgbToLinear(double c) {
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+
+// Uniform variates from raw mt19937_64 output, so a seed gives the same world with any
+// standard library (std::uniform_real_distribution is implementation-defined).
+class Sampler {
+ public:
+  explicit Sampler(std::uint64_t seed) : engine_(seed) {}
+  double uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }
+  double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
+  int uniformInt(int lo, int hi) {  // inclusive
+    return lo + static_cast<int>(uniform() * (hi - lo + 1) - 1e-12);
+  }
+  bool coin() { return (engine_() >> 63) != 0; }
+  Eigen::Vector3d unitVector() {
+    const double z = uniform(-1.0, 1.0);
+    const double phi = uniform(0.0, 2.0 * kPi);
+    const double s = std::sqrt(std::max(0.0, 1.0 - z * z));
+    return {s * std::cos(phi), s * std::sin(phi), z};
+  }
+  Eigen::Vector3d inBall(double radius) { return radius * std::cbrt(uniform()) * unitVector(); }
+  // Shoemake's uniform random rotation.
+  Eigen::Matrix3d rotation() {
+    const double u1 = uniform(), u2 = uniform(), u3 = uniform();
+    const double a = std::sqrt(1.0 - u1), b = std::sqrt(u1);
+    const Eigen::Quaterniond q(b * std::cos(2 * kPi * u3), a * std::sin(2 * kPi * u2),
+                               a * std::cos(2 * kPi * u2), b * std::sin(2 * kPi * u3));
+    return q.normalized().toRotationMatrix();
+  }
+
+ private:
+  std::mt19937_64 engine_;
+};
+
+double pointSegmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                            const Eigen::Vector3d& b) {
+  const Eigen::Vector3d ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double t = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).norm();
+}
+
+// Closest distance between segments [p1, q1] and [p2, q2] (Ericson, Real-Time Collision
+// Detection, 5.1.9).
+double segmentSegmentDistance(const Eigen::Vector3d& p1, const Eigen::Vector3d& q1,
+                              const Eigen::Vector3d& p2, const Eigen::Vector3d& q2) {
+  constexpr double kEps = 1e-15;
+  const Eigen::Vector3d d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
+  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
+  double s = 0.0, t = 0.0;
+  if (a <= kEps && e <= kEps) return r.norm();
+  if (a <= kEps) {
+    t = std::clamp(f / e, 0.0, 1.0);
+  } else {
+    const double c = d1.dot(r);
+    if (e <= kEps) {
+      s = std::clamp(-c / a, 0.0, 1.0);
+    } else {
+      const double b = d1.dot(d2);
+      const double denom = a * e - b * b;
+      s = denom > 0.0 ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
+      t = (b * s + f) / e;
+      if (t < 0.0) {
+        t = 0.0;
+        s = std::clamp(-c / a, 0.0, 1.0);
+      } else if (t > 1.0) {
+        t = 1.0;
+        s = std::clamp((b - c) / a, 0.0, 1.0);
+      }
+    }
+  }
+  return (p1 + s * d1 - (p2 + t * d2)).norm();
+}
+
+// Distance from p to the tag's square plate (a lower bound is not enough here: exact).
+double pointPlateDistance(const Eigen::Vector3d& p_world, const AprilTagPlacement& tag) {
+  const Eigen::Vector3d q = tag.T_world_tag.inverse() * p_world;
+  const double h = 0.5 * tag.plate_size_m;
+  const double dx = std::max(std::abs(q.x()) - h, 0.0);
+  const double dy = std::max(std::abs(q.y()) - h, 0.0);
+  return std::sqrt(dx * dx + dy * dy + q.z() * q.z());
+}
+
+// Lower bound of the distance from p to a leaf: the distance to the leaf's bounding box
+// in the leaf frame (the box contains the curled ellipse).
+double pointLeafDistanceLowerBound(const Eigen::Vector3d& p_world, const Leaf& leaf) {
+  const Eigen::Vector3d q = leaf.T_world_leaf.inverse() * p_world;
+  const double sag = leaf.curl_per_m * leaf.half_length_m * leaf.half_length_m;
+  const double z_lo = std::min(0.0, sag), z_hi = std::max(0.0, sag);
+  const double dx = std::max(std::abs(q.x()) - leaf.half_length_m, 0.0);
+  const double dy = std::max(std::abs(q.y()) - leaf.half_width_m, 0.0);
+  const double dz = std::max({z_lo - q.z(), q.z() - z_hi, 0.0});
+  return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+// Whether any of a dense set of points on the leaf lies between the camera centre and the
+// tag plate (enlarged by kTagSightMarginM) as seen from that centre.
+bool leafHidesTag(const Leaf& leaf, const AprilTagPlacement& tag, const Eigen::Vector3d& camera_m) {
+  constexpr int kRings = 6, kSpokes = 24;
+  const Eigen::Isometry3d T_tag_world = tag.T_world_tag.inverse();
+  const Eigen::Vector3d c_tag = T_tag_world * camera_m;
+  const double h = 0.5 * tag.plate_size_m + kTagSightMarginM;
+  for (int ring = 0; ring <= kRings; ++ring) {
+    const double rho = static_cast<double>(ring) / kRings;
+    for (int spoke = 0; spoke < (ring == 0 ? 1 : kSpokes); ++spoke) {
+      const double theta = 2.0 * kPi * spoke / kSpokes;
+      const double x = leaf.half_length_m * rho * std::cos(theta);
+      const double y = leaf.half_width_m * rho * std::sin(theta);
+      const Eigen::Vector3d p_tag =
+          T_tag_world * (leaf.T_world_leaf * Eigen::Vector3d(x, y, leaf.curl_per_m * x * x));
+      // The ray camera -> p meets the plate plane z = 0 at parameter s; p hides the plate
+      // if it lies before the plane (s > 1) and the crossing is on the plate.
+      const double dz = p_tag.z() - c_tag.z();
+      if (std::abs(dz) < 1e-12) continue;
+      const double s = -c_tag.z() / dz;
+      if (s <= 1.0) continue;
+      const Eigen::Vector3d hit = c_tag + s * (p_tag - c_tag);
+      if (std::abs(hit.x()) <= h && std::abs(hit.y()) <= h) return true;
+    }
+  }
+  return false;
+}
+
+nlohmann::ordered_json toJson(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
+
+nlohmann::ordered_json toJson(const Eigen::Matrix4d& m) {
+  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+  for (int r = 0; r < 4; ++r) rows.push_back({m(r, 0), m(r, 1), m(r, 2), m(r, 3)});
+  return rows;
+}
+
+nlohmann::ordered_json toJson(const Eigen::Matrix3d& m) {
+  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+  for (int r = 0; r < 3; ++r) rows.push_back({m(r, 0), m(r, 1), m(r, 2)});
+  return rows;
+}
+
+}  // namespace
+
+Eigen::Vector3d World::clusterCenter_m() const {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const Fruitlet& f : fruitlets_) sum += f.center_m;
+  return fruitlets_.empty() ? sum : Eigen::Vector3d(sum / static_cast<double>(fruitlets_.size()));
+}
+
+World World::fromParts(std::vector<Fruitlet> fruitlets, std::vector<Leaf> leaves,
+                       std::vector<BranchSegment> branches, std::optional<AprilTagPlacement> tag,
+                       const WorldConfig& config) {
+  for (std::size_t i = 0; i < fruitlets.size(); ++i) {
+    if (fruitlets[i].index != static_cast<int>(i)) {
+      throw std::invalid_argument("World::fromParts: fruitlet indices must be 0..n-1 in order");
+    }
+  }
+  for (std::size_t i = 0; i < leaves.size(); ++i) {
+    if (leaves[i].index != static_cast<int>(i)) {
+      throw std::invalid_argument("World::fromParts: leaf indices must be 0..n-1 in order");
+    }
+  }
+  World world;
+  world.config_ = config;
+  world.fruitlets_ = std::move(fruitlets);
+  world.leaves_ = std::move(leaves);
+  world.branches_ = std::move(branches);
+  world.has_tag_ = tag.has_value();
+  if (tag) world.tag_ = *tag;
+  const Eigen::Vector3d c = world.clusterCenter_m();
+  world.T_world_start_camera_ =
+      lookAt(c - config.start_view_distance_m * Eigen::Vector3d::UnitY(), c);
+  return world;
+}
+
+World World::generate(const WorldConfig& config, std::uint64_t seed) {
+  config.validate("world config");
+  Sampler rng(seed);
+  World world;
+  world.config_ = config;
+  world.seed_ = seed;
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+
+  // Trunk and the fruiting branch, heading along +x or -x with some yaw, sloping up.
+  world.branches_.push_back(
+      {Eigen::Vector3d::Zero(), config.trunk_height_m * up, config.trunk_radius_m});
+  const double side = rng.coin() ? 1.0 : -1.0;
+  const double yaw = rng.uniform(-kMaxBranchYawDeg, kMaxBranchYawDeg) * kDegToRad;
+  const double elevation = rng.uniform(kMinBranchElevationDeg, kMaxBranchElevationDeg) * kDegToRad;
+  const Eigen::Vector3d heading(side * std::cos(yaw), std::sin(yaw), 0.0);
+  const Eigen::Vector3d branch_dir = std::cos(elevation) * heading + std::sin(elevation) * up;
+  const Eigen::Vector3d branch_start = config.cluster_height_m * up;
+  const Eigen::Vector3d branch_end = branch_start + kFruitingBranchLengthM * branch_dir;
+  world.branches_.push_back({branch_start, branch_end, config.branch_radius_m});
+  const double along_m = rng.uniform(kMinClusterAlongBranchM, kMaxClusterAlongBranchM);
+  const Eigen::Vector3d branch_point = branch_start + along_m * branch_dir;
+  // Horizontal normal of the branch towards -y: where the start view and the tag face.
+  const Eigen::Vector3d toward_view =
+      (-Eigen::Vector3d::UnitY() + heading.y() * heading).normalized();
+
+  // The cluster hangs under the branch; its centroid is exactly the anchor below.
+  const double max_bound_m = config.max_radius_m * std::max(1.0, config.max_elongation);
+  const Eigen::Vector3d anchor =
+      branch_point - (config.branch_radius_m + 0.5 * config.cluster_spread_m + max_bound_m) * up;
+  const auto clearOfBranch = [&](const Fruitlet& f) {
+    return pointSegmentDistance(f.center_m, branch_start, branch_end) >=
+           config.branch_radius_m + f.boundingRadius_m() + config.min_gap_m;
+  };
+  const int count = rng.uniformInt(config.min_fruitlets, config.max_fruitlets);
+  std::array<int, kPaletteSrgb.size()> palette_order = {0, 1, 2, 3, 4, 5};
+  for (std::size_t i = palette_order.size() - 1; i > 0; --i) {
+    std::swap(palette_order[i], palette_order[rng.uniformInt(0, static_cast<int>(i))]);
+  }
+  bool placed = false;
+  for (int attempt = 0; attempt < kClusterAttempts && !placed; ++attempt) {
+    std::vector<Fruitlet> fruitlets;
+    for (int i = 0; i < count; ++i) {
+      Fruitlet f;
+      f.index = i;
+      f.radius_m = rng.uniform(config.min_radius_m, config.max_radius_m);
+      f.elongation = rng.uniform(config.min_elongation, config.max_elongation);
+      f.R_world_fruitlet = rng.rotation();
+      const auto& srgb = kPaletteSrgb[palette_order[i % palette_order.size()]];
+      f.rgb = {srgbToLinear(srgb[0]), srgbToLinear(srgb[1]), srgbToLinear(srgb[2])};
+      bool clear = false;
+      for (int tries = 0; tries < kPlacementAttempts && !clear; ++tries) {
+        f.center_m = anchor + rng.inBall(config.cluster_spread_m);
+        // Conservative: bounding spheres (largest semi-axis) at least min_gap_m apart.
+        clear = true;
+        for (const Fruitlet& other : fruitlets) {
+          clear = clear && (f.center_m - other.center_m).norm() >=
+                               f.boundingRadius_m() + other.boundingRadius_m() + config.min_gap_m;
+        }
+      }
+      if (!clear) break;
+      fruitlets.push_back(f);
+    }
+    if (static_cast<int>(fruitlets.size()) != count) continue;
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (const Fruitlet& f : fruitlets) centroid += f.center_m;
+    centroid /= count;
+    placed = true;
+    for (Fruitlet& f : fruitlets) {
+      f.center_m += anchor - centroid;  // pairwise gaps are unchanged by the shift
+      placed =
+          placed && (f.center_m - anchor).norm() <= config.cluster_spread_m && clearOfBranch(f);
+    }
+    if (placed) world.fruitlets_ = std::move(fruitlets);
+  }
+  if (!placed) {
+    throw std::runtime_error("world generation (seed " + std::to_string(seed) + "): cannot fit " +
+                             std::to_string(count) + " fruitlets within cluster_spread_m = " +
+                             std::to_string(config.cluster_spread_m) +
+                             " m; increase cluster_spread_m or reduce max_radius_m");
+  }
+  const Eigen::Vector3d cluster = anchor;
+
+  // Start view: straight out from the branch, at the requested distance.
+  const Eigen::Vector3d camera_m = cluster + config.start_view_distance_m * toward_view;
+  world.T_world_start_camera_ = lookAt(camera_m, cluster);
+
+  // The tag plate, beside the cluster on the branch, facing the start view up to a tilt.
+  AprilTagPlacement tag;
+  tag.tag_id = config.tag_id;
+  tag.tag_size_m = config.tag_size_m;
+  tag.plate_size_m = kTagPlateScale * config.tag_size_m;
+  bool tag_placed = false;
+  for (int tries = 0; tries < kPlacementAttempts && !tag_placed; ++tries) {
+    // tag_side is right (+1) or left (-1) of the cluster as the start view sees it.
+    const double rightward = branch_dir.dot(world.T_world_start_camera_.linear().col(0)) >= 0.0 ? 1.0 : -1.0;
+    const double sign = config.tag_side != 0 ? config.tag_side * rightward : (rng.coin() ? 1.0 : -1.0);
+    const double t = rng.uniform(0.0, config.max_tag_distance_m + config.cluster_spread_m);
+    const double tilt = config.max_tag_tilt_deg * kDegToRad;
+    const double yaw_t = rng.uniform(-tilt, tilt), pitch_t = rng.uniform(-tilt, tilt);
+    const double roll_t = rng.uniform(-tilt, tilt);
+    const Eigen::Vector3d centre = branch_point + sign * t * branch_dir +
+                                   (config.branch_radius_m + kTagStandoffM) * toward_view;
+    const double distance = (centre - cluster).norm();
+    if (distance < config.min_tag_distance_m || distance > config.max_tag_distance_m) continue;
+    const Eigen::Isometry3d upright = lookAt(centre + toward_view, centre);
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = Eigen::AngleAxisd(yaw_t, up).toRotationMatrix() *
+                 Eigen::AngleAxisd(pitch_t, upright.linear().col(0)).toRotationMatrix() *
+                 upright.linear() * Eigen::AngleAxisd(roll_t, Eigen::Vector3d::UnitZ());
+    T.translation() = centre;
+    tag.T_world_tag = T;
+    tag_placed = true;
+    for (const Fruitlet& f : world.fruitlets_) {
+      tag_placed = tag_placed &&
+                   pointPlateDistance(f.center_m, tag) >= f.boundingRadius_m() + config.min_gap_m;
+    }
+  }
+  if (!tag_placed) {
+    throw std::runtime_error("world generation (seed " + std::to_string(seed) +
+                             "): cannot place the tag between min_tag_distance_m and "
+                             "max_tag_distance_m without touching a fruitlet");
+  }
+  world.tag_ = tag;
+  world.has_tag_ = true;
+
+  // Extra branches: clutter that keeps off the cluster and the start view's lines of sight.
+  const double plate_half_m = 0.5 * tag.plate_size_m;
+  const Eigen::Vector3d tag_centre = tag.T_world_tag.translation();
+  for (int b = 0; b < config.extra_branch_count; ++b) {
+    for (int tries = 0; tries < kPlacementAttempts; ++tries) {
+      const double height = config.cluster_height_m + rng.uniform(-0.4, 0.4);
+      const double azimuth = rng.uniform(0.0, 2.0 * kPi);
+      const double slope = rng.uniform(10.0, 50.0) * kDegToRad;
+      const double length = rng.uniform(0.3, 0.6);
+      const double radius = config.branch_radius_m * rng.uniform(0.6, 1.5);
+      const Eigen::Vector3d start(0.0, 0.0, std::clamp(height, 0.0, config.trunk_height_m));
+      const Eigen::Vector3d end =
+          start + length * Eigen::Vector3d(std::cos(slope) * std::cos(azimuth),
+                                           std::cos(slope) * std::sin(azimuth), std::sin(slope));
+      const double clearance = radius + 0.01;
+      if (segmentSegmentDistance(start, end, camera_m, cluster) <
+              clearance + config.cluster_spread_m + max_bound_m ||
+          segmentSegmentDistance(start, end, camera_m, tag_centre) <
+              clearance + plate_half_m * std::sqrt(2.0)) {
+        continue;
+      }
+      world.branches_.push_back({start, end, radius});
+      break;
+    }
+  }
+
+  // Leaves: a share in front of the cluster (towards the start view), the rest anywhere in
+  // the leaf region; never touching a fruitlet, never hiding the tag from the start view.
+  const int front_leaves =
+      static_cast<int>(std::lround(config.front_leaf_fraction * config.leaf_count));
+  const double front_reach_m =
+      std::max(0.02, std::min(config.leaf_region_m, 0.5 * config.start_view_distance_m));
+  const Eigen::Matrix3d R_view = world.T_world_start_camera_.linear();
+  for (int k = 0; k < config.leaf_count; ++k) {
+    bool leaf_placed = false;
+    for (int tries = 0; tries < kPlacementAttempts && !leaf_placed; ++tries) {
+      Leaf leaf;
+      leaf.index = k;
+      leaf.half_length_m = 0.5 * rng.uniform(config.min_leaf_length_m, config.max_leaf_length_m);
+      leaf.half_width_m = 0.5 * rng.uniform(config.min_leaf_width_m, config.max_leaf_width_m);
+      leaf.curl_per_m = rng.coin() ? 0.0 : rng.uniform(-1.0, 1.0) * config.max_leaf_curl_per_m;
+      leaf.T_world_leaf.linear() = rng.rotation();
+      Eigen::Vector3d centre;
+      if (k < front_leaves) {
+        const double ahead = rng.uniform(0.02, front_reach_m);
+        const double lateral = (config.cluster_spread_m + 0.02) * std::sqrt(rng.uniform());
+        const double phi = rng.uniform(0.0, 2.0 * kPi);
+        centre = cluster +
+                 R_view * Eigen::Vector3d(lateral * std::cos(phi), lateral * std::sin(phi), -ahead);
+      } else {
+        centre = cluster + rng.inBall(config.leaf_region_m);
+      }
+      if ((centre - cluster).norm() > config.leaf_region_m) continue;
+      leaf.T_world_leaf.translation() = centre;
+      if ((centre - camera_m).norm() < kLeafCameraClearanceM + leaf.half_length_m) continue;
+      leaf_placed = !leafHidesTag(leaf, tag, camera_m);
+      for (const Fruitlet& f : world.fruitlets_) {
+        leaf_placed = leaf_placed && pointLeafDistanceLowerBound(f.center_m, leaf) >=
+                                         f.boundingRadius_m() + config.min_gap_m;
+      }
+      if (leaf_placed) world.leaves_.push_back(leaf);
+    }
+    if (!leaf_placed) {
+      throw std::runtime_error("world generation (seed " + std::to_string(seed) +
+                               "): cannot place leaf " + std::to_string(k) +
+                               "; reduce leaf_count or enlarge leaf_region_m");
+    }
+  }
+  return world;
+}
+
+std::string World::groundTruthJson() const {
+  nlohmann::ordered_json json;
+  json["seed"] = seed_;
+  json["config"] = nlohmann::ordered_json::parse(config_.toJson());
+  json["cluster_center_m"] = toJson(clusterCenter_m());
+  json["fruitlets"] = nlohmann::ordered_json::array();
+  for (const Fruitlet& f : fruitlets_) {
+    json["fruitlets"].push_back({{"index", f.index},
+                                 {"object_id", host::kFirstFruitletId + f.index},
+                                 {"center_m", toJson(f.center_m)},
+                                 {"gt_size_mm", f.gtSizeMm()},
+                                 {"radius_m", f.radius_m},
+                                 {"elongation", f.elongation},
+                                 {"semi_axes_m", toJson(f.semiAxes_m())},
+                                 {"R_world_fruitlet", toJson(f.R_world_fruitlet)},
+                                 {"rgb_linear", toJson(f.rgb)}});
+  }
+  if (has_tag_) {
+    json["tag"] = {{"family", "tag36h11"},
+                   {"id", tag_.tag_id},
+                   {"size_m", tag_.tag_size_m},
+                   {"plate_size_m", tag_.plate_size_m},
+                   {"T_world_tag", toJson(tag_.T_world_tag.matrix())}};
+  } else {
+    json["tag"] = nullptr;
+  }
+  json["start_camera"] = {{"T_world_camera", toJson(T_world_start_camera_.matrix())}};
+  json["branches"] = nlohmann::ordered_json::array();
+  for (const BranchSegment& b : branches_) {
+    json["branches"].push_back(
+        {{"start_m", toJson(b.start_m)}, {"end_m", toJson(b.end_m)}, {"radius_m", b.radius_m}});
+  }
+  json["leaves"] = nlohmann::ordered_json::array();
+  for (const Leaf& l : leaves_) {
+    json["leaves"].push_back({{"index", l.index},
+                              {"T_world_leaf", toJson(l.T_world_leaf.matrix())},
+                              {"half_length_m", l.half_length_m},
+                              {"half_width_m", l.half_width_m},
+                              {"curl_per_m", l.curl_per_m}});
+  }
+  return json.dump(2);
+}
+
+}  // namespace fvp::robot::sim

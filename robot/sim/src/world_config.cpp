@@ -1,0 +1,172 @@
+#include "fvp/robot/sim/world_config.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+#include <variant>
+
+#include "fvp/host/perception/stereo_frame.h"
+
+namespace fvp::robot::sim {
+namespace {
+
+using Member = std::variant<int WorldConfig::*, double WorldConfig::*>;
+
+// One YAML key: its field, its static range [lo, hi] and, for min/max pairs, the key whose
+// value bounds it from below (max_x >= min_x). The ranges guard against nonsense, not taste.
+struct KeySpec {
+  const char* name;
+  Member member;
+  double lo;
+  double hi;
+  const char* at_least_key = nullptr;
+};
+
+constexpr double kTagFamilyCodes = 587;  // tag36h11 has 587 codes: ids 0..586
+
+const std::vector<KeySpec>& keySpecs() {
+  static const std::vector<KeySpec> specs = {
+      {"min_fruitlets", &WorldConfig::min_fruitlets, 1, host::kMaxFruitlets},
+      {"max_fruitlets", &WorldConfig::max_fruitlets, 1, host::kMaxFruitlets, "min_fruitlets"},
+      {"min_radius_m", &WorldConfig::min_radius_m, 0.0005, 0.05},
+      {"max_radius_m", &WorldConfig::max_radius_m, 0.0005, 0.05, "min_radius_m"},
+      {"min_elongation", &WorldConfig::min_elongation, 0.5, 2.0},
+      {"max_elongation", &WorldConfig::max_elongation, 0.5, 2.0, "min_elongation"},
+      {"cluster_spread_m", &WorldConfig::cluster_spread_m, 0.001, 0.2},
+      {"min_gap_m", &WorldConfig::min_gap_m, 0.0, 0.02},
+      {"leaf_count", &WorldConfig::leaf_count, 0, 1000},
+      {"min_leaf_length_m", &WorldConfig::min_leaf_length_m, 0.005, 0.3},
+      {"max_leaf_length_m", &WorldConfig::max_leaf_length_m, 0.005, 0.3, "min_leaf_length_m"},
+      {"min_leaf_width_m", &WorldConfig::min_leaf_width_m, 0.002, 0.3},
+      {"max_leaf_width_m", &WorldConfig::max_leaf_width_m, 0.002, 0.3, "min_leaf_width_m"},
+      {"leaf_region_m", &WorldConfig::leaf_region_m, 0.01, 1.0},
+      {"max_leaf_curl_per_m", &WorldConfig::max_leaf_curl_per_m, 0.0, 50.0},
+      {"front_leaf_fraction", &WorldConfig::front_leaf_fraction, 0.0, 1.0},
+      {"tag_id", &WorldConfig::tag_id, 0, kTagFamilyCodes - 1},
+      {"tag_size_m", &WorldConfig::tag_size_m, 0.005, 0.2},
+      {"min_tag_distance_m", &WorldConfig::min_tag_distance_m, 0.0, 0.5},
+      {"max_tag_distance_m", &WorldConfig::max_tag_distance_m, 0.0, 0.5, "min_tag_distance_m"},
+      {"max_tag_tilt_deg", &WorldConfig::max_tag_tilt_deg, 0.0, 60.0},
+      {"tag_side", &WorldConfig::tag_side, -1, 1},
+      {"trunk_radius_m", &WorldConfig::trunk_radius_m, 0.005, 0.5},
+      {"trunk_height_m", &WorldConfig::trunk_height_m, 0.1, 10.0},
+      {"cluster_height_m", &WorldConfig::cluster_height_m, 0.05, 10.0},
+      {"branch_radius_m", &WorldConfig::branch_radius_m, 0.001, 0.1},
+      {"extra_branch_count", &WorldConfig::extra_branch_count, 0, 20},
+      {"start_view_distance_m", &WorldConfig::start_view_distance_m, 0.05, 5.0},
+  };
+  return specs;
+}
+
+double valueOf(const WorldConfig& config, const Member& member) {
+  return std::visit([&](auto field) { return static_cast<double>(config.*field); }, member);
+}
+
+const KeySpec& specNamed(const std::string& name) {
+  for (const KeySpec& spec : keySpecs()) {
+    if (name == spec.name) return spec;
+  }
+  throw std::logic_error("world config: no key spec named '" + name + "'");
+}
+
+std::string formatNumber(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+std::string knownKeysList() {
+  std::string list;
+  for (const KeySpec& spec : keySpecs())
+    list += (list.empty() ? "" : ", ") + std::string(spec.name);
+  return list;
+}
+
+}  // namespace
+
+const std::vector<std::string>& WorldConfig::keyNames() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const KeySpec& spec : keySpecs()) out.emplace_back(spec.name);
+    return out;
+  }();
+  return names;
+}
+
+void WorldConfig::validate(const std::string& source) const {
+  for (const KeySpec& spec : keySpecs()) {
+    const double value = valueOf(*this, spec.member);
+    double lo = spec.lo;
+    std::string lo_text = formatNumber(spec.lo);
+    if (spec.at_least_key != nullptr) {
+      const double other = valueOf(*this, specNamed(spec.at_least_key).member);
+      if (other > lo) {
+        lo = other;
+        lo_text = std::string(spec.at_least_key) + " (" + formatNumber(other) + ")";
+      }
+    }
+    // `!(a <= b)` also rejects NaN.
+    if (!(value >= lo) || !(value <= spec.hi)) {
+      throw std::invalid_argument(source + ": key '" + spec.name + "' = " + formatNumber(value) +
+                                  " is out of range; expected " + lo_text + " <= " + spec.name +
+                                  " <= " + formatNumber(spec.hi));
+    }
+  }
+}
+
+WorldConfig WorldConfig::fromYamlFile(const std::filesystem::path& path) {
+  const std::string source = "world config '" + path.string() + "'";
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path.string());
+  } catch (const YAML::Exception& e) {
+    throw std::invalid_argument(source + ": cannot read YAML: " + e.what());
+  }
+  WorldConfig config;
+  if (root.IsNull()) {
+    config.validate(source);
+    return config;
+  }
+  if (!root.IsMap()) throw std::invalid_argument(source + ": expected a mapping of key: value");
+  for (const auto& entry : root) {
+    const std::string key = entry.first.as<std::string>();
+    const KeySpec* spec = nullptr;
+    for (const KeySpec& candidate : keySpecs()) {
+      if (key == candidate.name) spec = &candidate;
+    }
+    if (spec == nullptr) {
+      throw std::invalid_argument(source + ": unknown key '" + key +
+                                  "' (known keys: " + knownKeysList() + ")");
+    }
+    const YAML::Node& value = entry.second;
+    const bool is_int = std::holds_alternative<int WorldConfig::*>(spec->member);
+    const std::string expected = is_int ? "an integer" : "a number";
+    if (!value.IsScalar()) {
+      throw std::invalid_argument(source + ": key '" + key + "' must be " + expected);
+    }
+    try {
+      if (is_int) {
+        config.*std::get<int WorldConfig::*>(spec->member) = value.as<int>();
+      } else {
+        config.*std::get<double WorldConfig::*>(spec->member) = value.as<double>();
+      }
+    } catch (const YAML::Exception&) {
+      throw std::invalid_argument(source + ": key '" + key + "' must be " + expected + ", got '" +
+                                  value.Scalar() + "'");
+    }
+  }
+  config.validate(source);
+  return config;
+}
+
+std::string WorldConfig::toJson() const {
+  nlohmann::ordered_json json;
+  for (const KeySpec& spec : keySpecs()) {
+    std::visit([&](auto field) { json[spec.name] = this->*field; }, spec.member);
+  }
+  return json.dump();
+}
+
+}  // namespace fvp::robot::sim

@@ -1,0 +1,325 @@
+// The grid map engine: scan-integration semantics on hand-made scans, every backend
+// identical to the cpu reference, the ROI distance field against brute force and the
+// frontier definitions on hand-made grids.
+#include <gtest/gtest.h>
+
+#include "backend_test_support.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <random>
+#include <string>
+
+#include "fvp/accel/backend.h"
+#include "fvp/host/map/grid_map_engine.h"
+#include "synthetic_scan.h"
+
+namespace fvp::host::map {
+namespace {
+
+using accel::BackendKind;
+
+MapConfig smallConfig() {
+  MapConfig c;
+  c.observation_min_m = {-0.3, -0.3, -0.3};
+  c.observation_max_m = {0.3, 0.3, 0.5};
+  c.coarse_voxel_size_m = 0.01;
+  c.fine_voxel_size_m = 0.001;
+  c.sensor_max_range_m = 0.6;
+  return c;
+}
+
+const ClusterRegion kRegion(Eigen::Vector3d(0.01, -0.02, 0.3), 0.04);
+
+// A view of a fixed synthetic cluster from a random direction on the sensor's side (-z),
+// 0.25-0.35 m away; side x side rays.
+testing::SyntheticScan viewOfCluster(std::uint64_t seed, int side) {
+  static const testing::SyntheticWorld world = testing::makeWorld(1234, kRegion.center_m());
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> gauss;
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const Eigen::Vector3d dir(gauss(rng), gauss(rng), -std::abs(gauss(rng)) - 1.0);
+  const Eigen::Vector3d origin = kRegion.center_m() + dir.normalized() * (0.25 + 0.1 * unit(rng));
+  return testing::renderScan(world, origin, side, side, 0.7, seed);
+}
+
+class GridEngineSemantics : public ::testing::Test {
+ protected:
+  std::unique_ptr<accel::Backend> cpu_ = accel::createBackend(BackendKind::kCpu);
+};
+
+TEST_F(GridEngineSemantics, OneRayFreesItsPathAndHitsItsEnd) {
+  GridMapEngine map(smallConfig(), kRegion, *cpu_);
+  const Eigen::Vector3d sensor(0.0, 0.0, 0.0);
+  const Eigen::Vector3f end(0.0105f, -0.0195f, 0.3005f);  // inside the region
+  const ScanStats stats = map.integrate(sensor, {end}, {});
+  EXPECT_EQ(stats.points, 1u);
+  EXPECT_GT(stats.coarse_voxels_updated, 20u);
+  EXPECT_GT(stats.fine_voxels_updated, 20u);
+  EXPECT_EQ(map.fineState(end.cast<double>()).occupancy, VoxelClass::kOccupied);
+  EXPECT_TRUE(map.fineState(end.cast<double>()).roi);
+  EXPECT_EQ(map.coarseClass(end.cast<double>()), VoxelClass::kOccupied);
+  // Half way to the end inside the region: free, not ROI.
+  const Eigen::Vector3d inside = sensor + (end.cast<double>() - sensor) * 0.93;
+  ASSERT_TRUE(kRegion.contains(inside));
+  EXPECT_EQ(map.fineState(inside).occupancy, VoxelClass::kFree);
+  EXPECT_FALSE(map.fineState(inside).roi);
+  EXPECT_EQ(map.coarseClass(sensor + (end.cast<double>() - sensor) * 0.5), VoxelClass::kFree);
+  // Off the ray: unknown.
+  EXPECT_EQ(map.fineState(kRegion.center_m() + Eigen::Vector3d(0.02, 0.0, 0.0)).occupancy,
+            VoxelClass::kUnknown);
+  // Outside the Cluster Region the fine map is never updated.
+  EXPECT_EQ(map.fineState(sensor + (end.cast<double>() - sensor) * 0.5).occupancy,
+            VoxelClass::kUnknown);
+}
+
+TEST_F(GridEngineSemantics, EachVoxelIsUpdatedOncePerScan) {
+  GridMapEngine map(smallConfig(), kRegion, *cpu_);
+  const Eigen::Vector3d sensor(0.0, 0.0, 0.0);
+  // Two points in the same fine voxel, one ROI and one not: one hit, and the ROI wins.
+  const Eigen::Vector3f a(0.0102f, -0.0198f, 0.3002f), b(0.0107f, -0.0193f, 0.3008f);
+  map.integrate(sensor, {a}, {b});
+  std::array<int, 3> index;
+  ASSERT_TRUE(map.fine().geometry().gridIndex(a.cast<double>(), index));
+  const OccupancyModel& m = map.config().model;
+  EXPECT_FLOAT_EQ(map.fine().occupancyAt(index), m.hitLogOdds());
+  EXPECT_FLOAT_EQ(map.fine().roiAt(index), m.hitLogOdds());
+  // A non-ROI end point alone: ROI miss.
+  map.integrate(sensor, {}, {b});
+  EXPECT_FLOAT_EQ(map.fine().occupancyAt(index), 2 * m.hitLogOdds());
+  EXPECT_FLOAT_EQ(map.fine().roiAt(index), m.hitLogOdds() + m.missLogOdds());
+}
+
+TEST_F(GridEngineSemantics, EndPointVoxelsAreHitsEvenWhereOtherRaysPass) {
+  GridMapEngine map(smallConfig(), kRegion, *cpu_);
+  const Eigen::Vector3d sensor(0.0, 0.0, 0.0);
+  const Eigen::Vector3f near_end(0.0100f, -0.0190f, 0.2800f);
+  const Eigen::Vector3f far_end =
+      (near_end.cast<double>() * (0.31 / 0.28)).cast<float>();  // same line, behind
+  map.integrate(sensor, {}, {near_end, far_end});
+  EXPECT_EQ(map.fineState(near_end.cast<double>()).occupancy, VoxelClass::kOccupied);
+  EXPECT_EQ(map.fineState(far_end.cast<double>()).occupancy, VoxelClass::kOccupied);
+}
+
+TEST_F(GridEngineSemantics, BadAndFarPointsAreCountedNotWritten) {
+  GridMapEngine map(smallConfig(), kRegion, *cpu_);
+  const Eigen::Vector3d sensor(0.0, 0.0, 0.0);
+  const float nan = std::nanf(""), inf = INFINITY;
+  const Eigen::Vector3f far(0.0f, 0.0f, 0.9f);  // beyond the 0.6 m max range
+  const ScanStats stats =
+      map.integrate(sensor, {Eigen::Vector3f(nan, 0, 0.3f)}, {Eigen::Vector3f(0, inf, 0.3f), far});
+  EXPECT_EQ(stats.points, 3u);
+  EXPECT_EQ(stats.skipped_invalid, 2u);
+  EXPECT_EQ(stats.truncated, 1u);
+  // Free up to the cut, the cut voxel itself untouched, nothing occupied.
+  EXPECT_EQ(map.coarseClass({0.0, 0.0, 0.3}), VoxelClass::kFree);
+  EXPECT_EQ(map.coarseClass({0.0, 0.0, 0.6049}), VoxelClass::kUnknown);
+  EXPECT_EQ(map.coarseClass(far.cast<double>()), VoxelClass::kUnknown);
+}
+
+TEST_F(GridEngineSemantics, LogOddsClampAfterManyScans) {
+  GridMapEngine map(smallConfig(), kRegion, *cpu_);
+  const Eigen::Vector3f end(0.0105f, -0.0195f, 0.3005f);
+  for (int i = 0; i < 12; ++i) map.integrate({0, 0, 0}, {}, {end});
+  std::array<int, 3> index;
+  ASSERT_TRUE(map.fine().geometry().gridIndex(end.cast<double>(), index));
+  EXPECT_FLOAT_EQ(map.fine().occupancyAt(index), map.config().model.clampMaxLogOdds());
+  EXPECT_FLOAT_EQ(map.fine().roiAt(index), map.config().model.clampMinLogOdds());
+}
+
+TEST_F(GridEngineSemantics, FineVoxelsOutsideTheRegionAreNeverMapped) {
+  GridMapEngine map(smallConfig(), kRegion, *cpu_);
+  const auto scan = viewOfCluster(3, 150);
+  map.integrate(scan.origin_m, scan.roi_points_m, scan.other_points_m);
+  std::size_t known = 0;
+  map.fine().forEachVoxel([&](const std::array<int, 3>& index, float occupancy, float) {
+    if (std::isnan(occupancy)) return;
+    ++known;
+    EXPECT_TRUE(kRegion.contains(map.fine().geometry().voxelCenter_m(index)) ||
+                (map.fine().geometry().voxelCenter_m(index) - kRegion.center_m()).norm() <
+                    kRegion.radius_m() + 1e-6);
+  });
+  EXPECT_GT(known, 1000u);
+}
+
+TEST(GridEngine, RequiresABackendAndAKnownEngineName) {
+  EXPECT_THROW(createMapEngine("grid", smallConfig(), kRegion, nullptr), std::invalid_argument);
+  EXPECT_THROW(createMapEngine("voxblox", smallConfig(), kRegion, nullptr), std::invalid_argument);
+  MapConfig bad = smallConfig();
+  bad.model.prob_hit = 0.3;
+  auto cpu = accel::createBackend(BackendKind::kCpu);
+  try {
+    createMapEngine("grid", bad, kRegion, cpu.get());
+    FAIL() << "a bad model must be rejected";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("prob_hit"), std::string::npos);
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// Every backend against the cpu reference.
+
+class GridEngineBackends : public ::testing::TestWithParam<BackendKind> {
+ protected:
+  void SetUp() override {
+    try {
+      backend_ = accel::createBackend(GetParam());
+    } catch (const accel::BackendUnavailable& e) {
+      if (fvp::testing::allBackendsRequired()) FAIL() << e.what();
+      GTEST_SKIP() << e.what();
+    }
+    cpu_ = accel::createBackend(BackendKind::kCpu);
+  }
+
+  static void expectSameVoxels(const BrickedVoxelGrid& got, const BrickedVoxelGrid& want) {
+    ASSERT_EQ(got.allocatedBricks(), want.allocatedBricks());
+    std::size_t compared = 0;
+    want.forEachVoxel([&](const std::array<int, 3>& index, float occupancy, float roi) {
+      const float o = got.occupancyAt(index), r = got.roiAt(index);
+      // Bit-exact: the same updates in the same order on every backend.
+      ASSERT_TRUE((std::isnan(o) && std::isnan(occupancy)) || o == occupancy)
+          << "occupancy at " << index[0] << "," << index[1] << "," << index[2];
+      if (want.hasRoi()) {
+        ASSERT_TRUE((std::isnan(r) && std::isnan(roi)) || r == roi);
+      }
+      ++compared;
+    });
+    EXPECT_GT(compared, 0u);
+  }
+
+  std::unique_ptr<accel::Backend> backend_, cpu_;
+};
+
+TEST_P(GridEngineBackends, ScanIntegrationMatchesCpuExactly) {
+  const std::uint64_t seed = fvp::testing::freshSeed();
+  SCOPED_TRACE(fvp::testing::replayHint(seed));
+  GridMapEngine got(smallConfig(), kRegion, *backend_), want(smallConfig(), kRegion, *cpu_);
+  for (int view = 0; view < 3; ++view) {
+    const auto scan = viewOfCluster(seed + view, 170);
+    const ScanStats a = got.integrate(scan.origin_m, scan.roi_points_m, scan.other_points_m);
+    const ScanStats b = want.integrate(scan.origin_m, scan.roi_points_m, scan.other_points_m);
+    EXPECT_EQ(a.coarse_voxels_updated, b.coarse_voxels_updated);
+    EXPECT_EQ(a.fine_voxels_updated, b.fine_voxels_updated);
+  }
+  expectSameVoxels(got.coarse(), want.coarse());
+  expectSameVoxels(got.fine(), want.fine());
+}
+
+TEST_P(GridEngineBackends, OnTouchBrickAllocationMatchesCpu) {
+  // A grid too large to allocate up front: bricks appear as rays reach them.
+  GridGeometry g;
+  g.voxel_size_m = 0.001;
+  g.first_voxel = {-400, -400, -100};
+  g.dims = {800, 800, 800};
+  BrickedVoxelGrid got(*backend_, g, true, std::nullopt, BrickedVoxelGrid::Allocation::kOnTouch);
+  BrickedVoxelGrid want(*cpu_, g, true, std::nullopt, BrickedVoxelGrid::Allocation::kOnTouch);
+  const auto scan = viewOfCluster(17, 70);
+  ScanStats stats;
+  const auto points =
+      prepareScanPoints(scan.origin_m, scan.roi_points_m, scan.other_points_m, 0.6, stats);
+  auto on_backend = backend_->createBufferFrom(points);
+  auto on_cpu = cpu_->createBufferFrom(points);
+  const OccupancyModel model;
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(got.integrate(*on_backend, points.size(), scan.origin_m.cast<float>(), model),
+              want.integrate(*on_cpu, points.size(), scan.origin_m.cast<float>(), model));
+  }
+  EXPECT_GT(want.allocatedBricks(), 100u);
+  EXPECT_LT(want.allocatedBricks(), 100u * 100u * 100u / 4);  // far fewer than the 10^6 of the box
+  expectSameVoxels(got, want);
+}
+
+TEST_P(GridEngineBackends, RoiDistanceFieldEqualsBruteForce) {
+  const std::uint64_t seed = fvp::testing::freshSeed();
+  SCOPED_TRACE(fvp::testing::replayHint(seed));
+  std::mt19937_64 rng(seed);
+  GridGeometry g;
+  g.voxel_size_m = 0.001;
+  g.first_voxel = {0, 0, 0};
+  g.dims = {24, 16, 32};
+  const auto n = static_cast<std::size_t>(g.voxelCount());
+  std::vector<float> occupancy(n, -0.4f), roi(n, std::nanf(""));
+  std::vector<std::array<int, 3>> roi_voxels;
+  std::uniform_int_distribution<int> pick(0, static_cast<int>(n) - 1);
+  for (int k = 0; k < 12; ++k) {
+    const int i = pick(rng);
+    roi[i] = 0.85f;
+    roi_voxels.push_back({i % g.dims[0], (i / g.dims[0]) % g.dims[1], i / (g.dims[0] * g.dims[1])});
+  }
+  for (int k = 0; k < 30; ++k) roi[pick(rng)] = -0.4f;  // known, not ROI: must not count
+  BrickedVoxelGrid grid(*backend_, g, true, std::nullopt, BrickedVoxelGrid::Allocation::kUpFront);
+  grid.assignDense(occupancy, roi);
+  const int radius = 9;
+  const std::vector<float> d = grid.roiDistanceVox(radius);
+  for (int z = 0; z < g.dims[2]; ++z)
+    for (int y = 0; y < g.dims[1]; ++y)
+      for (int x = 0; x < g.dims[0]; ++x) {
+        double best = radius;
+        for (const auto& r : roi_voxels)
+          best = std::min(best, std::sqrt(double((x - r[0]) * (x - r[0]) + (y - r[1]) * (y - r[1]) +
+                                                 (z - r[2]) * (z - r[2]))));
+        ASSERT_NEAR(d[x + g.dims[0] * (y + g.dims[1] * z)], best, 1e-5)
+            << "voxel " << x << "," << y << "," << z;
+      }
+}
+
+TEST_P(GridEngineBackends, FrontiersFollowTheirDefinitions) {
+  // A hand-made 16^3 grid: known free slab z < 8 with an ROI voxel on the slab's top
+  // face, a known occupied voxel inside the slab, unknown above.
+  GridGeometry g;
+  g.voxel_size_m = 0.001;
+  g.first_voxel = {0, 0, 0};
+  g.dims = {16, 16, 16};
+  const auto n = static_cast<std::size_t>(g.voxelCount());
+  auto at = [&](int x, int y, int z) { return x + 16 * (y + 16 * z); };
+  std::vector<float> occupancy(n, std::nanf("")), roi(n, std::nanf(""));
+  for (int z = 0; z < 8; ++z)
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 16; ++x) occupancy[at(x, y, z)] = -0.4f;
+  occupancy[at(5, 5, 7)] = 0.85f;
+  roi[at(5, 5, 7)] = 0.85f;  // ROI at the top face: next to unknown
+  occupancy[at(9, 9, 3)] = 0.85f;
+  roi[at(9, 9, 3)] = 0.85f;  // ROI buried in known space: not a frontier
+  BrickedVoxelGrid grid(*backend_, g, true, std::nullopt, BrickedVoxelGrid::Allocation::kUpFront);
+  grid.assignDense(occupancy, roi);
+  const auto frontiers = grid.extractFrontiers(0.0f);
+  std::size_t roi_count = 0, explore = 0;
+  for (const auto& f : frontiers) {
+    if (f.roi_frontier) {
+      ++roi_count;
+      EXPECT_EQ(f.index, (std::array<int, 3>{5, 5, 7}));
+    }
+    if (f.exploration_frontier) {
+      ++explore;
+      EXPECT_EQ(f.index[2], 7) << "only the top layer of the free slab touches unknown space";
+      EXPECT_LT(f.normal.z(), -0.5) << "normals point away from the unknown (down)";
+      const bool interior = f.index[0] > 0 && f.index[0] < 15 && f.index[1] > 0 && f.index[1] < 15;
+      if (interior) {
+        EXPECT_EQ(f.normal, Eigen::Vector3d(0, 0, -1));
+      }
+    }
+  }
+  EXPECT_EQ(roi_count, 1u);
+  EXPECT_EQ(explore, 16u * 16u - 1u);  // the top layer minus the occupied ROI voxel
+  // Sorted by index and identical to the cpu reference.
+  BrickedVoxelGrid reference(*cpu_, g, true, std::nullopt, BrickedVoxelGrid::Allocation::kUpFront);
+  reference.assignDense(occupancy, roi);
+  const auto want = reference.extractFrontiers(0.0f);
+  ASSERT_EQ(frontiers.size(), want.size());
+  for (std::size_t i = 0; i < want.size(); ++i) {
+    EXPECT_EQ(frontiers[i].index, want[i].index);
+    EXPECT_EQ(frontiers[i].normal, want[i].normal);
+  }
+}
+
+std::string backendName(const ::testing::TestParamInfo<BackendKind>& info) {
+  return std::string(accel::toString(info.param));
+}
+
+INSTANTIATE_TEST_SUITE_P(AllBackends, GridEngineBackends,
+                         ::testing::Values(BackendKind::kCpu, BackendKind::kOpenCl,
+                                           BackendKind::kVulkan),
+                         backendName);
+
+}  // namespace
+}  // namespace fvp::host::map

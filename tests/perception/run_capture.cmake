@@ -1,0 +1,31 @@
+# cmake -P script: `fvp capture --seed 3 --out OUT` exits 0, prints the statistics, and writes
+# every file of the capture format (docs/capture-format.md).
+file(REMOVE_RECURSE "${OUT}")
+execute_process(COMMAND "${FVP}" capture --seed 3 --out "${OUT}"
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message("${out}${err}")
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "fvp capture exited with ${rc}")
+endif()
+foreach(pattern "render +[0-9.]+ ms" "SGBM +[0-9.]+ ms" "points +[0-9]+ ROI, [0-9]+ other"
+                "dropped [0-9]+" "tag +detected id 0" "mean +[0-9.]+ over [0-9]+ fruitlets")
+  if(NOT out MATCHES "${pattern}")
+    message(FATAL_ERROR "output does not match '${pattern}'")
+  endif()
+endforeach()
+foreach(f left.png right.png disparity.png mask.png camera.yaml roi.ply other.ply
+          ground_truth.json)
+  if(NOT EXISTS "${OUT}/${f}")
+    message(FATAL_ERROR "missing ${OUT}/${f}")
+  endif()
+endforeach()
+file(READ "${OUT}/camera.yaml" yaml)
+foreach(key width height fx fy cx cy baseline_m disparity_scale T_world_camera)
+  if(NOT yaml MATCHES "${key}:")
+    message(FATAL_ERROR "camera.yaml lacks ${key}")
+  endif()
+endforeach()
+file(READ "${OUT}/roi.ply" ply LIMIT 40)
+if(NOT ply MATCHES "^ply\nformat binary_little_endian 1.0")
+  message(FATAL_ERROR "roi.ply is not a binary little-endian PLY")
+endif()

@@ -1,0 +1,161 @@
+#include "fvp/host/perception/stereo_matcher.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <iostream>
+
+#include "synthetic_scenes.h"
+
+namespace fvp::host {
+namespace {
+
+constexpr double kDepthM = 0.3;
+
+StereoIntrinsics smallCamera() {
+  StereoIntrinsics K;  // full focal length and baseline, narrower image: quicker tests
+  K.width_px = 960;
+  K.height_px = 240;
+  K.cx_px = 0.5 * (K.width_px - 1);
+  K.cy_px = 0.5 * (K.height_px - 1);
+  return K;
+}
+
+double median(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+TEST(StereoMatcher, DefaultsAreTheReferenceConfiguration) {
+  const SgbmConfig c;
+  EXPECT_EQ(c.num_disparities, 320);
+  EXPECT_EQ(c.block_size, 3);
+  EXPECT_EQ(c.p1, 216);
+  EXPECT_EQ(c.p2, 864);
+  EXPECT_EQ(c.disp12_max_diff, 1);
+  EXPECT_EQ(c.pre_filter_cap, 63);
+  EXPECT_EQ(c.uniqueness_ratio, 10);
+  EXPECT_EQ(c.speckle_window_size, 100);
+  EXPECT_EQ(c.speckle_range, 2);
+  EXPECT_EQ(c.mode, cv::StereoSGBM::MODE_SGBM);
+  const SgbmConfig half = c.scaled(2);
+  EXPECT_EQ(half.num_disparities, 160);
+  EXPECT_EQ(half.speckle_window_size, 25);
+  SgbmConfig bad;
+  bad.num_disparities = 100;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+}
+
+// A textured patch at 0.3 m over a background at 0.5 m: the fine band recovers its depth.
+TEST(StereoMatcher, FineBandDepthErrorAtPointThreeMetres) {
+  const StereoIntrinsics K = smallCamera();
+  const double d_true = K.fx_px * K.baseline_m / kDepthM;  // 183.33 px
+  const cv::Rect patch(500, 60, 200, 120);
+  const auto pair =
+      test::makeStereoPair(K, K.fx_px * K.baseline_m / 0.5, {{patch, d_true}}, 2.0, 7);
+  StereoMatcher matcher;
+  const DisparityResult r = matcher.compute(pair.left, pair.right, patch);
+  EXPECT_EQ(r.fine_rect, patch);
+  EXPECT_EQ(r.coarse_scale, 2);
+  std::vector<double> depth_err_m;
+  const cv::Rect inner(patch.x + 4, patch.y + 4, patch.width - 8, patch.height - 8);
+  for (int v = inner.y; v < inner.br().y; ++v)
+    for (int u = inner.x; u < inner.br().x; ++u) {
+      const float d = r.disparity_px.at<float>(v, u);
+      if (d > 0) depth_err_m.push_back(std::abs(K.depthFromDisparity(d) - kDepthM));
+    }
+  ASSERT_GT(depth_err_m.size(), inner.area() * 0.95);
+  const double med_mm = median(depth_err_m) * 1e3;
+  std::cout << "[ measured ] synthetic plane at 0.3 m: median |depth error| " << med_mm
+            << " mm over " << depth_err_m.size() << " px, SGBM " << r.stats.sgbm_s * 1e3 << " ms\n";
+  EXPECT_LE(med_mm, 1.0);
+}
+
+// The left-most numDisparities columns have no match: invalid (0) and counted as blind.
+TEST(StereoMatcher, BlindLeftBandIsInvalidAndCounted) {
+  const StereoIntrinsics K = smallCamera();
+  const auto pair = test::makeStereoPair(K, 100.0, {}, 2.0, 11);
+  StereoMatcherConfig config;
+  config.coarse_scale = 1;  // everything at full resolution
+  const DisparityResult r = StereoMatcher(config).compute(pair.left, pair.right, {});
+  EXPECT_EQ(r.stats.fine_samples, static_cast<std::int64_t>(K.width_px) * K.height_px);
+  EXPECT_EQ(cv::countNonZero(r.disparity_px.colRange(0, 320)), 0);
+  EXPECT_EQ(r.stats.blind_band, 320LL * K.height_px);
+  // Elsewhere the background's 100 px is found nearly everywhere.
+  const cv::Mat rest = r.disparity_px.colRange(330, K.width_px);
+  EXPECT_GT(cv::countNonZero(cv::abs(rest - 100.0) < 0.5), rest.total() * 0.95);
+}
+
+// Objects at or beyond the top of the search range (nearer than ~0.17 m) come out at
+// 318-319 px instead of invalid (DESIGN.md section 10): they are rejected and counted.
+TEST(StereoMatcher, SaturatedDisparitiesAreRejected) {
+  const StereoIntrinsics K = smallCamera();
+  const cv::Rect near_patch(600, 50, 200, 140);
+  StereoMatcherConfig config;
+  config.coarse_scale = 1;
+  SgbmConfig raw = config.sgbm;
+  raw.saturation_margin_px = 0;
+  for (double d : {319.0, 340.0}) {
+    const auto pair = test::makeStereoPair(K, 100.0, {{near_patch, d}}, 2.0, 13);
+    const DisparityResult r = StereoMatcher(config).compute(pair.left, pair.right, {});
+    double max_d = 0;
+    cv::minMaxLoc(r.disparity_px, nullptr, &max_d);
+    EXPECT_LT(max_d, 318.0) << "patch at " << d << " px";
+    PerceptionStats raw_stats;
+    const cv::Mat unrejected = StereoMatcher::runSgbm(pair.left, pair.right, raw, &raw_stats);
+    const long at_top = cv::countNonZero(unrejected(near_patch) >= 318.0);
+    std::cout << "[ measured ] patch at " << d << " px: " << at_top << " of " << near_patch.area()
+              << " px at >= 318 px without rejection; rejected as saturated " << r.stats.saturated
+              << ", SGBM-invalid " << r.stats.sgbm_invalid << "\n";
+    EXPECT_EQ(raw_stats.saturated, 0);
+    if (d == 319.0) {
+      EXPECT_GT(at_top, near_patch.area() / 2);
+      EXPECT_GE(r.stats.saturated, at_top);
+    }
+  }
+}
+
+// The band + coarse assembly: full resolution inside the band (identical to a whole-image
+// pass up to strip-boundary effects), coarse samples elsewhere within a pixel of the truth.
+TEST(StereoMatcher, BandAndCoarsePassesMatchTheFullPass) {
+  const StereoIntrinsics K = smallCamera();
+  const cv::Rect patch(520, 40, 220, 150);
+  const auto pair = test::makeStereoPair(K, 90.0, {{patch, 183.3}}, 2.0, 17);
+  StereoMatcherConfig full_cfg;
+  full_cfg.coarse_scale = 1;
+  full_cfg.threads = 1;
+  const DisparityResult full = StereoMatcher(full_cfg).compute(pair.left, pair.right, {});
+  StereoMatcherConfig band_cfg;
+  band_cfg.threads = 2;
+  const DisparityResult band = StereoMatcher(band_cfg).compute(pair.left, pair.right, patch);
+  const cv::Mat a = full.disparity_px(patch), b = band.disparity_px(patch);
+  const long both = cv::countNonZero((a > 0) & (b > 0));
+  const long close = cv::countNonZero((a > 0) & (b > 0) & (cv::abs(a - b) <= 0.25));
+  EXPECT_GT(both, patch.area() * 0.9);
+  EXPECT_GT(close, both * 0.97);
+  // Coarse samples outside the band: background 90 px.
+  long coarse_ok = 0, coarse_valid = 0;
+  for (int v = 0; v < K.height_px; v += 2)
+    for (int u = 340; u < K.width_px; u += 2) {
+      if (patch.contains({u, v})) continue;
+      const float d = band.disparity_px.at<float>(v, u);
+      if (d > 0) {
+        ++coarse_valid;
+        coarse_ok += std::abs(d - pair.disparity_px.at<float>(v, u)) <= 1.0;
+      }
+    }
+  EXPECT_GT(coarse_ok, coarse_valid * 0.9);
+  EXPECT_GT(band.stats.coarse_samples, 0);
+  EXPECT_EQ(band.stats.fine_samples, patch.area());
+  std::cout << "[ measured ] " << K.width_px << "x" << K.height_px << ": full pass (1 thread) "
+            << full.stats.sgbm_s * 1e3 << " ms, band + half-res coarse (2 threads) "
+            << band.stats.sgbm_s * 1e3 << " ms\n";
+}
+
+TEST(StereoMatcher, RejectsMismatchedImages) {
+  cv::Mat a(100, 400, CV_8UC3, cv::Scalar::all(0)), b(100, 300, CV_8UC3, cv::Scalar::all(0));
+  EXPECT_THROW(StereoMatcher().compute(a, b, {}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace fvp::host

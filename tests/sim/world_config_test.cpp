@@ -1,0 +1,100 @@
+#include "fvp/robot/sim/world_config.h"
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <set>
+#include <stdexcept>
+#include <string>
+
+namespace fvp::robot::sim {
+namespace {
+
+const std::filesystem::path kDefaultConfig =
+    std::filesystem::path(FVP_SOURCE_DIR) / "robot/sim/config/world_default.yaml";
+
+std::filesystem::path writeTemp(const std::string& name, const std::string& text) {
+  const std::filesystem::path path = std::filesystem::temp_directory_path() / name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+// The message of the std::invalid_argument that reading `text` throws ("" if none).
+std::string readError(const std::string& name, const std::string& text) {
+  try {
+    WorldConfig::fromYamlFile(writeTemp(name, text));
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(WorldConfig, DefaultFileListsEveryKeyWithItsDefault) {
+  EXPECT_EQ(WorldConfig::fromYamlFile(kDefaultConfig), WorldConfig{});
+  std::set<std::string> listed;
+  for (const auto& entry : YAML::LoadFile(kDefaultConfig.string())) {
+    listed.insert(entry.first.as<std::string>());
+  }
+  const auto& names = WorldConfig::keyNames();
+  EXPECT_EQ(listed, std::set<std::string>(names.begin(), names.end()));
+}
+
+TEST(WorldConfig, ReadsKeysAndKeepsOtherDefaults) {
+  const WorldConfig config = WorldConfig::fromYamlFile(
+      writeTemp("fvp_sim_ok.yaml", "leaf_count: 12\nmax_radius_m: 0.006\n"));
+  EXPECT_EQ(config.leaf_count, 12);
+  EXPECT_DOUBLE_EQ(config.max_radius_m, 0.006);
+  EXPECT_DOUBLE_EQ(config.min_radius_m, WorldConfig{}.min_radius_m);
+}
+
+TEST(WorldConfig, UnknownKeyIsAnErrorNamingKeyAndFile) {
+  const std::string error = readError("fvp_sim_unknown.yaml", "leaf_cout: 12\n");
+  EXPECT_NE(error.find("unknown key 'leaf_cout'"), std::string::npos) << error;
+  EXPECT_NE(error.find("fvp_sim_unknown.yaml"), std::string::npos) << error;
+}
+
+TEST(WorldConfig, OutOfRangeNamesKeyAndExpectedRange) {
+  std::string error = readError("fvp_sim_range.yaml", "max_radius_m: 0.002\n");
+  EXPECT_NE(error.find("'max_radius_m'"), std::string::npos) << error;
+  EXPECT_NE(error.find("min_radius_m (0.003) <= max_radius_m <= 0.05"), std::string::npos) << error;
+  EXPECT_NE(error.find("fvp_sim_range.yaml"), std::string::npos) << error;
+  error = readError("fvp_sim_range2.yaml", "min_fruitlets: 0\n");
+  EXPECT_NE(error.find("1 <= min_fruitlets <= 64"), std::string::npos) << error;
+  error = readError("fvp_sim_range3.yaml", "tag_id: 587\n");
+  EXPECT_NE(error.find("0 <= tag_id <= 586"), std::string::npos) << error;
+}
+
+TEST(WorldConfig, WrongTypeNamesKey) {
+  std::string error = readError("fvp_sim_type.yaml", "leaf_count: many\n");
+  EXPECT_NE(error.find("'leaf_count' must be an integer"), std::string::npos) << error;
+  error = readError("fvp_sim_type2.yaml", "leaf_count: 2.5\n");
+  EXPECT_NE(error.find("'leaf_count' must be an integer"), std::string::npos) << error;
+  error = readError("fvp_sim_type3.yaml", "tag_size_m: [1, 2]\n");
+  EXPECT_NE(error.find("'tag_size_m' must be a number"), std::string::npos) << error;
+}
+
+TEST(WorldConfig, UnreadableFileNamesIt) {
+  try {
+    WorldConfig::fromYamlFile("/nonexistent/world.yaml");
+    FAIL() << "expected an error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/world.yaml"), std::string::npos);
+  }
+}
+
+TEST(WorldConfig, ValidateRejectsNaN) {
+  WorldConfig config;
+  config.leaf_region_m = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(config.validate(), std::invalid_argument);
+}
+
+TEST(WorldConfig, ToJsonHasEveryKey) {
+  const std::string json = WorldConfig{}.toJson();
+  for (const std::string& key : WorldConfig::keyNames()) {
+    EXPECT_NE(json.find("\"" + key + "\""), std::string::npos) << key;
+  }
+}
+
+}  // namespace
+}  // namespace fvp::robot::sim
