@@ -18,6 +18,7 @@ void addMapCommand(CLI::App& app) {
   struct Options {
     std::uint64_t seed = 1;
     std::string world_file;
+    std::string map_config_file;
     int views = 5;
     double arc_deg = 90.0;
     std::string engine = "grid";
@@ -30,6 +31,9 @@ void addMapCommand(CLI::App& app) {
              "and map.json to --out");
   cmd->add_option("--seed", opt->seed, "world seed")->capture_default_str();
   cmd->add_option("--world", opt->world_file, "world config YAML (default: built-in defaults)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--map-config", opt->map_config_file,
+                  "map config YAML (keys and defaults: host/config/map_default.yaml)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--views", opt->views, "number of views")->check(CLI::Range(1, 360))->capture_default_str();
   cmd->add_option("--arc-deg", opt->arc_deg, "arc the views span around the cluster")
@@ -49,6 +53,7 @@ void addMapCommand(CLI::App& app) {
     if (opt->engine == "grid") backend = accel::createBackend(opt->backend);
     robot::sim::SimulatedMappingOptions options;
     options.engine = opt->engine;
+    if (!opt->map_config_file.empty()) options.map = host::map::MapConfig::fromYamlFile(opt->map_config_file);
     const auto poses = robot::sim::orbitViews(world, opt->views, opt->arc_deg);
     const auto result = robot::sim::mapSimulatedViews(world, poses, options, backend.get());
 

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <iostream>
+#include <set>
 #include <random>
 
 #include "fvp/accel/backend.h"
@@ -88,6 +89,57 @@ TEST(EngineAgreement, AgreeOnSyntheticScansOfACluster) {
   EXPECT_GT(c.coarse.known_either, 5000u);
   EXPECT_GE(c.fine.fraction(), 0.999);
   EXPECT_GE(c.coarse.fraction(), 0.999);
+}
+
+// The Embree scenes over occupied voxels follow the scans (only changed bricks rebuilt),
+// agree between the engines, and their first hits land on occupied voxels of the map.
+TEST(EngineAgreement, OccupiedScenesFollowTheScansAndAgree) {
+  MapConfig config;
+  config.observation_min_m = {-0.4, -0.4, -0.2};
+  config.observation_max_m = {0.4, 0.4, 0.6};
+  const ClusterRegion region(Eigen::Vector3d(0.012, -0.007, 0.31), 0.05);
+  auto cpu = accel::createBackend(accel::BackendKind::kCpu);
+  GridMapEngine grid(config, region, *cpu);
+  OctomapMapEngine octo(config, region);
+  const auto world = testing::makeWorld(99, region.center_m());
+  const Eigen::Vector3d origin = region.center_m() + Eigen::Vector3d(0.05, 0.02, -0.3);
+  const auto scan = testing::renderScan(world, origin, 200, 150, 0.8, 1);
+  grid.integrate(scan.origin_m, scan.roi_points_m, scan.other_points_m);
+  octo.integrate(scan.origin_m, scan.roi_points_m, scan.other_points_m);
+
+  for (MapLevel level : {MapLevel::kCoarse, MapLevel::kFine}) {
+    const auto grid_voxels = grid.occupiedVoxels(level);
+    const auto octo_voxels = octo.occupiedVoxels(level);
+    ASSERT_GT(grid_voxels.size(), 100u);
+    std::set<std::array<int, 3>> a(grid_voxels.begin(), grid_voxels.end()), b(octo_voxels.begin(), octo_voxels.end());
+    std::size_t common = 0;
+    for (const auto& v : a) common += b.count(v);
+    EXPECT_GE(common, 0.999 * std::max(a.size(), b.size()));
+    EXPECT_EQ(grid.occupiedScene(level).occupiedCount(), a.size());
+    EXPECT_EQ(octo.occupiedScene(level).occupiedCount(), b.size());
+  }
+  // Rays from the sensor to the ROI points hit the fine map at an occupied voxel near the
+  // point (the fruitlet surface).
+  const OccupiedVoxelScene& fine = grid.occupiedScene(MapLevel::kFine);
+  std::size_t hits = 0, near = 0;
+  for (std::size_t i = 0; i < scan.roi_points_m.size(); ++i) {
+    const Eigen::Vector3f o = scan.origin_m.cast<float>(), p = scan.roi_points_m[i];
+    const auto hit = fine.firstHit(o, (p - o) * 1.01f, 0.0f, 1.0f);
+    if (!hit) continue;
+    ++hits;
+    near += (hit->point_m - p).norm() < 0.003f;
+    EXPECT_EQ(grid.fineState(grid.fine().geometry().voxelCenter_m(hit->voxel)).occupancy, VoxelClass::kOccupied);
+  }
+  ASSERT_GT(scan.roi_points_m.size(), 200u);
+  EXPECT_GE(hits, scan.roi_points_m.size() * 99 / 100);
+  EXPECT_GE(near, hits * 99 / 100);
+  // A second view: the next query rebuilds only the bricks that changed.
+  const std::size_t before = grid.occupiedScene(MapLevel::kFine).occupiedCount();
+  const auto scan2 = testing::renderScan(world, region.center_m() + Eigen::Vector3d(-0.1, 0.05, -0.28), 200, 150, 0.8, 2);
+  grid.integrate(scan2.origin_m, scan2.roi_points_m, scan2.other_points_m);
+  const OccupiedVoxelScene& updated = grid.occupiedScene(MapLevel::kFine);
+  EXPECT_EQ(updated.occupiedCount(), grid.occupiedVoxels(MapLevel::kFine).size());
+  EXPECT_NE(updated.occupiedCount(), before);
 }
 
 // The real chain: rendered stereo pairs of a generated world, SGBM, segmentation, the

@@ -5,7 +5,11 @@
 
 #include "backend_test_support.h"
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <cstdlib>
 #include <random>
 #include <string>
@@ -320,6 +324,48 @@ INSTANTIATE_TEST_SUITE_P(AllBackends, GridEngineBackends,
                          ::testing::Values(BackendKind::kCpu, BackendKind::kOpenCl,
                                            BackendKind::kVulkan),
                          backendName);
+
+}  // namespace
+}  // namespace fvp::host::map
+
+namespace fvp::host::map {
+namespace {
+
+TEST(MapConfigYaml, TheDefaultsFileHoldsTheDefaults) {
+  const MapConfig read = MapConfig::fromYamlFile(FVP_SOURCE_DIR "/host/config/map_default.yaml");
+  const MapConfig defaults;
+  EXPECT_EQ(read.coarse_voxel_size_m, defaults.coarse_voxel_size_m);
+  EXPECT_EQ(read.fine_voxel_size_m, defaults.fine_voxel_size_m);
+  EXPECT_EQ(read.observation_min_m, defaults.observation_min_m);
+  EXPECT_EQ(read.observation_max_m, defaults.observation_max_m);
+  EXPECT_EQ(read.sensor_max_range_m, defaults.sensor_max_range_m);
+  EXPECT_EQ(read.model.prob_hit, defaults.model.prob_hit);
+  EXPECT_EQ(read.model.occupied_prob, defaults.model.occupied_prob);
+}
+
+TEST(MapConfigYaml, ErrorsNameTheFileAndTheKey) {
+  const auto dir = std::filesystem::temp_directory_path() / ("fvp_map_config_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  auto expectError = [&](const std::string& yaml, const std::string& key, const std::string& expected) {
+    const auto path = dir / "map.yaml";
+    std::ofstream(path) << yaml;
+    try {
+      MapConfig::fromYamlFile(path);
+      FAIL() << "accepted: " << yaml;
+    } catch (const std::invalid_argument& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(path.string()), std::string::npos) << what;
+      EXPECT_NE(what.find(key), std::string::npos) << what;
+      EXPECT_NE(what.find(expected), std::string::npos) << what;
+    }
+  };
+  expectError("fine_voxel_size_m: -1\n", "fine_voxel_size_m", "expected a value in");
+  expectError("fine_voxel_size: 0.001\n", "fine_voxel_size", "unknown key");
+  expectError("observation_min_m: [0, 0]\n", "observation_min_m", "list of 3 numbers");
+  expectError("prob_hit: high\n", "prob_hit", "expected a number");
+  expectError("observation_min_m: [0, 0, 3]\n", "observation_max_m", "must exceed");
+  std::filesystem::remove_all(dir);
+}
 
 }  // namespace
 }  // namespace fvp::host::map

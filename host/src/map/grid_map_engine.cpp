@@ -65,9 +65,9 @@ GridMapEngine::GridMapEngine(const MapConfig& config, const ClusterRegion& regio
                                              regionInGrid(fine, region), allocationFor(fine));
 }
 
-ScanStats GridMapEngine::integrate(const Eigen::Vector3d& sensor_origin_m,
-                                   const std::vector<Eigen::Vector3f>& roi_points_m,
-                                   const std::vector<Eigen::Vector3f>& other_points_m) {
+ScanStats GridMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
+                                       const std::vector<Eigen::Vector3f>& roi_points_m,
+                                       const std::vector<Eigen::Vector3f>& other_points_m) {
   const auto t0 = std::chrono::steady_clock::now();
   ScanStats stats;
   const auto points = prepareScanPoints(sensor_origin_m, roi_points_m, other_points_m,
@@ -124,6 +124,20 @@ void GridMapEngine::exportFine(const std::filesystem::path& ot_path) const {
   });
   tree.updateInnerOccupancy();
   writeFineOt(tree, ot_path);
+}
+
+const GridGeometry& GridMapEngine::gridGeometry(MapLevel level) const {
+  return level == MapLevel::kCoarse ? coarse_->geometry() : fine_->geometry();
+}
+
+std::vector<std::array<int, 3>> GridMapEngine::occupiedVoxels(MapLevel level) const {
+  const BrickedVoxelGrid& grid = level == MapLevel::kCoarse ? *coarse_ : *fine_;
+  const float occupied = config().model.occupiedLogOdds();
+  std::vector<std::array<int, 3>> voxels;
+  grid.forEachVoxel([&](const std::array<int, 3>& index, float occupancy, float) {
+    if (occupancy > occupied) voxels.push_back(index);  // NaN (unknown) fails
+  });
+  return voxels;
 }
 
 std::vector<float> GridMapEngine::roiDistance_m(double max_d_m) {

@@ -1,3 +1,7 @@
+#include <yaml-cpp/yaml.h>
+
+#include <functional>
+#include <map>
 #include <stdexcept>
 #include <string>
 
@@ -38,6 +42,55 @@ void MapConfig::validate(const std::string& source) const {
     }
   }
   model.validate(source + ".model");
+}
+
+MapConfig MapConfig::fromYamlFile(const std::filesystem::path& path) {
+  const std::string source = path.string();
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(source);
+  } catch (const YAML::Exception& e) {
+    throw std::invalid_argument(source + ": not a readable YAML file: " + e.what());
+  }
+  MapConfig config;
+  if (root.IsNull()) return config;
+  if (!root.IsMap()) throw std::invalid_argument(source + ": expected a map of keys");
+  auto number = [&](const YAML::Node& node, const std::string& key) {
+    try {
+      return node.as<double>();
+    } catch (const YAML::Exception&) {
+      throw std::invalid_argument(source + ": " + key + ": expected a number");
+    }
+  };
+  auto vector3 = [&](const YAML::Node& node, const std::string& key) {
+    if (!node.IsSequence() || node.size() != 3)
+      throw std::invalid_argument(source + ": " + key + ": expected a list of 3 numbers [x, y, z]");
+    return Eigen::Vector3d(number(node[0], key), number(node[1], key), number(node[2], key));
+  };
+  const std::map<std::string, std::function<void(const YAML::Node&, const std::string&)>> keys = {
+      {"coarse_voxel_size_m", [&](auto& n, auto& k) { config.coarse_voxel_size_m = number(n, k); }},
+      {"fine_voxel_size_m", [&](auto& n, auto& k) { config.fine_voxel_size_m = number(n, k); }},
+      {"observation_min_m", [&](auto& n, auto& k) { config.observation_min_m = vector3(n, k); }},
+      {"observation_max_m", [&](auto& n, auto& k) { config.observation_max_m = vector3(n, k); }},
+      {"sensor_max_range_m", [&](auto& n, auto& k) { config.sensor_max_range_m = number(n, k); }},
+      {"prob_hit", [&](auto& n, auto& k) { config.model.prob_hit = number(n, k); }},
+      {"prob_miss", [&](auto& n, auto& k) { config.model.prob_miss = number(n, k); }},
+      {"clamp_min", [&](auto& n, auto& k) { config.model.clamp_min = number(n, k); }},
+      {"clamp_max", [&](auto& n, auto& k) { config.model.clamp_max = number(n, k); }},
+      {"occupied_prob", [&](auto& n, auto& k) { config.model.occupied_prob = number(n, k); }},
+  };
+  for (const auto& entry : root) {
+    const std::string key = entry.first.as<std::string>();
+    const auto it = keys.find(key);
+    if (it == keys.end()) {
+      std::string known;
+      for (const auto& [name, _] : keys) known += (known.empty() ? "" : ", ") + name;
+      throw std::invalid_argument(source + ": unknown key '" + key + "' (known: " + known + ")");
+    }
+    it->second(entry.second, key);
+  }
+  config.validate(source);
+  return config;
 }
 
 }  // namespace fvp::host::map

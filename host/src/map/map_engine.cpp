@@ -8,6 +8,28 @@
 
 namespace fvp::host::map {
 
+MapEngine::~MapEngine() = default;
+
+ScanStats MapEngine::integrate(const Eigen::Vector3d& sensor_origin_m,
+                               const std::vector<Eigen::Vector3f>& roi_points_m,
+                               const std::vector<Eigen::Vector3f>& other_points_m) {
+  ++scans_;
+  return integrateScan(sensor_origin_m, roi_points_m, other_points_m);
+}
+
+const OccupiedVoxelScene& MapEngine::occupiedScene(MapLevel level) {
+  SceneState& state = scenes_[level == MapLevel::kCoarse ? 0 : 1];
+  if (!state.scene) {
+    state.scene = std::make_unique<OccupiedVoxelScene>(gridGeometry(level), occupiedVoxels(level));
+    state.synced_scans = scans_;
+  } else if (state.synced_scans != scans_) {
+    state.scene->assignOccupied(occupiedVoxels(level));
+    state.scene->commit();
+    state.synced_scans = scans_;
+  }
+  return *state.scene;
+}
+
 std::unique_ptr<MapEngine> createMapEngine(std::string_view engine, const MapConfig& config,
                                            const ClusterRegion& region, accel::Backend* backend) {
   if (engine == "grid") {

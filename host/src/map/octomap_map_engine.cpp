@@ -151,7 +151,7 @@ octomap::OcTreeKey OctomapMapEngine::fineKey(const std::array<int, 3>& index) co
   return key;
 }
 
-ScanStats OctomapMapEngine::integrate(const Eigen::Vector3d& sensor_origin_m,
+ScanStats OctomapMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
                                       const std::vector<Eigen::Vector3f>& roi_points_m,
                                       const std::vector<Eigen::Vector3f>& other_points_m) {
   const auto start = std::chrono::steady_clock::now();
@@ -330,6 +330,37 @@ void OctomapMapEngine::exportCoarse(const std::filesystem::path& bt_path) const 
 
 void OctomapMapEngine::exportFine(const std::filesystem::path& ot_path) const {
   writeFineOt(*fine_, ot_path);
+}
+
+namespace {
+
+// Grid indices of the occupied leaves of `tree` (pruned leaves expanded to their voxels).
+template <typename Tree>
+std::vector<std::array<int, 3>> occupiedLeaves(const Tree& tree, const GridGeometry& grid,
+                                               float occupied_logodds) {
+  std::vector<std::array<int, 3>> voxels;
+  const double res = tree.getResolution();
+  for (auto it = tree.begin_leafs(); it != tree.end_leafs(); ++it) {
+    if (!(it->getLogOdds() > occupied_logodds)) continue;  // the strict rule of both engines
+    const auto n = static_cast<std::int64_t>(std::llround(it.getSize() / res));
+    std::array<std::int64_t, 3> lo;
+    for (int a = 0; a < 3; ++a)
+      lo[a] = std::llround((it.getCoordinate()(a) - 0.5 * it.getSize()) / res) - grid.first_voxel[a];
+    for (std::int64_t z = lo[2]; z < lo[2] + n; ++z)
+      for (std::int64_t y = lo[1]; y < lo[1] + n; ++y)
+        for (std::int64_t x = lo[0]; x < lo[0] + n; ++x)
+          if (x >= 0 && y >= 0 && z >= 0 && x < grid.dims[0] && y < grid.dims[1] && z < grid.dims[2])
+            voxels.push_back({static_cast<int>(x), static_cast<int>(y), static_cast<int>(z)});
+  }
+  return voxels;
+}
+
+}  // namespace
+
+std::vector<std::array<int, 3>> OctomapMapEngine::occupiedVoxels(MapLevel level) const {
+  const float occupied = config().model.occupiedLogOdds();
+  return level == MapLevel::kCoarse ? occupiedLeaves(*coarse_, coarse_grid_, occupied)
+                                    : occupiedLeaves(*fine_, fine_grid_, occupied);
 }
 
 }  // namespace fvp::host::map

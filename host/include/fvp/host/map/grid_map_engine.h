@@ -20,13 +20,12 @@ class GridMapEngine final : public MapEngine {
   GridMapEngine(const MapConfig& config, const ClusterRegion& region, accel::Backend& backend);
 
   std::string_view engineName() const override { return "grid"; }
-  ScanStats integrate(const Eigen::Vector3d& sensor_origin_m,
-                      const std::vector<Eigen::Vector3f>& roi_points_m,
-                      const std::vector<Eigen::Vector3f>& other_points_m) override;
   VoxelClass coarseClass(const Eigen::Vector3d& p_m) const override;
   VoxelState fineState(const Eigen::Vector3d& p_m) const override;
   void exportCoarse(const std::filesystem::path& bt_path) const override;
   void exportFine(const std::filesystem::path& ot_path) const override;
+  const GridGeometry& gridGeometry(MapLevel level) const override;
+  std::vector<std::array<int, 3>> occupiedVoxels(MapLevel level) const override;
 
   accel::Backend& backend() const { return backend_; }
   BrickedVoxelGrid& coarse() { return *coarse_; }
@@ -38,6 +37,11 @@ class GridMapEngine final : public MapEngine {
   std::vector<float> roiDistance_m(double max_d_m);
   /// ROI and exploration frontiers of the fine map, sorted by grid index.
   std::vector<FrontierVoxel> frontiers();
+
+ protected:
+  ScanStats integrateScan(const Eigen::Vector3d& sensor_origin_m,
+                          const std::vector<Eigen::Vector3f>& roi_points_m,
+                          const std::vector<Eigen::Vector3f>& other_points_m) override;
 
  private:
   accel::Backend& backend_;

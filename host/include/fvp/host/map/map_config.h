@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <filesystem>
 #include <string>
 
 #include "fvp/host/map/occupancy_model.h"
@@ -27,6 +28,11 @@ struct MapConfig {
 
   /// Throws std::invalid_argument naming `source`.field and the expected range.
   void validate(const std::string& source = "map config") const;
+
+  /// Reads a YAML file (keys and defaults: host/config/map_default.yaml); missing keys keep
+  /// their defaults. Unknown keys, wrong types and out-of-range values throw
+  /// std::invalid_argument naming the file and the key.
+  static MapConfig fromYamlFile(const std::filesystem::path& path);
 };
 
 }  // namespace fvp::host::map

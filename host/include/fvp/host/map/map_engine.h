@@ -16,7 +16,9 @@
 #include <string_view>
 #include <vector>
 
+#include "fvp/host/map/grid_geometry.h"
 #include "fvp/host/map/map_config.h"
+#include "fvp/host/map/occupied_voxel_scene.h"
 #include "fvp/host/map/scan_stats.h"
 #include "fvp/host/map/voxel_state.h"
 #include "fvp/host/perception/cluster_region.h"
@@ -27,9 +29,11 @@ class Backend;
 
 namespace fvp::host::map {
 
+enum class MapLevel { kCoarse, kFine };
+
 class MapEngine {
  public:
-  virtual ~MapEngine() = default;
+  virtual ~MapEngine();
   MapEngine(const MapEngine&) = delete;
   MapEngine& operator=(const MapEngine&) = delete;
 
@@ -39,9 +43,9 @@ class MapEngine {
   const ClusterRegion& region() const { return region_; }
 
   /// Integrates one view: rays from sensor_origin_m to every point (world frame).
-  virtual ScanStats integrate(const Eigen::Vector3d& sensor_origin_m,
-                              const std::vector<Eigen::Vector3f>& roi_points_m,
-                              const std::vector<Eigen::Vector3f>& other_points_m) = 0;
+  ScanStats integrate(const Eigen::Vector3d& sensor_origin_m,
+                      const std::vector<Eigen::Vector3f>& roi_points_m,
+                      const std::vector<Eigen::Vector3f>& other_points_m);
 
   /// State of the coarse voxel containing p (unknown outside the observation box).
   virtual VoxelClass coarseClass(const Eigen::Vector3d& p_m) const = 0;
@@ -53,13 +57,32 @@ class MapEngine {
   /// Fine map as an OctoMap .ot file (occupancy + ROI; format in docs/maps.md).
   virtual void exportFine(const std::filesystem::path& ot_path) const = 0;
 
+  /// The map's voxel lattice (the same for both engines).
+  virtual const GridGeometry& gridGeometry(MapLevel level) const = 0;
+  /// Grid indices of the occupied voxels of one map.
+  virtual std::vector<std::array<int, 3>> occupiedVoxels(MapLevel level) const = 0;
+
+  /// Embree scene over the occupied voxels of one map for first-hit and occlusion queries,
+  /// current with every scan integrated so far: after new scans, the next call rebuilds
+  /// only the bricks whose voxels changed.
+  const OccupiedVoxelScene& occupiedScene(MapLevel level);
+
  protected:
   MapEngine(const MapConfig& config, const ClusterRegion& region)
       : config_(config), region_(region) {}
+  virtual ScanStats integrateScan(const Eigen::Vector3d& sensor_origin_m,
+                                  const std::vector<Eigen::Vector3f>& roi_points_m,
+                                  const std::vector<Eigen::Vector3f>& other_points_m) = 0;
 
  private:
+  struct SceneState {
+    std::unique_ptr<OccupiedVoxelScene> scene;
+    std::size_t synced_scans = 0;
+  };
   MapConfig config_;
   ClusterRegion region_;
+  std::size_t scans_ = 0;
+  SceneState scenes_[2];
 };
 
 /// engine: "grid" (needs a compute backend) or "octomap" (backend ignored, may be null).

@@ -46,10 +46,17 @@ class OctomapMapEngine : public MapEngine {
 
   std::string_view engineName() const override { return "octomap"; }
 
-  ScanStats integrate(const Eigen::Vector3d& sensor_origin_m,
-                      const std::vector<Eigen::Vector3f>& roi_points_m,
-                      const std::vector<Eigen::Vector3f>& other_points_m) override;
+  const GridGeometry& gridGeometry(MapLevel level) const override {
+    return level == MapLevel::kCoarse ? coarse_grid_ : fine_grid_;
+  }
+  std::vector<std::array<int, 3>> occupiedVoxels(MapLevel level) const override;
 
+ protected:
+  ScanStats integrateScan(const Eigen::Vector3d& sensor_origin_m,
+                      const std::vector<Eigen::Vector3f>& roi_points_m,
+                          const std::vector<Eigen::Vector3f>& other_points_m) override;
+
+ public:
   VoxelClass coarseClass(const Eigen::Vector3d& p_m) const override;
   VoxelState fineState(const Eigen::Vector3d& p_m) const override;
   /// The same by grid index (coarseGrid() / fineGrid()); unknown outside the grid/region.
