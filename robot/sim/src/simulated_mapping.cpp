@@ -14,7 +14,8 @@ SimulatedMapping mapSimulatedViews(const World& world, const std::vector<Eigen::
   SimulatedMapping out;
   const StereoRenderer renderer(world, options.render);
   const host::PerceptionPipeline perception(options.perception);
-  std::vector<host::LabeledClouds> pending;  // clouds seen before the region was known
+  // Clouds seen before the region was known, with the index of their view.
+  std::vector<std::pair<std::size_t, host::LabeledClouds>> pending;
   for (const Eigen::Isometry3d& pose : poses) {
     MappedView view;
     view.T_world_camera = pose;
@@ -32,15 +33,17 @@ SimulatedMapping mapSimulatedViews(const World& world, const std::vector<Eigen::
     if (!out.region && perceived.region) {
       out.region = perceived.region;
       out.map = host::map::createMapEngine(options.engine, options.map, *out.region, backend);
-      for (const auto& clouds : pending)
-        out.map->integrate(clouds.sensor_origin_m, clouds.roi_points_m, clouds.other_points_m);
+      for (const auto& [index, clouds] : pending) {
+        out.views[index].scan =
+            out.map->integrate(clouds.sensor_origin_m, clouds.roi_points_m, clouds.other_points_m);
+      }
       pending.clear();
     }
     if (out.map) {
       view.scan = out.map->integrate(perceived.clouds.sensor_origin_m, perceived.clouds.roi_points_m,
                                      perceived.clouds.other_points_m);
     } else {
-      pending.push_back(std::move(perceived.clouds));
+      pending.emplace_back(out.views.size(), std::move(perceived.clouds));
     }
     out.views.push_back(view);
   }

@@ -22,7 +22,7 @@ struct MappedView {
   double perceive_s = 0.0;
   std::size_t roi_points = 0, other_points = 0;
   bool tag_detected = false;
-  host::map::ScanStats scan;  ///< empty for views before the Cluster Region is known
+  host::map::ScanStats scan;  ///< empty when no view detected the tag
 };
 
 struct SimulatedMapping {
@@ -39,7 +39,7 @@ struct SimulatedMappingOptions {
 };
 
 /// backend: required for the grid engine. Views seen before the tag is detected are
-/// integrated once the region is known (their clouds are kept).
+/// integrated, in order, as soon as the region is known (their clouds are kept).
 SimulatedMapping mapSimulatedViews(const World& world, const std::vector<Eigen::Isometry3d>& poses,
                                    const SimulatedMappingOptions& options, accel::Backend* backend);
 
