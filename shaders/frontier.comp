@@ -22,7 +22,7 @@ layout(std430, set = 0, binding = 5) buffer Count { uint count[]; };
 bool unknownAt(FvpBrickedGrid m, ivec3 n) {
   int nb = brick_table[fvp_brick_of(m, n.x, n.y, n.z)];
   if (nb < 0) return true;
-  return isnan(occupancy[(nb & FVP_BRICK_INDEX_MASK) * FVP_BRICK_VOXELS + fvp_local_of(n.x, n.y, n.z)]);
+  return fvp_is_nan(occupancy[(nb & FVP_BRICK_INDEX_MASK) * FVP_BRICK_VOXELS + fvp_local_of(n.x, n.y, n.z)]);
 }
 
 void main() {
@@ -34,8 +34,9 @@ void main() {
             ivec3(int(in_brick & 7u), int((in_brick >> 3) & 7u), int(in_brick >> 6));
   if (!fvp_in_map(p.map, v.x, v.y, v.z)) return;
   float occ = occupancy[slot];
-  if (isnan(occ)) return;
-  bool is_roi = roi[slot] > 0.0;
+  if (fvp_is_nan(occ)) return;
+  float roi_value = roi[slot];
+  bool is_roi = !fvp_is_nan(roi_value) && roi_value > 0.0;
   bool is_free = !(occ > p.occupied_logodds);
   if (!is_roi && !is_free) return;
   ivec3 normal = ivec3(0);

@@ -43,14 +43,20 @@ struct FvpDda {
   int64_t cross_xy, cross_xz, cross_yz;
 };
 
+// NaN and infinity tests on the bits: Vulkan lets compilers assume float operands are not
+// NaN, so isnan() and comparisons cannot be trusted to see them.
+bool fvp_is_nan(float v) { return (floatBitsToUint(v) & 0x7fffffffu) > 0x7f800000u; }
+bool fvp_is_finite(float v) { return (floatBitsToUint(v) & 0x7f800000u) != 0x7f800000u; }
+
 int64_t fvp_floor_div_one(int64_t v) {
   return v >= 0l ? v / FVP_DDA_ONE : -((-v + FVP_DDA_ONE - 1l) / FVP_DDA_ONE);
 }
 
 bool fvp_dda_quantize(float p_m, float origin_m, float fixed_per_m, out int64_t q_fixed) {
-  precise float q = (p_m - origin_m) * fixed_per_m;
   q_fixed = 0l;
-  if (!(q > -FVP_DDA_MAX_ABS_FIXED && q < FVP_DDA_MAX_ABS_FIXED)) return false;
+  if (!fvp_is_finite(p_m)) return false;
+  precise float q = (p_m - origin_m) * fixed_per_m;
+  if (!fvp_is_finite(q) || !(q > -FVP_DDA_MAX_ABS_FIXED && q < FVP_DDA_MAX_ABS_FIXED)) return false;
   q_fixed = int64_t(floor(q));
   return true;
 }

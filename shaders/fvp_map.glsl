@@ -82,7 +82,7 @@ bool fvp_region_contains(FvpRegion r, int x, int y, int z) {
 }
 
 float fvp_logodds_update(float value, float delta, float clamp_min, float clamp_max) {
-  precise float v = isnan(value) ? 0.0 : value;
+  precise float v = fvp_is_nan(value) ? 0.0 : value;
   v = v + delta;
   if (v < clamp_min) v = clamp_min;
   if (v > clamp_max) v = clamp_max;

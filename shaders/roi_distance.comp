@@ -40,7 +40,8 @@ void main() {
     int s = (nb & FVP_BRICK_INDEX_MASK) * FVP_BRICK_VOXELS + fvp_local_of(n.x, n.y, n.z);
     uint value;
     if (axis == 0) {
-      if (!(roi[s] > 0.0)) continue;
+      float r = roi[s];
+      if (fvp_is_nan(r) || !(r > 0.0)) continue;
       value = 0u;
     } else {
       value = sq_in[s];

@@ -99,9 +99,13 @@ Selected selectDevice() {
       continue;  // a platform without devices is not an error while others remain
     }
     for (const auto& device : devices) {
-      if (!device.getInfo<CL_DEVICE_AVAILABLE>() || !device.getInfo<CL_DEVICE_COMPILER_AVAILABLE>())
-        continue;
-      if (device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_GPU) return {platform, device};
+      try {
+        if (!device.getInfo<CL_DEVICE_AVAILABLE>() || !device.getInfo<CL_DEVICE_COMPILER_AVAILABLE>())
+          continue;
+        if (device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_GPU) return {platform, device};
+      } catch (const cl::Error&) {
+        continue;  // a device that cannot describe itself is not usable
+      }
       if (!fallback) fallback = Selected{platform, device};
     }
   }
@@ -116,7 +120,7 @@ class OpenClBackend final : public Backend {
   OpenClBackend() {
     Selected s = selectDevice();
     device_ = s.device;
-    is_gpu_ = (device_.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_GPU) != 0;
+    is_gpu_ = (FVP_CL(device_.getInfo<CL_DEVICE_TYPE>()) & CL_DEVICE_TYPE_GPU) != 0;
     device_name_ = FVP_CL(device_.getInfo<CL_DEVICE_NAME>()) + " (" +
                    FVP_CL(s.platform.getInfo<CL_PLATFORM_NAME>()) + ")";
     context_ = FVP_CL(cl::Context(device_));

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdlib>
 #include <cstring>
 #include <optional>
 #include <sstream>
@@ -113,28 +114,7 @@ class VulkanBackend final : public Backend {
   bool isGpu() const { return is_gpu_; }
 
   std::unique_ptr<DeviceBuffer> createBuffer(std::size_t size_bytes) override {
-    // Vulkan rejects zero-sized buffers; an empty buffer still owns a few bytes.
-    const vk::DeviceSize bytes = std::max<std::size_t>(size_bytes, 4);
-    auto usage = vk::BufferUsageFlagBits::eStorageBuffer | vk::BufferUsageFlagBits::eTransferSrc |
-                 vk::BufferUsageFlagBits::eTransferDst;
-    vk::raii::Buffer buffer =
-        FVP_VK(vk::raii::Buffer(device_, vk::BufferCreateInfo({}, bytes, usage)));
-    const vk::MemoryRequirements req = buffer.getMemoryRequirements();
-    // Unified memory (integrated GPUs, lavapipe) is mapped directly; discrete GPUs get
-    // device-local memory filled through staging copies.
-    using M = vk::MemoryPropertyFlagBits;
-    std::optional<uint32_t> type = findMemoryType(req, M::eDeviceLocal | M::eHostVisible | M::eHostCoherent);
-    if (!type) type = findMemoryType(req, M::eDeviceLocal);
-    if (!type) type = findMemoryType(req, M::eHostVisible | M::eHostCoherent);
-    if (!type) throw BackendError("vulkan: no memory type for a storage buffer");
-    vk::raii::DeviceMemory memory =
-        FVP_VK(vk::raii::DeviceMemory(device_, vk::MemoryAllocateInfo(req.size, *type)));
-    FVP_VK(buffer.bindMemory(*memory, 0));
-    const auto flags = memory_props_.memoryTypes[*type].propertyFlags;
-    void* mapped = nullptr;
-    if ((flags & M::eHostVisible) && (flags & M::eHostCoherent))
-      mapped = FVP_VK(memory.mapMemory(0, VK_WHOLE_SIZE));
-    return std::make_unique<VkBuffer>(size_bytes, std::move(buffer), std::move(memory), mapped);
+    return allocateBuffer(size_bytes, unified_memory_ ? Placement::kUnified : Placement::kDevice);
   }
 
  protected:
@@ -145,7 +125,7 @@ class VulkanBackend final : public Backend {
       std::memcpy(dst.mapped() + offset_bytes, src, size_bytes);
       return;
     }
-    auto staging = createBuffer(size_bytes);
+    auto staging = allocateBuffer(size_bytes, Placement::kStagingUpload);
     std::memcpy(vkBuf(*staging).mapped(), src, size_bytes);
     submit([&](const vk::raii::CommandBuffer& cmd) {
       cmd.copyBuffer(vkBuf(*staging).get(), dst.get(), vk::BufferCopy(0, offset_bytes, size_bytes));
@@ -159,7 +139,7 @@ class VulkanBackend final : public Backend {
       std::memcpy(dst, src.mapped() + offset_bytes, size_bytes);
       return;
     }
-    auto staging = createBuffer(size_bytes);
+    auto staging = allocateBuffer(size_bytes, Placement::kStagingDownload);
     submit([&](const vk::raii::CommandBuffer& cmd) {
       cmd.copyBuffer(src.get(), vkBuf(*staging).get(), vk::BufferCopy(offset_bytes, 0, size_bytes));
     });
@@ -224,6 +204,54 @@ class VulkanBackend final : public Backend {
   }
 
  private:
+  enum class Placement {
+    kUnified,          // integrated GPUs and CPU devices: device memory the host maps
+    kDevice,           // discrete GPUs: device-local, filled through staging copies
+    kStagingUpload,    // host-visible, coherent
+    kStagingDownload,  // host-visible, coherent, cached when available
+  };
+
+  std::unique_ptr<DeviceBuffer> allocateBuffer(std::size_t size_bytes, Placement placement) {
+    // Vulkan rejects zero-sized buffers; an empty buffer still owns a few bytes.
+    const vk::DeviceSize bytes = std::max<std::size_t>(size_bytes, 4);
+    if (bytes > max_allocation_bytes_)
+      throw BackendError("vulkan: a buffer of " + std::to_string(bytes) +
+                         " bytes exceeds the device's maxMemoryAllocationSize (" +
+                         std::to_string(max_allocation_bytes_) + ")");
+    const auto usage = vk::BufferUsageFlagBits::eStorageBuffer |
+                       vk::BufferUsageFlagBits::eTransferSrc | vk::BufferUsageFlagBits::eTransferDst;
+    vk::raii::Buffer buffer = FVP_VK(vk::raii::Buffer(device_, vk::BufferCreateInfo({}, bytes, usage)));
+    const vk::MemoryRequirements req = buffer.getMemoryRequirements();
+    using M = vk::MemoryPropertyFlagBits;
+    const vk::MemoryPropertyFlags host = M::eHostVisible | M::eHostCoherent;
+    std::optional<uint32_t> type;
+    switch (placement) {
+      case Placement::kUnified:
+        type = findMemoryType(req, host | M::eDeviceLocal);
+        if (!type) type = findMemoryType(req, host);
+        break;
+      case Placement::kDevice:
+        type = findMemoryType(req, M::eDeviceLocal);
+        break;
+      case Placement::kStagingUpload:
+        type = findMemoryType(req, host);
+        break;
+      case Placement::kStagingDownload:
+        type = findMemoryType(req, host | M::eHostCached);
+        if (!type) type = findMemoryType(req, host);
+        break;
+    }
+    if (!type) throw BackendError("vulkan: no suitable memory type for a buffer of " + std::to_string(bytes) + " bytes");
+    vk::raii::DeviceMemory memory =
+        FVP_VK(vk::raii::DeviceMemory(device_, vk::MemoryAllocateInfo(req.size, *type)));
+    FVP_VK(buffer.bindMemory(*memory, 0));
+    // Device buffers of discrete GPUs are reached through staging copies only, even where
+    // their memory happens to be host-visible.
+    void* mapped = nullptr;
+    if (placement != Placement::kDevice) mapped = FVP_VK(memory.mapMemory(0, VK_WHOLE_SIZE));
+    return std::make_unique<VkBuffer>(size_bytes, std::move(buffer), std::move(memory), mapped);
+  }
+
   // Push-constant blocks: the kernel parameters plus the first work item of a chunk.
   struct TraversePushConstants {
     TraverseParams params;
@@ -260,6 +288,10 @@ class VulkanBackend final : public Backend {
     std::string rejected;
     for (std::size_t i = 0; i < devices.size(); ++i) {
       const auto props = devices[i].getProperties();
+      if (props.apiVersion < VK_API_VERSION_1_1) {
+        rejected += std::string(" ") + props.deviceName.data() + " (Vulkan 1.0 only; 1.1 needed);";
+        continue;
+      }
       if (!devices[i].getFeatures().shaderInt64) {
         rejected += std::string(" ") + props.deviceName.data() + " (no shaderInt64);";
         continue;
@@ -277,6 +309,16 @@ class VulkanBackend final : public Backend {
     physical_ = std::move(devices[*best]);
     const auto props = physical_.getProperties();
     is_gpu_ = deviceIsGpu(props.deviceType);
+    // Integrated GPUs and CPU implementations share memory with the host: map it directly.
+    // FVP_VULKAN_STAGING=1 forces the discrete-GPU path (tests run it on any device).
+    const char* force_staging = std::getenv("FVP_VULKAN_STAGING");
+    unified_memory_ = props.deviceType != vk::PhysicalDeviceType::eDiscreteGpu &&
+                      !(force_staging && std::string(force_staging) == "1");
+    max_allocation_bytes_ = physical_
+                                .getProperties2<vk::PhysicalDeviceProperties2,
+                                                vk::PhysicalDeviceMaintenance3Properties>()
+                                .get<vk::PhysicalDeviceMaintenance3Properties>()
+                                .maxMemoryAllocationSize;
     device_name_ = std::string(props.deviceName.data()) + " (Vulkan " +
                    std::to_string(VK_API_VERSION_MAJOR(props.apiVersion)) + "." +
                    std::to_string(VK_API_VERSION_MINOR(props.apiVersion)) + ")";
@@ -360,6 +402,13 @@ class VulkanBackend final : public Backend {
     const vk::raii::CommandBuffer& cmd = command_buffer_;
     FVP_VK(cmd.reset());
     FVP_VK(cmd.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit)));
+    // Earlier submissions' device writes must be visible to this one's reads and writes:
+    // a fence wait only makes them available.
+    vk::MemoryBarrier from_before(vk::AccessFlagBits::eShaderWrite | vk::AccessFlagBits::eTransferWrite,
+                                  vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite |
+                                      vk::AccessFlagBits::eTransferRead | vk::AccessFlagBits::eTransferWrite);
+    const auto stages = vk::PipelineStageFlagBits::eComputeShader | vk::PipelineStageFlagBits::eTransfer;
+    cmd.pipelineBarrier(stages, stages, {}, from_before, {}, {});
     record(cmd);
     // Make shader and transfer writes visible to the host reads that follow the fence.
     vk::MemoryBarrier to_host(vk::AccessFlagBits::eShaderWrite | vk::AccessFlagBits::eTransferWrite,
@@ -384,7 +433,13 @@ class VulkanBackend final : public Backend {
         device_, vk::DescriptorSetAllocateInfo(*descriptor_pool_, *p.set_layout)));
     vk::raii::DescriptorSet& set = sets.front();
     std::vector<vk::DescriptorBufferInfo> infos;
-    for (const DeviceBuffer* b : buffers) infos.emplace_back(vkBuf(*b).get(), 0, VK_WHOLE_SIZE);
+    for (const DeviceBuffer* b : buffers) {
+      if (b->sizeBytes() > limits_.maxStorageBufferRange)
+        throw BackendError("vulkan: a buffer of " + std::to_string(b->sizeBytes()) +
+                           " bytes exceeds the device's maxStorageBufferRange (" +
+                           std::to_string(limits_.maxStorageBufferRange) + ")");
+      infos.emplace_back(vkBuf(*b).get(), 0, VK_WHOLE_SIZE);
+    }
     std::vector<vk::WriteDescriptorSet> writes;
     for (uint32_t i = 0; i < infos.size(); ++i)
       writes.emplace_back(*set, i, 0, 1, vk::DescriptorType::eStorageBuffer, nullptr, &infos[i]);
@@ -411,6 +466,8 @@ class VulkanBackend final : public Backend {
   vk::PhysicalDeviceMemoryProperties memory_props_;
   uint32_t queue_family_ = 0;
   bool is_gpu_ = false;
+  bool unified_memory_ = false;
+  vk::DeviceSize max_allocation_bytes_ = 0;
   std::string device_name_;
   vk::raii::Device device_{nullptr};
   vk::raii::Queue queue_{nullptr};

@@ -146,6 +146,16 @@ TEST_F(GridEngineSemantics, FineVoxelsOutsideTheRegionAreNeverMapped) {
   EXPECT_GT(known, 1000u);
 }
 
+TEST_F(GridEngineSemantics, ASensorTooFarForTheExactWalkIsAnErrorNotADroppedScan) {
+  GridMapEngine map(smallConfig(), kRegion, *cpu_);
+  try {
+    map.integrate({9.0, 0.0, 0.3}, {}, {Eigen::Vector3f(8.5f, 0.0f, 0.3f)});
+    FAIL() << "a sensor 9 m from a 1 mm grid must be rejected";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("voxels from a map's corner"), std::string::npos) << e.what();
+  }
+}
+
 TEST(GridEngine, RequiresABackendAndAKnownEngineName) {
   EXPECT_THROW(createMapEngine("grid", smallConfig(), kRegion, nullptr), std::invalid_argument);
   EXPECT_THROW(createMapEngine("voxblox", smallConfig(), kRegion, nullptr), std::invalid_argument);
@@ -364,7 +374,41 @@ TEST(MapConfigYaml, ErrorsNameTheFileAndTheKey) {
   expectError("observation_min_m: [0, 0]\n", "observation_min_m", "list of 3 numbers");
   expectError("prob_hit: high\n", "prob_hit", "expected a number");
   expectError("observation_min_m: [0, 0, 3]\n", "observation_max_m", "must exceed");
+  expectError("sensor_max_range_m: 5.0\n", "sensor_max_range_m", "fewer than 4096 voxels per ray");
   std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace fvp::host::map
+
+namespace fvp::host::map {
+namespace {
+
+// Review finding: with bricks allocated on touch, the separable distance passes lost
+// values carried through voxels of unallocated bricks. Here the ROI voxel's brick and a
+// diagonal neighbour are the only bricks a ray reached.
+TEST(GridEngineDistance, DistancesCrossUnallocatedBricksExactly) {
+  auto cpu = accel::createBackend(accel::BackendKind::kCpu);
+  GridGeometry g;
+  g.voxel_size_m = 0.001;
+  g.first_voxel = {0, 0, 0};
+  g.dims = {32, 32, 32};
+  BrickedVoxelGrid grid(*cpu, g, true, std::nullopt, BrickedVoxelGrid::Allocation::kOnTouch);
+  // One ROI ray ending in voxel (7, 0, 0) from a sensor at voxel (15.5, 15.5, 0.5): it
+  // touches bricks (0,0,0), (1,0,0), (0,1,0) or (1,1,0) only.
+  const accel::ScanPoint end{0.0075f, 0.0005f, 0.0005f, FVP_POINT_HIT | FVP_POINT_ROI};
+  auto points = cpu->createBufferFrom(std::vector<accel::ScanPoint>{end});
+  grid.integrate(*points, 1, Eigen::Vector3f(0.0155f, 0.0155f, 0.0005f), OccupancyModel{});
+  ASSERT_LT(grid.allocatedBricks(), 5u);
+  const int radius = 10;
+  const std::vector<float> d = grid.roiDistanceVox(radius);
+  for (int z = 0; z < 32; ++z)
+    for (int y = 0; y < 32; ++y)
+      for (int x = 0; x < 32; ++x) {
+        const double exact = std::sqrt(double((x - 7) * (x - 7) + y * y + z * z));
+        ASSERT_NEAR(d[x + 32 * (y + 32 * z)], std::min<double>(exact, radius), 1e-5)
+            << "voxel " << x << "," << y << "," << z;
+      }
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <limits>
 #include <stdexcept>
 #include <tuple>
+#include <mutex>
 
 namespace fvp::host::map {
 namespace {
@@ -37,11 +38,10 @@ BrickedVoxelGrid::BrickedVoxelGrid(accel::Backend& backend, const GridGeometry& 
   counter_ = backend_.createBuffer(sizeof(std::uint32_t));
   ensurePoolCapacity(0);
   if (allocation == Allocation::kUpFront) {
-    std::vector<int> ids;
-    for (int bz = 0; bz < params_.bricks_z; ++bz)
-      for (int by = 0; by < params_.bricks_y; ++by)
-        for (int bx = 0; bx < params_.bricks_x; ++bx)
-          if (brickTouchesRegion(bx, by, bz)) ids.push_back(brickIndex(bx, by, bz));
+    // Every brick of the box, also those outside the region: the separable distance passes
+    // carry values through voxels between two region voxels that may lie outside it.
+    std::vector<int> ids(brick_count);
+    for (std::size_t id = 0; id < brick_count; ++id) ids[id] = static_cast<int>(id);
     allocate(ids);
   } else {
     uploadTables();
@@ -56,23 +56,6 @@ std::size_t BrickedVoxelGrid::deviceBytes() const {
   bytes += backend_.scanMarkBytes(pool_bricks_ * accel::kBrickVoxels);
   if (distance_) bytes += distance_->sizeBytes();
   return bytes;
-}
-
-bool BrickedVoxelGrid::brickTouchesRegion(int bx, int by, int bz) const {
-  if (!params_.use_region) return true;
-  // Nearest voxel centre of the brick to the sphere centre, in voxel units; one voxel of
-  // slack keeps every voxel whose centre passes fvp_region_contains.
-  const float c[3] = {params_.region.center_x_vox, params_.region.center_y_vox,
-                      params_.region.center_z_vox};
-  const int b[3] = {bx, by, bz};
-  double d2 = 0.0;
-  for (int a = 0; a < 3; ++a) {
-    const double lo = b[a] * 8 + 0.5, hi = b[a] * 8 + 7.5;
-    const double d = std::max({lo - c[a], 0.0, c[a] - hi});
-    d2 += d * d;
-  }
-  const double r = std::sqrt(params_.region.radius_sq_vox) + 1.0;
-  return d2 <= r * r;
 }
 
 bool BrickedVoxelGrid::brickInsideRegion(int bx, int by, int bz) const {
@@ -93,8 +76,14 @@ bool BrickedVoxelGrid::brickInsideRegion(int bx, int by, int bz) const {
 
 void BrickedVoxelGrid::ensurePoolCapacity(std::size_t bricks) {
   if (occupancy_ && bricks <= pool_bricks_) return;
+  // Kernels index slots with 32-bit ints: brick * 512 + local must stay below 2^31.
+  if (bricks > kMaxBricks) {
+    throw std::length_error("voxel map: " + std::to_string(bricks) + " bricks of 512 voxels needed, at most " +
+                            std::to_string(kMaxBricks) + " fit the kernels' 32-bit slot indices; "
+                            "use a coarser voxel size or a smaller box");
+  }
   // Grow geometrically; keep what is there (download, then upload into the new pools).
-  const std::size_t capacity = std::max<std::size_t>({bricks, pool_bricks_ * 2, 8});
+  const std::size_t capacity = std::min(std::max<std::size_t>({bricks, pool_bricks_ * 2, 8}), kMaxBricks);
   const std::size_t old_slots = allocatedBricks() * accel::kBrickVoxels;
   const std::size_t slots = capacity * accel::kBrickVoxels;
   std::vector<float> occ(slots, kUnknown), roi(with_roi_ ? slots : 1, kUnknown);
@@ -128,6 +117,7 @@ void BrickedVoxelGrid::allocate(const std::vector<int>& brick_ids) {
   }
   uploadTables();
   host_stale_ = true;
+  distance_.reset();  // computed for the old brick set
 }
 
 std::size_t BrickedVoxelGrid::integrate(const accel::DeviceBuffer& points, std::uint32_t point_count,
@@ -172,10 +162,13 @@ std::size_t BrickedVoxelGrid::integrate(const accel::DeviceBuffer& points, std::
   std::uint32_t updated = 0;
   backend_.download(*counter_, &updated, sizeof(updated));
   host_stale_ = true;
+  distance_.reset();  // the ROI changed: recompute on request
   return updated;
 }
 
 void BrickedVoxelGrid::refreshHostCopy() const {
+  // Const queries may come from several threads; the first one refreshes the mirror.
+  std::lock_guard<std::mutex> lock(host_mutex_);
   if (!host_stale_) return;
   const std::size_t slots = slotCount();
   host_occupancy_.resize(slots);
@@ -231,8 +224,36 @@ void BrickedVoxelGrid::assignDense(const std::vector<float>& occupancy, const st
   host_stale_ = true;
 }
 
+void BrickedVoxelGrid::allocateRoiHalo(int radius_vox) {
+  // The passes need every voxel within radius_vox (Chebyshev) of an ROI voxel to have a
+  // slot: the x pass result at (qx, py, pz) is what carries p's distance to q.
+  refreshHostCopy();
+  const int halo = (radius_vox + accel::kBrickEdge - 1) / accel::kBrickEdge;
+  std::vector<char> wanted(table_.size(), 0);
+  bool any = false;
+  for (std::size_t b = 0; b < allocatedBricks(); ++b) {
+    bool has_roi = false;
+    for (int local = 0; local < accel::kBrickVoxels && !has_roi; ++local)
+      has_roi = host_roi_[b * accel::kBrickVoxels + local] > 0.0f;
+    if (!has_roi) continue;
+    const int* c = &brick_coords_[3 * b];
+    for (int z = std::max(0, c[2] - halo); z <= std::min(params_.bricks_z - 1, c[2] + halo); ++z)
+      for (int y = std::max(0, c[1] - halo); y <= std::min(params_.bricks_y - 1, c[1] + halo); ++y)
+        for (int x = std::max(0, c[0] - halo); x <= std::min(params_.bricks_x - 1, c[0] + halo); ++x) {
+          const int id = brickIndex(x, y, z);
+          if (table_[id] == accel::kNoBrick) wanted[id] = any = true;
+        }
+  }
+  if (!any) return;
+  std::vector<int> ids;
+  for (std::size_t id = 0; id < wanted.size(); ++id)
+    if (wanted[id]) ids.push_back(static_cast<int>(id));
+  allocate(ids);
+}
+
 std::vector<float> BrickedVoxelGrid::roiDistanceVox(int radius_vox) {
   if (!with_roi_) throw std::logic_error("roiDistanceVox needs a map with ROI");
+  if (allocation_ == Allocation::kOnTouch) allocateRoiHalo(radius_vox);
   const std::size_t slots = slotCount();
   accel::EdtParams edt{};
   edt.map = params_;

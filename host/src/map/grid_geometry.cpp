@@ -26,9 +26,10 @@ GridGeometry boxGeometry(const Eigen::Vector3d& min_m, const Eigen::Vector3d& ma
       throw std::invalid_argument(std::string(what) + ": more than 8192 voxels along an axis");
     voxels *= g.dims[a];
   }
-  // Slots (allocated voxels) are 32-bit; the brick table must stay addressable too.
-  if (voxels / (FVP_BRICK_VOXELS) >= (std::int64_t{1} << 28))
-    throw std::invalid_argument(std::string(what) + ": 2^28 bricks or more");
+  // The brick table holds an int per brick of the box, allocated or not: keep it below
+  // 256 MiB. (Allocated bricks are limited separately, BrickedVoxelGrid::kMaxBricks.)
+  if (voxels / FVP_BRICK_VOXELS >= (std::int64_t{1} << 26))
+    throw std::invalid_argument(std::string(what) + ": a box of 2^26 bricks (8^3 voxels) or more");
   return g;
 }
 

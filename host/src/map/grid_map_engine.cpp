@@ -70,6 +70,22 @@ ScanStats GridMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
                                        const std::vector<Eigen::Vector3f>& other_points_m) {
   const auto t0 = std::chrono::steady_clock::now();
   ScanStats stats;
+  // Every end point lies within max range of the sensor; the exact walk needs it within
+  // 8192 voxels of each grid's corner (fvp_dda.h), else its rays would be dropped.
+  for (const BrickedVoxelGrid* grid : {coarse_.get(), fine_.get()}) {
+    const GridGeometry& g = grid->geometry();
+    for (int a = 0; a < 3; ++a) {
+      const double from_corner_vox =
+          std::abs(sensor_origin_m[a] / g.voxel_size_m - static_cast<double>(g.first_voxel[a])) +
+          config().sensor_max_range_m / g.voxel_size_m;
+      if (!(from_corner_vox < 8000.0)) {
+        throw std::invalid_argument("map integration: sensor origin " + std::to_string(sensor_origin_m[a]) +
+                                    " m (axis " + std::to_string(a) + ") plus sensor_max_range_m lies " +
+                                    std::to_string(from_corner_vox) +
+                                    " voxels from a map's corner; at most 8000 are walked exactly");
+      }
+    }
+  }
   const auto points = prepareScanPoints(sensor_origin_m, roi_points_m, other_points_m,
                                         config().sensor_max_range_m, stats);
   if (!points.empty() && sensor_origin_m.allFinite()) {

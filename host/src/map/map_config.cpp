@@ -1,5 +1,6 @@
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <functional>
 #include <map>
 #include <stdexcept>
@@ -40,6 +41,14 @@ void MapConfig::validate(const std::string& source) const {
       throw std::invalid_argument(source + ".observation_max_m must exceed " + source +
                                   ".observation_min_m on every axis");
     }
+  }
+  // The exact DDA walks end points within 8192 voxels of a grid's corner; rays up to
+  // max range from a sensor near the box must stay well inside that.
+  const double max_range_vox = sensor_max_range_m / std::min(coarse_voxel_size_m, fine_voxel_size_m);
+  if (max_range_vox >= 4096.0) {
+    throw std::invalid_argument(source + ".sensor_max_range_m / " + source +
+                                ".fine_voxel_size_m = " + std::to_string(max_range_vox) +
+                                ": expected fewer than 4096 voxels per ray");
   }
   model.validate(source + ".model");
 }

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <vector>
 
@@ -30,8 +31,12 @@ struct FrontierVoxel {
 
 class BrickedVoxelGrid {
  public:
+  /// The most bricks one grid may allocate: kernels index slots (brick * 512 + voxel) with
+  /// 32-bit ints.
+  static constexpr std::size_t kMaxBricks = (std::size_t{1} << 22) - 1;
+
   enum class Allocation {
-    kUpFront,  ///< every brick of the grid (inside the region, if any) at construction
+    kUpFront,  ///< every brick of the grid box at construction
     kOnTouch,  ///< bricks as scans reach them
   };
 
@@ -69,7 +74,8 @@ class BrickedVoxelGrid {
 
   /// Paper Eq. 1's d_i: Euclidean distance in voxels from every voxel to the nearest known
   /// ROI voxel, capped at radius_vox; dense over the grid (unallocated voxels: the cap).
-  /// The per-slot result stays on the device for the information-gain kernel.
+  /// The per-slot result stays on the device for the information-gain kernel until the next
+  /// scan or allocation.
   std::vector<float> roiDistanceVox(int radius_vox);
   const accel::DeviceBuffer* roiDistanceBuffer() const { return distance_.get(); }
 
@@ -85,9 +91,9 @@ class BrickedVoxelGrid {
   int brickIndex(int bx, int by, int bz) const {
     return bx + params_.bricks_x * (by + params_.bricks_y * bz);
   }
-  bool brickTouchesRegion(int bx, int by, int bz) const;
   bool brickInsideRegion(int bx, int by, int bz) const;
   void allocate(const std::vector<int>& brick_ids);
+  void allocateRoiHalo(int radius_vox);
   void ensurePoolCapacity(std::size_t bricks);
   void uploadTables();
   void refreshHostCopy() const;
@@ -106,6 +112,7 @@ class BrickedVoxelGrid {
   std::unique_ptr<accel::DeviceBuffer> occupancy_, roi_, marks_;
   std::unique_ptr<accel::DeviceBuffer> distance_;
 
+  mutable std::mutex host_mutex_;
   mutable bool host_stale_ = true;
   mutable std::vector<float> host_occupancy_, host_roi_;
 };
