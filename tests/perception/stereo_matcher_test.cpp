@@ -152,6 +152,25 @@ TEST(StereoMatcher, BandAndCoarsePassesMatchTheFullPass) {
             << band.stats.sgbm_s * 1e3 << " ms\n";
 }
 
+// A trial must be reproducible on any machine: the disparities may not depend on how many
+// cores split the work.
+TEST(StereoMatcher, DisparityIsTheSameForEveryThreadCount) {
+  const StereoIntrinsics K = smallCamera();
+  const cv::Rect patch(520, 40, 220, 150);
+  const auto pair = test::makeStereoPair(K, 90.0, {{patch, 183.3}}, 2.0, 23);
+  cv::Mat reference;
+  for (int threads : {1, 2, 3, 8}) {
+    StereoMatcherConfig cfg;
+    cfg.threads = threads;
+    const cv::Mat d = StereoMatcher(cfg).compute(pair.left, pair.right, patch).disparity_px;
+    if (reference.empty()) {
+      reference = d;
+      continue;
+    }
+    EXPECT_EQ(cv::countNonZero(d != reference), 0) << threads << " threads";
+  }
+}
+
 TEST(StereoMatcher, RejectsMismatchedImages) {
   cv::Mat a(100, 400, CV_8UC3, cv::Scalar::all(0)), b(100, 300, CV_8UC3, cv::Scalar::all(0));
   EXPECT_THROW(StereoMatcher().compute(a, b, {}), std::invalid_argument);

@@ -83,6 +83,18 @@ TEST(WorldConfig, UnreadableFileNamesIt) {
   }
 }
 
+TEST(WorldConfig, TheClusterBranchMustLeaveTheTrunk) {
+  WorldConfig config;
+  config.cluster_height_m = 2.5;
+  config.trunk_height_m = 2.0;
+  try {
+    config.validate("test");
+    FAIL() << "a cluster above the trunk's top was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("cluster_height_m"), std::string::npos) << e.what();
+  }
+}
+
 TEST(WorldConfig, ValidateRejectsNaN) {
   WorldConfig config;
   config.leaf_region_m = std::numeric_limits<double>::quiet_NaN();

@@ -71,6 +71,9 @@ std::vector<TagDetection> AprilTagDetector::detectAll(
   std::vector<TagDetection> out;
   std::lock_guard lock(mutex_);
   zarray_t* detections = apriltag_detector_detect(impl_->detector, &im);
+  // Freed however this scope is left (a throwing push_back included).
+  const std::unique_ptr<zarray_t, void (*)(zarray_t*)> detections_owner(detections,
+                                                                        apriltag_detections_destroy);
   for (int i = 0; i < zarray_size(detections); ++i) {
     apriltag_detection_t* det = nullptr;
     zarray_get(detections, i, &det);
@@ -85,6 +88,12 @@ std::vector<TagDetection> AprilTagDetector::detectAll(
     apriltag_detection_info_t info{det, config_.tag_size_m, K.fx_px, K.fy_px, K.cx_px, K.cy_px};
     apriltag_pose_t pose{nullptr, nullptr};
     d.object_space_error = estimate_tag_pose(&info, &pose);
+    // A degenerate quad can leave no pose (NaN errors pick a missing second solution).
+    if (pose.R == nullptr || pose.t == nullptr) {
+      std::free(pose.R);
+      std::free(pose.t);
+      continue;
+    }
     Eigen::Matrix3d R;
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) R(r, c) = MATD_EL(pose.R, r, c);
@@ -96,12 +105,12 @@ std::vector<TagDetection> AprilTagDetector::detectAll(
     // Re-orthonormalise (orthogonal iteration returns R up to rounding).
     Eigen::JacobiSVD<Eigen::Matrix3d> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);
     R = svd.matrixU() * svd.matrixV().transpose();
+    if (!R.allFinite() || !t.allFinite()) continue;
     d.T_camera_tag.linear() = R;
     d.T_camera_tag.translation() = t;
     d.T_world_tag = T_world_camera * d.T_camera_tag;
     out.push_back(d);
   }
-  apriltag_detections_destroy(detections);
   return out;
 }
 

@@ -185,6 +185,7 @@ cv::Mat readImage(const fs::path& file, int flags, const StereoIntrinsics& K, bo
 void removeIfExists(const fs::path& path) {
   std::error_code ec;
   fs::remove(path, ec);
+  if (ec) throw std::runtime_error(path.string() + ": cannot remove a stale file: " + ec.message());
 }
 
 }  // namespace
@@ -208,6 +209,9 @@ void writeCapture(const fs::path& dir, const Capture& c) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) throw std::runtime_error(dir.string() + ": cannot create directory: " + ec.message());
+  // First: an old camera.yaml beside new images would make a mixed capture look complete.
+  fs::remove(dir / kCamera, ec);
+  if (ec) throw std::runtime_error((dir / kCamera).string() + ": cannot remove the old file: " + ec.message());
 
   writePng(dir / kLeft, c.left_bgr);
   writePng(dir / kRight, c.right_bgr);

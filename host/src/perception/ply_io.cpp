@@ -58,10 +58,13 @@ std::vector<Eigen::Vector3f> readPlyPoints(const std::filesystem::path& path) {
       if (fmt != "binary_little_endian") fail("format", "binary_little_endian, got '" + fmt + "'");
       format_ok = true;
     } else if (word == "element") {
-      std::string el;
+      std::string el, rest;
       long long n = -1;
       ls >> el >> n;
+      if (!ls || (ls >> rest)) fail("element " + el, "'element <name> <count>'");
       in_vertex = el == "vertex";
+      // Other elements' data would precede or follow the vertices unaccounted for.
+      if (!in_vertex) fail("element " + el, "only a vertex element");
       if (in_vertex) {
         if (have_vertex) fail("element vertex", "a single vertex element");
         if (n < 0) fail("element vertex", "a non-negative count");
@@ -104,6 +107,15 @@ std::vector<Eigen::Vector3f> readPlyPoints(const std::filesystem::path& path) {
     offsets[i] = stride;
     stride += prop_sizes[i];
   }
+  // The count must fit the bytes that follow the header before anything is allocated.
+  const std::streampos data_start = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::streamoff available = in.tellg() - data_start;
+  in.seekg(data_start);
+  if (stride <= 0 || available < 0 ||
+      vertices > static_cast<std::size_t>(available) / static_cast<std::size_t>(stride))
+    fail("vertex data", std::to_string(vertices) + " vertices of " + std::to_string(stride) +
+                            " bytes, the file is truncated");
   std::vector<char> data(vertices * stride);
   in.read(data.data(), static_cast<std::streamsize>(data.size()));
   if (static_cast<std::size_t>(in.gcount()) != data.size())

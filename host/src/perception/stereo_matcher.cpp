@@ -52,6 +52,10 @@ cv::Mat sgbmCodes(const cv::Mat& left, const cv::Mat& right, const SgbmConfig& c
 }
 
 // Row strips [begin, end) of n roughly equal parts.
+// Strips per pass, fixed rather than one per core so the disparities (SGBM's paths, the
+// uniqueness and speckle filters near strip edges) are the same on every machine.
+constexpr int kSgbmStrips = 4;
+
 std::vector<cv::Range> strips(int begin, int end, int n) {
   std::vector<cv::Range> out;
   const int rows = end - begin;
@@ -161,12 +165,15 @@ DisparityResult StereoMatcher::compute(const cv::Mat& left, const cv::Mat& right
     const int margin = fine_cfg.block_size + 2;
     const int x0 =
         std::max(0, fine_rect.x - fine_cfg.min_disparity - fine_cfg.num_disparities - margin);
-    const int x1 = std::min(W, fine_rect.br().x + margin);
+    // Right of the band too: the left-right check compares each pixel with left pixels up to
+    // minD + numDisp columns to its right, and a right-to-left path aggregates from there.
+    const int x1 =
+        std::min(W, fine_rect.br().x + fine_cfg.min_disparity + fine_cfg.num_disparities + margin);
     fine_codes.create(fine_rect.size(), CV_32F);
-    for (const cv::Range& r : strips(fine_rect.y, fine_rect.br().y, threads)) {
-      tasks.emplace_back([&, r, x0, x1, margin] {
+    for (const cv::Range& r : strips(fine_rect.y, fine_rect.br().y, kSgbmStrips)) {
+      tasks.emplace_back([&, r, x0, x1] {
         const int y0 = std::max(0, r.start - config_.strip_overlap_px);
-        const int y1 = std::min(H, r.end + margin);
+        const int y1 = std::min(H, r.end + config_.strip_overlap_px);
         const cv::Rect roi(x0, y0, x1 - x0, y1 - y0);
         cv::Mat codes = sgbmCodes(left(roi), right(roi), fine_cfg, x0);
         codes(cv::Rect(fine_rect.x - x0, r.start - y0, fine_rect.width, r.size()))
@@ -189,11 +196,10 @@ DisparityResult StereoMatcher::compute(const cv::Mat& left, const cv::Mat& right
     reduce(left, left_small);
     reduce(right, right_small);
     coarse_codes.create(left_small.size(), CV_32F);
-    const int margin = coarse_cfg.block_size + 2;
-    for (const cv::Range& r : strips(0, left_small.rows, threads)) {
-      tasks.emplace_back([&, r, margin] {
+    for (const cv::Range& r : strips(0, left_small.rows, kSgbmStrips)) {
+      tasks.emplace_back([&, r] {
         const int y0 = std::max(0, r.start - config_.strip_overlap_px);
-        const int y1 = std::min(left_small.rows, r.end + margin);
+        const int y1 = std::min(left_small.rows, r.end + config_.strip_overlap_px);
         const cv::Rect roi(0, y0, left_small.cols, y1 - y0);
         cv::Mat codes = sgbmCodes(left_small(roi), right_small(roi), coarse_cfg, 0);
         codes(cv::Rect(0, r.start - y0, left_small.cols, r.size()))

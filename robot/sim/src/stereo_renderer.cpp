@@ -321,6 +321,12 @@ StereoRenderer::StereoRenderer(const World& world, const RenderConfig& config)
   if (in.width_px <= 0 || in.height_px <= 0 || !(in.fx_px > 0.0) || !(in.fy_px > 0.0)) {
     throw std::invalid_argument("StereoRenderer: intrinsics need positive size and focal length");
   }
+  if (!(in.baseline_m > 0.0) || !(in.cx_px >= 0.0 && in.cx_px <= in.width_px) ||
+      !(in.cy_px >= 0.0 && in.cy_px <= in.height_px)) {
+    throw std::invalid_argument(
+        "StereoRenderer: intrinsics need baseline_m > 0 (the right camera is at +x) and the "
+        "principal point inside the image");
+  }
   if (config.samples_per_pixel < 1 || config.threads < 0) {
     throw std::invalid_argument("StereoRenderer: samples_per_pixel must be >= 1, threads >= 0");
   }

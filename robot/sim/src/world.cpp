@@ -322,8 +322,10 @@ World World::generate(const WorldConfig& config, std::uint64_t seed) {
     const double tilt = config.max_tag_tilt_deg * kDegToRad;
     const double yaw_t = rng.uniform(-tilt, tilt), pitch_t = rng.uniform(-tilt, tilt);
     const double roll_t = rng.uniform(-tilt, tilt);
+    // Yaw and pitch swing the plate's edges back towards the branch: stand off that much more.
+    const double swing_m = 0.5 * tag.plate_size_m * (std::abs(std::sin(yaw_t)) + std::abs(std::sin(pitch_t)));
     const Eigen::Vector3d centre = branch_point + sign * t * branch_dir +
-                                   (config.branch_radius_m + kTagStandoffM) * toward_view;
+                                   (config.branch_radius_m + kTagStandoffM + swing_m) * toward_view;
     const double distance = (centre - cluster).norm();
     if (distance < config.min_tag_distance_m || distance > config.max_tag_distance_m) continue;
     const Eigen::Isometry3d upright = lookAt(centre + toward_view, centre);
@@ -361,7 +363,7 @@ World World::generate(const WorldConfig& config, std::uint64_t seed) {
       const Eigen::Vector3d end =
           start + length * Eigen::Vector3d(std::cos(slope) * std::cos(azimuth),
                                            std::cos(slope) * std::sin(azimuth), std::sin(slope));
-      const double clearance = radius + 0.01;
+      const double clearance = radius + std::max(0.01, config.min_gap_m);
       if (segmentSegmentDistance(start, end, camera_m, cluster) <
               clearance + config.cluster_spread_m + max_bound_m ||
           segmentSegmentDistance(start, end, camera_m, tag_centre) <

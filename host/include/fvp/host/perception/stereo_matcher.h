@@ -27,7 +27,7 @@ inline constexpr int kDefaultSgbmMode = cv::StereoSGBM::MODE_SGBM;
 /// Disparities >= num_disparities - margin are saturated (SGBM clamps near objects there).
 inline constexpr int kDefaultSaturationMarginPx = 2;
 inline constexpr int kDefaultCoarseScale = 2;      ///< coarse pass at 1/2 resolution
-inline constexpr int kDefaultStripOverlapPx = 24;  ///< rows for SGBM's top-down paths to settle
+inline constexpr int kDefaultStripOverlapPx = 24;  ///< rows above and below each strip for SGBM's paths to settle
 
 /// OpenCV StereoSGBM parameters at full resolution.
 struct SgbmConfig {
