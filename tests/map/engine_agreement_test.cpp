@@ -62,14 +62,22 @@ EngineComparison compareEngines(const GridMapEngine& grid, const OctomapMapEngin
   return c;
 }
 
-TEST(EngineAgreement, AgreeOnSyntheticScansOfACluster) {
-  MapConfig config;
-  config.observation_min_m = {-0.4, -0.4, -0.2};
-  config.observation_max_m = {0.4, 0.4, 0.6};
-  const ClusterRegion region(Eigen::Vector3d(0.012, -0.007, 0.31), 0.05);
-  auto cpu = accel::createBackend(accel::BackendKind::kCpu);
-  GridMapEngine grid(config, region, *cpu);
-  OctomapMapEngine octo(config, region);
+// Both engines over the same small box and Cluster Region, for synthetic scans.
+class SyntheticEnginePair : public ::testing::Test {
+ protected:
+  static MapConfig boxConfig() {
+    MapConfig config;
+    config.observation_min_m = {-0.4, -0.4, -0.2};
+    config.observation_max_m = {0.4, 0.4, 0.6};
+    return config;
+  }
+  const ClusterRegion region{Eigen::Vector3d(0.012, -0.007, 0.31), 0.05};
+  std::unique_ptr<accel::Backend> cpu = accel::createBackend(accel::BackendKind::kCpu);
+  GridMapEngine grid{boxConfig(), region, *cpu};
+  OctomapMapEngine octo{boxConfig(), region};
+};
+
+TEST_F(SyntheticEnginePair, AgreeOnSyntheticScansOfACluster) {
   ASSERT_EQ(grid.fine().geometry().first_voxel, octo.fineGrid().first_voxel);
   ASSERT_EQ(grid.coarse().geometry().dims, octo.coarseGrid().dims);
 
@@ -93,14 +101,7 @@ TEST(EngineAgreement, AgreeOnSyntheticScansOfACluster) {
 
 // The Embree scenes over occupied voxels follow the scans (only changed bricks rebuilt),
 // agree between the engines, and their first hits land on occupied voxels of the map.
-TEST(EngineAgreement, OccupiedScenesFollowTheScansAndAgree) {
-  MapConfig config;
-  config.observation_min_m = {-0.4, -0.4, -0.2};
-  config.observation_max_m = {0.4, 0.4, 0.6};
-  const ClusterRegion region(Eigen::Vector3d(0.012, -0.007, 0.31), 0.05);
-  auto cpu = accel::createBackend(accel::BackendKind::kCpu);
-  GridMapEngine grid(config, region, *cpu);
-  OctomapMapEngine octo(config, region);
+TEST_F(SyntheticEnginePair, OccupiedScenesFollowTheScansAndAgree) {
   const auto world = testing::makeWorld(99, region.center_m());
   const Eigen::Vector3d origin = region.center_m() + Eigen::Vector3d(0.05, 0.02, -0.3);
   const auto scan = testing::renderScan(world, origin, 200, 150, 0.8, 1);
