@@ -445,29 +445,4 @@ host::StereoFrame StereoRenderer::render(const Eigen::Isometry3d& T_world_camera
   return frame;
 }
 
-std::vector<FruitletVisibility> StereoRenderer::fruitletVisibility(
-    const Eigen::Isometry3d& T_world_camera) const {
-  RenderOptions gt_only;
-  gt_only.images = false;
-  const cv::Mat with_leaves = render(T_world_camera, gt_only).gt_object_id;
-  gt_only.with_leaves = false;
-  const cv::Mat without_leaves = render(T_world_camera, gt_only).gt_object_id;
-  std::vector<FruitletVisibility> result(impl_->world.fruitlets().size());
-  for (std::size_t i = 0; i < result.size(); ++i) result[i].index = static_cast<int>(i);
-  const auto count = [&](const cv::Mat& ids, long FruitletVisibility::*field) {
-    for (int row = 0; row < ids.rows; ++row) {
-      for (int col = 0; col < ids.cols; ++col) {
-        const int id = ids.at<std::int32_t>(row, col);
-        if (host::isFruitletId(id) &&
-            id - host::kFirstFruitletId < static_cast<int>(result.size())) {
-          ++(result[id - host::kFirstFruitletId].*field);
-        }
-      }
-    }
-  };
-  count(with_leaves, &FruitletVisibility::visible_px);
-  count(without_leaves, &FruitletVisibility::unoccluded_px);
-  return result;
-}
-
 }  // namespace fvp::robot::sim

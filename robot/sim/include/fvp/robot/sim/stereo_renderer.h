@@ -44,17 +44,6 @@ struct RenderOptions {
   bool images = true;        ///< false: skip the pair (left_bgr/right_bgr stay empty)
 };
 
-/// How much of one fruitlet the left camera sees: pixel centres showing it with leaves vs
-/// in the same view rendered without leaves.
-struct FruitletVisibility {
-  int index = 0;
-  long visible_px = 0;
-  long unoccluded_px = 0;
-  /// visible / unoccluded, 0 when the fruitlet is out of view even without leaves.
-  double visibleFraction() const {
-    return unoccluded_px > 0 ? static_cast<double>(visible_px) / unoccluded_px : 0.0;
-  }
-};
 
 class StereoRenderer {
  public:
@@ -70,9 +59,6 @@ class StereoRenderer {
                            const RenderOptions& options = {}) const;
   /// Wall time of the last render() call, seconds.
   double lastRenderSeconds() const;
-
-  /// Per-fruitlet leaf occlusion of the left camera's view (ground-truth ids only, fast).
-  std::vector<FruitletVisibility> fruitletVisibility(const Eigen::Isometry3d& T_world_camera) const;
 
   const RenderConfig& config() const;
 
