@@ -94,6 +94,16 @@ void checkSlots(std::uint32_t slot_count, const char* what) {
   if (slot_count % kBrickVoxels != 0)
     throw std::invalid_argument(std::string(what) + ": slot_count must be a multiple of 512");
 }
+// The checks every per-slot kernel over bricked storage shares.
+void checkSlotKernel(const BrickedGridParams& m, std::uint32_t slot_count,
+                     const DeviceBuffer& brick_coords, const DeviceBuffer& brick_table,
+                     const std::string& what) {
+  checkBrickedGrid(m, what.c_str());
+  checkSlots(slot_count, what.c_str());
+  checkRange(brick_coords, std::size_t{slot_count} / kBrickVoxels * 3 * sizeof(int), 0,
+             (what + ": brick_coords").c_str());
+  checkRange(brick_table, brickCount(m) * sizeof(int), 0, (what + ": brick_table").c_str());
+}
 }  // namespace
 
 void Backend::scanMark(const ScanParams& params, const DeviceBuffer& points,
@@ -126,14 +136,11 @@ void Backend::roiDistancePass(const EdtParams& params, int axis, const DeviceBuf
                               const DeviceBuffer& brick_table, const DeviceBuffer& roi,
                               const DeviceBuffer& sq_in, DeviceBuffer& sq_out,
                               DeviceBuffer& distance_vox) {
-  checkBrickedGrid(params.map, "roiDistancePass");
-  checkSlots(params.slot_count, "roiDistancePass");
+  checkSlotKernel(params.map, params.slot_count, brick_coords, brick_table, "roiDistancePass");
   if (axis < 0 || axis > 2) throw std::invalid_argument("roiDistancePass: axis must be 0, 1 or 2");
   if (params.radius_vox < 1 || params.radius_vox > 1000)
     throw std::invalid_argument("roiDistancePass: radius_vox must be in [1, 1000]");
   const std::size_t slots = params.slot_count;
-  checkRange(brick_coords, slots / kBrickVoxels * 3 * sizeof(int), 0, "roiDistancePass: brick_coords");
-  checkRange(brick_table, brickCount(params.map) * sizeof(int), 0, "roiDistancePass: brick_table");
   if (axis == 0) checkRange(roi, slots * sizeof(float), 0, "roiDistancePass: roi");
   if (axis > 0) checkRange(sq_in, slots * sizeof(std::uint32_t), 0, "roiDistancePass: sq_in");
   if (axis < 2) checkRange(sq_out, slots * sizeof(std::uint32_t), 0, "roiDistancePass: sq_out");
@@ -144,11 +151,8 @@ void Backend::roiDistancePass(const EdtParams& params, int axis, const DeviceBuf
 void Backend::extractFrontiers(const FrontierParams& params, const DeviceBuffer& brick_coords,
                                const DeviceBuffer& brick_table, const DeviceBuffer& occupancy,
                                const DeviceBuffer& roi, DeviceBuffer& out, DeviceBuffer& count) {
-  checkBrickedGrid(params.map, "extractFrontiers");
-  checkSlots(params.slot_count, "extractFrontiers");
+  checkSlotKernel(params.map, params.slot_count, brick_coords, brick_table, "extractFrontiers");
   const std::size_t slots = params.slot_count;
-  checkRange(brick_coords, slots / kBrickVoxels * 3 * sizeof(int), 0, "extractFrontiers: brick_coords");
-  checkRange(brick_table, brickCount(params.map) * sizeof(int), 0, "extractFrontiers: brick_table");
   checkRange(occupancy, slots * sizeof(float), 0, "extractFrontiers: occupancy");
   checkRange(roi, slots * sizeof(float), 0, "extractFrontiers: roi");
   checkRange(out, std::size_t{params.capacity} * sizeof(Frontier), 0, "extractFrontiers: out");

@@ -335,11 +335,6 @@ INSTANTIATE_TEST_SUITE_P(AllBackends, GridEngineBackends,
                                            BackendKind::kVulkan),
                          backendName);
 
-}  // namespace
-}  // namespace fvp::host::map
-
-namespace fvp::host::map {
-namespace {
 
 TEST(MapConfigYaml, TheDefaultsFileHoldsTheDefaults) {
   const MapConfig read = MapConfig::fromYamlFile(FVP_SOURCE_DIR "/host/config/map_default.yaml");
@@ -378,11 +373,6 @@ TEST(MapConfigYaml, ErrorsNameTheFileAndTheKey) {
   std::filesystem::remove_all(dir);
 }
 
-}  // namespace
-}  // namespace fvp::host::map
-
-namespace fvp::host::map {
-namespace {
 
 // Review finding: with bricks allocated on touch, the separable distance passes lost
 // values carried through voxels of unallocated bricks. Here the ROI voxel's brick and a
