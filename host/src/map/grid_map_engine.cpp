@@ -117,15 +117,7 @@ VoxelState GridMapEngine::fineState(const Eigen::Vector3d& p_m) const {
 // Exports build the same OctoMap trees the octomap engine holds and write them with its
 // writers (octomap_io.h), so both engines produce interchangeable files.
 void GridMapEngine::exportCoarse(const std::filesystem::path& bt_path) const {
-  octomap::OcTree tree(config().coarse_voxel_size_m);
-  tree.setOccupancyThres(config().model.occupied_prob);
-  coarse_->forEachVoxel([&](const std::array<int, 3>& index, float occupancy, float) {
-    if (std::isnan(occupancy)) return;
-    const Eigen::Vector3d c = coarse_->geometry().voxelCenter_m(index);
-    tree.setNodeValue(octomap::point3d(c.x(), c.y(), c.z()), occupancy, /*lazy_eval=*/true);
-  });
-  tree.updateInnerOccupancy();
-  writeCoarseBt(tree, bt_path);
+  writeCoarseBt(*buildCoarseTree(), bt_path);
 }
 
 void GridMapEngine::exportFine(const std::filesystem::path& ot_path) const {
@@ -156,16 +148,47 @@ std::vector<std::array<int, 3>> GridMapEngine::occupiedVoxels(MapLevel level) co
   return voxels;
 }
 
-std::vector<float> GridMapEngine::roiDistance_m(double max_d_m) {
+void GridMapEngine::updateRoiDistance(double max_d_m) {
+  if (!(max_d_m > 0.0)) throw std::invalid_argument("updateRoiDistance: max_d_m must be positive");
+  if (distance_max_d_m_ == max_d_m && distance_scans_ == scanCount()) return;
   const double voxel = fine_->geometry().voxel_size_m;
   const int radius_vox = std::max(1, static_cast<int>(std::ceil(max_d_m / voxel)));
-  std::vector<float> d = fine_->roiDistanceVox(radius_vox);
-  for (float& v : d) v = static_cast<float>(std::min(v * voxel, max_d_m));
-  return d;
+  distance_vox_ = fine_->roiDistanceVox(radius_vox);
+  distance_max_d_m_ = max_d_m;
+  distance_scans_ = scanCount();
+}
+
+double GridMapEngine::roiDistance_m(const std::array<int, 3>& fine_index) const {
+  if (distance_max_d_m_ < 0.0) throw std::logic_error("roiDistance_m: call updateRoiDistance() first");
+  const GridGeometry& g = fine_->geometry();
+  for (int a = 0; a < 3; ++a)
+    if (fine_index[a] < 0 || fine_index[a] >= g.dims[a]) return distance_max_d_m_;
+  const std::size_t dense =
+      fine_index[0] + g.dims[0] * (fine_index[1] + static_cast<std::size_t>(g.dims[1]) * fine_index[2]);
+  return std::min(distance_vox_[dense] * g.voxel_size_m, distance_max_d_m_);
 }
 
 std::vector<FrontierVoxel> GridMapEngine::frontiers() {
   return fine_->extractFrontiers(config().model.occupiedLogOdds());
+}
+
+std::unique_ptr<octomap::OcTree> GridMapEngine::buildCoarseTree() const {
+  auto tree = std::make_unique<octomap::OcTree>(config().coarse_voxel_size_m);
+  tree->setOccupancyThres(config().model.occupied_prob);
+  coarse_->forEachVoxel([&](const std::array<int, 3>& index, float occupancy, float) {
+    if (std::isnan(occupancy)) return;
+    const Eigen::Vector3d c = coarse_->geometry().voxelCenter_m(index);
+    tree->setNodeValue(octomap::point3d(c.x(), c.y(), c.z()), occupancy, /*lazy_eval=*/true);
+  });
+  tree->updateInnerOccupancy();
+  return tree;
+}
+
+const octomap::OcTree& GridMapEngine::coarseOcTree() {
+  if (coarse_tree_ && coarse_tree_scans_ == scanCount()) return *coarse_tree_;
+  coarse_tree_ = buildCoarseTree();
+  coarse_tree_scans_ = scanCount();
+  return *coarse_tree_;
 }
 
 }  // namespace fvp::host::map

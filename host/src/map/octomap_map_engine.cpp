@@ -363,4 +363,14 @@ std::vector<std::array<int, 3>> OctomapMapEngine::occupiedVoxels(MapLevel level)
                                     : occupiedLeaves(*fine_, fine_grid_, occupied);
 }
 
+void OctomapMapEngine::updateRoiDistance(double) {
+  throw std::logic_error("octomap engine: ROI distance field not written yet");
+}
+double OctomapMapEngine::roiDistance_m(const std::array<int, 3>&) const {
+  throw std::logic_error("octomap engine: ROI distance field not written yet");
+}
+std::vector<FrontierVoxel> OctomapMapEngine::frontiers() {
+  throw std::logic_error("octomap engine: frontiers not written yet");
+}
+
 }  // namespace fvp::host::map

@@ -15,19 +15,11 @@
 #include <vector>
 
 #include "fvp/accel/backend.h"
+#include "fvp/host/map/frontier_voxel.h"
 #include "fvp/host/map/grid_geometry.h"
 #include "fvp/host/map/occupancy_model.h"
 
 namespace fvp::host::map {
-
-/// One frontier voxel of a fine map (see extractFrontiers in fvp/accel/backend.h).
-struct FrontierVoxel {
-  std::array<int, 3> index{};              ///< grid index
-  Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
-  bool roi_frontier = false;               ///< known ROI voxel next to unknown space
-  bool exploration_frontier = false;       ///< known free voxel next to unknown space
-  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  ///< away from the unknown; zero if undefined
-};
 
 class BrickedVoxelGrid {
  public:

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <octomap/OcTree.h>
 
 #include "fvp/accel/backend.h"
 #include "fvp/host/map/bricked_voxel_grid.h"
@@ -33,10 +34,10 @@ class GridMapEngine final : public MapEngine {
   const BrickedVoxelGrid& coarse() const { return *coarse_; }
   const BrickedVoxelGrid& fine() const { return *fine_; }
 
-  /// Paper Eq. 1's d_i over the fine grid, metres, capped at max_d_m (dense, x fastest).
-  std::vector<float> roiDistance_m(double max_d_m);
-  /// ROI and exploration frontiers of the fine map, sorted by grid index.
-  std::vector<FrontierVoxel> frontiers();
+  void updateRoiDistance(double max_d_m) override;
+  double roiDistance_m(const std::array<int, 3>& fine_index) const override;
+  std::vector<FrontierVoxel> frontiers() override;
+  const octomap::OcTree& coarseOcTree() override;
 
  protected:
   ScanStats integrateScan(const Eigen::Vector3d& sensor_origin_m,
@@ -44,8 +45,16 @@ class GridMapEngine final : public MapEngine {
                           const std::vector<Eigen::Vector3f>& other_points_m) override;
 
  private:
+  std::unique_ptr<octomap::OcTree> buildCoarseTree() const;
+
   accel::Backend& backend_;
   std::unique_ptr<BrickedVoxelGrid> coarse_, fine_;
+  // ROI distance as of distance_scans_ scans with cap distance_max_d_m_ (per fine slot).
+  std::vector<float> distance_vox_;
+  double distance_max_d_m_ = -1.0;
+  std::size_t distance_scans_ = 0;
+  std::unique_ptr<octomap::OcTree> coarse_tree_;
+  std::size_t coarse_tree_scans_ = 0;
 };
 
 /// Turns two clouds into kernel scan points: non-finite points are skipped and counted,

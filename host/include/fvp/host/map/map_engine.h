@@ -16,6 +16,7 @@
 #include <string_view>
 #include <vector>
 
+#include "fvp/host/map/frontier_voxel.h"
 #include "fvp/host/map/grid_geometry.h"
 #include "fvp/host/map/map_config.h"
 #include "fvp/host/map/occupied_voxel_scene.h"
@@ -25,6 +26,9 @@
 
 namespace fvp::accel {
 class Backend;
+}
+namespace octomap {
+class OcTree;
 }
 
 namespace fvp::host::map {
@@ -41,6 +45,8 @@ class MapEngine {
   virtual std::string_view engineName() const = 0;
   const MapConfig& config() const { return config_; }
   const ClusterRegion& region() const { return region_; }
+  /// Scans integrated so far.
+  std::size_t scanCount() const { return scans_; }
 
   /// Integrates one view: rays from sensor_origin_m to every point (world frame).
   ScanStats integrate(const Eigen::Vector3d& sensor_origin_m,
@@ -66,6 +72,22 @@ class MapEngine {
   /// current with every scan integrated so far: after new scans, the next call rebuilds
   /// only the bricks whose voxels changed.
   const OccupiedVoxelScene& occupiedScene(MapLevel level);
+
+  // ---- Reads the planner needs, with the same results on both engines ----
+
+  /// Paper Eq. 1's d_i over the fine grid: Euclidean distance between voxel centres to the
+  /// nearest known ROI voxel (ROI log-odds > 0), in metres, capped at max_d_m. Recomputes
+  /// when scans arrived or the cap changed since the last call; otherwise free.
+  virtual void updateRoiDistance(double max_d_m) = 0;
+  /// d_i of one fine voxel as of the last updateRoiDistance(); the cap outside the fine
+  /// grid. Throws std::logic_error before the first updateRoiDistance().
+  virtual double roiDistance_m(const std::array<int, 3>& fine_index) const = 0;
+  /// ROI and exploration frontiers of the fine map (frontier_voxel.h), sorted by grid index
+  /// (z, then y, then x).
+  virtual std::vector<FrontierVoxel> frontiers() = 0;
+  /// The coarse map as an octomap::OcTree at the coarse resolution (the FCL collision
+  /// world, as MoveIt's occupancy map monitor uses), current with every scan so far.
+  virtual const octomap::OcTree& coarseOcTree() = 0;
 
  protected:
   MapEngine(const MapConfig& config, const ClusterRegion& region)

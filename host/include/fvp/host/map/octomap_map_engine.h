@@ -67,6 +67,13 @@ class OctomapMapEngine : public MapEngine {
   void exportCoarse(const std::filesystem::path& bt_path) const override;
   void exportFine(const std::filesystem::path& ot_path) const override;
 
+  // Planner reads (map_engine.h). Transient: the distance field and frontiers are being
+  // written (DynamicEDTOctomap); until then they throw std::logic_error.
+  void updateRoiDistance(double max_d_m) override;
+  double roiDistance_m(const std::array<int, 3>& fine_index) const override;
+  std::vector<FrontierVoxel> frontiers() override;
+  const octomap::OcTree& coarseOcTree() override { return *coarse_; }
+
   const octomap::OcTree& coarseTree() const { return *coarse_; }
   const RoiOcTree& fineTree() const { return *fine_; }
   const GridGeometry& coarseGrid() const { return coarse_grid_; }
