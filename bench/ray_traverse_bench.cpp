@@ -11,6 +11,7 @@
 
 #include "bench_common.h"
 #include "fvp/accel/backend.h"
+#include "fvp/accel/kernels.h"
 #include "fvp/accel/ray_workload.h"
 
 namespace fvp::bench {
@@ -108,7 +109,7 @@ void BM_RayTraverseGrid(benchmark::State& state, BackendKind kind, int threads) 
                                static_cast<unsigned>(n)};
   std::vector<RayResult> out(n);
   for (auto _ : state) {
-    backend->traverseRays(params, *ray_buffer, *occupancy, *field, *results);
+    backend->run(accel::kernels::rayTraverse(), params, {ray_buffer.get(), occupancy.get(), field.get(), results.get()});
     backend->download(*results, out.data(), n * sizeof(RayResult));
     benchmark::DoNotOptimize(out.data());
   }

@@ -1,15 +1,15 @@
 /* fvp_map_kernels.h: bodies of the map kernels (scan integration, ROI distance field,
  * frontier extraction) over bricked voxel storage. C subset shared by the C++ reference
- * backend and the OpenCL kernels; shaders/fvp_map_kernels.glsl mirrors it.
+ * backend and the OpenCL kernels; shaders/fvp_map_kernels.glsl has a GLSL function of the
+ * same name for each function here.
  *
- * Storage: a brick table (int per 8^3 brick of the grid; FVP_NO_BRICK where nothing is
- * allocated) and pools indexed by slot = brick * 512 + local voxel. Occupancy and ROI
- * pools hold log-odds, NaN for unknown.
+ * Storage (fvp_map.h): a brick table (int per 8^3 brick of the grid; FVP_NO_BRICK where
+ * nothing is allocated) and channels indexed by slot = brick * 512 + local voxel.
+ * Occupancy and ROI channels hold log-odds, NaN for unknown.
  *
- * Determinism: scan integration runs in two passes. The mark pass walks every ray and
- * only stores the constant 1 into per-slot mark planes (free, hit, roi): racing stores of
- * the same value leave the same result in any order. The update pass then changes each
- * voxel once, from its marks, by one work item. */
+ * Determinism: scan integration runs in two passes. The mark pass walks every ray and only
+ * ORs constant bits into the per-slot marks: the result is the same in any order. The
+ * update pass then changes each voxel once, from its marks, by one work item. */
 #ifndef FVP_MAP_KERNELS_H
 #define FVP_MAP_KERNELS_H
 
@@ -17,21 +17,28 @@
 #include "fvp_map.h"
 
 #ifdef __OPENCL_VERSION__
-#define FVP_MARK(ptr) (*(ptr) = 1)
-#define FVP_ATOMIC_ADD(ptr, v) atomic_add((ptr), (v))
+#define FVP_ATOMIC_OR(ptr, v) atomic_or((ptr), (v))
 #define FVP_ATOMIC_INC(ptr) atomic_inc(ptr)
+#define FVP_LOAD(ptr) (*(ptr))
+#define FVP_FLAG(ptr) (*(ptr) = 1u)
 #define FVP_SQRTF sqrt
 #else
-/* Relaxed atomic stores: the racing same-value stores are well defined in C++ too. */
-#define FVP_MARK(ptr) __atomic_store_n((ptr), 1, __ATOMIC_RELAXED)
-#define FVP_ATOMIC_ADD(ptr, v) __atomic_fetch_add((ptr), (v), __ATOMIC_RELAXED)
+#define FVP_ATOMIC_OR(ptr, v) __atomic_fetch_or((ptr), (v), __ATOMIC_RELAXED)
 #define FVP_ATOMIC_INC(ptr) __atomic_fetch_add((ptr), 1u, __ATOMIC_RELAXED)
+#define FVP_LOAD(ptr) __atomic_load_n((ptr), __ATOMIC_RELAXED)
+/* Racing stores of the same constant: relaxed atomics keep them well defined in C++. */
+#define FVP_FLAG(ptr) __atomic_store_n((ptr), 1u, __ATOMIC_RELAXED)
 #define FVP_SQRTF sqrtf
 #endif
 
 /* Point flags */
 #define FVP_POINT_HIT 1u /* the end point is a measured surface (not cut at max range) */
 #define FVP_POINT_ROI 2u /* the end point is a segmented fruitlet pixel */
+
+/* Scan marks: one byte lane per slot in 32-bit words (GLSL has no portable byte stores). */
+#define FVP_MARK_FREE 1u
+#define FVP_MARK_HIT 2u
+#define FVP_MARK_ROI 4u
 
 /* Frontier flags */
 #define FVP_FRONTIER_ROI 1u     /* known ROI voxel next to unknown space */
@@ -40,23 +47,20 @@
 /* Squared distance meaning "no ROI voxel within the cap". */
 #define FVP_EDT_FAR 0x7fffffffu
 
+/* Slots per work item of the update pass. */
+#define FVP_UPDATE_CHUNK 64u
+
 typedef struct fvp_scan_point {
   float x_m, y_m, z_m;
   unsigned int flags; /* FVP_POINT_* */
 } fvp_scan_point;
 
-/* A bricked grid: voxel geometry (dims multiples of 8) and the brick table's dims. */
-typedef struct fvp_bricked_grid {
-  fvp_grid_params grid;
-  int bricks_x, bricks_y, bricks_z;
-  int use_region; /* 1: only voxels inside `region` are mapped (fine map) */
-  fvp_region region;
-} fvp_bricked_grid;
-
 typedef struct fvp_scan_params {
   fvp_bricked_grid map;
   float sensor_x_m, sensor_y_m, sensor_z_m;
   unsigned int point_count;
+  unsigned int slot_count; /* slots of the channels (the marks hold one byte lane each) */
+  int brick_count;         /* bricks in the table; missing[brick_count] flags "any missing" */
 } fvp_scan_params;
 
 typedef struct fvp_update_params {
@@ -69,6 +73,7 @@ typedef struct fvp_edt_params {
   fvp_bricked_grid map;
   int radius_vox; /* the cap: distances beyond it read as the cap */
   unsigned int slot_count;
+  int axis; /* the pass: 0 seeds from the ROI channel, 1 and 2 read the previous pass */
 } fvp_edt_params;
 
 typedef struct fvp_frontier_params {
@@ -87,118 +92,74 @@ typedef struct fvp_frontier {
   int pad;
 } fvp_frontier;
 
-/* Slot of voxel (x, y, z), or -1 when its brick is not allocated. */
-FVP_FN int fvp_slot(const fvp_bricked_grid* m, FVP_GLOBAL const int* table, int x, int y, int z) {
-  int b = (x >> FVP_BRICK_SHIFT) + m->bricks_x * ((y >> FVP_BRICK_SHIFT) + m->bricks_y * (z >> FVP_BRICK_SHIFT));
-  int brick = table[b];
-  if (brick < 0) return -1;
-  return (brick & FVP_BRICK_INDEX_MASK) * FVP_BRICK_VOXELS + (x & 7) + 8 * ((y & 7) + 8 * (z & 7));
-}
-
-FVP_FN int fvp_brick_of(const fvp_bricked_grid* m, int x, int y, int z) {
-  return (x >> FVP_BRICK_SHIFT) + m->bricks_x * ((y >> FVP_BRICK_SHIFT) + m->bricks_y * (z >> FVP_BRICK_SHIFT));
-}
-
-FVP_FN int fvp_in_map(const fvp_bricked_grid* m, int x, int y, int z) {
-  if (x < 0 || y < 0 || z < 0 || x >= m->grid.dim_x || y >= m->grid.dim_y || z >= m->grid.dim_z)
-    return 0;
-  return !m->use_region || fvp_region_contains(&m->region, x, y, z);
-}
-
-/* Voxel coordinates of a slot, given the brick's grid coordinates table. */
-FVP_FN void fvp_slot_voxel(FVP_GLOBAL const int* brick_coords, unsigned int slot, int* x, int* y,
-                           int* z) {
-  unsigned int brick = slot / FVP_BRICK_VOXELS, in_brick = slot % FVP_BRICK_VOXELS;
-  *x = brick_coords[3 * brick + 0] * FVP_BRICK_EDGE + (int)(in_brick & 7u);
-  *y = brick_coords[3 * brick + 1] * FVP_BRICK_EDGE + (int)((in_brick >> 3) & 7u);
-  *z = brick_coords[3 * brick + 2] * FVP_BRICK_EDGE + (int)(in_brick >> 6);
+/* Sets mark bits of one slot. Reading first skips the atomic where the bits are already
+ * set: most rays of a view cross the same voxels near the sensor. */
+FVP_FN void fvp_mark(FVP_GLOBAL unsigned int* marks, int slot, unsigned int bits) {
+  FVP_GLOBAL unsigned int* word = marks + (slot >> 2);
+  unsigned int lane_bits = bits << (8 * (slot & 3));
+  if ((FVP_LOAD(word) & lane_bits) != lane_bits) FVP_ATOMIC_OR(word, lane_bits);
 }
 
 /* Mark pass for one point: free marks along the ray, a hit (and ROI) mark at its end.
  * Voxels in unallocated bricks flag their brick in `missing` (and missing[brick_count])
- * for the host to allocate and re-run: marks are idempotent. The brick table is read only
- * when the walk enters a new brick. */
+ * for the host to allocate and re-run: marks are idempotent. */
 FVP_FN void fvp_scan_mark_point(const fvp_scan_params* p, fvp_scan_point pt,
-                                FVP_GLOBAL const int* table, FVP_GLOBAL unsigned char* free_marks,
-                                FVP_GLOBAL unsigned char* hit_marks, FVP_GLOBAL unsigned char* roi_marks,
-                                FVP_GLOBAL unsigned int* missing, int brick_count) {
-  fvp_dda d;
+                                FVP_GLOBAL const int* table, FVP_GLOBAL unsigned int* marks,
+                                FVP_GLOBAL unsigned int* missing) {
+  fvp_walk w;
   float o[3], e[3];
-  int dim[3], brick_stride[3], local_stride[3];
-  int brick, entry, local_index;
   o[0] = p->sensor_x_m;
   o[1] = p->sensor_y_m;
   o[2] = p->sensor_z_m;
   e[0] = pt.x_m;
   e[1] = pt.y_m;
   e[2] = pt.z_m;
-  if (fvp_dda_init(&d, &p->map.grid, o, e) != 0) return;
-  dim[0] = p->map.grid.dim_x;
-  dim[1] = p->map.grid.dim_y;
-  dim[2] = p->map.grid.dim_z;
-  brick_stride[0] = 1;
-  brick_stride[1] = p->map.bricks_x;
-  brick_stride[2] = p->map.bricks_x * p->map.bricks_y;
-  local_stride[0] = 1;
-  local_stride[1] = 8;
-  local_stride[2] = 64;
-  brick = fvp_brick_of(&p->map, d.key[0], d.key[1], d.key[2]);
-  entry = table[brick];
-  local_index = (d.key[0] & 7) + 8 * ((d.key[1] & 7) + 8 * (d.key[2] & 7));
+  if (fvp_walk_init(&w, &p->map, o, e, table) != 0) return;
   for (;;) {
-    int axis = fvp_dda_next_axis(&d);
+    int axis = fvp_dda_next_axis(&w.d);
     int last = axis < 0;
-    int mapped = !p->map.use_region || (entry >= 0 && (entry & FVP_BRICK_INSIDE)) ||
-                 fvp_region_contains(&p->map.region, d.key[0], d.key[1], d.key[2]);
-    if (mapped) {
-      if (entry < 0) {
-        FVP_MARK(&missing[brick]);
-        FVP_MARK(&missing[brick_count]);
-      } else {
-        int slot = (entry & FVP_BRICK_INDEX_MASK) * FVP_BRICK_VOXELS + local_index;
-        if (!last) {
-          FVP_MARK(&free_marks[slot]);
-        } else if (pt.flags & FVP_POINT_HIT) {
-          FVP_MARK(&hit_marks[slot]);
-          if (pt.flags & FVP_POINT_ROI) FVP_MARK(&roi_marks[slot]);
-        }
-        /* The cut end of a ray beyond max range is neither free nor hit (OctoMap's maxrange). */
+    if (fvp_walk_mapped(&w, &p->map)) {
+      if (w.entry < 0) {
+        FVP_FLAG(&missing[w.brick]);
+        FVP_FLAG(&missing[p->brick_count]);
+      } else if (!last) {
+        fvp_mark(marks, fvp_walk_slot(&w), FVP_MARK_FREE);
+      } else if (pt.flags & FVP_POINT_HIT) {
+        fvp_mark(marks, fvp_walk_slot(&w),
+                 (pt.flags & FVP_POINT_ROI) ? (FVP_MARK_HIT | FVP_MARK_ROI) : FVP_MARK_HIT);
       }
+      /* The cut end of a ray beyond max range is neither free nor hit (OctoMap's maxrange). */
     }
-    if (last) return;
-    fvp_dda_advance(&d, axis);
-    if (d.key[axis] < 0 || d.key[axis] >= dim[axis]) return;
-    if ((d.key[axis] & 7) == (d.step[axis] > 0 ? 0 : 7)) {
-      brick += d.step[axis] * brick_stride[axis];
-      entry = table[brick];
-      local_index -= d.step[axis] * 7 * local_stride[axis];
-    } else {
-      local_index += d.step[axis] * local_stride[axis];
-    }
+    if (last || !fvp_walk_step(&w, &p->map, axis, table)) return;
   }
 }
 
-/* Update pass over slots [first, first + count): apply each voxel's marks once and clear
- * them. Returns the number of voxels updated. */
-FVP_FN unsigned int fvp_scan_update_slots(const fvp_update_params* p, unsigned int first, unsigned int count,
-                                          FVP_GLOBAL unsigned char* free_marks, FVP_GLOBAL unsigned char* hit_marks,
-                                          FVP_GLOBAL unsigned char* roi_marks, FVP_GLOBAL float* occupancy,
-                                          FVP_GLOBAL float* roi) {
-  unsigned int updated = 0, s;
-  for (s = first; s < first + count; ++s) {
-    if (hit_marks[s]) {
-      occupancy[s] = fvp_logodds_update(occupancy[s], p->hit_logodds, p->clamp_min_logodds, p->clamp_max_logodds);
-      if (p->has_roi)
-        roi[s] = fvp_logodds_update(roi[s], roi_marks[s] ? p->hit_logodds : p->miss_logodds,
-                                    p->clamp_min_logodds, p->clamp_max_logodds);
-      ++updated;
-    } else if (free_marks[s]) {
-      occupancy[s] = fvp_logodds_update(occupancy[s], p->miss_logodds, p->clamp_min_logodds, p->clamp_max_logodds);
-      ++updated;
+/* Update pass over slots [first, first + FVP_UPDATE_CHUNK): apply each voxel's marks once
+ * and clear them. Returns the number of voxels updated. */
+FVP_FN unsigned int fvp_scan_update_chunk(const fvp_update_params* p, unsigned int first,
+                                          FVP_GLOBAL unsigned int* marks,
+                                          FVP_GLOBAL float* occupancy, FVP_GLOBAL float* roi) {
+  unsigned int updated = 0, w, lane;
+  for (w = first >> 2; w < (first + FVP_UPDATE_CHUNK) >> 2; ++w) {
+    unsigned int word = marks[w];
+    if (word == 0u) continue;
+    for (lane = 0; lane < 4u; ++lane) {
+      unsigned int m = (word >> (8u * lane)) & 0xffu;
+      unsigned int s = w * 4u + lane;
+      if (m & FVP_MARK_HIT) {
+        occupancy[s] = fvp_logodds_update(occupancy[s], p->hit_logodds, p->clamp_min_logodds,
+                                          p->clamp_max_logodds);
+        if (p->has_roi)
+          roi[s] = fvp_logodds_update(roi[s], (m & FVP_MARK_ROI) ? p->hit_logodds : p->miss_logodds,
+                                      p->clamp_min_logodds, p->clamp_max_logodds);
+        ++updated;
+      } else if (m & FVP_MARK_FREE) {
+        occupancy[s] = fvp_logodds_update(occupancy[s], p->miss_logodds, p->clamp_min_logodds,
+                                          p->clamp_max_logodds);
+        ++updated;
+      }
     }
-    free_marks[s] = 0;
-    hit_marks[s] = 0;
-    roi_marks[s] = 0;
+    marks[w] = 0u;
   }
   return updated;
 }
@@ -206,11 +167,11 @@ FVP_FN unsigned int fvp_scan_update_slots(const fvp_update_params* p, unsigned i
 /* ROI distance field, one separable pass for one voxel (exact squared Euclidean distance
  * within the cap radius; Felzenszwalb-style min-plus over a window). axis 0 seeds from
  * the ROI log-odds (known ROI: roi > 0); axes 1 and 2 read the previous pass. */
-FVP_FN unsigned int fvp_edt_pass_voxel(const fvp_edt_params* p, int axis, int x, int y, int z,
+FVP_FN unsigned int fvp_edt_pass_voxel(const fvp_edt_params* p, int x, int y, int z,
                                        FVP_GLOBAL const int* table, FVP_GLOBAL const float* roi,
                                        FVP_GLOBAL const unsigned int* sq_in) {
   unsigned int best = FVP_EDT_FAR;
-  int k;
+  int axis = p->axis, k;
   for (k = -p->radius_vox; k <= p->radius_vox; ++k) {
     int nx = x + (axis == 0 ? k : 0), ny = y + (axis == 1 ? k : 0), nz = z + (axis == 2 ? k : 0);
     int slot;
@@ -283,6 +244,45 @@ FVP_FN unsigned int fvp_frontier_voxel(const fvp_frontier_params* p, int x, int 
   if (is_roi) flags |= FVP_FRONTIER_ROI;
   if (is_free) flags |= FVP_FRONTIER_EXPLORE;
   return flags;
+}
+
+/* Classifies one voxel and appends it to `frontiers` when it is a frontier (up to
+ * p->capacity entries; *count receives the total found, which may exceed it). */
+FVP_FN void fvp_frontier_append(const fvp_frontier_params* p, int x, int y, int z,
+                                FVP_GLOBAL const int* table, FVP_GLOBAL const float* occupancy,
+                                FVP_GLOBAL const float* roi, FVP_GLOBAL fvp_frontier* frontiers,
+                                FVP_GLOBAL unsigned int* count) {
+  int normal[3];
+  unsigned int flags = fvp_frontier_voxel(p, x, y, z, table, occupancy, roi, normal);
+  unsigned int index;
+  fvp_frontier f;
+  if (!flags) return;
+  index = FVP_ATOMIC_INC(count);
+  if (index >= p->capacity) return;
+  f.x = x;
+  f.y = y;
+  f.z = z;
+  f.flags = flags;
+  f.normal_x = normal[0];
+  f.normal_y = normal[1];
+  f.normal_z = normal[2];
+  f.pad = 0;
+  frontiers[index] = f;
+}
+
+/* One ROI distance pass (p->axis) for one slot: axes 0 and 1 write the squared distance
+ * to sq_out, axis 2 the capped distance in voxels to distance_vox. */
+FVP_FN void fvp_roi_distance_slot(const fvp_edt_params* p, unsigned int slot,
+                                  FVP_GLOBAL const int* brick_coords, FVP_GLOBAL const int* table,
+                                  FVP_GLOBAL const float* roi, FVP_GLOBAL const unsigned int* sq_in,
+                                  FVP_GLOBAL unsigned int* sq_out,
+                                  FVP_GLOBAL float* distance_vox) {
+  int x, y, z;
+  unsigned int best;
+  fvp_slot_voxel(brick_coords, slot, &x, &y, &z);
+  best = fvp_edt_pass_voxel(p, x, y, z, table, roi, sq_in);
+  if (p->axis < 2) sq_out[slot] = best;
+  else distance_vox[slot] = fvp_edt_distance_vox(best, p->radius_vox);
 }
 
 #endif /* FVP_MAP_KERNELS_H */

@@ -35,6 +35,12 @@ struct FvpRayResult {
   uint status;
 };
 
+struct FvpTraverseParams {
+  FvpGridParams grid;
+  float occupied_threshold;
+  uint ray_count;
+};
+
 struct FvpDda {
   ivec3 key;
   ivec3 step;
@@ -175,3 +181,44 @@ void fvp_dda_advance(inout FvpDda d, int axis) {
 }
 
 #endif  // FVP_DDA_GLSL
+
+// Functions over buffers: the C versions take them as pointers, the shaders declare them as
+// storage buffers of the same names. A shader includes this file once for the types, then
+// declares its buffers, defines FVP_HAS_<buffers> and includes it again for the functions.
+
+// Needs the buffers `occupancy` and `field` (dense grid, float each).
+#if defined(FVP_HAS_DENSE_GRID) && !defined(FVP_DDA_DENSE_GLSL)
+#define FVP_DDA_DENSE_GLSL
+FvpRayResult fvp_traverse_ray(FvpGridParams g, float occupied_threshold, vec3 origin_m,
+                              vec3 end_m) {
+  FvpRayResult r = FvpRayResult(0u, 0.0, -1, 0u);
+  FvpDda d;
+  r.status = fvp_dda_init(d, g, origin_m, end_m);
+  if (r.status != 0u) return r;
+  ivec3 dim = ivec3(g.dim_x, g.dim_y, g.dim_z);
+  ivec3 stride = ivec3(1, g.dim_x, g.dim_x * g.dim_y);
+  int index = d.key.x + stride.y * d.key.y + stride.z * d.key.z;
+  for (;;) {
+    r.steps += 1u;
+    r.field_sum += field[index];
+    if (occupancy[index] >= occupied_threshold) {
+      r.status = FVP_RAY_HIT_OCCUPIED;
+      r.stop_voxel = index;
+      return r;
+    }
+    int axis = fvp_dda_next_axis(d);
+    if (axis < 0) {
+      r.status = FVP_RAY_REACHED_END;
+      r.stop_voxel = index;
+      return r;
+    }
+    fvp_dda_advance(d, axis);
+    if (d.key[axis] < 0 || d.key[axis] >= dim[axis]) {
+      r.status = FVP_RAY_LEFT_GRID;
+      return r;
+    }
+    index += d.step[axis] * stride[axis];
+  }
+  return r;
+}
+#endif

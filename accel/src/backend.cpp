@@ -67,97 +67,28 @@ void Backend::download(const DeviceBuffer& buf, void* dst, std::size_t size_byte
   if (size_bytes) downloadBytes(buf, dst, size_bytes, offset_bytes);
 }
 
-void Backend::traverseRays(const TraverseParams& params, const DeviceBuffer& rays,
-                           const DeviceBuffer& occupancy, const DeviceBuffer& field,
-                           DeviceBuffer& results) {
-  const std::size_t n = params.ray_count;
-  const auto voxels = static_cast<std::size_t>(voxelCount(params.grid));
-  if (voxelCount(params.grid) >= (std::int64_t{1} << 31))
-    throw std::invalid_argument("traverseRays: dense grids hold fewer than 2^31 voxels");
-  checkRange(rays, n * sizeof(Ray), 0, "traverseRays: rays");
-  checkRange(occupancy, voxels * sizeof(float), 0, "traverseRays: occupancy");
-  checkRange(field, voxels * sizeof(float), 0, "traverseRays: field");
-  checkRange(results, n * sizeof(RayResult), 0, "traverseRays: results");
-  if (n) dispatchTraverseRays(params, rays, occupancy, field, results);
-}
-
-namespace {
-std::size_t brickCount(const BrickedGridParams& m) {
-  return static_cast<std::size_t>(m.bricks_x) * m.bricks_y * m.bricks_z;
-}
-void checkBrickedGrid(const BrickedGridParams& m, const char* what) {
-  if (m.grid.dim_x != m.bricks_x * kBrickEdge || m.grid.dim_y != m.bricks_y * kBrickEdge ||
-      m.grid.dim_z != m.bricks_z * kBrickEdge)
-    throw std::invalid_argument(std::string(what) + ": grid dims must be 8 x the brick dims");
-}
-void checkSlots(std::uint32_t slot_count, const char* what) {
-  if (slot_count % kBrickVoxels != 0)
-    throw std::invalid_argument(std::string(what) + ": slot_count must be a multiple of 512");
-}
-// The checks every per-slot kernel over bricked storage shares.
-void checkSlotKernel(const BrickedGridParams& m, std::uint32_t slot_count,
-                     const DeviceBuffer& brick_coords, const DeviceBuffer& brick_table,
-                     const std::string& what) {
-  checkBrickedGrid(m, what.c_str());
-  checkSlots(slot_count, what.c_str());
-  checkRange(brick_coords, std::size_t{slot_count} / kBrickVoxels * 3 * sizeof(int), 0,
-             (what + ": brick_coords").c_str());
-  checkRange(brick_table, brickCount(m) * sizeof(int), 0, (what + ": brick_table").c_str());
-}
-}  // namespace
-
-void Backend::scanMark(const ScanParams& params, const DeviceBuffer& points,
-                       const DeviceBuffer& brick_table, DeviceBuffer& marks, DeviceBuffer& missing,
-                       std::uint32_t slot_count, std::uint32_t brick_count) {
-  checkBrickedGrid(params.map, "scanMark");
-  checkSlots(slot_count, "scanMark");
-  if (brick_count != brickCount(params.map))
-    throw std::invalid_argument("scanMark: brick_count differs from the grid's brick dims");
-  checkRange(points, std::size_t{params.point_count} * sizeof(ScanPoint), 0, "scanMark: points");
-  checkRange(brick_table, brickCount(params.map) * sizeof(int), 0, "scanMark: brick_table");
-  checkRange(marks, scanMarkBytes(slot_count), 0, "scanMark: marks");
-  checkRange(missing, (brickCount(params.map) + 1) * sizeof(std::uint32_t), 0, "scanMark: missing");
-  if (params.point_count)
-    dispatchScanMark(params, points, brick_table, marks, missing, slot_count, brick_count);
-}
-
-void Backend::scanUpdate(const UpdateParams& params, DeviceBuffer& marks, DeviceBuffer& occupancy,
-                         DeviceBuffer& roi, DeviceBuffer& updated) {
-  checkSlots(params.slot_count, "scanUpdate");
-  checkRange(marks, scanMarkBytes(params.slot_count), 0, "scanUpdate: marks");
-  checkRange(occupancy, std::size_t{params.slot_count} * sizeof(float), 0, "scanUpdate: occupancy");
-  if (params.has_roi)
-    checkRange(roi, std::size_t{params.slot_count} * sizeof(float), 0, "scanUpdate: roi");
-  checkRange(updated, sizeof(std::uint32_t), 0, "scanUpdate: updated");
-  if (params.slot_count) dispatchScanUpdate(params, marks, occupancy, roi, updated);
-}
-
-void Backend::roiDistancePass(const EdtParams& params, int axis, const DeviceBuffer& brick_coords,
-                              const DeviceBuffer& brick_table, const DeviceBuffer& roi,
-                              const DeviceBuffer& sq_in, DeviceBuffer& sq_out,
-                              DeviceBuffer& distance_vox) {
-  checkSlotKernel(params.map, params.slot_count, brick_coords, brick_table, "roiDistancePass");
-  if (axis < 0 || axis > 2) throw std::invalid_argument("roiDistancePass: axis must be 0, 1 or 2");
-  if (params.radius_vox < 1 || params.radius_vox > 1000)
-    throw std::invalid_argument("roiDistancePass: radius_vox must be in [1, 1000]");
-  const std::size_t slots = params.slot_count;
-  if (axis == 0) checkRange(roi, slots * sizeof(float), 0, "roiDistancePass: roi");
-  if (axis > 0) checkRange(sq_in, slots * sizeof(std::uint32_t), 0, "roiDistancePass: sq_in");
-  if (axis < 2) checkRange(sq_out, slots * sizeof(std::uint32_t), 0, "roiDistancePass: sq_out");
-  if (axis == 2) checkRange(distance_vox, slots * sizeof(float), 0, "roiDistancePass: distance_vox");
-  if (slots) dispatchRoiDistancePass(params, axis, brick_coords, brick_table, roi, sq_in, sq_out, distance_vox);
-}
-
-void Backend::extractFrontiers(const FrontierParams& params, const DeviceBuffer& brick_coords,
-                               const DeviceBuffer& brick_table, const DeviceBuffer& occupancy,
-                               const DeviceBuffer& roi, DeviceBuffer& out, DeviceBuffer& count) {
-  checkSlotKernel(params.map, params.slot_count, brick_coords, brick_table, "extractFrontiers");
-  const std::size_t slots = params.slot_count;
-  checkRange(occupancy, slots * sizeof(float), 0, "extractFrontiers: occupancy");
-  checkRange(roi, slots * sizeof(float), 0, "extractFrontiers: roi");
-  checkRange(out, std::size_t{params.capacity} * sizeof(Frontier), 0, "extractFrontiers: out");
-  checkRange(count, sizeof(std::uint32_t), 0, "extractFrontiers: count");
-  if (slots) dispatchExtractFrontiers(params, brick_coords, brick_table, occupancy, roi, out, count);
+void Backend::dispatch(const KernelDescriptor& kernel, const void* params,
+                       std::size_t params_bytes, std::span<DeviceBuffer* const> buffers) {
+  const std::string name(kernel.name);
+  if (params_bytes != kernel.params_bytes)
+    throw std::invalid_argument(name + ": parameter block of " + std::to_string(params_bytes) +
+                                " bytes, the kernel takes " + std::to_string(kernel.params_bytes));
+  if (buffers.size() != kernel.bindings.size())
+    throw std::invalid_argument(name + ": " + std::to_string(buffers.size()) + " buffers given, the kernel binds " +
+                                std::to_string(kernel.bindings.size()));
+  if (kernel.validate) kernel.validate(params);
+  for (std::size_t i = 0; i < buffers.size(); ++i) {
+    const KernelBinding& binding = kernel.bindings[i];
+    const std::size_t needed = binding.required_elements(params);
+    const std::string what = name + ": binding " + std::to_string(i) + " (" + std::string(binding.name) + ")";
+    if (!buffers[i]) {
+      if (needed) throw std::invalid_argument(what + " is used by this dispatch but no buffer was given");
+      continue;
+    }
+    checkRange(*buffers[i], needed * binding.element_bytes, 0, what.c_str());
+  }
+  const std::uint32_t items = kernel.item_count(params);
+  if (items) dispatchKernel(kernel, params, buffers, items);
 }
 
 std::unique_ptr<Backend> createBackend(BackendKind kind) {

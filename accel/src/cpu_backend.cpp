@@ -1,5 +1,6 @@
-// The reference backend: plain C++ over host memory, parallel over rays with OpenMP.
-// It runs the same kernel bodies (kernels/fvp_dda.h) as the OpenCL backend.
+// The reference backend: plain C++ over host memory. It runs each kernel descriptor's CPU
+// loop (accel/src/kernels/), which calls the same bodies (kernels/*.h) as the OpenCL kernels
+// and is parallel with OpenMP.
 #include <omp.h>
 
 #include <cstring>
@@ -49,100 +50,12 @@ class CpuBackend final : public Backend {
     std::memcpy(dst, cpu(buf).data() + offset_bytes, size_bytes);
   }
 
-  void dispatchTraverseRays(const TraverseParams& params, const DeviceBuffer& rays,
-                            const DeviceBuffer& occupancy, const DeviceBuffer& field,
-                            DeviceBuffer& results) override {
-    const Ray* ray = cpu(rays).as<Ray>();
-    const float* occ = cpu(occupancy).as<float>();
-    const float* fld = cpu(field).as<float>();
-    RayResult* out = cpu(results).as<RayResult>();
-    const auto count = static_cast<std::ptrdiff_t>(params.ray_count);
-    // Rays differ a lot in length: small dynamic chunks balance the threads.
-#pragma omp parallel for schedule(dynamic, 64)
-    for (std::ptrdiff_t i = 0; i < count; ++i) {
-      out[i] = fvp_traverse_ray(&params.grid, params.occupied_threshold, ray[i].origin_m,
-                                ray[i].end_m, occ, fld);
-    }
-  }
-
- public:
-  // Three byte planes: free | hit | roi.
-  std::size_t scanMarkBytes(std::size_t slot_count) const override { return 3 * slot_count; }
-
- protected:
-  void dispatchScanMark(const ScanParams& params, const DeviceBuffer& points,
-                        const DeviceBuffer& brick_table, DeviceBuffer& marks, DeviceBuffer& missing,
-                        std::uint32_t slot_count, std::uint32_t brick_count) override {
-    const ScanPoint* pts = cpu(points).as<ScanPoint>();
-    const int* table = cpu(brick_table).as<int>();
-    unsigned char* m = cpu(marks).as<unsigned char>();
-    unsigned int* miss = cpu(missing).as<unsigned int>();
-    const auto count = static_cast<std::ptrdiff_t>(params.point_count);
-#pragma omp parallel for schedule(dynamic, 256)
-    for (std::ptrdiff_t i = 0; i < count; ++i) {
-      fvp_scan_mark_point(&params, pts[i], table, m, m + slot_count, m + 2 * std::size_t{slot_count},
-                          miss, static_cast<int>(brick_count));
-    }
-  }
-
-  void dispatchScanUpdate(const UpdateParams& params, DeviceBuffer& marks, DeviceBuffer& occupancy,
-                          DeviceBuffer& roi, DeviceBuffer& updated) override {
-    unsigned char* m = cpu(marks).as<unsigned char>();
-    const std::size_t slots = params.slot_count;
-    float* occ = cpu(occupancy).as<float>();
-    float* roi_values = params.has_roi ? cpu(roi).as<float>() : nullptr;
-    const auto chunks = static_cast<std::ptrdiff_t>(slots / kUpdateChunkSlots);
-    unsigned long long total = 0;
-#pragma omp parallel for schedule(static) reduction(+ : total)
-    for (std::ptrdiff_t c = 0; c < chunks; ++c) {
-      total += fvp_scan_update_slots(&params, static_cast<unsigned>(c * kUpdateChunkSlots),
-                                     kUpdateChunkSlots, m, m + slots, m + 2 * slots, occ, roi_values);
-    }
-    cpu(updated).as<std::uint32_t>()[0] += static_cast<std::uint32_t>(total);
-  }
-
-  void dispatchRoiDistancePass(const EdtParams& params, int axis, const DeviceBuffer& brick_coords,
-                               const DeviceBuffer& brick_table, const DeviceBuffer& roi,
-                               const DeviceBuffer& sq_in, DeviceBuffer& sq_out,
-                               DeviceBuffer& distance_vox) override {
-    const int* coords = cpu(brick_coords).as<int>();
-    const int* table = cpu(brick_table).as<int>();
-    const float* roi_values = axis == 0 ? cpu(roi).as<float>() : nullptr;
-    const unsigned int* in = axis > 0 ? cpu(sq_in).as<unsigned int>() : nullptr;
-    unsigned int* out = axis < 2 ? cpu(sq_out).as<unsigned int>() : nullptr;
-    float* dist = axis == 2 ? cpu(distance_vox).as<float>() : nullptr;
-    const auto slots = static_cast<std::ptrdiff_t>(params.slot_count);
-#pragma omp parallel for schedule(static)
-    for (std::ptrdiff_t s = 0; s < slots; ++s) {
-      int x, y, z;
-      fvp_slot_voxel(coords, static_cast<unsigned>(s), &x, &y, &z);
-      const unsigned best = fvp_edt_pass_voxel(&params, axis, x, y, z, table, roi_values, in);
-      if (axis < 2) out[s] = best;
-      else dist[s] = fvp_edt_distance_vox(best, params.radius_vox);
-    }
-  }
-
-  void dispatchExtractFrontiers(const FrontierParams& params, const DeviceBuffer& brick_coords,
-                                const DeviceBuffer& brick_table, const DeviceBuffer& occupancy,
-                                const DeviceBuffer& roi, DeviceBuffer& out,
-                                DeviceBuffer& count) override {
-    const int* coords = cpu(brick_coords).as<int>();
-    const int* table = cpu(brick_table).as<int>();
-    const float* occ = cpu(occupancy).as<float>();
-    const float* roi_values = cpu(roi).as<float>();
-    Frontier* list = cpu(out).as<Frontier>();
-    unsigned int* found = cpu(count).as<unsigned int>();
-    const auto slots = static_cast<std::ptrdiff_t>(params.slot_count);
-#pragma omp parallel for schedule(static)
-    for (std::ptrdiff_t s = 0; s < slots; ++s) {
-      int x, y, z, normal[3];
-      fvp_slot_voxel(coords, static_cast<unsigned>(s), &x, &y, &z);
-      const unsigned flags = fvp_frontier_voxel(&params, x, y, z, table, occ, roi_values, normal);
-      if (!flags) continue;
-      const unsigned index = FVP_ATOMIC_INC(found);
-      if (index < params.capacity)
-        list[index] = Frontier{x, y, z, flags, normal[0], normal[1], normal[2], 0};
-    }
+  void dispatchKernel(const KernelDescriptor& kernel, const void* params,
+                      std::span<DeviceBuffer* const> buffers, std::uint32_t item_count) override {
+    std::vector<void*> memory(buffers.size(), nullptr);
+    for (std::size_t i = 0; i < buffers.size(); ++i)
+      if (buffers[i]) memory[i] = cpu(*buffers[i]).data();
+    kernel.cpu(params, memory.data(), item_count);
   }
 };
 

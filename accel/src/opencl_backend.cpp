@@ -15,10 +15,6 @@
 #include "backends.h"
 #include "check.h"
 
-extern const char kOpenClSource_ray_traverse[];
-extern const char kOpenClSource_scan_integrate[];
-extern const char kOpenClSource_roi_distance[];
-extern const char kOpenClSource_frontier[];
 
 namespace fvp::accel::detail {
 namespace {
@@ -125,11 +121,10 @@ class OpenClBackend final : public Backend {
                    FVP_CL(s.platform.getInfo<CL_PLATFORM_NAME>()) + ")";
     context_ = FVP_CL(cl::Context(device_));
     queue_ = FVP_CL(cl::CommandQueue(context_, device_));
-    ray_traverse_ = buildKernel(kOpenClSource_ray_traverse, "fvp_ray_traverse");
-    scan_mark_ = buildKernel(kOpenClSource_scan_integrate, "fvp_scan_mark");
-    scan_update_ = buildKernel(kOpenClSource_scan_integrate, "fvp_scan_update");
-    roi_distance_ = buildKernel(kOpenClSource_roi_distance, "fvp_roi_distance_pass");
-    frontier_ = buildKernel(kOpenClSource_frontier, "fvp_extract_frontiers");
+    // Every kernel up front: a kernel that does not build fails here, naming itself.
+    for (const KernelDescriptor* kernel : allKernels()) kernels_.emplace(kernel, buildKernel(*kernel));
+    // Bound where a dispatch does not use a binding: every argument needs a valid buffer.
+    unused_ = std::make_unique<ClBuffer>(context_, 16);
   }
 
   BackendKind kind() const override { return BackendKind::kOpenCl; }
@@ -150,45 +145,17 @@ class OpenClBackend final : public Backend {
     FVP_CL(queue_.enqueueReadBuffer(clBuf(buf), CL_TRUE, offset_bytes, size_bytes, dst));
   }
 
-  void dispatchTraverseRays(const TraverseParams& params, const DeviceBuffer& rays,
-                            const DeviceBuffer& occupancy, const DeviceBuffer& field,
-                            DeviceBuffer& results) override {
-    run(ray_traverse_, params.ray_count, params, clBuf(rays), clBuf(occupancy), clBuf(field),
-        clBuf(results));
-  }
-
- public:
-  // Three byte planes: free | hit | roi (plain byte stores; see fvp_map_kernels.h).
-  std::size_t scanMarkBytes(std::size_t slot_count) const override { return 3 * slot_count; }
-
- protected:
-  void dispatchScanMark(const ScanParams& params, const DeviceBuffer& points,
-                        const DeviceBuffer& brick_table, DeviceBuffer& marks, DeviceBuffer& missing,
-                        std::uint32_t slot_count, std::uint32_t brick_count) override {
-    run(scan_mark_, params.point_count, params, clBuf(points), clBuf(brick_table), clBuf(marks),
-        clBuf(missing), cl_uint{slot_count}, static_cast<cl_int>(brick_count));
-  }
-
-  void dispatchScanUpdate(const UpdateParams& params, DeviceBuffer& marks, DeviceBuffer& occupancy,
-                          DeviceBuffer& roi, DeviceBuffer& updated) override {
-    run(scan_update_, params.slot_count / kUpdateChunkSlots, params, clBuf(marks), clBuf(occupancy),
-        clBuf(roi), clBuf(updated));
-  }
-
-  void dispatchRoiDistancePass(const EdtParams& params, int axis, const DeviceBuffer& brick_coords,
-                               const DeviceBuffer& brick_table, const DeviceBuffer& roi,
-                               const DeviceBuffer& sq_in, DeviceBuffer& sq_out,
-                               DeviceBuffer& distance_vox) override {
-    run(roi_distance_, params.slot_count, params, cl_int{axis}, clBuf(brick_coords),
-        clBuf(brick_table), clBuf(roi), clBuf(sq_in), clBuf(sq_out), clBuf(distance_vox));
-  }
-
-  void dispatchExtractFrontiers(const FrontierParams& params, const DeviceBuffer& brick_coords,
-                                const DeviceBuffer& brick_table, const DeviceBuffer& occupancy,
-                                const DeviceBuffer& roi, DeviceBuffer& out,
-                                DeviceBuffer& count) override {
-    run(frontier_, params.slot_count, params, clBuf(brick_coords), clBuf(brick_table),
-        clBuf(occupancy), clBuf(roi), clBuf(out), clBuf(count));
+  void dispatchKernel(const KernelDescriptor& kernel, const void* params,
+                      std::span<DeviceBuffer* const> buffers, std::uint32_t item_count) override {
+    Kernel& k = kernels_.at(&kernel);
+    FVP_CL(k.kernel.setArg(0, kernel.params_bytes, params));
+    FVP_CL(k.kernel.setArg(1, cl_uint{item_count}));
+    for (std::size_t i = 0; i < buffers.size(); ++i)
+      FVP_CL(k.kernel.setArg(static_cast<cl_uint>(2 + i), clBuf(buffers[i] ? *buffers[i] : *unused_)));
+    const std::size_t global = (std::size_t{item_count} + k.local - 1) / k.local * k.local;
+    FVP_CL(queue_.enqueueNDRangeKernel(k.kernel, cl::NullRange, cl::NDRange(global),
+                                       cl::NDRange(k.local)));
+    FVP_CL(queue_.finish());
   }
 
  private:
@@ -197,26 +164,34 @@ class OpenClBackend final : public Backend {
     std::size_t local = 1;
   };
 
-  // Builds one embedded source (programs are cached per source) and takes one kernel.
-  Kernel buildKernel(const char* source, const char* name) {
-    auto it = programs_.find(source);
-    if (it == programs_.end()) {
-      cl::Program program = FVP_CL(cl::Program(context_, std::string(source)));
-      FVP_CL(program.build(std::vector<cl::Device>{device_}, "-cl-std=CL1.2"));
-      it = programs_.emplace(source, std::move(program)).first;
-    }
+  // Builds a descriptor's source and checks its arguments against the descriptor: the
+  // parameter block, the item count, then one buffer per binding with the binding's name.
+  Kernel buildKernel(const KernelDescriptor& descriptor) {
+    const std::string name(descriptor.name);
+    if (!descriptor.opencl_source)
+      throw BackendError("opencl: kernel " + name + " has no OpenCL source in this build");
+    cl::Program program = FVP_CL(cl::Program(context_, std::string(descriptor.opencl_source)));
+    FVP_CL(program.build(std::vector<cl::Device>{device_}, "-cl-std=CL1.2 -cl-kernel-arg-info"));
     Kernel k;
-    k.kernel = FVP_CL(cl::Kernel(it->second, name));
+    k.kernel = FVP_CL(cl::Kernel(program, descriptor.opencl_entry));
+    const cl_uint args = FVP_CL(k.kernel.getInfo<CL_KERNEL_NUM_ARGS>());
+    if (args != descriptor.bindings.size() + 2)
+      throw BackendError("opencl: kernel " + name + " takes " + std::to_string(args) +
+                         " arguments; its descriptor has " + std::to_string(descriptor.bindings.size()) +
+                         " bindings after the parameters and the item count");
+    for (std::size_t i = 0; i < descriptor.bindings.size(); ++i) {
+      std::string arg_name;
+      // Argument names are optional in OpenCL 1.2 (CL_KERNEL_ARG_INFO_NOT_AVAILABLE).
+      if (k.kernel.getArgInfo(static_cast<cl_uint>(2 + i), CL_KERNEL_ARG_NAME, &arg_name) != CL_SUCCESS)
+        break;
+      arg_name = arg_name.c_str();  // some drivers count the terminating NUL
+      if (arg_name != descriptor.bindings[i].name)
+        throw BackendError("opencl: kernel " + name + " argument " + std::to_string(2 + i) + " is '" +
+                           arg_name + "', its descriptor's binding " + std::to_string(i) + " is '" +
+                           std::string(descriptor.bindings[i].name) + "'");
+    }
     k.local = workGroupSize(k.kernel);
     return k;
-  }
-
-  // Sets the arguments in order and runs the kernel over `items` work items.
-  template <typename... Args>
-  void run(Kernel& k, std::size_t items, const Args&... args) {
-    cl_uint index = 0;
-    (FVP_CL(k.kernel.setArg(index++, args)), ...);
-    enqueue1D(k.kernel, items, k.local);
   }
 
   // Largest multiple of the preferred multiple not above 64 and the kernel's limit:
@@ -231,20 +206,13 @@ class OpenClBackend final : public Backend {
     return std::max<std::size_t>(local, 1);
   }
 
-  void enqueue1D(const cl::Kernel& kernel, std::size_t items, std::size_t local) {
-    const std::size_t global = (items + local - 1) / local * local;
-    FVP_CL(queue_.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global),
-                                       cl::NDRange(local)));
-    FVP_CL(queue_.finish());
-  }
-
   cl::Device device_;
   bool is_gpu_ = false;
   std::string device_name_;
   cl::Context context_;
   cl::CommandQueue queue_;
-  std::map<const char*, cl::Program> programs_;
-  Kernel ray_traverse_, scan_mark_, scan_update_, roi_distance_, frontier_;
+  std::map<const KernelDescriptor*, Kernel> kernels_;
+  std::unique_ptr<ClBuffer> unused_;
 };
 
 }  // namespace

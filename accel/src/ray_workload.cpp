@@ -1,5 +1,7 @@
 #include "fvp/accel/ray_workload.h"
 
+#include "fvp/accel/kernels.h"
+
 #include <algorithm>
 #include <cmath>
 #include <random>
@@ -136,7 +138,7 @@ std::vector<RayResult> traverseOnBackend(Backend& backend, const DenseGrid& grid
   auto field = backend.createBufferFrom(grid.field);
   auto ray_buffer = backend.createBufferFrom(rays);
   auto results = backend.createBuffer(rays.size() * sizeof(RayResult));
-  backend.traverseRays(params, *ray_buffer, *occupancy, *field, *results);
+  backend.run(kernels::rayTraverse(), params, {ray_buffer.get(), occupancy.get(), field.get(), results.get()});
   return backend.downloadAll<RayResult>(*results);
 }
 

@@ -2,10 +2,14 @@
 // embedded. Prefers a discrete or integrated GPU; falls back to a CPU implementation
 // (Mesa lavapipe here). Every dispatch is recorded into a command buffer, submitted and
 // waited for with a fence, so results are ready when the call returns.
+#include <dlfcn.h>
+#include <link.h>
 #include <vulkan/vulkan_raii.hpp>
 
 #include <algorithm>
 #include <array>
+#include <map>
+#include <set>
 #include <cstdlib>
 #include <cstring>
 #include <optional>
@@ -15,10 +19,6 @@
 
 #include "backends.h"
 #include "check.h"
-#include "embedded/spirv_frontier.h"
-#include "embedded/spirv_ray_traverse.h"
-#include "embedded/spirv_roi_distance.h"
-#include "embedded/spirv_scan_integrate.h"
 
 namespace fvp::accel::detail {
 namespace {
@@ -34,6 +34,36 @@ auto vkChecked(F&& f, const char* call, const char* file, int line) -> decltype(
 #define FVP_VK(expr) vkChecked([&]() { return expr; }, #expr, __FILE__, __LINE__)
 
 constexpr uint32_t kPreferredWorkGroupSize = 64;
+// The dispatch header every shader's parameter block starts with (shaders/fvp_kernel.glsl).
+constexpr uint32_t kDispatchHeaderBytes = 2 * sizeof(uint32_t);
+
+std::set<std::string> loadedObjects() {
+  std::set<std::string> names;
+  dl_iterate_phdr(
+      [](dl_phdr_info* info, std::size_t, void* out) {
+        if (info->dlpi_name && info->dlpi_name[0])
+          static_cast<std::set<std::string>*>(out)->insert(info->dlpi_name);
+        return 0;
+      },
+      &names);
+  return names;
+}
+
+// The Vulkan loader dlcloses its drivers in vkDestroyInstance. Mesa keeps process-lifetime
+// allocations in driver globals (lavapipe's CPU cache topology on AMD CPUs), which
+// LeakSanitizer then reports as direct leaks from an <unknown module> that no suppression
+// can name. Keeping every object the instance loaded (drivers, layers, libLLVM) mapped for
+// the life of the process keeps those allocations reachable. Best effort: never fails.
+void pinObjectsLoadedSince(const std::set<std::string>& before) noexcept {
+  try {
+    for (const auto& name : loadedObjects()) {
+      if (before.count(name)) continue;
+      // RTLD_NOLOAD only flags what is already loaded; dlclose drops just our reference.
+      if (void* handle = dlopen(name.c_str(), RTLD_LAZY | RTLD_NOLOAD | RTLD_NODELETE)) dlclose(handle);
+    }
+  } catch (...) {
+  }
+}
 
 bool deviceIsGpu(vk::PhysicalDeviceType type) {
   return type == vk::PhysicalDeviceType::eDiscreteGpu ||
@@ -74,38 +104,40 @@ const VkBuffer& vkBuf(const DeviceBuffer& b) { return static_cast<const VkBuffer
 
 // One compute pipeline: storage buffers at bindings 0..n-1 of set 0, push constants,
 // work-group size as specialisation constant 0.
+// One kernel's compute pipeline: its buffers at set 0, bindings 0..n-1; the dispatch header
+// (first item, item count) in push constants, followed there by the parameter block when
+// it fits, else the parameters in a storage buffer at set 1, binding 0; work-group size as
+// specialisation constant 0.
 struct ComputePipeline {
   vk::raii::DescriptorSetLayout set_layout{nullptr};
+  vk::raii::DescriptorSetLayout params_set_layout{nullptr};
   vk::raii::PipelineLayout layout{nullptr};
   vk::raii::ShaderModule module{nullptr};
   vk::raii::Pipeline pipeline{nullptr};
-  uint32_t buffer_count = 0;
-  uint32_t push_constant_bytes = 0;
+  bool params_in_buffer = false;
 };
 
 class VulkanBackend final : public Backend {
  public:
   VulkanBackend() {
     vk::ApplicationInfo app("fvp", 1, "fvp", 1, VK_API_VERSION_1_1);
+    std::set<std::string> loaded_before;
+    try {
+      loaded_before = loadedObjects();
+    } catch (...) {
+    }
     try {
       instance_ = vk::raii::Instance(context_, vk::InstanceCreateInfo({}, &app));
     } catch (const vk::Error& e) {
       throw BackendUnavailable(std::string("vulkan: cannot create an instance (") + e.what() +
                                "); install a driver such as mesa-vulkan-drivers");
     }
+    pinObjectsLoadedSince(loaded_before);
     pickDevice();
     createDevice();
-    ray_traverse_ = createPipeline(kSpirv_ray_traverse, sizeof(kSpirv_ray_traverse), 4,
-                                   sizeof(TraversePushConstants));
-    scan_mark_ = createPipeline(kSpirv_scan_integrate, sizeof(kSpirv_scan_integrate), 7,
-                                sizeof(ScanPushConstants), /*mode=*/0);
-    scan_update_ = createPipeline(kSpirv_scan_integrate, sizeof(kSpirv_scan_integrate), 7,
-                                  sizeof(ScanPushConstants), /*mode=*/1);
-    roi_distance_ = createPipeline(kSpirv_roi_distance, sizeof(kSpirv_roi_distance), 6,
-                                   sizeof(EdtPushConstants));
-    frontier_ = createPipeline(kSpirv_frontier, sizeof(kSpirv_frontier), 6,
-                               sizeof(FrontierPushConstants));
-    // Bound where a pass does not use a binding: every binding needs a valid buffer.
+    // Every kernel up front: a pipeline that cannot be created fails here.
+    for (const KernelDescriptor* kernel : allKernels()) pipelines_.emplace(kernel, createPipeline(*kernel));
+    // Bound where a dispatch does not use a binding: every binding needs a valid buffer.
     unused_ = createBuffer(16);
   }
 
@@ -146,61 +178,17 @@ class VulkanBackend final : public Backend {
     std::memcpy(dst, vkBuf(*staging).mapped(), size_bytes);
   }
 
-  void dispatchTraverseRays(const TraverseParams& params, const DeviceBuffer& rays,
-                            const DeviceBuffer& occupancy, const DeviceBuffer& field,
-                            DeviceBuffer& results) override {
-    TraversePushConstants push{params, 0};
-    dispatch1D(ray_traverse_, {&rays, &occupancy, &field, &results}, params.ray_count, push,
-               push.first_ray);
-  }
-
- public:
-  // Packed marks: a byte lane per slot in uint words (atomicOr), see shaders/fvp_map.glsl.
-  std::size_t scanMarkBytes(std::size_t slot_count) const override {
-    return (slot_count + 3) / 4 * 4;
-  }
-
- protected:
-  void dispatchScanMark(const ScanParams& params, const DeviceBuffer& points,
-                        const DeviceBuffer& brick_table, DeviceBuffer& marks, DeviceBuffer& missing,
-                        std::uint32_t slot_count, std::uint32_t brick_count) override {
-    ScanPushConstants push{};
-    push.scan = params;
-    push.slot_count = slot_count;
-    push.brick_count = static_cast<int32_t>(brick_count);
-    dispatch1D(scan_mark_, {&points, &brick_table, &marks, &missing, unused_.get(), unused_.get(), unused_.get()},
-               params.point_count, push, push.first_item);
-  }
-
-  void dispatchScanUpdate(const UpdateParams& params, DeviceBuffer& marks, DeviceBuffer& occupancy,
-                          DeviceBuffer& roi, DeviceBuffer& updated) override {
-    ScanPushConstants push{};
-    push.update = params;
-    push.slot_count = params.slot_count;
-    dispatch1D(scan_update_, {unused_.get(), unused_.get(), &marks, unused_.get(), &occupancy,
-                              params.has_roi ? &roi : unused_.get(), &updated},
-               params.slot_count / kUpdateChunkSlots, push, push.first_item);
-  }
-
-  void dispatchRoiDistancePass(const EdtParams& params, int axis, const DeviceBuffer& brick_coords,
-                               const DeviceBuffer& brick_table, const DeviceBuffer& roi,
-                               const DeviceBuffer& sq_in, DeviceBuffer& sq_out,
-                               DeviceBuffer& distance_vox) override {
-    EdtPushConstants push{params, axis, 0};
-    dispatch1D(roi_distance_,
-               {&brick_coords, &brick_table, axis == 0 ? &roi : unused_.get(),
-                axis > 0 ? &sq_in : unused_.get(), axis < 2 ? &sq_out : unused_.get(),
-                axis == 2 ? &distance_vox : unused_.get()},
-               params.slot_count, push, push.first_item);
-  }
-
-  void dispatchExtractFrontiers(const FrontierParams& params, const DeviceBuffer& brick_coords,
-                                const DeviceBuffer& brick_table, const DeviceBuffer& occupancy,
-                                const DeviceBuffer& roi, DeviceBuffer& out,
-                                DeviceBuffer& count) override {
-    FrontierPushConstants push{params, 0};
-    dispatch1D(frontier_, {&brick_coords, &brick_table, &occupancy, &roi, &out, &count},
-               params.slot_count, push, push.first_item);
+  void dispatchKernel(const KernelDescriptor& kernel, const void* params,
+                      std::span<DeviceBuffer* const> buffers, std::uint32_t item_count) override {
+    const ComputePipeline& p = pipelines_.at(&kernel);
+    std::vector<const DeviceBuffer*> bound;
+    for (DeviceBuffer* b : buffers) bound.push_back(b ? b : unused_.get());
+    std::unique_ptr<DeviceBuffer> params_buffer;
+    if (p.params_in_buffer) {
+      params_buffer = createBuffer(kernel.params_bytes);
+      upload(*params_buffer, params, kernel.params_bytes);
+    }
+    dispatch1D(p, bound, params_buffer.get(), params, kernel.params_bytes, item_count);
   }
 
  private:
@@ -251,31 +239,6 @@ class VulkanBackend final : public Backend {
     if (placement != Placement::kDevice) mapped = FVP_VK(memory.mapMemory(0, VK_WHOLE_SIZE));
     return std::make_unique<VkBuffer>(size_bytes, std::move(buffer), std::move(memory), mapped);
   }
-
-  // Push-constant blocks: the kernel parameters plus the first work item of a chunk.
-  struct TraversePushConstants {
-    TraverseParams params;
-    uint32_t first_ray;
-  };
-  struct ScanPushConstants {
-    ScanParams scan;
-    UpdateParams update;
-    uint32_t slot_count;
-    int32_t brick_count;
-    uint32_t first_item;
-  };
-  struct EdtPushConstants {
-    EdtParams edt;
-    int32_t axis;
-    uint32_t first_item;
-  };
-  struct FrontierPushConstants {
-    FrontierParams frontier;
-    uint32_t first_item;
-  };
-  static_assert(sizeof(ScanPushConstants) == 116 && sizeof(EdtPushConstants) == 80 &&
-                    sizeof(FrontierPushConstants) == 80,
-                "must match the shaders' push-constant blocks");
 
   void pickDevice() {
     std::vector<vk::raii::PhysicalDevice> devices;
@@ -348,7 +311,8 @@ class VulkanBackend final : public Backend {
         device_, vk::CommandBufferAllocateInfo(*command_pool_, vk::CommandBufferLevel::ePrimary, 1)));
     command_buffer_ = std::move(buffers.front());
     fence_ = FVP_VK(vk::raii::Fence(device_, vk::FenceCreateInfo()));
-    vk::DescriptorPoolSize pool_size(vk::DescriptorType::eStorageBuffer, 16);
+    // One dispatch at a time: its buffers' set and the parameter buffer's set.
+    vk::DescriptorPoolSize pool_size(vk::DescriptorType::eStorageBuffer, 32);
     descriptor_pool_ = FVP_VK(vk::raii::DescriptorPool(
         device_, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 4,
                                               pool_size)));
@@ -365,35 +329,37 @@ class VulkanBackend final : public Backend {
     return std::nullopt;
   }
 
-  ComputePipeline createPipeline(const uint32_t* spirv, std::size_t spirv_bytes,
-                                 uint32_t buffer_count, uint32_t push_constant_bytes,
-                                 int32_t mode = 0) {
+  ComputePipeline createPipeline(const KernelDescriptor& kernel) {
     ComputePipeline p;
-    p.buffer_count = buffer_count;
-    p.push_constant_bytes = push_constant_bytes;
+    // FVP_VULKAN_PARAMS_IN_BUFFER=1 forces the path of devices with little push-constant
+    // space (tests run it on any device).
+    const char* force_buffer = std::getenv("FVP_VULKAN_PARAMS_IN_BUFFER");
+    p.params_in_buffer = kDispatchHeaderBytes + kernel.params_bytes > limits_.maxPushConstantsSize ||
+                         (force_buffer && std::string(force_buffer) == "1");
+    const SpirvCode& code = p.params_in_buffer ? kernel.spirv_params_buffer : kernel.spirv_push_constants;
+    if (!code.words)
+      throw BackendError("vulkan: kernel " + std::string(kernel.name) + " has no SPIR-V in this build");
     std::vector<vk::DescriptorSetLayoutBinding> bindings;
-    for (uint32_t b = 0; b < buffer_count; ++b)
-      bindings.emplace_back(b, vk::DescriptorType::eStorageBuffer, 1,
-                            vk::ShaderStageFlagBits::eCompute);
-    p.set_layout = FVP_VK(vk::raii::DescriptorSetLayout(
-        device_, vk::DescriptorSetLayoutCreateInfo({}, bindings)));
-    vk::PushConstantRange push(vk::ShaderStageFlagBits::eCompute, 0, push_constant_bytes);
-    vk::DescriptorSetLayout set_layout = *p.set_layout;
-    p.layout = FVP_VK(vk::raii::PipelineLayout(
-        device_, vk::PipelineLayoutCreateInfo({}, set_layout, push)));
-    p.module = FVP_VK(vk::raii::ShaderModule(
-        device_, vk::ShaderModuleCreateInfo({}, spirv_bytes, spirv)));
-    // Specialisation constants: 0 = work-group size, 1 = kernel mode (shaders with several passes).
-    const std::array<uint32_t, 2> spec_values{work_group_size_, static_cast<uint32_t>(mode)};
-    const std::array<vk::SpecializationMapEntry, 2> entries{
-        vk::SpecializationMapEntry(0, 0, sizeof(uint32_t)),
-        vk::SpecializationMapEntry(1, sizeof(uint32_t), sizeof(uint32_t))};
-    vk::SpecializationInfo spec(static_cast<uint32_t>(entries.size()), entries.data(),
-                                sizeof(spec_values), spec_values.data());
-    vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, *p.module,
-                                            "main", &spec);
-    p.pipeline = FVP_VK(vk::raii::Pipeline(
-        device_, nullptr, vk::ComputePipelineCreateInfo({}, stage, *p.layout)));
+    for (uint32_t b = 0; b < kernel.bindings.size(); ++b)
+      bindings.emplace_back(b, vk::DescriptorType::eStorageBuffer, 1, vk::ShaderStageFlagBits::eCompute);
+    p.set_layout = FVP_VK(vk::raii::DescriptorSetLayout(device_, vk::DescriptorSetLayoutCreateInfo({}, bindings)));
+    std::vector<vk::DescriptorSetLayout> set_layouts{*p.set_layout};
+    if (p.params_in_buffer) {
+      vk::DescriptorSetLayoutBinding params_binding(0, vk::DescriptorType::eStorageBuffer, 1,
+                                                    vk::ShaderStageFlagBits::eCompute);
+      p.params_set_layout =
+          FVP_VK(vk::raii::DescriptorSetLayout(device_, vk::DescriptorSetLayoutCreateInfo({}, params_binding)));
+      set_layouts.push_back(*p.params_set_layout);
+    }
+    const uint32_t push_bytes =
+        kDispatchHeaderBytes + (p.params_in_buffer ? 0 : static_cast<uint32_t>(kernel.params_bytes));
+    vk::PushConstantRange push(vk::ShaderStageFlagBits::eCompute, 0, push_bytes);
+    p.layout = FVP_VK(vk::raii::PipelineLayout(device_, vk::PipelineLayoutCreateInfo({}, set_layouts, push)));
+    p.module = FVP_VK(vk::raii::ShaderModule(device_, vk::ShaderModuleCreateInfo({}, code.bytes, code.words)));
+    vk::SpecializationMapEntry entry(0, 0, sizeof(uint32_t));
+    vk::SpecializationInfo spec(1, &entry, sizeof(work_group_size_), &work_group_size_);
+    vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, *p.module, "main", &spec);
+    p.pipeline = FVP_VK(vk::raii::Pipeline(device_, nullptr, vk::ComputePipelineCreateInfo({}, stage, *p.layout)));
     return p;
   }
 
@@ -424,36 +390,48 @@ class VulkanBackend final : public Backend {
     FVP_VK(device_.resetFences(*fence_));
   }
 
-  // Records one pipeline over `items` work items, chunked so that no dispatch exceeds
-  // the device's work-group count limit; `first` (a member of `push`) is set per chunk.
-  template <typename Push>
-  void dispatch1D(const ComputePipeline& p, std::initializer_list<const DeviceBuffer*> buffers,
-                  uint32_t items, Push& push, uint32_t& first) {
-    vk::raii::DescriptorSets sets = FVP_VK(vk::raii::DescriptorSets(
-        device_, vk::DescriptorSetAllocateInfo(*descriptor_pool_, *p.set_layout)));
-    vk::raii::DescriptorSet& set = sets.front();
-    std::vector<vk::DescriptorBufferInfo> infos;
-    for (const DeviceBuffer* b : buffers) {
-      if (b->sizeBytes() > limits_.maxStorageBufferRange)
-        throw BackendError("vulkan: a buffer of " + std::to_string(b->sizeBytes()) +
-                           " bytes exceeds the device's maxStorageBufferRange (" +
-                           std::to_string(limits_.maxStorageBufferRange) + ")");
-      infos.emplace_back(vkBuf(*b).get(), 0, VK_WHOLE_SIZE);
-    }
-    std::vector<vk::WriteDescriptorSet> writes;
-    for (uint32_t i = 0; i < infos.size(); ++i)
-      writes.emplace_back(*set, i, 0, 1, vk::DescriptorType::eStorageBuffer, nullptr, &infos[i]);
-    device_.updateDescriptorSets(writes, {});
+  vk::DescriptorBufferInfo bufferInfo(const DeviceBuffer& b) const {
+    if (b.sizeBytes() > limits_.maxStorageBufferRange)
+      throw BackendError("vulkan: a buffer of " + std::to_string(b.sizeBytes()) +
+                         " bytes exceeds the device's maxStorageBufferRange (" +
+                         std::to_string(limits_.maxStorageBufferRange) + ")");
+    return vk::DescriptorBufferInfo(vkBuf(b).get(), 0, VK_WHOLE_SIZE);
+  }
 
-    const uint64_t max_groups = limits_.maxComputeWorkGroupCount[0];
-    const uint64_t chunk = max_groups * work_group_size_;
+  // Records one pipeline over `items` work items, chunked so that no dispatch exceeds the
+  // device's work-group count limit; the push constants carry each chunk's first item.
+  void dispatch1D(const ComputePipeline& p, const std::vector<const DeviceBuffer*>& buffers,
+                  const DeviceBuffer* params_buffer, const void* params, std::size_t params_bytes,
+                  uint32_t items) {
+    std::vector<vk::DescriptorSetLayout> layouts{*p.set_layout};
+    if (p.params_in_buffer) layouts.push_back(*p.params_set_layout);
+    vk::raii::DescriptorSets sets =
+        FVP_VK(vk::raii::DescriptorSets(device_, vk::DescriptorSetAllocateInfo(*descriptor_pool_, layouts)));
+    std::vector<vk::DescriptorBufferInfo> infos;
+    for (const DeviceBuffer* b : buffers) infos.push_back(bufferInfo(*b));
+    if (params_buffer) infos.push_back(bufferInfo(*params_buffer));
+    std::vector<vk::WriteDescriptorSet> writes;
+    for (uint32_t i = 0; i < buffers.size(); ++i)
+      writes.emplace_back(*sets[0], i, 0, 1, vk::DescriptorType::eStorageBuffer, nullptr, &infos[i]);
+    if (params_buffer)
+      writes.emplace_back(*sets[1], 0, 0, 1, vk::DescriptorType::eStorageBuffer, nullptr, &infos.back());
+    device_.updateDescriptorSets(writes, {});
+    std::vector<vk::DescriptorSet> bound_sets;
+    for (const auto& set : sets) bound_sets.push_back(*set);
+
+    // Push constants: {first_item, item_count} then, when they fit, the parameters.
+    std::vector<std::byte> push(kDispatchHeaderBytes + (p.params_in_buffer ? 0 : params_bytes));
+    std::memcpy(push.data() + sizeof(uint32_t), &items, sizeof(uint32_t));
+    if (!p.params_in_buffer) std::memcpy(push.data() + kDispatchHeaderBytes, params, params_bytes);
+    const uint64_t chunk = uint64_t{limits_.maxComputeWorkGroupCount[0]} * work_group_size_;
     submit([&](const vk::raii::CommandBuffer& cmd) {
       cmd.bindPipeline(vk::PipelineBindPoint::eCompute, *p.pipeline);
-      cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *p.layout, 0, *set, {});
+      cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *p.layout, 0, bound_sets, {});
       for (uint64_t start = 0; start < items; start += chunk) {
         const uint64_t n = std::min<uint64_t>(chunk, items - start);
-        first = static_cast<uint32_t>(start);
-        cmd.pushConstants<Push>(*p.layout, vk::ShaderStageFlagBits::eCompute, 0, push);
+        const auto first = static_cast<uint32_t>(start);
+        std::memcpy(push.data(), &first, sizeof(uint32_t));
+        cmd.pushConstants<std::byte>(*p.layout, vk::ShaderStageFlagBits::eCompute, 0, push);
         cmd.dispatch(static_cast<uint32_t>((n + work_group_size_ - 1) / work_group_size_), 1, 1);
       }
     });
@@ -476,7 +454,7 @@ class VulkanBackend final : public Backend {
   vk::raii::Fence fence_{nullptr};
   vk::raii::DescriptorPool descriptor_pool_{nullptr};
   uint32_t work_group_size_ = 1;
-  ComputePipeline ray_traverse_, scan_mark_, scan_update_, roi_distance_, frontier_;
+  std::map<const KernelDescriptor*, ComputePipeline> pipelines_;
   std::unique_ptr<DeviceBuffer> unused_;
 };
 

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "fvp/accel/backend.h"
+#include "fvp/accel/kernels.h"
 #include "fvp/accel/ray_workload.h"
 
 namespace fvp::accel {
@@ -77,8 +78,36 @@ TEST_P(BackendTest, TraverseRejectsShortBuffers) {
   auto rays = backend_->createBuffer(sizeof(Ray));
   auto results = backend_->createBuffer(sizeof(RayResult));
   TraverseParams params{grid.params, kDefaultOccupiedThreshold, 1};
-  EXPECT_THROW(backend_->traverseRays(params, *rays, *occupancy, *field, *results),
+  EXPECT_THROW(backend_->run(kernels::rayTraverse(), params,
+                            {rays.get(), occupancy.get(), field.get(), results.get()}),
                std::out_of_range);
+}
+
+TEST_P(BackendTest, DispatchChecksTheBindings) {
+  const DenseGrid grid = makeCanopyGrid(16, 0.01f, 1);
+  auto occupancy = backend_->createBufferFrom(grid.occupancy);
+  auto rays = backend_->createBuffer(sizeof(Ray));
+  auto results = backend_->createBuffer(sizeof(RayResult));
+  TraverseParams params{grid.params, kDefaultOccupiedThreshold, 1};
+  // One buffer short, and a used binding left null.
+  EXPECT_THROW(backend_->run(kernels::rayTraverse(), params, {rays.get(), occupancy.get(), results.get()}),
+               std::invalid_argument);
+  EXPECT_THROW(backend_->run(kernels::rayTraverse(), params,
+                            {rays.get(), occupancy.get(), nullptr, results.get()}),
+               std::invalid_argument);
+}
+
+TEST(KernelDescriptors, EveryKernelHasItsCodeAndDistinctBindingNames) {
+  for (const KernelDescriptor* kernel : allKernels()) {
+    SCOPED_TRACE(std::string(kernel->name));
+    EXPECT_GT(kernel->params_bytes, 0u);
+    EXPECT_NE(kernel->cpu, nullptr);
+    EXPECT_NE(kernel->item_count, nullptr);
+    for (std::size_t i = 0; i < kernel->bindings.size(); ++i) {
+      EXPECT_NE(kernel->bindings[i].required_elements, nullptr);
+      for (std::size_t j = 0; j < i; ++j) EXPECT_NE(kernel->bindings[i].name, kernel->bindings[j].name);
+    }
+  }
 }
 
 TEST_P(BackendTest, EmptyBatchIsANoOp) {

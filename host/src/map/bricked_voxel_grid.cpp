@@ -1,5 +1,7 @@
 #include "fvp/host/map/bricked_voxel_grid.h"
 
+#include "fvp/accel/kernels.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -53,7 +55,7 @@ BrickedVoxelGrid::~BrickedVoxelGrid() = default;
 std::size_t BrickedVoxelGrid::deviceBytes() const {
   std::size_t bytes = table_.size() * sizeof(int) * 2 + brick_coords_.capacity() * sizeof(int);
   bytes += pool_bricks_ * accel::kBrickVoxels * sizeof(float) * (with_roi_ ? 2 : 1);
-  bytes += backend_.scanMarkBytes(pool_bricks_ * accel::kBrickVoxels);
+  bytes += pool_bricks_ * accel::kBrickVoxels;  // marks: one byte lane per slot
   if (distance_) bytes += distance_->sizeBytes();
   return bytes;
 }
@@ -94,7 +96,7 @@ void BrickedVoxelGrid::ensurePoolCapacity(std::size_t bricks) {
   occupancy_ = backend_.createBufferFrom(occ);
   roi_ = backend_.createBufferFrom(roi);
   // Marks are all zero between scans, so new ones start zeroed.
-  marks_ = backend_.createBufferFrom(std::vector<std::uint8_t>(backend_.scanMarkBytes(slots), 0));
+  marks_ = backend_.createBufferFrom(std::vector<std::uint32_t>(slots / 4, 0u));
   pool_bricks_ = capacity;
   distance_.reset();
 }
@@ -120,7 +122,7 @@ void BrickedVoxelGrid::allocate(const std::vector<int>& brick_ids) {
   distance_.reset();  // computed for the old brick set
 }
 
-std::size_t BrickedVoxelGrid::integrate(const accel::DeviceBuffer& points, std::uint32_t point_count,
+std::size_t BrickedVoxelGrid::integrate(accel::DeviceBuffer& points, std::uint32_t point_count,
                                         const Eigen::Vector3f& sensor_m, const OccupancyModel& model) {
   accel::ScanParams scan{};
   scan.map = params_;
@@ -128,10 +130,12 @@ std::size_t BrickedVoxelGrid::integrate(const accel::DeviceBuffer& points, std::
   scan.sensor_y_m = sensor_m.y();
   scan.sensor_z_m = sensor_m.z();
   scan.point_count = point_count;
+  scan.brick_count = static_cast<int>(table_.size());
   const auto brick_count = static_cast<std::uint32_t>(table_.size());
   for (int attempt = 0;; ++attempt) {
-    const auto slots = static_cast<std::uint32_t>(pool_bricks_ * accel::kBrickVoxels);
-    backend_.scanMark(scan, points, *table_buf_, *marks_, *missing_, slots, brick_count);
+    scan.slot_count = static_cast<std::uint32_t>(pool_bricks_ * accel::kBrickVoxels);
+    backend_.run(accel::kernels::scanMark(), scan,
+                 {&points, table_buf_.get(), marks_.get(), missing_.get()});
     if (allocation_ == Allocation::kUpFront) break;
     std::uint32_t any_missing = 0;
     backend_.download(*missing_, &any_missing, sizeof(any_missing), brick_count * sizeof(std::uint32_t));
@@ -158,7 +162,8 @@ std::size_t BrickedVoxelGrid::integrate(const accel::DeviceBuffer& points, std::
   update.has_roi = with_roi_;
   const std::uint32_t zero = 0;
   backend_.upload(*counter_, &zero, sizeof(zero));
-  backend_.scanUpdate(update, *marks_, *occupancy_, *roi_, *counter_);
+  backend_.run(accel::kernels::scanUpdate(), update,
+               {marks_.get(), occupancy_.get(), with_roi_ ? roi_.get() : nullptr, counter_.get()});
   std::uint32_t updated = 0;
   backend_.download(*counter_, &updated, sizeof(updated));
   host_stale_ = true;
@@ -262,9 +267,14 @@ std::vector<float> BrickedVoxelGrid::roiDistanceVox(int radius_vox) {
   auto sq_a = backend_.createBuffer(std::max<std::size_t>(slots, 1) * sizeof(std::uint32_t));
   auto sq_b = backend_.createBuffer(std::max<std::size_t>(slots, 1) * sizeof(std::uint32_t));
   distance_ = backend_.createBuffer(std::max<std::size_t>(slots, 1) * sizeof(float));
-  backend_.roiDistancePass(edt, 0, *coords_buf_, *table_buf_, *roi_, *sq_b, *sq_a, *distance_);
-  backend_.roiDistancePass(edt, 1, *coords_buf_, *table_buf_, *roi_, *sq_a, *sq_b, *distance_);
-  backend_.roiDistancePass(edt, 2, *coords_buf_, *table_buf_, *roi_, *sq_b, *sq_a, *distance_);
+  // x pass: roi -> sq_a; y pass: sq_a -> sq_b; z pass: sq_b -> distance.
+  const auto kernel = accel::kernels::roiDistance();
+  edt.axis = 0;
+  backend_.run(kernel, edt, {coords_buf_.get(), table_buf_.get(), roi_.get(), nullptr, sq_a.get(), nullptr});
+  edt.axis = 1;
+  backend_.run(kernel, edt, {coords_buf_.get(), table_buf_.get(), nullptr, sq_a.get(), sq_b.get(), nullptr});
+  edt.axis = 2;
+  backend_.run(kernel, edt, {coords_buf_.get(), table_buf_.get(), nullptr, sq_b.get(), nullptr, distance_.get()});
   std::vector<float> per_slot(slots);
   if (slots) backend_.download(*distance_, per_slot.data(), slots * sizeof(float));
   std::vector<float> dense(static_cast<std::size_t>(geometry_.voxelCount()), static_cast<float>(radius_vox));
@@ -291,7 +301,8 @@ std::vector<FrontierVoxel> BrickedVoxelGrid::extractFrontiers(float occupied_log
     auto out = backend_.createBuffer(std::size_t{capacity} * sizeof(accel::Frontier));
     const std::uint32_t zero = 0;
     backend_.upload(*counter_, &zero, sizeof(zero));
-    backend_.extractFrontiers(params, *coords_buf_, *table_buf_, *occupancy_, *roi_, *out, *counter_);
+    backend_.run(accel::kernels::frontier(), params,
+                 {coords_buf_.get(), table_buf_.get(), occupancy_.get(), roi_.get(), out.get(), counter_.get()});
     std::uint32_t found = 0;
     backend_.download(*counter_, &found, sizeof(found));
     if (found <= capacity) {

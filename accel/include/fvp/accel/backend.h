@@ -6,6 +6,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <initializer_list>
+#include <span>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -13,6 +15,7 @@
 #include <string_view>
 #include <vector>
 
+#include "fvp/accel/kernel.h"
 #include "fvp/accel/kernel_types.h"
 
 namespace fvp::accel {
@@ -71,39 +74,20 @@ class Backend {
   void download(const DeviceBuffer& buf, void* dst, std::size_t size_bytes,
                 std::size_t offset_bytes = 0);
 
-  /// Kernel: batched voxel ray traversal (kernels/fvp_dda.h, fvp_traverse_ray).
-  /// rays: params.ray_count Ray; occupancy, field: voxelCount(params.grid) float;
-  /// results: params.ray_count RayResult. Throws std::out_of_range for short buffers.
-  void traverseRays(const TraverseParams& params, const DeviceBuffer& rays,
-                    const DeviceBuffer& occupancy, const DeviceBuffer& field,
-                    DeviceBuffer& results);
-
-  // ---- Map kernels over bricked storage (kernels/fvp_map_kernels.h) ----
-  // Slots: brick * 512 + local voxel. brick_table: int per brick of the grid (kNoBrick where
-  // unallocated); brick_coords: 3 int (brick grid coordinates) per allocated brick.
-
-  /// Bytes of the scan mark buffer for slot_count slots (its layout is the backend's own).
-  /// Mark buffers must start zeroed; the update pass leaves them zeroed.
-  virtual std::size_t scanMarkBytes(std::size_t slot_count) const = 0;
-  /// Mark pass: params.point_count ScanPoint. missing: brick_count + 1 uint; voxels in
-  /// unallocated bricks set missing[brick] and missing[brick_count] to 1.
-  void scanMark(const ScanParams& params, const DeviceBuffer& points, const DeviceBuffer& brick_table,
-                DeviceBuffer& marks, DeviceBuffer& missing, std::uint32_t slot_count,
-                std::uint32_t brick_count);
-  /// Update pass over params.slot_count slots (a multiple of kBrickVoxels); roi is read and
-  /// written only when params.has_roi. Adds the number of updated voxels to updated[0].
-  void scanUpdate(const UpdateParams& params, DeviceBuffer& marks, DeviceBuffer& occupancy,
-                  DeviceBuffer& roi, DeviceBuffer& updated);
-  /// One pass (axis 0, 1, 2) of the ROI distance field. Axis 0 reads roi and writes
-  /// sq_out; axis 1 reads sq_in, writes sq_out; axis 2 reads sq_in, writes distance_vox.
-  void roiDistancePass(const EdtParams& params, int axis, const DeviceBuffer& brick_coords,
-                       const DeviceBuffer& brick_table, const DeviceBuffer& roi,
-                       const DeviceBuffer& sq_in, DeviceBuffer& sq_out, DeviceBuffer& distance_vox);
-  /// Appends every frontier voxel to out (up to params.capacity entries, in any order);
-  /// count[0] receives the total number found (may exceed the capacity).
-  void extractFrontiers(const FrontierParams& params, const DeviceBuffer& brick_coords,
-                        const DeviceBuffer& brick_table, const DeviceBuffer& occupancy,
-                        const DeviceBuffer& roi, DeviceBuffer& out, DeviceBuffer& count);
+  /// Runs a kernel (fvp/accel/kernels.h) over the work items its parameters define, with
+  /// buffers in the kernel's binding order; returns when its results are ready. A buffer
+  /// may be null where the binding is unused for these parameters. Throws
+  /// std::invalid_argument for a wrong buffer count, bad parameters or a null buffer that
+  /// is used, and std::out_of_range for a buffer too small for its binding.
+  template <typename Params>
+  void run(Kernel<Params> kernel, const Params& params,
+           std::initializer_list<DeviceBuffer*> buffers) {
+    dispatch(*kernel.descriptor, &params, sizeof(Params),
+             std::span<DeviceBuffer* const>(buffers.begin(), buffers.size()));
+  }
+  /// The untyped form of run(): params_bytes must equal the descriptor's.
+  void dispatch(const KernelDescriptor& kernel, const void* params, std::size_t params_bytes,
+                std::span<DeviceBuffer* const> buffers);
 
   // Typed conveniences over upload/download.
   template <typename T>
@@ -126,29 +110,11 @@ class Backend {
                            std::size_t offset_bytes) = 0;
   virtual void downloadBytes(const DeviceBuffer& buf, void* dst, std::size_t size_bytes,
                              std::size_t offset_bytes) = 0;
-  // ray_count > 0.
-  virtual void dispatchTraverseRays(const TraverseParams& params, const DeviceBuffer& rays,
-                                    const DeviceBuffer& occupancy, const DeviceBuffer& field,
-                                    DeviceBuffer& results) = 0;
-  // point_count > 0.
-  virtual void dispatchScanMark(const ScanParams& params, const DeviceBuffer& points,
-                                const DeviceBuffer& brick_table, DeviceBuffer& marks,
-                                DeviceBuffer& missing, std::uint32_t slot_count,
-                                std::uint32_t brick_count) = 0;
-  // slot_count > 0.
-  virtual void dispatchScanUpdate(const UpdateParams& params, DeviceBuffer& marks,
-                                  DeviceBuffer& occupancy, DeviceBuffer& roi,
-                                  DeviceBuffer& updated) = 0;
-  virtual void dispatchRoiDistancePass(const EdtParams& params, int axis,
-                                       const DeviceBuffer& brick_coords,
-                                       const DeviceBuffer& brick_table, const DeviceBuffer& roi,
-                                       const DeviceBuffer& sq_in, DeviceBuffer& sq_out,
-                                       DeviceBuffer& distance_vox) = 0;
-  virtual void dispatchExtractFrontiers(const FrontierParams& params,
-                                        const DeviceBuffer& brick_coords,
-                                        const DeviceBuffer& brick_table,
-                                        const DeviceBuffer& occupancy, const DeviceBuffer& roi,
-                                        DeviceBuffer& out, DeviceBuffer& count) = 0;
+  /// Runs item_count > 0 work items; arguments are checked (Backend::dispatch). Buffers
+  /// unused by this dispatch are null.
+  virtual void dispatchKernel(const KernelDescriptor& kernel, const void* params,
+                              std::span<DeviceBuffer* const> buffers,
+                              std::uint32_t item_count) = 0;
 };
 
 struct BackendInfo {

@@ -4,7 +4,10 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <stdexcept>
+#include <string>
 
 extern "C" {
 #include "fvp_dda.h"
@@ -30,24 +33,36 @@ using Frontier = fvp_frontier;
 inline constexpr int kBrickEdge = FVP_BRICK_EDGE;
 inline constexpr int kBrickVoxels = FVP_BRICK_VOXELS;
 inline constexpr int kNoBrick = FVP_NO_BRICK;
-inline constexpr std::uint32_t kUpdateChunkSlots = 64;  // slots per update work item
 
 static_assert(sizeof(ScanPoint) == 16, "must match FvpScanPoint");
 static_assert(sizeof(BrickedGridParams) == 64, "must match FvpBrickedGrid");
-static_assert(sizeof(ScanParams) == 80, "must match the scan_integrate push constants");
+static_assert(sizeof(ScanParams) == 88, "must match FvpScanParams");
 static_assert(sizeof(UpdateParams) == 24, "must match FvpUpdateParams");
-static_assert(sizeof(EdtParams) == 72, "must match FvpEdtParams");
+static_assert(sizeof(EdtParams) == 76, "must match FvpEdtParams");
 static_assert(sizeof(FrontierParams) == 76, "must match FvpFrontierParams");
 static_assert(sizeof(Frontier) == 32, "must match FvpFrontier");
 static_assert(sizeof(GridParams) == 32, "must match FvpGridParams in shaders/fvp_dda.glsl");
 static_assert(sizeof(Ray) == 32, "must match FvpRay (two vec4)");
 static_assert(sizeof(RayResult) == 16, "must match FvpRayResult");
-static_assert(sizeof(TraverseParams) == 40, "must match the ray_traverse push constants");
+static_assert(sizeof(TraverseParams) == 40, "must match FvpTraverseParams");
 
 /// Geometry of a dense grid whose voxel (0,0,0) has its lower corner at origin_m.
 /// Throws std::invalid_argument for non-positive sizes or more than 16384 voxels per axis.
 GridParams makeGridParams(std::array<int, 3> dims, std::array<float, 3> origin_m,
                           float voxel_size_m);
+
+/// Bricks in the grid's brick table.
+inline std::size_t brickCount(const BrickedGridParams& m) {
+  return static_cast<std::size_t>(m.bricks_x) * m.bricks_y * m.bricks_z;
+}
+
+/// Throws std::invalid_argument (naming `what`) unless the grid is a whole number of bricks.
+inline void checkBrickedGrid(const BrickedGridParams& m, const char* what) {
+  if (m.bricks_x <= 0 || m.bricks_y <= 0 || m.bricks_z <= 0 ||
+      m.grid.dim_x != m.bricks_x * kBrickEdge || m.grid.dim_y != m.bricks_y * kBrickEdge ||
+      m.grid.dim_z != m.bricks_z * kBrickEdge)
+    throw std::invalid_argument(std::string(what) + ": grid dims must be 8 x the brick dims");
+}
 
 inline std::int64_t voxelCount(const GridParams& g) {
   return std::int64_t{g.dim_x} * g.dim_y * g.dim_z;

@@ -49,7 +49,7 @@ class BrickedVoxelGrid {
 
   /// Integrates one scan whose prepared points (finite, cut at max range, flagged) are
   /// on the device. Returns the number of voxels updated.
-  std::size_t integrate(const accel::DeviceBuffer& points, std::uint32_t point_count,
+  std::size_t integrate(accel::DeviceBuffer& points, std::uint32_t point_count,
                         const Eigen::Vector3f& sensor_m, const OccupancyModel& model);
 
   /// Occupancy / ROI log-odds of a grid voxel, NaN when unknown (or not mapped).

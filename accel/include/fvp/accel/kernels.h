@@ -1,0 +1,36 @@
+// The library's kernels (kernels/*.cl, shaders/*.comp, CPU loops in accel/src/kernels/).
+// Run one with Backend::run(kernel, params, {buffers in binding order}).
+#pragma once
+
+#include "fvp/accel/kernel.h"
+#include "fvp/accel/kernel_types.h"
+
+namespace fvp::accel::kernels {
+
+/// Batched voxel ray traversal over a dense grid (fvp_traverse_ray). Bindings: rays
+/// (ray_count Ray), occupancy and field (voxelCount(grid) float each), results (ray_count
+/// RayResult).
+Kernel<TraverseParams> rayTraverse();
+
+/// Scan integration, mark pass (fvp_scan_mark_point): one item per point. Bindings: points
+/// (point_count ScanPoint), brick_table (brick_count int), marks (slot_count / 4 uint,
+/// zero before the first scan; the update pass leaves them zero), missing (brick_count + 1
+/// uint): voxels in unallocated bricks set missing[brick] and missing[brick_count].
+Kernel<ScanParams> scanMark();
+
+/// Scan integration, update pass (fvp_scan_update_chunk): one item per 64 slots. Bindings:
+/// marks (slot_count / 4 uint), occupancy (slot_count float), roi (slot_count float, unused
+/// unless has_roi), updated (1 uint; the number of updated voxels is added to it).
+Kernel<UpdateParams> scanUpdate();
+
+/// One pass (params.axis) of the ROI distance field (fvp_roi_distance_slot): one item per
+/// slot. Bindings: brick_coords (3 int per brick), brick_table, roi (axis 0), sq_in (axes 1
+/// and 2), sq_out (axes 0 and 1) as slot_count uint, distance_vox (axis 2, slot_count float).
+Kernel<EdtParams> roiDistance();
+
+/// Frontier extraction (fvp_frontier_append): one item per slot. Bindings: brick_coords,
+/// brick_table, occupancy, roi (slot_count float), frontiers (capacity Frontier, filled in
+/// any order), count (1 uint: the total found, which may exceed the capacity).
+Kernel<FrontierParams> frontier();
+
+}  // namespace fvp::accel::kernels

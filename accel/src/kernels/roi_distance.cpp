@@ -1,0 +1,71 @@
+// Descriptor of the ROI distance-field pass (kernels/roi_distance.cl, shaders/roi_distance.comp).
+#include <stdexcept>
+
+#include "fvp/accel/kernels.h"
+#include "kernel_code.h"
+
+FVP_KERNEL_CODE(roi_distance)
+
+namespace fvp::accel::kernels {
+namespace {
+
+using detail::paramsOf;
+
+const EdtParams& edt(const void* p) { return paramsOf<EdtParams>(p); }
+std::size_t slots(const void* p) { return edt(p).slot_count; }
+
+void validate(const void* p) {
+  const EdtParams& params = edt(p);
+  checkBrickedGrid(params.map, "roi_distance");
+  if (params.slot_count % kBrickVoxels != 0)
+    throw std::invalid_argument("roi_distance: slot_count must be a multiple of 512");
+  if (params.axis < 0 || params.axis > 2)
+    throw std::invalid_argument("roi_distance: axis must be 0, 1 or 2");
+  if (params.radius_vox < 1 || params.radius_vox > 1000)
+    throw std::invalid_argument("roi_distance: radius_vox must be in [1, 1000]");
+}
+
+void cpuLoop(const void* p, void* const* buffers, std::uint32_t count) {
+  const EdtParams& params = edt(p);
+  const auto* coords = static_cast<const int*>(buffers[0]);
+  const auto* table = static_cast<const int*>(buffers[1]);
+  const auto* roi = static_cast<const float*>(buffers[2]);
+  const auto* sq_in = static_cast<const unsigned int*>(buffers[3]);
+  auto* sq_out = static_cast<unsigned int*>(buffers[4]);
+  auto* distance = static_cast<float*>(buffers[5]);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t s = 0; s < count; ++s)
+    fvp_roi_distance_slot(&params, static_cast<unsigned>(s), coords, table, roi, sq_in, sq_out,
+                          distance);
+}
+
+constexpr KernelBinding kBindings[] = {
+    {"brick_coords", sizeof(int), Access::kRead,
+     [](const void* p) { return slots(p) / kBrickVoxels * 3; }},
+    {"brick_table", sizeof(int), Access::kRead,
+     [](const void* p) { return brickCount(edt(p).map); }},
+    {"roi", sizeof(float), Access::kRead,
+     [](const void* p) { return edt(p).axis == 0 ? slots(p) : 0; }},
+    {"sq_in", sizeof(std::uint32_t), Access::kRead,
+     [](const void* p) { return edt(p).axis > 0 ? slots(p) : 0; }},
+    {"sq_out", sizeof(std::uint32_t), Access::kWrite,
+     [](const void* p) { return edt(p).axis < 2 ? slots(p) : 0; }},
+    {"distance_vox", sizeof(float), Access::kWrite,
+     [](const void* p) { return edt(p).axis == 2 ? slots(p) : 0; }},
+};
+
+const KernelDescriptor kDescriptor{
+    "roi_distance",
+    sizeof(EdtParams),
+    kBindings,
+    [](const void* p) { return edt(p).slot_count; },
+    validate,
+    cpuLoop,
+    FVP_OPENCL_CODE(roi_distance, "fvp_roi_distance"),
+    FVP_SPIRV_CODE(roi_distance)};
+
+}  // namespace
+
+Kernel<EdtParams> roiDistance() { return {&kDescriptor}; }
+
+}  // namespace fvp::accel::kernels

@@ -1,0 +1,57 @@
+// Descriptor of the scan update pass (kernels/scan_update.cl, shaders/scan_update.comp).
+#include <stdexcept>
+
+#include "fvp/accel/kernels.h"
+#include "kernel_code.h"
+
+FVP_KERNEL_CODE(scan_update)
+
+namespace fvp::accel::kernels {
+namespace {
+
+using detail::paramsOf;
+
+std::size_t slots(const void* p) { return paramsOf<UpdateParams>(p).slot_count; }
+
+void validate(const void* p) {
+  if (paramsOf<UpdateParams>(p).slot_count % kBrickVoxels != 0)
+    throw std::invalid_argument("scan_update: slot_count must be a multiple of 512");
+}
+
+void cpuLoop(const void* p, void* const* buffers, std::uint32_t count) {
+  const auto& params = paramsOf<UpdateParams>(p);
+  auto* marks = static_cast<unsigned int*>(buffers[0]);
+  auto* occupancy = static_cast<float*>(buffers[1]);
+  auto* roi = static_cast<float*>(buffers[2]);
+  unsigned long long total = 0;
+#pragma omp parallel for schedule(static) reduction(+ : total)
+  for (std::int64_t c = 0; c < count; ++c)
+    total += fvp_scan_update_chunk(&params, static_cast<unsigned>(c) * FVP_UPDATE_CHUNK, marks,
+                                   occupancy, roi);
+  static_cast<std::uint32_t*>(buffers[3])[0] += static_cast<std::uint32_t>(total);
+}
+
+constexpr KernelBinding kBindings[] = {
+    {"marks", sizeof(std::uint32_t), Access::kReadWrite,
+     [](const void* p) { return slots(p) / 4; }},
+    {"occupancy", sizeof(float), Access::kReadWrite, slots},
+    {"roi", sizeof(float), Access::kReadWrite,
+     [](const void* p) -> std::size_t { return paramsOf<UpdateParams>(p).has_roi ? slots(p) : 0; }},
+    {"updated", sizeof(std::uint32_t), Access::kReadWrite, [](const void*) -> std::size_t { return 1; }},
+};
+
+const KernelDescriptor kDescriptor{
+    "scan_update",
+    sizeof(UpdateParams),
+    kBindings,
+    [](const void* p) { return paramsOf<UpdateParams>(p).slot_count / FVP_UPDATE_CHUNK; },
+    validate,
+    cpuLoop,
+    FVP_OPENCL_CODE(scan_update, "fvp_scan_update"),
+    FVP_SPIRV_CODE(scan_update)};
+
+}  // namespace
+
+Kernel<UpdateParams> scanUpdate() { return {&kDescriptor}; }
+
+}  // namespace fvp::accel::kernels
