@@ -6,13 +6,16 @@
 #include <octomap/OcTree.h>
 
 #include <unistd.h>
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <limits>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "fvp/host/map/octomap_io.h"
 #include "fvp/host/map/octomap_map_engine.h"
@@ -498,6 +501,250 @@ TEST(OctomapEngineFiles, FailuresNameTheFile) {
   TempDir dir;
   e->exportCoarse(dir.path() / "coarse.bt");
   EXPECT_THROW(readFineOt(dir.path() / "coarse.bt"), std::runtime_error);  // a .bt is no .ot
+}
+
+// ---- planner reads: ROI distance field, frontiers (brute force by their definitions) ---
+
+// The fine map's voxel states over the grid box, read voxel by voxel (x fastest).
+std::vector<VoxelState> denseFineStates(const OctomapMapEngine& e) {
+  const GridGeometry& g = e.fineGrid();
+  std::vector<VoxelState> states(static_cast<std::size_t>(g.voxelCount()));
+  for (int z = 0; z < g.dims[2]; ++z)
+    for (int y = 0; y < g.dims[1]; ++y)
+      for (int x = 0; x < g.dims[0]; ++x)
+        states[x + g.dims[0] * (y + static_cast<std::size_t>(g.dims[1]) * z)] =
+            e.fineStateAt({x, y, z});
+  return states;
+}
+
+// map_engine.h's d_i: distance between voxel centres to the nearest known ROI voxel, in
+// metres, capped at max_d_m; every ROI voxel within the cap's cube is visited.
+std::vector<double> bruteForceRoiDistance_m(const OctomapMapEngine& e, double max_d_m) {
+  const GridGeometry& g = e.fineGrid();
+  const auto states = denseFineStates(e);
+  const int window = static_cast<int>(std::ceil(max_d_m / g.voxel_size_m));
+  std::vector<double> d(states.size(), max_d_m);
+  for (int rz = 0; rz < g.dims[2]; ++rz)
+    for (int ry = 0; ry < g.dims[1]; ++ry)
+      for (int rx = 0; rx < g.dims[0]; ++rx) {
+        if (!states[rx + g.dims[0] * (ry + static_cast<std::size_t>(g.dims[1]) * rz)].roi) continue;
+        for (int z = std::max(0, rz - window); z <= std::min(g.dims[2] - 1, rz + window); ++z)
+          for (int y = std::max(0, ry - window); y <= std::min(g.dims[1] - 1, ry + window); ++y)
+            for (int x = std::max(0, rx - window); x <= std::min(g.dims[0] - 1, rx + window); ++x) {
+              const double dist_m =
+                  g.voxel_size_m * std::sqrt(double((x - rx) * (x - rx) + (y - ry) * (y - ry) +
+                                                    (z - rz) * (z - rz)));
+              double& out = d[x + g.dims[0] * (y + static_cast<std::size_t>(g.dims[1]) * z)];
+              out = std::min(out, dist_m);
+            }
+      }
+  return d;
+}
+
+// frontier_voxel.h's definition, voxel by voxel over the grid box.
+std::vector<FrontierVoxel> bruteForceFrontiers(const OctomapMapEngine& e) {
+  const GridGeometry& g = e.fineGrid();
+  const auto states = denseFineStates(e);
+  const fvp_region region = regionInGrid(g, e.region());
+  auto inRegion = [&](int x, int y, int z) {
+    return x >= 0 && y >= 0 && z >= 0 && x < g.dims[0] && y < g.dims[1] && z < g.dims[2] &&
+           fvp_region_contains(&region, x, y, z);
+  };
+  auto state = [&](int x, int y, int z) {
+    return states[x + g.dims[0] * (y + static_cast<std::size_t>(g.dims[1]) * z)];
+  };
+  std::vector<FrontierVoxel> out;
+  for (int z = 0; z < g.dims[2]; ++z)
+    for (int y = 0; y < g.dims[1]; ++y)
+      for (int x = 0; x < g.dims[0]; ++x) {
+        const VoxelState s = state(x, y, z);
+        if (s.occupancy == VoxelClass::kUnknown) continue;
+        const bool is_free = s.occupancy == VoxelClass::kFree;
+        if (!s.roi && !is_free) continue;
+        bool face_unknown = false;
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        for (int dz = -1; dz <= 1; ++dz)
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+              if (dx == 0 && dy == 0 && dz == 0) continue;
+              if (!inRegion(x + dx, y + dy, z + dz)) continue;
+              if (state(x + dx, y + dy, z + dz).occupancy != VoxelClass::kUnknown) continue;
+              face_unknown |= std::abs(dx) + std::abs(dy) + std::abs(dz) == 1;
+              sum -= Eigen::Vector3d(dx, dy, dz);
+            }
+        if (!face_unknown) continue;
+        FrontierVoxel f;
+        f.index = {x, y, z};
+        f.center_m = g.voxelCenter_m(f.index);
+        f.roi_frontier = s.roi;
+        f.exploration_frontier = is_free;
+        if (sum.squaredNorm() > 0) f.normal = sum.normalized();
+        out.push_back(f);
+      }
+  return out;  // z, then y, then x: the engines' order
+}
+
+void expectSameFrontiers(const std::vector<FrontierVoxel>& got,
+                         const std::vector<FrontierVoxel>& want) {
+  ASSERT_EQ(got.size(), want.size());
+  for (std::size_t i = 0; i < want.size(); ++i) {
+    ASSERT_EQ(got[i].index, want[i].index) << i;
+    EXPECT_EQ(got[i].center_m, want[i].center_m) << i;
+    EXPECT_EQ(got[i].roi_frontier, want[i].roi_frontier) << i;
+    EXPECT_EQ(got[i].exploration_frontier, want[i].exploration_frontier) << i;
+    EXPECT_LE((got[i].normal - want[i].normal).norm(), 1e-12) << i;
+  }
+}
+
+std::array<int, 3> fineIndex(const OctomapMapEngine& e, const Eigen::Vector3d& p) {
+  std::array<int, 3> i{};
+  EXPECT_TRUE(e.fineGrid().gridIndex(p, i));
+  return i;
+}
+
+TEST(OctomapEnginePlannerReads, RoiDistanceOnAHandMadeMapEqualsBruteForce) {
+  OctomapMapEngine e(smallConfig(), kRegion);
+  EXPECT_THROW(e.roiDistance_m({0, 0, 0}), std::logic_error);
+  EXPECT_THROW(e.updateRoiDistance(0.0), std::invalid_argument);
+  const Eigen::Vector3d origin(0.0051, 0.0052, 0.0053);
+  // Three ROI voxels (one on the sphere's edge), a known non-ROI voxel, and a voxel whose
+  // one ROI hit three later other hits outweigh (ROI log-odds 0.85 - 3 * 0.4 < 0).
+  e.integrate(origin,
+              {Vec3f(0.0051f, 0.0052f, 0.2103f), Vec3f(-0.0103f, 0.0071f, 0.1952f),
+               Vec3f(0.0152f, -0.0121f, 0.2204f), Vec3f(0.0263f, 0.0025f, 0.2031f),
+               Vec3f(-0.0041f, -0.0182f, 0.1857f)},
+              {Vec3f(0.0085f, 0.0052f, 0.2053f)});
+  for (int i = 0; i < 3; ++i) e.integrate(origin, {}, {Vec3f(-0.0041f, -0.0182f, 0.1857f)});
+  std::size_t roi_voxels = 0;
+  for (const VoxelState& s : denseFineStates(e)) roi_voxels += s.roi;
+  ASSERT_EQ(roi_voxels, 4u);
+  ASSERT_FALSE(e.fineState(Eigen::Vector3d(-0.0041, -0.0182, 0.1857)).roi);
+  ASSERT_EQ(e.fineState(Eigen::Vector3d(-0.0041, -0.0182, 0.1857)).occupancy,
+            VoxelClass::kOccupied);
+
+  const GridGeometry& g = e.fineGrid();
+  for (const double cap_m : {0.0125, 0.02}) {  // 12.5 and 20 voxels: a cap between voxels too
+    e.updateRoiDistance(cap_m);
+    const std::vector<double> want = bruteForceRoiDistance_m(e, cap_m);
+    std::size_t below_cap = 0;
+    for (int z = 0; z < g.dims[2]; ++z)
+      for (int y = 0; y < g.dims[1]; ++y)
+        for (int x = 0; x < g.dims[0]; ++x) {
+          const double w = want[x + g.dims[0] * (y + static_cast<std::size_t>(g.dims[1]) * z)];
+          // float square root (the grid kernel's conversion): within 1e-8 m at 1 mm voxels.
+          ASSERT_NEAR(e.roiDistance_m({x, y, z}), w, 1e-8) << x << " " << y << " " << z;
+          below_cap += w < cap_m;
+        }
+    EXPECT_GT(below_cap, 4u * 1000u);
+    EXPECT_EQ(e.roiDistance_m({-1, 0, 0}), cap_m);  // outside the fine grid: the cap
+    EXPECT_EQ(e.roiDistance_m({0, g.dims[1], 0}), cap_m);
+    EXPECT_EQ(e.roiDistance_m(fineIndex(e, Eigen::Vector3d(0.0051, 0.0052, 0.2103))), 0.0);
+  }
+
+  // A new scan with a new ROI voxel: the next update recomputes.
+  const std::array<int, 3> fresh = fineIndex(e, Eigen::Vector3d(0.0005, 0.0005, 0.2005));
+  EXPECT_GT(e.roiDistance_m(fresh), 0.0);
+  e.integrate(origin, {Vec3f(0.0005f, 0.0005f, 0.2005f)}, {});
+  e.updateRoiDistance(0.02);
+  EXPECT_EQ(e.roiDistance_m(fresh), 0.0);
+}
+
+TEST(OctomapEnginePlannerReads, RoiDistanceOnFruitletSurfacesWithinDynamicEdtsDeviation) {
+  const auto e = mappedEngine();
+  const GridGeometry& g = e->fineGrid();
+  const double cap_m = 0.02;
+  e->updateRoiDistance(cap_m);
+  const std::vector<double> want = bruteForceRoiDistance_m(*e, cap_m);
+  std::size_t equal = 0, below_cap = 0;
+  double max_error_m = 0.0;
+  for (int z = 0; z < g.dims[2]; ++z)
+    for (int y = 0; y < g.dims[1]; ++y)
+      for (int x = 0; x < g.dims[0]; ++x) {
+        const double w = want[x + g.dims[0] * (y + static_cast<std::size_t>(g.dims[1]) * z)];
+        const double err = e->roiDistance_m({x, y, z}) - w;
+        // DynamicEDT may miss the nearest ROI voxel, never finds a nearer one than exists.
+        ASSERT_GE(err, -1e-8) << x << " " << y << " " << z;
+        equal += err <= 1e-8;
+        max_error_m = std::max(max_error_m, err);
+        below_cap += w < cap_m;
+      }
+  std::cout << "DynamicEDT vs brute force: " << equal << " of " << want.size()
+            << " fine voxels equal, max excess " << max_error_m * 1e3 << " mm\n";
+  EXPECT_GT(below_cap, want.size() / 10);
+  EXPECT_GE(double(equal), 0.999 * want.size());
+  EXPECT_LE(max_error_m, 0.1 * g.voxel_size_m);  // docs/maps.md: DynamicEDT's deviation
+}
+
+TEST(OctomapEnginePlannerReads, FrontiersOfOneRayByHand) {
+  OctomapMapEngine e(smallConfig(), kRegion);
+  EXPECT_TRUE(e.frontiers().empty());
+  const Eigen::Vector3d origin(0.0051, 0.0052, 0.0053);
+  // Column x = 5, y = 5 (world lattice): an ROI hit at z = 205, then three scans whose rays
+  // pass it to end at z = 215: voxel 205 turns free (0.85 - 3 * 0.4) but stays ROI.
+  e.integrate(origin, {Vec3f(0.0051f, 0.0052f, 0.2053f)}, {});
+  for (int i = 0; i < 3; ++i) e.integrate(origin, {}, {Vec3f(0.0051f, 0.0052f, 0.2153f)});
+  const auto frontiers = e.frontiers();
+  expectSameFrontiers(frontiers, bruteForceFrontiers(e));
+
+  std::size_t known = 0;
+  for (const VoxelState& s : denseFineStates(e)) known += s.occupancy != VoxelClass::kUnknown;
+  // Every known voxel of the column but the occupied non-ROI end (z = 215) is a frontier:
+  // its four side neighbours are unknown.
+  EXPECT_EQ(frontiers.size(), known - 1);
+  const auto at = [&](int z) {
+    const std::array<int, 3> i = fineIndex(e, fineCenter(5, 5, z));
+    const auto it = std::find_if(frontiers.begin(), frontiers.end(),
+                                 [&](const FrontierVoxel& f) { return f.index == i; });
+    return it == frontiers.end() ? nullptr : &*it;
+  };
+  const FrontierVoxel* both = at(205);
+  ASSERT_NE(both, nullptr);
+  EXPECT_TRUE(both->roi_frontier);
+  EXPECT_TRUE(both->exploration_frontier);
+  EXPECT_EQ(both->normal, Eigen::Vector3d::Zero());  // unknown all around the column
+  const FrontierVoxel* below_end = at(214);
+  ASSERT_NE(below_end, nullptr);
+  EXPECT_FALSE(below_end->roi_frontier);
+  EXPECT_TRUE(below_end->exploration_frontier);
+  EXPECT_EQ(below_end->normal, Eigen::Vector3d::Zero());
+  EXPECT_EQ(at(215), nullptr);  // occupied, not ROI
+  for (int z = 190; z < 214; ++z) {
+    const FrontierVoxel* f = at(z);
+    ASSERT_NE(f, nullptr) << z;
+    EXPECT_EQ(f->exploration_frontier, true) << z;
+    EXPECT_EQ(f->roi_frontier, z == 205) << z;
+  }
+
+  // The ROI end voxel alone on top of its column: unknown above and around, so the normal
+  // points down the known column: -(9 * (+z) + 8 * (-z)) = -z.
+  OctomapMapEngine top(smallConfig(), kRegion);
+  top.integrate(origin, {Vec3f(0.0051f, 0.0052f, 0.2103f)}, {});
+  const auto tf = top.frontiers();
+  expectSameFrontiers(tf, bruteForceFrontiers(top));
+  ASSERT_FALSE(tf.empty());
+  const FrontierVoxel& end = tf.back();  // the largest z
+  EXPECT_EQ(end.index, fineIndex(top, fineCenter(5, 5, 210)));
+  EXPECT_TRUE(end.roi_frontier);
+  EXPECT_FALSE(end.exploration_frontier);  // occupied
+  EXPECT_EQ(end.normal, Eigen::Vector3d(0, 0, -1));
+}
+
+TEST(OctomapEnginePlannerReads, FrontiersOfSyntheticViewsEqualBruteForce) {
+  const auto e = mappedEngine();
+  // Pruned leafs (eight equal voxels merged) must be expanded into their voxels.
+  std::size_t pruned = 0;
+  for (auto it = e->fineTree().begin_leafs(); it != e->fineTree().end_leafs(); ++it)
+    pruned += it.getDepth() < e->fineTree().getTreeDepth();
+  EXPECT_GT(pruned, 100u);
+  const auto frontiers = e->frontiers();
+  std::size_t roi = 0, exploration = 0;
+  for (const auto& f : frontiers) {
+    roi += f.roi_frontier;
+    exploration += f.exploration_frontier;
+  }
+  EXPECT_GT(roi, 50u);
+  EXPECT_GT(exploration, 500u);
+  expectSameFrontiers(frontiers, bruteForceFrontiers(*e));
 }
 
 }  // namespace

@@ -8,7 +8,11 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 
+#include <dynamicEDT3D/dynamicEDTOctomap.h>
+
+#include "fvp/accel/kernel_types.h"  // fvp_edt_distance_vox: the grid engine's conversion
 #include "fvp/host/map/octomap_io.h"
 
 namespace fvp::host::map {
@@ -152,8 +156,8 @@ octomap::OcTreeKey OctomapMapEngine::fineKey(const std::array<int, 3>& index) co
 }
 
 ScanStats OctomapMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
-                                      const std::vector<Eigen::Vector3f>& roi_points_m,
-                                      const std::vector<Eigen::Vector3f>& other_points_m) {
+                                          const std::vector<Eigen::Vector3f>& roi_points_m,
+                                          const std::vector<Eigen::Vector3f>& other_points_m) {
   const auto start = std::chrono::steady_clock::now();
   if (!sensor_origin_m.allFinite()) {
     throw std::invalid_argument("octomap engine: the sensor origin is not finite");
@@ -345,11 +349,13 @@ std::vector<std::array<int, 3>> occupiedLeaves(const Tree& tree, const GridGeome
     const auto n = static_cast<std::int64_t>(std::llround(it.getSize() / res));
     std::array<std::int64_t, 3> lo;
     for (int a = 0; a < 3; ++a)
-      lo[a] = std::llround((it.getCoordinate()(a) - 0.5 * it.getSize()) / res) - grid.first_voxel[a];
+      lo[a] =
+          std::llround((it.getCoordinate()(a) - 0.5 * it.getSize()) / res) - grid.first_voxel[a];
     for (std::int64_t z = lo[2]; z < lo[2] + n; ++z)
       for (std::int64_t y = lo[1]; y < lo[1] + n; ++y)
         for (std::int64_t x = lo[0]; x < lo[0] + n; ++x)
-          if (x >= 0 && y >= 0 && z >= 0 && x < grid.dims[0] && y < grid.dims[1] && z < grid.dims[2])
+          if (x >= 0 && y >= 0 && z >= 0 && x < grid.dims[0] && y < grid.dims[1] &&
+              z < grid.dims[2])
             voxels.push_back({static_cast<int>(x), static_cast<int>(y), static_cast<int>(z)});
   }
   return voxels;
@@ -363,14 +369,165 @@ std::vector<std::array<int, 3>> OctomapMapEngine::occupiedVoxels(MapLevel level)
                                     : occupiedLeaves(*fine_, fine_grid_, occupied);
 }
 
-void OctomapMapEngine::updateRoiDistance(double) {
-  throw std::logic_error("octomap engine: ROI distance field not written yet");
+namespace {
+
+// A known fine voxel as the leaf iteration yields it (pruned leafs expanded).
+struct KnownVoxel {
+  std::array<int, 3> index;
+  const RoiOcTreeNode* node;
+};
+
+// Every voxel of the fine grid's region the tree knows: its leafs at the fine depth, a
+// pruned leaf standing for its whole cube of voxels.
+std::vector<KnownVoxel> knownFineVoxels(const RoiOcTree& tree, const GridGeometry& grid,
+                                        const fvp_region& region, int key_offset) {
+  std::vector<KnownVoxel> voxels;
+  const unsigned depth = tree.getTreeDepth();
+  for (auto it = tree.begin_leafs(); it != tree.end_leafs(); ++it) {
+    const int n = 1 << (depth - it.getDepth());
+    const octomap::OcTreeKey corner = it.getIndexKey();
+    std::array<std::int64_t, 3> lo;
+    for (int a = 0; a < 3; ++a) lo[a] = std::int64_t{corner[a]} - key_offset - grid.first_voxel[a];
+    for (std::int64_t z = lo[2]; z < lo[2] + n; ++z)
+      for (std::int64_t y = lo[1]; y < lo[1] + n; ++y)
+        for (std::int64_t x = lo[0]; x < lo[0] + n; ++x) {
+          if (x < 0 || y < 0 || z < 0 || x >= grid.dims[0] || y >= grid.dims[1] ||
+              z >= grid.dims[2])
+            continue;
+          const std::array<int, 3> index{static_cast<int>(x), static_cast<int>(y),
+                                         static_cast<int>(z)};
+          if (!fvp_region_contains(&region, index[0], index[1], index[2])) continue;
+          voxels.push_back({index, &*it});
+        }
+  }
+  return voxels;
 }
-double OctomapMapEngine::roiDistance_m(const std::array<int, 3>&) const {
-  throw std::logic_error("octomap engine: ROI distance field not written yet");
+
+}  // namespace
+
+void OctomapMapEngine::updateRoiDistance(double max_d_m) {
+  if (!(max_d_m > 0.0)) throw std::invalid_argument("updateRoiDistance: max_d_m must be positive");
+  if (distance_max_d_m_ == max_d_m && distance_scans_ == scanCount()) return;
+  const double voxel = fine_grid_.voxel_size_m;
+  // The grid engine's window radius: the same cap in voxels on both engines.
+  const int radius_vox = std::max(1, static_cast<int>(std::ceil(max_d_m / voxel)));
+  const auto& dims = fine_grid_.dims;
+  distance_vox_.assign(static_cast<std::size_t>(fine_grid_.voxelCount()),
+                       static_cast<float>(radius_vox));
+
+  // The obstacles of the transform: known ROI voxels only, as occupied leafs of a plain
+  // OcTree on the fine lattice (same resolution, so the same keys). Everything else is
+  // left unknown, which DynamicEDT treats as free (treatUnknownAsOccupied = false).
+  octomap::OcTree roi_tree(voxel);
+  bool any_roi = false;
+  for (const KnownVoxel& v : knownFineVoxels(*fine_, fine_grid_, fine_region_, key_offset_)) {
+    if (!v.node->isRoi()) continue;
+    roi_tree.setNodeValue(fineKey(v.index), roi_tree.getClampingThresMaxLog(),
+                          /*lazy_eval=*/true);
+    any_roi = true;
+  }
+  if (any_roi) {
+    roi_tree.updateInnerOccupancy();
+    const octomap::point3d box_min = roi_tree.keyToCoord(fineKey({0, 0, 0}));
+    const octomap::point3d box_max =
+        roi_tree.keyToCoord(fineKey({dims[0] - 1, dims[1] - 1, dims[2] - 1}));
+    // DynamicEDT saturates at int(maxdist / resolution + 1) cells: R + 0.5 voxels gives
+    // R + 1, so every distance below the cap R is propagated; the cap is applied below.
+    const auto maxdist_m = static_cast<float>((radius_vox + 0.5) * voxel);
+    DynamicEDTOctomap edt(maxdist_m, &roi_tree, box_min, box_max, /*treatUnknownAsOccupied=*/false);
+    edt.update(/*updateRealDist=*/false);  // only squared cell distances are read
+    for (int z = 0; z < dims[2]; ++z)
+      for (int y = 0; y < dims[1]; ++y)
+        for (int x = 0; x < dims[0]; ++x) {
+          // Squared distance between cell centres in cells (exact integers), converted as
+          // the grid engine's kernel does so that equal squares give equal distances.
+          const int sq = edt.getSquaredDistanceInCells(roi_tree.keyToCoord(fineKey({x, y, z})));
+          if (sq < 0)
+            throw std::logic_error("updateRoiDistance: a fine voxel outside DynamicEDT's box");
+          distance_vox_[x + dims[0] * (y + static_cast<std::size_t>(dims[1]) * z)] =
+              fvp_edt_distance_vox(static_cast<unsigned int>(sq), radius_vox);
+        }
+  }
+  distance_max_d_m_ = max_d_m;
+  distance_scans_ = scanCount();
 }
+
+double OctomapMapEngine::roiDistance_m(const std::array<int, 3>& fine_index) const {
+  if (distance_max_d_m_ < 0.0)
+    throw std::logic_error("roiDistance_m: call updateRoiDistance() first");
+  for (int a = 0; a < 3; ++a)
+    if (fine_index[a] < 0 || fine_index[a] >= fine_grid_.dims[a]) return distance_max_d_m_;
+  const std::size_t dense =
+      fine_index[0] +
+      fine_grid_.dims[0] *
+          (fine_index[1] + static_cast<std::size_t>(fine_grid_.dims[1]) * fine_index[2]);
+  return std::min(distance_vox_[dense] * fine_grid_.voxel_size_m, distance_max_d_m_);
+}
+
 std::vector<FrontierVoxel> OctomapMapEngine::frontiers() {
-  throw std::logic_error("octomap engine: frontiers not written yet");
+  const float occupied = config().model.occupiedLogOdds();
+  const std::vector<KnownVoxel> known =
+      knownFineVoxels(*fine_, fine_grid_, fine_region_, key_offset_);
+  // Unknown space of the fine map: a voxel of the region the tree has no node for.
+  auto unknown = [&](int x, int y, int z) {
+    if (x < 0 || y < 0 || z < 0 || x >= fine_grid_.dims[0] || y >= fine_grid_.dims[1] ||
+        z >= fine_grid_.dims[2])
+      return false;
+    if (!fvp_region_contains(&fine_region_, x, y, z)) return false;
+    return fine_->search(fineKey({x, y, z})) == nullptr;
+  };
+  constexpr int kFaces[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+  std::vector<FrontierVoxel> frontiers;
+  const auto count = static_cast<std::int64_t>(known.size());
+#pragma omp parallel
+  {
+    std::vector<FrontierVoxel> local;
+#pragma omp for schedule(dynamic, 4096)
+    for (std::int64_t k = 0; k < count; ++k) {
+      const KnownVoxel& v = known[static_cast<std::size_t>(k)];
+      const bool is_roi = v.node->isRoi();
+      const bool is_free = !(v.node->getLogOdds() > occupied);
+      if (!is_roi && !is_free) continue;
+      const auto [x, y, z] = v.index;
+      // Face neighbours first: most known voxels have none unknown, and then the 26-sum
+      // for the normal is not needed.
+      bool face_unknown = false;
+      for (const auto& f : kFaces) {
+        if (unknown(x + f[0], y + f[1], z + f[2])) {
+          face_unknown = true;
+          break;
+        }
+      }
+      if (!face_unknown) continue;
+      // Integer sum of -offset over the unknown 26-neighbours, as fvp_frontier_voxel.
+      int normal[3] = {0, 0, 0};
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            if ((dx | dy | dz) == 0 || !unknown(x + dx, y + dy, z + dz)) continue;
+            normal[0] -= dx;
+            normal[1] -= dy;
+            normal[2] -= dz;
+          }
+      FrontierVoxel f;
+      f.index = v.index;
+      f.center_m = fine_grid_.voxelCenter_m(v.index);
+      f.roi_frontier = is_roi;
+      f.exploration_frontier = is_free;
+      const Eigen::Vector3d n(normal[0], normal[1], normal[2]);
+      if (n.squaredNorm() > 0) f.normal = n.normalized();
+      local.push_back(f);
+    }
+#pragma omp critical(fvp_octomap_engine_frontiers)
+    frontiers.insert(frontiers.end(), local.begin(), local.end());
+  }
+  // Threads append in any order: sort by grid index, as the grid engine does.
+  std::sort(frontiers.begin(), frontiers.end(), [](const FrontierVoxel& a, const FrontierVoxel& b) {
+    return std::tie(a.index[2], a.index[1], a.index[0]) <
+           std::tie(b.index[2], b.index[1], b.index[0]);
+  });
+  return frontiers;
 }
 
 }  // namespace fvp::host::map

@@ -31,6 +31,7 @@
 
 #include <array>
 #include <memory>
+#include <vector>
 
 #include "fvp/host/map/grid_geometry.h"
 #include "fvp/host/map/map_engine.h"
@@ -53,7 +54,7 @@ class OctomapMapEngine : public MapEngine {
 
  protected:
   ScanStats integrateScan(const Eigen::Vector3d& sensor_origin_m,
-                      const std::vector<Eigen::Vector3f>& roi_points_m,
+                          const std::vector<Eigen::Vector3f>& roi_points_m,
                           const std::vector<Eigen::Vector3f>& other_points_m) override;
 
  public:
@@ -67,10 +68,14 @@ class OctomapMapEngine : public MapEngine {
   void exportCoarse(const std::filesystem::path& bt_path) const override;
   void exportFine(const std::filesystem::path& ot_path) const override;
 
-  // Planner reads (map_engine.h). Transient: the distance field and frontiers are being
-  // written (DynamicEDTOctomap); until then they throw std::logic_error.
+  // Planner reads (map_engine.h): the grid engine's definitions and results, except that
+  // DynamicEDT overestimates a distance now and then (1e-6 to 1e-5 of the voxels, at most
+  // 0.1 voxel measured; docs/maps.md).
+  /// DynamicEDTOctomap (OctoMap's dynamicEDT3D) over the fine grid's box, on an OcTree
+  /// holding the known ROI voxels as its only occupied voxels.
   void updateRoiDistance(double max_d_m) override;
   double roiDistance_m(const std::array<int, 3>& fine_index) const override;
+  /// Visits the fine tree's leafs (the known voxels); neighbours are looked up in the tree.
   std::vector<FrontierVoxel> frontiers() override;
   const octomap::OcTree& coarseOcTree() override { return *coarse_; }
 
@@ -89,6 +94,11 @@ class OctomapMapEngine : public MapEngine {
   int key_offset_ = 0;  ///< OctoMap key of lattice index 0 (tree_max_val)
   std::unique_ptr<octomap::OcTree> coarse_;
   std::unique_ptr<RoiOcTree> fine_;
+  // ROI distance in voxels over the fine grid box (x fastest) as of distance_scans_ scans
+  // with cap distance_max_d_m_ (negative before the first updateRoiDistance()).
+  std::vector<float> distance_vox_;
+  double distance_max_d_m_ = -1.0;
+  std::size_t distance_scans_ = 0;
 };
 
 }  // namespace fvp::host::map
