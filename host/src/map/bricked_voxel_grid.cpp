@@ -256,8 +256,8 @@ void BrickedVoxelGrid::allocateRoiHalo(int radius_vox) {
   allocate(ids);
 }
 
-std::vector<float> BrickedVoxelGrid::roiDistanceVox(int radius_vox) {
-  if (!with_roi_) throw std::logic_error("roiDistanceVox needs a map with ROI");
+void BrickedVoxelGrid::computeRoiDistance(int radius_vox) {
+  if (!with_roi_) throw std::logic_error("computeRoiDistance needs a map with ROI");
   if (allocation_ == Allocation::kOnTouch) allocateRoiHalo(radius_vox);
   const std::size_t slots = slotCount();
   accel::EdtParams edt{};
@@ -275,16 +275,30 @@ std::vector<float> BrickedVoxelGrid::roiDistanceVox(int radius_vox) {
   backend_.run(kernel, edt, {coords_buf_.get(), table_buf_.get(), nullptr, sq_a.get(), sq_b.get(), nullptr});
   edt.axis = 2;
   backend_.run(kernel, edt, {coords_buf_.get(), table_buf_.get(), nullptr, sq_b.get(), nullptr, distance_.get()});
-  std::vector<float> per_slot(slots);
-  if (slots) backend_.download(*distance_, per_slot.data(), slots * sizeof(float));
-  std::vector<float> dense(static_cast<std::size_t>(geometry_.voxelCount()), static_cast<float>(radius_vox));
-  for (std::size_t b = 0; b < allocatedBricks(); ++b)
-    for (int local = 0; local < accel::kBrickVoxels; ++local) {
-      const int x = brick_coords_[3 * b] * 8 + (local & 7), y = brick_coords_[3 * b + 1] * 8 + ((local >> 3) & 7),
-                z = brick_coords_[3 * b + 2] * 8 + (local >> 6);
-      dense[x + geometry_.dims[0] * (y + static_cast<std::size_t>(geometry_.dims[1]) * z)] =
-          per_slot[b * accel::kBrickVoxels + local];
-    }
+  distance_radius_vox_ = radius_vox;
+  std::lock_guard<std::mutex> lock(host_mutex_);
+  host_distance_.clear();  // downloaded on the first query
+}
+
+float BrickedVoxelGrid::roiDistanceVoxAt(const std::array<int, 3>& index) const {
+  if (!distance_) throw std::logic_error("roiDistanceVoxAt: call computeRoiDistance() first");
+  const std::int64_t slot = slotOf(index);
+  if (slot < 0) return static_cast<float>(distance_radius_vox_);
+  std::lock_guard<std::mutex> lock(host_mutex_);
+  if (host_distance_.empty()) {
+    host_distance_.resize(std::max<std::size_t>(slotCount(), 1));
+    if (slotCount()) backend_.download(*distance_, host_distance_.data(), slotCount() * sizeof(float));
+  }
+  return host_distance_[static_cast<std::size_t>(slot)];
+}
+
+std::vector<float> BrickedVoxelGrid::roiDistanceVox(int radius_vox) {
+  computeRoiDistance(radius_vox);
+  std::vector<float> dense(static_cast<std::size_t>(geometry_.voxelCount()));
+  std::size_t i = 0;
+  for (int z = 0; z < geometry_.dims[2]; ++z)
+    for (int y = 0; y < geometry_.dims[1]; ++y)
+      for (int x = 0; x < geometry_.dims[0]; ++x) dense[i++] = roiDistanceVoxAt({x, y, z});
   return dense;
 }
 

@@ -153,7 +153,7 @@ void GridMapEngine::updateRoiDistance(double max_d_m) {
   if (distance_max_d_m_ == max_d_m && distance_scans_ == scanCount()) return;
   const double voxel = fine_->geometry().voxel_size_m;
   const int radius_vox = std::max(1, static_cast<int>(std::ceil(max_d_m / voxel)));
-  distance_vox_ = fine_->roiDistanceVox(radius_vox);
+  fine_->computeRoiDistance(radius_vox);
   distance_max_d_m_ = max_d_m;
   distance_scans_ = scanCount();
 }
@@ -163,9 +163,7 @@ double GridMapEngine::roiDistance_m(const std::array<int, 3>& fine_index) const 
   const GridGeometry& g = fine_->geometry();
   for (int a = 0; a < 3; ++a)
     if (fine_index[a] < 0 || fine_index[a] >= g.dims[a]) return distance_max_d_m_;
-  const std::size_t dense =
-      fine_index[0] + g.dims[0] * (fine_index[1] + static_cast<std::size_t>(g.dims[1]) * fine_index[2]);
-  return std::min(distance_vox_[dense] * g.voxel_size_m, distance_max_d_m_);
+  return std::min(fine_->roiDistanceVoxAt(fine_index) * g.voxel_size_m, distance_max_d_m_);
 }
 
 std::vector<FrontierVoxel> GridMapEngine::frontiers() {

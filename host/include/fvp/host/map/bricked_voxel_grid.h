@@ -64,10 +64,14 @@ class BrickedVoxelGrid {
   /// allocating every brick. For tests and for loading maps.
   void assignDense(const std::vector<float>& occupancy, const std::vector<float>& roi);
 
-  /// Paper Eq. 1's d_i: Euclidean distance in voxels from every voxel to the nearest known
-  /// ROI voxel, capped at radius_vox; dense over the grid (unallocated voxels: the cap).
-  /// The per-slot result stays on the device for the information-gain kernel until the next
-  /// scan or allocation.
+  /// Paper Eq. 1's d_i: Euclidean distance in voxels from every allocated voxel to the
+  /// nearest known ROI voxel, capped at radius_vox, per brick slot on the device (for the
+  /// information-gain kernels) until the next scan or allocation.
+  void computeRoiDistance(int radius_vox);
+  /// d_i of one voxel as of the last computeRoiDistance() (the cap where no brick is
+  /// allocated); the per-slot result is downloaded once, on the first query.
+  float roiDistanceVoxAt(const std::array<int, 3>& index) const;
+  /// The same, dense over the grid (x fastest): for tests against brute force.
   std::vector<float> roiDistanceVox(int radius_vox);
   const accel::DeviceBuffer* roiDistanceBuffer() const { return distance_.get(); }
 
@@ -106,7 +110,8 @@ class BrickedVoxelGrid {
 
   mutable std::mutex host_mutex_;
   mutable bool host_stale_ = true;
-  mutable std::vector<float> host_occupancy_, host_roi_;
+  mutable std::vector<float> host_occupancy_, host_roi_, host_distance_;
+  int distance_radius_vox_ = 0;
 };
 
 template <typename F>

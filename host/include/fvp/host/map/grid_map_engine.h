@@ -49,8 +49,7 @@ class GridMapEngine final : public MapEngine {
 
   accel::Backend& backend_;
   std::unique_ptr<BrickedVoxelGrid> coarse_, fine_;
-  // ROI distance as of distance_scans_ scans with cap distance_max_d_m_ (per fine slot).
-  std::vector<float> distance_vox_;
+  // The fine map's ROI distance is as of distance_scans_ scans with cap distance_max_d_m_.
   double distance_max_d_m_ = -1.0;
   std::size_t distance_scans_ = 0;
   std::unique_ptr<octomap::OcTree> coarse_tree_;
