@@ -1,0 +1,47 @@
+// Whether an arm configuration is valid: within joint limits, free of self collision, the
+// ground and the slider rail, and with no link capsule (padded by collision_padding_m)
+// touching an occupied voxel of the coarse map. The map check is FCL's capsule-against-
+// fcl::OcTree test over a copy of the octomap::OcTree, as MoveIt does.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+
+#include "fvp/robot/arm_model.h"
+
+namespace octomap {
+class OcTree;
+}
+
+namespace fvp::robot {
+
+class ArmCollisionChecker {
+ public:
+  /// `arm` must outlive the checker. No map: only limits, self and static checks apply.
+  explicit ArmCollisionChecker(const ArmModel& arm);
+  ~ArmCollisionChecker();
+  ArmCollisionChecker(const ArmCollisionChecker&) = delete;
+  ArmCollisionChecker& operator=(const ArmCollisionChecker&) = delete;
+
+  /// Copies the coarse map (MapEngine::coarseOcTree()); voxels with occupancy above the
+  /// tree's threshold are obstacles, unknown space is not.
+  void setMap(const octomap::OcTree& coarse_map);
+  void clearMap();
+  bool hasMap() const;
+
+  bool isValid(const JointVector& q) const;
+  /// Only the map part of isValid, for given capsules (padding is added here).
+  bool mapCollision(const LinkCapsules& links) const;
+  const ArmModel& arm() const { return arm_; }
+  /// isValid calls so far (planning statistics).
+  std::uint64_t checks() const { return checks_.load(std::memory_order_relaxed); }
+
+ private:
+  struct Fcl;
+  const ArmModel& arm_;
+  std::unique_ptr<Fcl> fcl_;
+  mutable std::atomic<std::uint64_t> checks_{0};
+};
+
+}  // namespace fvp::robot

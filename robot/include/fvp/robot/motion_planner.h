@@ -1,0 +1,51 @@
+// moveToPose (DESIGN.md section 7): IK along the slider's travel -> the valid, collision-free
+// solution nearest the current configuration -> OMPL (RRTConnect by default) in the 7-D
+// joint space with an ArmCollisionChecker behind OMPL's StateValidityChecker -> path
+// simplification -> a Trajectory within the velocity and acceleration limits. Expected
+// failures come back as a MotionStatus; exceptions are for misconfiguration only.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+
+#include "fvp/robot/arm_collision_checker.h"
+#include "fvp/robot/trajectory.h"
+
+namespace fvp::robot {
+
+enum class MotionStatus {
+  kSuccess,
+  kNoIk,               ///< no IK solution within the joint limits at any slider position
+  kNoCollisionFreeIk,  ///< solutions exist, all in collision (self, static or map)
+  kStartInvalid,       ///< the current configuration itself is in collision or off limits
+  kNoPath,             ///< the planner gave up without reaching the goal
+  kTimeout,            ///< planning_time_s ran out before a path was found
+};
+
+const char* toString(MotionStatus status);
+
+struct MotionPlan {
+  MotionStatus status = MotionStatus::kNoPath;
+  JointVector goal = JointVector::Zero();  ///< the chosen IK solution (when there was one)
+  Trajectory trajectory;                   ///< empty unless kSuccess
+  double planning_wall_s = 0.0;            ///< IK + planning + simplification + timing
+  int ik_solutions = 0;                    ///< within limits, before collision checks
+  std::uint64_t validity_checks = 0;
+  bool ok() const { return status == MotionStatus::kSuccess; }
+};
+
+class MotionPlanner {
+ public:
+  /// `checker` (and its arm) must outlive the planner; the map is whatever the checker
+  /// holds at the time of each call.
+  explicit MotionPlanner(const ArmCollisionChecker& checker);
+
+  MotionPlan moveToPose(const JointVector& current, const Eigen::Isometry3d& T_world_camera) const;
+  /// Planning between two configurations (the goal must be valid).
+  MotionPlan planToJoints(const JointVector& current, const JointVector& goal) const;
+
+ private:
+  const ArmCollisionChecker& checker_;
+};
+
+}  // namespace fvp::robot

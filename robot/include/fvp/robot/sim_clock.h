@@ -1,0 +1,59 @@
+// The simulated clock (DESIGN.md section 7): every iteration is charged a fixed capture time
+// (exposure + a GPU stereo network), the measured wall time of mapping, TSDF integration,
+// planning and motion planning, and the trajectory's duration. Mode `fixed` charges a
+// constant per compute stage instead of the measured time, for deterministic tests. Every
+// charge is kept per iteration; the wall time of rendering and SGBM is recorded, not charged.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "fvp/robot/arm_config.h"
+
+namespace fvp::robot {
+
+enum class ClockStage { kCapture, kMapping, kTsdf, kPlanning, kMotionPlanning, kMotion };
+inline constexpr int kClockStages = 6;
+const char* toString(ClockStage stage);
+
+struct IterationCharges {
+  double charged_s[kClockStages] = {};   ///< per ClockStage, simulated seconds
+  double measured_s[kClockStages] = {};  ///< wall time measured for the compute stages
+  double rendering_wall_s = 0.0;         ///< not charged (simulator cost)
+  double sgbm_wall_s = 0.0;              ///< not charged (stands in for the capture charge)
+  double charged(ClockStage stage) const { return charged_s[static_cast<int>(stage)]; }
+  double total_s() const;
+};
+
+class SimClock {
+ public:
+  enum class Mode { kWall, kFixed };
+  SimClock(Mode mode, double capture_time_s, double fixed_stage_time_s);
+  /// From ArmConfig's clock, capture_time_s and fixed_stage_time_s keys.
+  static SimClock fromConfig(const ArmConfig& config);
+
+  /// Opens the next iteration's record (charges before the first call open one).
+  void beginIteration();
+  void chargeCapture();
+  /// A compute stage (mapping, TSDF, planning, motion planning) that took measured_wall_s.
+  void chargeCompute(ClockStage stage, double measured_wall_s);
+  void chargeMotion(double duration_s);
+  void recordUncharged(double rendering_wall_s, double sgbm_wall_s);
+
+  double now_s() const { return now_s_; }
+  Mode mode() const { return mode_; }
+  const std::vector<IterationCharges>& iterations() const { return iterations_; }
+  /// {"mode", "sim_time_s", "iterations": [{"capture_s", "mapping_s", ...}]} for result.json.
+  std::string toJson() const;
+
+ private:
+  void charge(ClockStage stage, double seconds);
+  IterationCharges& current();
+
+  Mode mode_;
+  double capture_time_s_, fixed_stage_time_s_;
+  double now_s_ = 0.0;
+  std::vector<IterationCharges> iterations_;
+};
+
+}  // namespace fvp::robot

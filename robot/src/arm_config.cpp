@@ -1,0 +1,193 @@
+#include "fvp/robot/arm_config.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+#include <variant>
+
+namespace fvp::robot {
+namespace {
+
+using Member = std::variant<double ArmConfig::*, int ArmConfig::*, std::int64_t ArmConfig::*,
+                            std::string ArmConfig::*, Eigen::Vector3d ArmConfig::*>;
+
+// One YAML key: its field and the static range of each numeric value (vectors: per
+// component). The ranges guard against nonsense, not taste.
+struct KeySpec {
+  const char* name;
+  Member member;
+  double lo = 0.0;
+  double hi = 0.0;
+};
+
+const std::vector<KeySpec>& keySpecs() {
+  static const std::vector<KeySpec> specs = {
+      {"slider_travel_m", &ArmConfig::slider_travel_m, 0.0, 10.0},
+      {"slider_origin_m", &ArmConfig::slider_origin_m, -10.0, 10.0},
+      {"slider_yaw_deg", &ArmConfig::slider_yaw_deg, -360.0, 360.0},
+      {"base_yaw_deg", &ArmConfig::base_yaw_deg, -360.0, 360.0},
+      {"slider_max_velocity_m_s", &ArmConfig::slider_max_velocity_m_s, 1e-3, 5.0},
+      {"slider_max_acceleration_m_s2", &ArmConfig::slider_max_acceleration_m_s2, 1e-3, 50.0},
+      {"joint_limit_rad", &ArmConfig::joint_limit_rad, 0.1, 2.0 * std::numbers::pi},
+      {"elbow_limit_rad", &ArmConfig::elbow_limit_rad, 0.1, std::numbers::pi},
+      {"joint_max_velocity_rad_s", &ArmConfig::joint_max_velocity_rad_s, 1e-3, std::numbers::pi},
+      {"joint_max_acceleration_rad_s2", &ArmConfig::joint_max_acceleration_rad_s2, 1e-3, 40.0},
+      {"hand_eye_translation_m", &ArmConfig::hand_eye_translation_m, -0.5, 0.5},
+      {"hand_eye_rpy_deg", &ArmConfig::hand_eye_rpy_deg, -360.0, 360.0},
+      {"camera_body_radius_m", &ArmConfig::camera_body_radius_m, 0.0, 0.2},
+      {"collision_padding_m", &ArmConfig::collision_padding_m, 0.0, 0.2},
+      {"ground_z_m", &ArmConfig::ground_z_m, -10.0, 10.0},
+      {"ik_slider_samples", &ArmConfig::ik_slider_samples, 1, 1000},
+      {"planner", &ArmConfig::planner},
+      {"planning_time_s", &ArmConfig::planning_time_s, 1e-3, 600.0},
+      {"simplify_time_s", &ArmConfig::simplify_time_s, 0.0, 60.0},
+      {"validity_step_rad", &ArmConfig::validity_step_rad, 1e-4, 0.5},
+      {"workspace_samples", &ArmConfig::workspace_samples, 1000, 1e10},
+      {"workspace_resolution_m", &ArmConfig::workspace_resolution_m, 0.005, 0.5},
+      {"workspace_direction_bins", &ArmConfig::workspace_direction_bins, 1, 16},
+      {"workspace_min_count", &ArmConfig::workspace_min_count, 1, 65535},
+      {"workspace_seed", &ArmConfig::workspace_seed, 0, 9e15},
+      {"workspace_cache_dir", &ArmConfig::workspace_cache_dir},
+      {"clock", &ArmConfig::clock},
+      {"capture_time_s", &ArmConfig::capture_time_s, 0.0, 60.0},
+      {"fixed_stage_time_s", &ArmConfig::fixed_stage_time_s, 0.0, 60.0},
+  };
+  return specs;
+}
+
+std::string formatNumber(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+void checkRange(const std::string& source, const KeySpec& spec, double value) {
+  // `!(a <= b)` also rejects NaN.
+  if (!(value >= spec.lo) || !(value <= spec.hi)) {
+    throw std::invalid_argument(source + ": key '" + spec.name + "' = " + formatNumber(value) +
+                                " is out of range; expected " + formatNumber(spec.lo) +
+                                " <= " + spec.name + " <= " + formatNumber(spec.hi));
+  }
+}
+
+std::string knownKeysList() {
+  std::string list;
+  for (const KeySpec& spec : keySpecs())
+    list += (list.empty() ? "" : ", ") + std::string(spec.name);
+  return list;
+}
+
+}  // namespace
+
+const std::vector<std::string>& knownPlanners() {
+  static const std::vector<std::string> names = {
+      "RRTConnect", "RRT", "RRTstar", "PRM", "KPIECE1", "BKPIECE1", "LBKPIECE1", "EST", "SBL"};
+  return names;
+}
+
+const std::vector<std::string>& ArmConfig::keyNames() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const KeySpec& spec : keySpecs()) out.emplace_back(spec.name);
+    return out;
+  }();
+  return names;
+}
+
+void ArmConfig::validate(const std::string& source) const {
+  for (const KeySpec& spec : keySpecs()) {
+    std::visit(
+        [&](auto field) {
+          using T = std::decay_t<decltype(this->*field)>;
+          if constexpr (std::is_same_v<T, Eigen::Vector3d>) {
+            for (int i = 0; i < 3; ++i) checkRange(source, spec, (this->*field)[i]);
+          } else if constexpr (std::is_arithmetic_v<T>) {
+            checkRange(source, spec, static_cast<double>(this->*field));
+          }
+        },
+        spec.member);
+  }
+  bool planner_known = false;
+  for (const std::string& name : knownPlanners()) planner_known |= name == planner;
+  if (!planner_known) {
+    std::string list;
+    for (const std::string& name : knownPlanners()) list += (list.empty() ? "" : ", ") + name;
+    throw std::invalid_argument(source + ": key 'planner' = '" + planner +
+                                "' is not a known OMPL planner; expected one of " + list);
+  }
+  if (clock != "wall" && clock != "fixed") {
+    throw std::invalid_argument(source + ": key 'clock' = '" + clock +
+                                "'; expected 'wall' or 'fixed'");
+  }
+}
+
+ArmConfig ArmConfig::fromYamlFile(const std::filesystem::path& path) {
+  const std::string source = "arm config '" + path.string() + "'";
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path.string());
+  } catch (const YAML::Exception& e) {
+    throw std::invalid_argument(source + ": cannot read YAML: " + e.what());
+  }
+  ArmConfig config;
+  if (root.IsNull()) {
+    config.validate(source);
+    return config;
+  }
+  if (!root.IsMap()) throw std::invalid_argument(source + ": expected a mapping of key: value");
+  for (const auto& entry : root) {
+    const std::string key = entry.first.as<std::string>();
+    const KeySpec* spec = nullptr;
+    for (const KeySpec& candidate : keySpecs()) {
+      if (key == candidate.name) spec = &candidate;
+    }
+    if (spec == nullptr) {
+      throw std::invalid_argument(source + ": unknown key '" + key +
+                                  "' (known keys: " + knownKeysList() + ")");
+    }
+    const YAML::Node& value = entry.second;
+    std::visit(
+        [&](auto field) {
+          using T = std::decay_t<decltype(config.*field)>;
+          const char* expected = std::is_same_v<T, Eigen::Vector3d> ? "a list of 3 numbers"
+                                 : std::is_same_v<T, std::string>   ? "a string"
+                                 : std::is_floating_point_v<T>      ? "a number"
+                                                                    : "an integer";
+          try {
+            if constexpr (std::is_same_v<T, Eigen::Vector3d>) {
+              if (!value.IsSequence() || value.size() != 3) throw YAML::Exception({}, "shape");
+              for (int i = 0; i < 3; ++i) (config.*field)[i] = value[i].as<double>();
+            } else {
+              if (!value.IsScalar()) throw YAML::Exception({}, "not a scalar");
+              config.*field = value.as<T>();
+            }
+          } catch (const YAML::Exception&) {
+            throw std::invalid_argument(source + ": key '" + key + "' must be " + expected);
+          }
+        },
+        spec->member);
+  }
+  config.validate(source);
+  return config;
+}
+
+std::string ArmConfig::toJson() const {
+  nlohmann::ordered_json json;
+  for (const KeySpec& spec : keySpecs()) {
+    std::visit(
+        [&](auto field) {
+          using T = std::decay_t<decltype(this->*field)>;
+          if constexpr (std::is_same_v<T, Eigen::Vector3d>) {
+            json[spec.name] = {(this->*field)[0], (this->*field)[1], (this->*field)[2]};
+          } else {
+            json[spec.name] = this->*field;
+          }
+        },
+        spec.member);
+  }
+  return json.dump();
+}
+
+}  // namespace fvp::robot

@@ -1,0 +1,167 @@
+#include "fvp/robot/motion_planner.h"
+
+#include <ompl/base/StateValidityChecker.h>
+#include <ompl/base/spaces/RealVectorStateSpace.h>
+#include <ompl/geometric/SimpleSetup.h>
+#include <ompl/geometric/planners/est/EST.h>
+#include <ompl/geometric/planners/kpiece/BKPIECE1.h>
+#include <ompl/geometric/planners/kpiece/KPIECE1.h>
+#include <ompl/geometric/planners/kpiece/LBKPIECE1.h>
+#include <ompl/geometric/planners/prm/PRM.h>
+#include <ompl/geometric/planners/rrt/RRT.h>
+#include <ompl/geometric/planners/rrt/RRTConnect.h>
+#include <ompl/geometric/planners/rrt/RRTstar.h>
+#include <ompl/geometric/planners/sbl/SBL.h>
+#include <ompl/util/Console.h>
+
+#include <chrono>
+#include <stdexcept>
+
+namespace fvp::robot {
+namespace {
+
+namespace ob = ompl::base;
+namespace og = ompl::geometric;
+
+using Clock = std::chrono::steady_clock;
+
+JointVector toJoints(const ob::State* state) {
+  const double* v = state->as<ob::RealVectorStateSpace::StateType>()->values;
+  return Eigen::Map<const JointVector>(v);
+}
+
+// OMPL's plug-in point: the planner asks, the arm's checker answers.
+class ArmValidityChecker : public ob::StateValidityChecker {
+ public:
+  ArmValidityChecker(const ob::SpaceInformationPtr& si, const ArmCollisionChecker& checker)
+      : ob::StateValidityChecker(si), checker_(checker) {}
+  bool isValid(const ob::State* state) const override { return checker_.isValid(toJoints(state)); }
+
+ private:
+  const ArmCollisionChecker& checker_;
+};
+
+ob::PlannerPtr makePlanner(const std::string& name, const ob::SpaceInformationPtr& si) {
+  if (name == "RRTConnect") return std::make_shared<og::RRTConnect>(si);
+  if (name == "RRT") return std::make_shared<og::RRT>(si);
+  if (name == "RRTstar") return std::make_shared<og::RRTstar>(si);
+  if (name == "PRM") return std::make_shared<og::PRM>(si);
+  if (name == "KPIECE1") return std::make_shared<og::KPIECE1>(si);
+  if (name == "BKPIECE1") return std::make_shared<og::BKPIECE1>(si);
+  if (name == "LBKPIECE1") return std::make_shared<og::LBKPIECE1>(si);
+  if (name == "EST") return std::make_shared<og::EST>(si);
+  if (name == "SBL") return std::make_shared<og::SBL>(si);
+  throw std::invalid_argument("arm config: key 'planner' = '" + name + "' is not a known planner");
+}
+
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+}  // namespace
+
+const char* toString(MotionStatus status) {
+  switch (status) {
+    case MotionStatus::kSuccess:
+      return "success";
+    case MotionStatus::kNoIk:
+      return "no_ik";
+    case MotionStatus::kNoCollisionFreeIk:
+      return "no_collision_free_ik";
+    case MotionStatus::kStartInvalid:
+      return "start_invalid";
+    case MotionStatus::kNoPath:
+      return "no_path";
+    case MotionStatus::kTimeout:
+      return "timeout";
+  }
+  return "unknown";
+}
+
+MotionPlanner::MotionPlanner(const ArmCollisionChecker& checker) : checker_(checker) {
+  // OMPL reports every query at INFO level; planning outcomes are in MotionPlan instead.
+  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+}
+
+MotionPlan MotionPlanner::moveToPose(const JointVector& current,
+                                     const Eigen::Isometry3d& T_world_camera) const {
+  const auto start = Clock::now();
+  MotionPlan plan;
+  const std::vector<JointVector> solutions = checker_.arm().inverse(T_world_camera, current);
+  plan.ik_solutions = static_cast<int>(solutions.size());
+  if (solutions.empty()) {
+    plan.status = MotionStatus::kNoIk;
+    plan.planning_wall_s = secondsSince(start);
+    return plan;
+  }
+  const JointVector* goal = nullptr;
+  for (const JointVector& q : solutions) {  // nearest first
+    if (checker_.isValid(q)) {
+      goal = &q;
+      break;
+    }
+  }
+  if (goal == nullptr) {
+    plan.status = MotionStatus::kNoCollisionFreeIk;
+    plan.planning_wall_s = secondsSince(start);
+    return plan;
+  }
+  plan = planToJoints(current, *goal);
+  plan.ik_solutions = static_cast<int>(solutions.size());
+  plan.planning_wall_s = secondsSince(start);
+  return plan;
+}
+
+MotionPlan MotionPlanner::planToJoints(const JointVector& current, const JointVector& goal) const {
+  const auto start_time = Clock::now();
+  const ArmModel& arm = checker_.arm();
+  const ArmConfig& config = arm.config();
+  const std::uint64_t checks_before = checker_.checks();
+  MotionPlan plan;
+  plan.goal = goal;
+  const auto finish = [&](MotionStatus status) {
+    plan.status = status;
+    plan.validity_checks = checker_.checks() - checks_before;
+    plan.planning_wall_s = secondsSince(start_time);
+    return plan;
+  };
+  if (!checker_.isValid(current)) return finish(MotionStatus::kStartInvalid);
+  if (!checker_.isValid(goal)) return finish(MotionStatus::kNoCollisionFreeIk);
+
+  auto space = std::make_shared<ob::RealVectorStateSpace>(kArmJoints);
+  ob::RealVectorBounds bounds(kArmJoints);
+  for (int j = 0; j < kArmJoints; ++j) {
+    bounds.setLow(j, arm.lowerLimits()[j]);
+    bounds.setHigh(j, arm.upperLimits()[j]);
+  }
+  space->setBounds(bounds);
+  og::SimpleSetup setup(space);
+  const ob::SpaceInformationPtr& si = setup.getSpaceInformation();
+  setup.setStateValidityChecker(std::make_shared<ArmValidityChecker>(si, checker_));
+  // OMPL's resolution is a fraction of the space's extent; ours is a joint-space step.
+  si->setStateValidityCheckingResolution(config.validity_step_rad / space->getMaximumExtent());
+  setup.setPlanner(makePlanner(config.planner, si));
+
+  ob::ScopedState<> start(space), goal_state(space);
+  for (int j = 0; j < kArmJoints; ++j) {
+    start[j] = current[j];
+    goal_state[j] = goal[j];
+  }
+  setup.setStartAndGoalStates(start, goal_state);
+  const ob::PlannerStatus solved = setup.solve(config.planning_time_s);
+  if (solved != ob::PlannerStatus::EXACT_SOLUTION) {
+    const bool out_of_time =
+        solved == ob::PlannerStatus::TIMEOUT || solved == ob::PlannerStatus::APPROXIMATE_SOLUTION;
+    return finish(out_of_time ? MotionStatus::kTimeout : MotionStatus::kNoPath);
+  }
+  if (config.simplify_time_s > 0.0) setup.simplifySolution(config.simplify_time_s);
+  const og::PathGeometric& path = setup.getSolutionPath();
+  std::vector<JointVector> waypoints;
+  waypoints.reserve(path.getStateCount());
+  for (std::size_t i = 0; i < path.getStateCount(); ++i)
+    waypoints.push_back(toJoints(path.getState(i)));
+  plan.trajectory = Trajectory(std::move(waypoints), arm.maxVelocity(), arm.maxAcceleration());
+  return finish(MotionStatus::kSuccess);
+}
+
+}  // namespace fvp::robot

@@ -1,0 +1,148 @@
+// FCL's capsule-against-OcTree check (ArmCollisionChecker) against a brute-force check of
+// every capsule against every occupied leaf box, on random maps and configurations.
+#include <gtest/gtest.h>
+#include <octomap/OcTree.h>
+
+#include <random>
+
+#include "fvp/robot/arm_collision_checker.h"
+#include "fvp/robot/sim/world.h"
+#include "fvp/robot/world_occupancy.h"
+
+namespace fvp::robot {
+namespace {
+
+double pointBoxDistance(const Eigen::Vector3d& p, const Eigen::AlignedBox3d& box) {
+  return (p - p.cwiseMax(box.min()).cwiseMin(box.max())).norm();
+}
+
+// The distance from a point moving along the segment to a box is convex in the segment
+// parameter: ternary search finds its minimum.
+double segmentBoxDistance(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                          const Eigen::AlignedBox3d& box) {
+  double lo = 0.0, hi = 1.0;
+  for (int i = 0; i < 100; ++i) {
+    const double m1 = lo + (hi - lo) / 3.0, m2 = hi - (hi - lo) / 3.0;
+    if (pointBoxDistance(a + m1 * (b - a), box) < pointBoxDistance(a + m2 * (b - a), box)) {
+      hi = m2;
+    } else {
+      lo = m1;
+    }
+  }
+  return pointBoxDistance(a + 0.5 * (lo + hi) * (b - a), box);
+}
+
+// Brute force: the smallest (distance - radius) over every capsule and occupied leaf.
+double bruteForceClearance(const octomap::OcTree& tree, const LinkCapsules& links, double pad) {
+  double clearance = std::numeric_limits<double>::infinity();
+  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
+    if (!tree.isNodeOccupied(*it)) continue;
+    const Eigen::Vector3d c(it.getX(), it.getY(), it.getZ());
+    const Eigen::Vector3d h = Eigen::Vector3d::Constant(0.5 * it.getSize());
+    const Eigen::AlignedBox3d box(c - h, c + h);
+    for (const Capsule& link : links) {
+      // Lower bound first (centre to segment minus the half diagonal): most boxes are far.
+      const double bound = segmentSegmentDistance(link.a_m, link.b_m, c, c) - h.norm();
+      if (bound - (link.radius_m + pad) >= clearance) continue;
+      clearance =
+          std::min(clearance, segmentBoxDistance(link.a_m, link.b_m, box) - (link.radius_m + pad));
+    }
+  }
+  return clearance;
+}
+
+JointVector randomConfiguration(const ArmModel& arm, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  JointVector q;
+  for (int j = 0; j < kArmJoints; ++j)
+    q[j] = arm.lowerLimits()[j] + unit(rng) * (arm.upperLimits()[j] - arm.lowerLimits()[j]);
+  return q;
+}
+
+// Random occupied voxels (and solid blocks octomap prunes into larger leaves, and free
+// voxels that must not count) in the arm's reach.
+octomap::OcTree randomMap(std::mt19937_64& rng, double resolution_m) {
+  octomap::OcTree tree(resolution_m);
+  std::uniform_real_distribution<double> x(-0.9, 0.9), y(-1.5, 0.1), z(0.6, 1.7);
+  for (int i = 0; i < 150; ++i) tree.updateNode(x(rng), y(rng), z(rng), true);
+  for (int i = 0; i < 150; ++i) tree.updateNode(x(rng), y(rng), z(rng), false);
+  for (int block = 0; block < 3; ++block) {
+    const Eigen::Vector3d corner(x(rng), y(rng), z(rng));
+    for (int i = 0; i < 8; ++i)
+      for (int j = 0; j < 8; ++j)
+        for (int k = 0; k < 8; ++k)
+          tree.updateNode(corner.x() + i * resolution_m, corner.y() + j * resolution_m,
+                          corner.z() + k * resolution_m, true);
+  }
+  tree.updateInnerOccupancy();
+  tree.prune();
+  return tree;
+}
+
+TEST(ArmCollisionChecker, AgreesWithBruteForceOnRandomMaps) {
+  const ArmModel arm{ArmConfig{}};
+  std::mt19937_64 rng(5);
+  int collisions = 0, free = 0, near_boundary = 0, disagreements = 0;
+  for (int m = 0; m < 10; ++m) {
+    const octomap::OcTree tree = randomMap(rng, m % 2 == 0 ? 0.02 : 0.05);
+    ArmCollisionChecker checker(arm);
+    checker.setMap(tree);
+    for (int i = 0; i < 150; ++i) {
+      const JointVector q = randomConfiguration(arm, rng);
+      const LinkCapsules links = arm.linkCapsules(q);
+      const double clearance = bruteForceClearance(tree, links, arm.config().collision_padding_m);
+      // FCL's GJK works to a tolerance: contacts within 0.1 mm are a tie.
+      if (std::abs(clearance) < 1e-4) {
+        ++near_boundary;
+        continue;
+      }
+      const bool expected = clearance < 0.0;
+      const bool got = checker.mapCollision(links);
+      disagreements += expected != got ? 1 : 0;
+      EXPECT_EQ(got, expected) << "map " << m << " configuration " << i << " clearance "
+                               << clearance;
+      (expected ? collisions : free) += 1;
+    }
+  }
+  std::cout << "collision checks: " << collisions << " colliding, " << free << " free, "
+            << near_boundary << " within 0.1 mm (skipped), " << disagreements << " disagreements\n";
+  EXPECT_GT(collisions, 100);
+  EXPECT_GT(free, 100);
+}
+
+TEST(ArmCollisionChecker, NoMapMeansOnlySelfAndStatic) {
+  const ArmModel arm{ArmConfig{}};
+  ArmCollisionChecker checker(arm);
+  EXPECT_FALSE(checker.hasMap());
+  const JointVector home = arm.homeConfiguration();
+  EXPECT_TRUE(checker.isValid(home));
+  JointVector off_limits = home;
+  off_limits[0] = arm.upperLimits()[0] + 0.01;
+  EXPECT_FALSE(checker.isValid(off_limits));
+  // A voxel on the camera makes the same configuration invalid.
+  octomap::OcTree tree(0.01);
+  const Eigen::Vector3d camera = arm.T_world_camera(home).translation();
+  tree.updateNode(camera.x(), camera.y(), camera.z(), true);
+  checker.setMap(tree);
+  EXPECT_FALSE(checker.isValid(home));
+  checker.clearMap();
+  EXPECT_TRUE(checker.isValid(home));
+}
+
+TEST(ArmCollisionChecker, StartViewOfAWorldIsFreeInItsFullMap) {
+  const ArmModel arm{ArmConfig{}};
+  const auto world = sim::World::generate(sim::WorldConfig{}, 1);
+  const Eigen::AlignedBox3d bounds(Eigen::Vector3d(-1.5, -1.5, 0.0),
+                                   Eigen::Vector3d(1.5, 1.5, 2.5));
+  const auto tree = worldOccupancy(world, 0.01, bounds);
+  EXPECT_GT(tree->getNumLeafNodes(), 1000u);
+  ArmCollisionChecker checker(arm);
+  checker.setMap(*tree);
+  int free_start = 0;
+  for (const JointVector& q : arm.inverse(world.startCameraPose(), arm.homeConfiguration()))
+    free_start += checker.isValid(q) ? 1 : 0;
+  EXPECT_GT(free_start, 0);
+}
+
+}  // namespace
+}  // namespace fvp::robot

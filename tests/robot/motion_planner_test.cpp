@@ -1,0 +1,79 @@
+// moveToPose: statuses, and a small version of the statistical planning test (the full
+// 100-query one is in arm_heavy_test.cpp).
+#include <gtest/gtest.h>
+
+#include "fvp/robot/motion_planner.h"
+#include "planning_queries.h"
+
+namespace fvp::robot {
+namespace {
+
+TEST(MotionPlanner, SucceedsOnRandomFeasibleQueriesInClutteredWorlds) {
+  const testing::QueryStats stats = testing::runPlanningQueries(3, 5, 100);
+  stats.print(std::cout);
+  EXPECT_EQ(stats.feasible, 15);
+  EXPECT_GE(stats.succeeded, 14);
+  EXPECT_EQ(stats.path_invalid, 0);
+}
+
+TEST(MotionPlanner, ReportsStatusesWithoutThrowing) {
+  const ArmModel arm{ArmConfig{}};
+  ArmCollisionChecker checker(arm);
+  const MotionPlanner planner(checker);
+  const JointVector home = arm.homeConfiguration();
+  // Out of reach.
+  Eigen::Isometry3d far = arm.T_world_camera(home);
+  far.translation().y() += 3.0;
+  EXPECT_EQ(planner.moveToPose(home, far).status, MotionStatus::kNoIk);
+  // Reachable but blocked: a wall of voxels through the camera's position.
+  const Eigen::Isometry3d goal = arm.T_world_camera(home);
+  octomap::OcTree tree(0.02);
+  for (double x = -0.2; x <= 0.2; x += 0.01)
+    for (double z = -0.2; z <= 0.2; z += 0.01)
+      tree.updateNode(goal.translation().x() + x, goal.translation().y(),
+                      goal.translation().z() + z, true);
+  checker.setMap(tree);
+  JointVector elsewhere = home;
+  elsewhere[0] = 0.4;
+  EXPECT_EQ(planner.moveToPose(elsewhere, goal).status, MotionStatus::kNoCollisionFreeIk);
+  EXPECT_EQ(planner.moveToPose(home, arm.T_world_camera(elsewhere)).status,
+            MotionStatus::kStartInvalid);
+  // Free space: success, and the trajectory ends at the goal.
+  checker.clearMap();
+  const MotionPlan plan = planner.moveToPose(elsewhere, goal);
+  ASSERT_EQ(plan.status, MotionStatus::kSuccess);
+  EXPECT_LT(
+      (arm.T_world_camera(plan.trajectory.waypoints().back()).translation() - goal.translation())
+          .norm(),
+      1e-6);
+  EXPECT_GT(plan.trajectory.duration_s(), 0.0);
+  EXPECT_STREQ(toString(MotionStatus::kTimeout), "timeout");
+}
+
+TEST(ArmController, ChargesPlanningAndMotionToTheClock) {
+  const ArmModel arm{ArmConfig{}};
+  SimClock clock(SimClock::Mode::kFixed, 0.2, 0.1);
+  ArmController controller(arm, clock, arm.homeConfiguration());
+  JointVector target = arm.homeConfiguration();
+  target[0] = -0.3;
+  target[1] = 0.4;
+  clock.beginIteration();
+  const MotionPlan plan = controller.moveToPose(arm.T_world_camera(target));
+  ASSERT_TRUE(plan.ok());
+  EXPECT_NEAR(clock.now_s(), 0.1 + plan.trajectory.duration_s(), 1e-12);
+  EXPECT_DOUBLE_EQ(clock.iterations()[0].charged(ClockStage::kMotion),
+                   plan.trajectory.duration_s());
+  EXPECT_LT(
+      (controller.cameraPose().translation() - arm.T_world_camera(target).translation()).norm(),
+      1e-6);
+  // A failed plan charges only its planning time and leaves the arm where it was.
+  const JointVector before = controller.joints();
+  Eigen::Isometry3d far = controller.cameraPose();
+  far.translation().z() += 5.0;
+  EXPECT_EQ(controller.moveToPose(far).status, MotionStatus::kNoIk);
+  EXPECT_EQ(controller.joints(), before);
+  EXPECT_NEAR(clock.now_s(), 0.2 + plan.trajectory.duration_s(), 1e-12);
+}
+
+}  // namespace
+}  // namespace fvp::robot

@@ -1,0 +1,58 @@
+// The simulated clock: charges add up, fixed mode is deterministic, records per iteration.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "fvp/robot/sim_clock.h"
+
+namespace fvp::robot {
+namespace {
+
+TEST(SimClock, AddsUpToTheSumOfItsCharges) {
+  SimClock clock(SimClock::Mode::kWall, 0.2, 0.1);
+  double expected = 0.0;
+  for (int i = 0; i < 5; ++i) {
+    clock.beginIteration();
+    clock.chargeCapture();
+    clock.chargeCompute(ClockStage::kMapping, 0.011 * i);
+    clock.chargeCompute(ClockStage::kTsdf, 0.003);
+    clock.chargeCompute(ClockStage::kPlanning, 0.05);
+    clock.chargeCompute(ClockStage::kMotionPlanning, 0.02);
+    clock.chargeMotion(1.5 + i);
+    clock.recordUncharged(0.7, 0.4);  // not charged
+    expected += 0.2 + 0.011 * i + 0.003 + 0.05 + 0.02 + 1.5 + i;
+  }
+  EXPECT_NEAR(clock.now_s(), expected, 1e-12);
+  double sum = 0.0;
+  for (const IterationCharges& it : clock.iterations()) sum += it.total_s();
+  EXPECT_NEAR(sum, clock.now_s(), 1e-12);
+  ASSERT_EQ(clock.iterations().size(), 5u);
+  EXPECT_DOUBLE_EQ(clock.iterations()[3].charged(ClockStage::kMotion), 4.5);
+  const auto json = nlohmann::json::parse(clock.toJson());
+  EXPECT_EQ(json["iterations"].size(), 5u);
+  EXPECT_DOUBLE_EQ(json["iterations"][2]["mapping_s"].get<double>(), 0.022);
+  EXPECT_DOUBLE_EQ(json["iterations"][2]["rendering_wall_s"].get<double>(), 0.7);
+}
+
+TEST(SimClock, FixedModeChargesConstantsAndKeepsTheMeasuredTime) {
+  SimClock clock(SimClock::Mode::kFixed, 0.2, 0.1);
+  clock.chargeCapture();  // opens the first iteration itself
+  clock.chargeCompute(ClockStage::kMapping, 3.7);
+  clock.chargeCompute(ClockStage::kPlanning, 0.001);
+  clock.chargeMotion(2.0);
+  EXPECT_NEAR(clock.now_s(), 0.2 + 0.1 + 0.1 + 2.0, 1e-12);
+  EXPECT_DOUBLE_EQ(clock.iterations()[0].measured_s[static_cast<int>(ClockStage::kMapping)], 3.7);
+  EXPECT_THROW(clock.chargeCompute(ClockStage::kMotion, 1.0), std::invalid_argument);
+  EXPECT_THROW(clock.chargeMotion(-1.0), std::invalid_argument);
+}
+
+TEST(SimClock, FromConfig) {
+  ArmConfig config;
+  config.clock = "fixed";
+  EXPECT_EQ(SimClock::fromConfig(config).mode(), SimClock::Mode::kFixed);
+  config.clock = "wall";
+  EXPECT_EQ(SimClock::fromConfig(config).mode(), SimClock::Mode::kWall);
+}
+
+}  // namespace
+}  // namespace fvp::robot

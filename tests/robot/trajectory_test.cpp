@@ -1,0 +1,75 @@
+// Time parameterisation: limits respected everywhere, waypoints reached, joints synchronised.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "fvp/robot/trajectory.h"
+
+namespace fvp::robot {
+namespace {
+
+TEST(Trajectory, NeverExceedsLimitsAndPassesEveryWaypoint) {
+  const ArmModel arm{ArmConfig{}};
+  std::mt19937_64 rng(2);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (int trial = 0; trial < 50; ++trial) {
+    std::vector<JointVector> waypoints;
+    const int n = 2 + trial % 6;
+    for (int i = 0; i < n; ++i) {
+      JointVector q;
+      for (int j = 0; j < kArmJoints; ++j) q[j] = (j == 0 ? 0.5 : 2.0) * unit(rng);
+      if (trial % 7 == 0 && i > 0) q = waypoints.back();  // zero-length segments too
+      waypoints.push_back(q);
+    }
+    const Trajectory traj(waypoints, arm.maxVelocity(), arm.maxAcceleration());
+    EXPECT_LT((traj.position(0.0) - waypoints.front()).norm(), 1e-12);
+    EXPECT_LT((traj.position(traj.duration_s()) - waypoints.back()).norm(), 1e-9);
+    const int steps = 4000;
+    const double dt = traj.duration_s() / steps;
+    for (int k = 0; k <= steps; ++k) {
+      const double t = k * dt;
+      const JointVector v = traj.velocity(t), a = traj.acceleration(t);
+      for (int j = 0; j < kArmJoints; ++j) {
+        ASSERT_LE(std::abs(v[j]), arm.maxVelocity()[j] * (1.0 + 1e-9))
+            << "t " << t << " joint " << j;
+        ASSERT_LE(std::abs(a[j]), arm.maxAcceleration()[j] * (1.0 + 1e-9))
+            << "t " << t << " joint " << j;
+      }
+      // Velocity is the derivative of position (central differences).
+      if (k > 0 && k < steps) {
+        const JointVector fd = (traj.position(t + 1e-6) - traj.position(t - 1e-6)) / 2e-6;
+        ASSERT_LT((fd - v).norm(), 1e-4) << "t " << t;
+      }
+    }
+    // Synchronised: every sample lies on the straight joint-space segment it is on.
+    for (int k = 0; k <= 200; ++k) {
+      const JointVector q = traj.position(k * traj.duration_s() / 200);
+      double best = std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i + 1 < waypoints.size(); ++i) {
+        const JointVector d = waypoints[i + 1] - waypoints[i];
+        const double s = d.squaredNorm() > 0
+                             ? std::clamp((q - waypoints[i]).dot(d) / d.squaredNorm(), 0.0, 1.0)
+                             : 0.0;
+        best = std::min(best, (waypoints[i] + s * d - q).norm());
+      }
+      ASSERT_LT(best, 1e-9);
+    }
+  }
+}
+
+TEST(Trajectory, MinimumTimeForOneJoint) {
+  const ArmModel arm{ArmConfig{}};
+  JointVector a = JointVector::Zero(), b = JointVector::Zero();
+  b[1] = 0.5;  // 0.5 rad: triangular at 1.4 rad/s^2 (v peak sqrt(0.7) < pi)
+  const Trajectory short_move({a, b}, arm.maxVelocity(), arm.maxAcceleration());
+  EXPECT_NEAR(short_move.duration_s(), 2.0 * std::sqrt(0.5 / 1.4), 1e-12);
+  b[1] = 10.0;  // long: trapezoid, 10/pi + pi/1.4
+  const Trajectory long_move({a, b}, arm.maxVelocity(), arm.maxAcceleration());
+  EXPECT_NEAR(long_move.duration_s(), 10.0 / std::numbers::pi + std::numbers::pi / 1.4, 1e-12);
+  const Trajectory still({a}, arm.maxVelocity(), arm.maxAcceleration());
+  EXPECT_EQ(still.duration_s(), 0.0);
+  EXPECT_EQ(still.position(1.0), a);
+}
+
+}  // namespace
+}  // namespace fvp::robot
