@@ -18,18 +18,19 @@ void addTraverseCommand(CLI::App& app) {
     bool check = true;
   };
   auto opt = std::make_shared<Options>();
-  auto* cmd = app.add_subcommand(
-      "traverse", "Run the batched voxel ray traversal kernel on a synthetic canopy grid, "
-                  "check it against the cpu reference and report voxel steps per second");
-  cmd->add_option("--backend", opt->backend, "cpu | opencl | vulkan | auto")
-      ->capture_default_str();
+  auto* cmd =
+      app.add_subcommand("traverse",
+                         "Run the batched voxel ray traversal kernel on a synthetic canopy grid, "
+                         "check it against the cpu reference and report voxel steps per second");
+  cmd->add_option("--backend", opt->backend, "cpu | opencl | vulkan | auto")->capture_default_str();
   cmd->add_option("--side-voxels", opt->side_voxels, "grid side in voxels")
       ->check(CLI::Range(8, 1024))
       ->capture_default_str();
   cmd->add_option("--voxel-size-m", opt->voxel_size_m, "voxel edge in metres")
       ->check(CLI::Range(1e-4, 1.0))
       ->capture_default_str();
-  cmd->add_option("--rays", opt->rays, "number of rays")->check(CLI::Range(1, 50000000))
+  cmd->add_option("--rays", opt->rays, "number of rays")
+      ->check(CLI::Range(1, 50000000))
       ->capture_default_str();
   cmd->add_option("--outside-fraction", opt->outside_fraction,
                   "fraction of rays starting outside the grid")
@@ -40,9 +41,10 @@ void addTraverseCommand(CLI::App& app) {
   cmd->callback([opt] {
     using Clock = std::chrono::steady_clock;
     auto backend = accel::createBackend(opt->backend);
-    const accel::DenseGrid grid = accel::makeCanopyGrid(opt->side_voxels, opt->voxel_size_m, opt->seed);
-    const auto rays = accel::makeRandomRays(
-        grid.params, {opt->rays, opt->outside_fraction}, opt->seed + 1);
+    const accel::DenseGrid grid =
+        accel::makeCanopyGrid(opt->side_voxels, opt->voxel_size_m, opt->seed);
+    const auto rays =
+        accel::makeRandomRays(grid.params, {opt->rays, opt->outside_fraction}, opt->seed + 1);
     accel::traverseOnBackend(*backend, grid, rays);  // warm-up: first-use compilation, caches
     const auto t0 = Clock::now();
     const auto results = accel::traverseOnBackend(*backend, grid, rays);
@@ -55,8 +57,8 @@ void addTraverseCommand(CLI::App& app) {
               << "grid           " << opt->side_voxels << "^3 voxels of " << opt->voxel_size_m * 1e3
               << " mm\n"
               << "rays           " << rays.size() << " (reached end " << by_status[0]
-              << ", hit occupied " << by_status[1] << ", left grid " << by_status[2]
-              << ", invalid " << by_status[3] << ")\n"
+              << ", hit occupied " << by_status[1] << ", left grid " << by_status[2] << ", invalid "
+              << by_status[3] << ")\n"
               << "voxel steps    " << steps << "\n"
               << "time           " << seconds * 1e3 << " ms (upload + dispatch + download)\n"
               << "throughput     " << steps / seconds / 1e6 << " M voxel steps/s\n";

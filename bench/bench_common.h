@@ -23,7 +23,8 @@ inline void setThroughput(benchmark::State& state, std::uint64_t steps_per_itera
 }
 
 /// The backend, or null after marking the benchmark skipped with the reason it is unavailable.
-inline std::unique_ptr<accel::Backend> backendOrSkip(benchmark::State& state, accel::BackendKind kind) {
+inline std::unique_ptr<accel::Backend> backendOrSkip(benchmark::State& state,
+                                                     accel::BackendKind kind) {
   try {
     return accel::createBackend(kind);
   } catch (const std::exception& e) {

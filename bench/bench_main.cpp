@@ -11,9 +11,8 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   for (const auto& info : fvp::accel::probeBackends()) {
-    benchmark::AddCustomContext(
-        "backend_" + std::string(fvp::accel::toString(info.kind)),
-        info.available ? info.device : "unavailable: " + info.reason);
+    benchmark::AddCustomContext("backend_" + std::string(fvp::accel::toString(info.kind)),
+                                info.available ? info.device : "unavailable: " + info.reason);
   }
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

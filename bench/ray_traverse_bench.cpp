@@ -23,18 +23,19 @@ using accel::DenseGrid;
 using accel::Ray;
 using accel::RayResult;
 
-constexpr int kSideVoxels = 160;          // 16 cm cube at 1 mm: a Cluster Region
+constexpr int kSideVoxels = 160;  // 16 cm cube at 1 mm: a Cluster Region
 constexpr float kVoxelSizeM = 0.001f;
 constexpr std::uint64_t kWorkloadSeed = 7;
 
 struct Workload {
   DenseGrid grid;
-  std::map<std::size_t, std::vector<Ray>> rays;  // by count
+  std::map<std::size_t, std::vector<Ray>> rays;             // by count
   std::map<std::size_t, std::vector<RayResult>> reference;  // cpu results by count
 
   const std::vector<Ray>& raysFor(std::size_t n) {
     auto it = rays.find(n);
-    if (it == rays.end()) it = rays.emplace(n, accel::makeRandomRays(grid.params, {n, 0.0f}, kWorkloadSeed + n)).first;
+    if (it == rays.end())
+      it = rays.emplace(n, accel::makeRandomRays(grid.params, {n, 0.0f}, kWorkloadSeed + n)).first;
     return it->second;
   }
   const std::vector<RayResult>& referenceFor(std::size_t n) {
@@ -109,7 +110,8 @@ void BM_RayTraverseGrid(benchmark::State& state, BackendKind kind, int threads) 
                                static_cast<unsigned>(n)};
   std::vector<RayResult> out(n);
   for (auto _ : state) {
-    backend->run(accel::kernels::rayTraverse(), params, {ray_buffer.get(), occupancy.get(), field.get(), results.get()});
+    backend->run(accel::kernels::rayTraverse(), params,
+                 {ray_buffer.get(), occupancy.get(), field.get(), results.get()});
     backend->download(*results, out.data(), n * sizeof(RayResult));
     benchmark::DoNotOptimize(out.data());
   }
@@ -160,13 +162,19 @@ void registerAll() {
     for (BackendKind kind : {BackendKind::kCpu, BackendKind::kOpenCl, BackendKind::kVulkan}) {
       const std::string name = "BM_RayTraverse/grid/" + std::string(accel::toString(kind));
       benchmark::RegisterBenchmark(name.c_str(), BM_RayTraverseGrid, kind, 0)
-          ->Arg(rays)->Unit(benchmark::kMillisecond)->UseRealTime();
+          ->Arg(rays)
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
     }
     benchmark::RegisterBenchmark("BM_RayTraverse/grid/cpu-1thread", BM_RayTraverseGrid,
                                  BackendKind::kCpu, 1)
-        ->Arg(rays)->Unit(benchmark::kMillisecond)->UseRealTime();
+        ->Arg(rays)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
     benchmark::RegisterBenchmark("BM_RayTraverse/octomap/cpu-1thread", BM_RayTraverseOctomap)
-        ->Arg(rays)->Unit(benchmark::kMillisecond)->UseRealTime();
+        ->Arg(rays)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
   }
 }
 

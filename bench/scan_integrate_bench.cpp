@@ -43,7 +43,8 @@ const Frame& frame() {
     const robot::sim::StereoRenderer renderer(world);
     const host::StereoFrame stereo = renderer.render(world.startCameraPose());
     const host::PerceptionResult perceived = host::PerceptionPipeline().process(stereo);
-    if (!perceived.region) throw std::runtime_error("benchmark frame: no Cluster Region (tag not seen)");
+    if (!perceived.region)
+      throw std::runtime_error("benchmark frame: no Cluster Region (tag not seen)");
     Frame out;
     out.sensor_m = perceived.clouds.sensor_origin_m;
     out.roi_m = perceived.clouds.roi_points_m;
@@ -90,7 +91,8 @@ void BM_ScanIntegrateGrid(benchmark::State& state, BackendKind kind) {
   }
   state.SetItemsProcessed(static_cast<int64_t>(f.points()) * state.iterations());
   state.counters["points"] = static_cast<double>(f.points());
-  state.counters["voxel_updates"] = static_cast<double>(stats.coarse_voxels_updated + stats.fine_voxels_updated);
+  state.counters["voxel_updates"] =
+      static_cast<double>(stats.coarse_voxels_updated + stats.fine_voxels_updated);
   state.counters["map_MB"] = map_bytes / 1e6;
   state.SetLabel(backend->deviceName());
 }
@@ -110,7 +112,8 @@ void BM_ScanIntegrateOctomap(benchmark::State& state) {
     state.ResumeTiming();
   }
   // Same semantics: the voxel updates agree with the grid engine's to within near-ties.
-  const double want = static_cast<double>(reference().fine_voxels_updated + reference().coarse_voxels_updated);
+  const double want =
+      static_cast<double>(reference().fine_voxels_updated + reference().coarse_voxels_updated);
   const double got = static_cast<double>(stats.fine_voxels_updated + stats.coarse_voxels_updated);
   if (std::abs(got - want) > 1e-3 * want) {
     state.SkipWithError("octomap engine's voxel updates differ from the grid engine's by > 0.1 %");
@@ -143,9 +146,11 @@ void BM_ScanIntegrateFineBoxGrid(benchmark::State& state, BackendKind kind) {
   for (auto _ : state) {
     state.PauseTiming();
     auto grid = std::make_unique<host::map::BrickedVoxelGrid>(
-        *backend, fineBoxGeometry(), true, std::nullopt, host::map::BrickedVoxelGrid::Allocation::kOnTouch);
+        *backend, fineBoxGeometry(), true, std::nullopt,
+        host::map::BrickedVoxelGrid::Allocation::kOnTouch);
     state.ResumeTiming();
-    updated = grid->integrate(*buffer, static_cast<std::uint32_t>(points.size()), f.sensor_m.cast<float>(), model);
+    updated = grid->integrate(*buffer, static_cast<std::uint32_t>(points.size()),
+                              f.sensor_m.cast<float>(), model);
     state.PauseTiming();
     bricks = grid->allocatedBricks();
     bytes = grid->deviceBytes();
@@ -187,17 +192,25 @@ void registerAll() {
   for (BackendKind kind : {BackendKind::kCpu, BackendKind::kOpenCl, BackendKind::kVulkan}) {
     const std::string b(accel::toString(kind));
     benchmark::RegisterBenchmark(("BM_ScanIntegrate/grid/" + b).c_str(), BM_ScanIntegrateGrid, kind)
-        ->Unit(benchmark::kMillisecond)->UseRealTime();
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
   }
   benchmark::RegisterBenchmark("BM_ScanIntegrate/octomap/cpu", BM_ScanIntegrateOctomap)
-      ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime()
+      ->Iterations(2);
   for (BackendKind kind : {BackendKind::kCpu, BackendKind::kOpenCl, BackendKind::kVulkan}) {
     const std::string b(accel::toString(kind));
-    benchmark::RegisterBenchmark(("BM_ScanIntegrateFineBox/grid/" + b).c_str(), BM_ScanIntegrateFineBoxGrid, kind)
-        ->Unit(benchmark::kMillisecond)->UseRealTime();
+    benchmark::RegisterBenchmark(("BM_ScanIntegrateFineBox/grid/" + b).c_str(),
+                                 BM_ScanIntegrateFineBoxGrid, kind)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
   }
-  benchmark::RegisterBenchmark("BM_ScanIntegrateFineBox/octomap/cpu", BM_ScanIntegrateFineBoxOctomap)
-      ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+  benchmark::RegisterBenchmark("BM_ScanIntegrateFineBox/octomap/cpu",
+                               BM_ScanIntegrateFineBoxOctomap)
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime()
+      ->Iterations(1);
 }
 
 const bool registered = (registerAll(), true);

@@ -4,9 +4,10 @@
 #include "fvp_map_kernels.h"
 
 __kernel void fvp_extract_frontiers(const fvp_frontier_params p, const uint item_count,
-                           __global const int* brick_coords, __global const int* brick_table,
-                           __global const float* occupancy, __global const float* roi,
-                           __global fvp_frontier* frontiers, __global uint* count) {
+                                    __global const int* brick_coords,
+                                    __global const int* brick_table,
+                                    __global const float* occupancy, __global const float* roi,
+                                    __global fvp_frontier* frontiers, __global uint* count) {
   const uint slot = get_global_id(0);
   if (slot >= item_count) return;
   int x, y, z;

@@ -65,9 +65,9 @@ typedef struct fvp_ray {
 } fvp_ray;
 
 typedef struct fvp_ray_result {
-  unsigned int steps; /* in-grid voxels visited, the stopping voxel included */
-  float field_sum;    /* sum of the per-voxel field over the visited voxels */
-  int stop_voxel;     /* linear index of the stopping voxel, -1 if none */
+  unsigned int steps;  /* in-grid voxels visited, the stopping voxel included */
+  float field_sum;     /* sum of the per-voxel field over the visited voxels */
+  int stop_voxel;      /* linear index of the stopping voxel, -1 if none */
   unsigned int status; /* FVP_RAY_* */
 } fvp_ray_result;
 
@@ -219,8 +219,7 @@ FVP_FN unsigned int fvp_dda_init(fvp_dda* d, const fvp_grid_params* g, const flo
 
 /* Axis of the next crossing, or -1 once the end voxel is reached. */
 FVP_FN int fvp_dda_next_axis(const fvp_dda* d) {
-  int done_x = d->remaining[0] == 0, done_y = d->remaining[1] == 0,
-      done_z = d->remaining[2] == 0;
+  int done_x = d->remaining[0] == 0, done_y = d->remaining[1] == 0, done_z = d->remaining[2] == 0;
   int x_first_y, x_first_z, y_first_z;
   if (done_x && done_y && done_z) return -1;
   x_first_y = !done_x && (done_y || d->cross_xy < 0);

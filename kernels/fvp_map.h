@@ -52,7 +52,9 @@ FVP_FN int fvp_brick_of(const fvp_bricked_grid* m, int x, int y, int z) {
 }
 
 /* Index of voxel (x, y, z) inside its brick. */
-FVP_FN int fvp_local_of(int x, int y, int z) { return (x & 7) + 8 * ((y & 7) + 8 * (z & 7)); }
+FVP_FN int fvp_local_of(int x, int y, int z) {
+  return (x & 7) + 8 * ((y & 7) + 8 * (z & 7));
+}
 
 /* Slot of a voxel given its brick's table entry: allocation index * 512 + in_brick index. */
 FVP_FN int fvp_slot_of_entry(int entry, int in_brick) {
@@ -91,8 +93,8 @@ FVP_FN void fvp_slot_voxel(FVP_GLOBAL const int* brick_coords, unsigned int slot
  *              if (!fvp_walk_step(&w, m, axis, table)) break; }       (left the grid) */
 typedef struct fvp_walk {
   fvp_dda d;
-  int brick; /* index in the brick table */
-  int entry; /* table[brick]: allocation index | flags, or FVP_NO_BRICK */
+  int brick;    /* index in the brick table */
+  int entry;    /* table[brick]: allocation index | flags, or FVP_NO_BRICK */
   int in_brick; /* index of the current voxel in its brick */
 } fvp_walk;
 
@@ -107,7 +109,9 @@ FVP_FN unsigned int fvp_walk_init(fvp_walk* w, const fvp_bricked_grid* m, const 
 }
 
 /* Slot of the current voxel; only meaningful when w->entry >= 0. */
-FVP_FN int fvp_walk_slot(const fvp_walk* w) { return fvp_slot_of_entry(w->entry, w->in_brick); }
+FVP_FN int fvp_walk_slot(const fvp_walk* w) {
+  return fvp_slot_of_entry(w->entry, w->in_brick);
+}
 
 /* True when the current voxel is mapped: in the region (bricks flagged inside skip the
  * sphere test) or the map has no region. */

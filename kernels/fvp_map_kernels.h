@@ -176,7 +176,8 @@ FVP_FN unsigned int fvp_edt_pass_voxel(const fvp_edt_params* p, int x, int y, in
     int nx = x + (axis == 0 ? k : 0), ny = y + (axis == 1 ? k : 0), nz = z + (axis == 2 ? k : 0);
     int slot;
     unsigned int v;
-    if (nx < 0 || ny < 0 || nz < 0 || nx >= p->map.grid.dim_x || ny >= p->map.grid.dim_y || nz >= p->map.grid.dim_z)
+    if (nx < 0 || ny < 0 || nz < 0 || nx >= p->map.grid.dim_x || ny >= p->map.grid.dim_y ||
+        nz >= p->map.grid.dim_z)
       continue;
     slot = fvp_slot(&p->map, table, nx, ny, nz);
     if (slot < 0) continue;
@@ -210,7 +211,8 @@ FVP_FN int fvp_voxel_unknown(const fvp_bricked_grid* m, FVP_GLOBAL const int* ta
  * exploration frontiers, the summed offsets away from unknown neighbours. Neighbours
  * outside the mapped region are ignored: they are not unknown space of this map. */
 FVP_FN unsigned int fvp_frontier_voxel(const fvp_frontier_params* p, int x, int y, int z,
-                                       FVP_GLOBAL const int* table, FVP_GLOBAL const float* occupancy,
+                                       FVP_GLOBAL const int* table,
+                                       FVP_GLOBAL const float* occupancy,
                                        FVP_GLOBAL const float* roi, int* normal) {
   int slot, dx, dy, dz, face_unknown = 0;
   unsigned int flags = 0;
@@ -275,14 +277,15 @@ FVP_FN void fvp_frontier_append(const fvp_frontier_params* p, int x, int y, int 
 FVP_FN void fvp_roi_distance_slot(const fvp_edt_params* p, unsigned int slot,
                                   FVP_GLOBAL const int* brick_coords, FVP_GLOBAL const int* table,
                                   FVP_GLOBAL const float* roi, FVP_GLOBAL const unsigned int* sq_in,
-                                  FVP_GLOBAL unsigned int* sq_out,
-                                  FVP_GLOBAL float* distance_vox) {
+                                  FVP_GLOBAL unsigned int* sq_out, FVP_GLOBAL float* distance_vox) {
   int x, y, z;
   unsigned int best;
   fvp_slot_voxel(brick_coords, slot, &x, &y, &z);
   best = fvp_edt_pass_voxel(p, x, y, z, table, roi, sq_in);
-  if (p->axis < 2) sq_out[slot] = best;
-  else distance_vox[slot] = fvp_edt_distance_vox(best, p->radius_vox);
+  if (p->axis < 2)
+    sq_out[slot] = best;
+  else
+    distance_vox[slot] = fvp_edt_distance_vox(best, p->radius_vox);
 }
 
 #endif /* FVP_MAP_KERNELS_H */

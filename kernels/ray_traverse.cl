@@ -8,6 +8,6 @@ __kernel void fvp_ray_traverse(const fvp_traverse_params p, const uint item_coun
   const uint i = get_global_id(0);
   if (i >= item_count) return;
   const fvp_ray ray = rays[i];  // private copy: the walk takes private pointers
-  results[i] = fvp_traverse_ray(&p.grid, p.occupied_threshold, ray.origin_m, ray.end_m, occupancy,
-                                field);
+  results[i] =
+      fvp_traverse_ray(&p.grid, p.occupied_threshold, ray.origin_m, ray.end_m, occupancy, field);
 }

@@ -9,9 +9,12 @@ namespace fvp::accel {
 
 std::string_view toString(BackendKind kind) {
   switch (kind) {
-    case BackendKind::kCpu: return "cpu";
-    case BackendKind::kOpenCl: return "opencl";
-    case BackendKind::kVulkan: return "vulkan";
+    case BackendKind::kCpu:
+      return "cpu";
+    case BackendKind::kOpenCl:
+      return "opencl";
+    case BackendKind::kVulkan:
+      return "vulkan";
   }
   return "unknown";
 }
@@ -67,22 +70,25 @@ void Backend::download(const DeviceBuffer& buf, void* dst, std::size_t size_byte
   if (size_bytes) downloadBytes(buf, dst, size_bytes, offset_bytes);
 }
 
-void Backend::dispatch(const KernelDescriptor& kernel, const void* params,
-                       std::size_t params_bytes, std::span<DeviceBuffer* const> buffers) {
+void Backend::dispatch(const KernelDescriptor& kernel, const void* params, std::size_t params_bytes,
+                       std::span<DeviceBuffer* const> buffers) {
   const std::string name(kernel.name);
   if (params_bytes != kernel.params_bytes)
     throw std::invalid_argument(name + ": parameter block of " + std::to_string(params_bytes) +
                                 " bytes, the kernel takes " + std::to_string(kernel.params_bytes));
   if (buffers.size() != kernel.bindings.size())
-    throw std::invalid_argument(name + ": " + std::to_string(buffers.size()) + " buffers given, the kernel binds " +
+    throw std::invalid_argument(name + ": " + std::to_string(buffers.size()) +
+                                " buffers given, the kernel binds " +
                                 std::to_string(kernel.bindings.size()));
   if (kernel.validate) kernel.validate(params);
   for (std::size_t i = 0; i < buffers.size(); ++i) {
     const KernelBinding& binding = kernel.bindings[i];
     const std::size_t needed = binding.required_elements(params);
-    const std::string what = name + ": binding " + std::to_string(i) + " (" + std::string(binding.name) + ")";
+    const std::string what =
+        name + ": binding " + std::to_string(i) + " (" + std::string(binding.name) + ")";
     if (!buffers[i]) {
-      if (needed) throw std::invalid_argument(what + " is used by this dispatch but no buffer was given");
+      if (needed)
+        throw std::invalid_argument(what + " is used by this dispatch but no buffer was given");
       continue;
     }
     checkRange(*buffers[i], needed * binding.element_bytes, 0, what.c_str());
@@ -93,7 +99,8 @@ void Backend::dispatch(const KernelDescriptor& kernel, const void* params,
 
 std::unique_ptr<Backend> createBackend(BackendKind kind) {
   switch (kind) {
-    case BackendKind::kCpu: return detail::createCpuBackend();
+    case BackendKind::kCpu:
+      return detail::createCpuBackend();
     case BackendKind::kOpenCl:
 #ifdef FVP_WITH_OPENCL
       return detail::createOpenClBackend();

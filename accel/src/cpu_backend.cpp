@@ -18,16 +18,24 @@ class CpuBuffer final : public DeviceBuffer {
   std::byte* data() { return bytes_.data(); }
   const std::byte* data() const { return bytes_.data(); }
   template <typename T>
-  const T* as() const { return reinterpret_cast<const T*>(bytes_.data()); }
+  const T* as() const {
+    return reinterpret_cast<const T*>(bytes_.data());
+  }
   template <typename T>
-  T* as() { return reinterpret_cast<T*>(bytes_.data()); }
+  T* as() {
+    return reinterpret_cast<T*>(bytes_.data());
+  }
 
  private:
   std::vector<std::byte> bytes_;  // operator new alignment (16) covers every kernel type
 };
 
-const CpuBuffer& cpu(const DeviceBuffer& b) { return static_cast<const CpuBuffer&>(b); }
-CpuBuffer& cpu(DeviceBuffer& b) { return static_cast<CpuBuffer&>(b); }
+const CpuBuffer& cpu(const DeviceBuffer& b) {
+  return static_cast<const CpuBuffer&>(b);
+}
+CpuBuffer& cpu(DeviceBuffer& b) {
+  return static_cast<CpuBuffer&>(b);
+}
 
 class CpuBackend final : public Backend {
  public:
@@ -61,6 +69,8 @@ class CpuBackend final : public Backend {
 
 }  // namespace
 
-std::unique_ptr<Backend> createCpuBackend() { return std::make_unique<CpuBackend>(); }
+std::unique_ptr<Backend> createCpuBackend() {
+  return std::make_unique<CpuBackend>();
+}
 
 }  // namespace fvp::accel::detail

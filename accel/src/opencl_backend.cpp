@@ -15,28 +15,43 @@
 #include "backends.h"
 #include "check.h"
 
-
 namespace fvp::accel::detail {
 namespace {
 
 const char* clErrorName(cl_int err) {
   switch (err) {
-    case CL_DEVICE_NOT_FOUND: return "CL_DEVICE_NOT_FOUND";
-    case CL_DEVICE_NOT_AVAILABLE: return "CL_DEVICE_NOT_AVAILABLE";
-    case CL_COMPILER_NOT_AVAILABLE: return "CL_COMPILER_NOT_AVAILABLE";
-    case CL_MEM_OBJECT_ALLOCATION_FAILURE: return "CL_MEM_OBJECT_ALLOCATION_FAILURE";
-    case CL_OUT_OF_RESOURCES: return "CL_OUT_OF_RESOURCES";
-    case CL_OUT_OF_HOST_MEMORY: return "CL_OUT_OF_HOST_MEMORY";
-    case CL_BUILD_PROGRAM_FAILURE: return "CL_BUILD_PROGRAM_FAILURE";
-    case CL_INVALID_VALUE: return "CL_INVALID_VALUE";
-    case CL_INVALID_DEVICE: return "CL_INVALID_DEVICE";
-    case CL_INVALID_BUFFER_SIZE: return "CL_INVALID_BUFFER_SIZE";
-    case CL_INVALID_KERNEL_ARGS: return "CL_INVALID_KERNEL_ARGS";
-    case CL_INVALID_WORK_GROUP_SIZE: return "CL_INVALID_WORK_GROUP_SIZE";
-    case CL_INVALID_ARG_SIZE: return "CL_INVALID_ARG_SIZE";
-    case CL_INVALID_KERNEL_NAME: return "CL_INVALID_KERNEL_NAME";
-    case CL_PLATFORM_NOT_FOUND_KHR: return "CL_PLATFORM_NOT_FOUND_KHR (no OpenCL driver installed)";
-    default: return "OpenCL error";
+    case CL_DEVICE_NOT_FOUND:
+      return "CL_DEVICE_NOT_FOUND";
+    case CL_DEVICE_NOT_AVAILABLE:
+      return "CL_DEVICE_NOT_AVAILABLE";
+    case CL_COMPILER_NOT_AVAILABLE:
+      return "CL_COMPILER_NOT_AVAILABLE";
+    case CL_MEM_OBJECT_ALLOCATION_FAILURE:
+      return "CL_MEM_OBJECT_ALLOCATION_FAILURE";
+    case CL_OUT_OF_RESOURCES:
+      return "CL_OUT_OF_RESOURCES";
+    case CL_OUT_OF_HOST_MEMORY:
+      return "CL_OUT_OF_HOST_MEMORY";
+    case CL_BUILD_PROGRAM_FAILURE:
+      return "CL_BUILD_PROGRAM_FAILURE";
+    case CL_INVALID_VALUE:
+      return "CL_INVALID_VALUE";
+    case CL_INVALID_DEVICE:
+      return "CL_INVALID_DEVICE";
+    case CL_INVALID_BUFFER_SIZE:
+      return "CL_INVALID_BUFFER_SIZE";
+    case CL_INVALID_KERNEL_ARGS:
+      return "CL_INVALID_KERNEL_ARGS";
+    case CL_INVALID_WORK_GROUP_SIZE:
+      return "CL_INVALID_WORK_GROUP_SIZE";
+    case CL_INVALID_ARG_SIZE:
+      return "CL_INVALID_ARG_SIZE";
+    case CL_INVALID_KERNEL_NAME:
+      return "CL_INVALID_KERNEL_NAME";
+    case CL_PLATFORM_NOT_FOUND_KHR:
+      return "CL_PLATFORM_NOT_FOUND_KHR (no OpenCL driver installed)";
+    default:
+      return "OpenCL error";
   }
 }
 
@@ -64,14 +79,17 @@ class ClBuffer final : public DeviceBuffer {
   ClBuffer(const cl::Context& context, std::size_t size_bytes)
       // OpenCL rejects zero-sized buffers; an empty buffer still owns a few bytes.
       : DeviceBuffer(size_bytes),
-        buffer_(FVP_CL(cl::Buffer(context, CL_MEM_READ_WRITE, std::max<std::size_t>(size_bytes, 4)))) {}
+        buffer_(
+            FVP_CL(cl::Buffer(context, CL_MEM_READ_WRITE, std::max<std::size_t>(size_bytes, 4)))) {}
   const cl::Buffer& get() const { return buffer_; }
 
  private:
   cl::Buffer buffer_;
 };
 
-const cl::Buffer& clBuf(const DeviceBuffer& b) { return static_cast<const ClBuffer&>(b).get(); }
+const cl::Buffer& clBuf(const DeviceBuffer& b) {
+  return static_cast<const ClBuffer&>(b).get();
+}
 
 struct Selected {
   cl::Platform platform;
@@ -96,7 +114,8 @@ Selected selectDevice() {
     }
     for (const auto& device : devices) {
       try {
-        if (!device.getInfo<CL_DEVICE_AVAILABLE>() || !device.getInfo<CL_DEVICE_COMPILER_AVAILABLE>())
+        if (!device.getInfo<CL_DEVICE_AVAILABLE>() ||
+            !device.getInfo<CL_DEVICE_COMPILER_AVAILABLE>())
           continue;
         if (device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_GPU) return {platform, device};
       } catch (const cl::Error&) {
@@ -122,7 +141,8 @@ class OpenClBackend final : public Backend {
     context_ = FVP_CL(cl::Context(device_));
     queue_ = FVP_CL(cl::CommandQueue(context_, device_));
     // Every kernel up front: a kernel that does not build fails here, naming itself.
-    for (const KernelDescriptor* kernel : allKernels()) kernels_.emplace(kernel, buildKernel(*kernel));
+    for (const KernelDescriptor* kernel : allKernels())
+      kernels_.emplace(kernel, buildKernel(*kernel));
     // Bound where a dispatch does not use a binding: every argument needs a valid buffer.
     unused_ = std::make_unique<ClBuffer>(context_, 16);
   }
@@ -151,7 +171,8 @@ class OpenClBackend final : public Backend {
     FVP_CL(k.kernel.setArg(0, kernel.params_bytes, params));
     FVP_CL(k.kernel.setArg(1, cl_uint{item_count}));
     for (std::size_t i = 0; i < buffers.size(); ++i)
-      FVP_CL(k.kernel.setArg(static_cast<cl_uint>(2 + i), clBuf(buffers[i] ? *buffers[i] : *unused_)));
+      FVP_CL(
+          k.kernel.setArg(static_cast<cl_uint>(2 + i), clBuf(buffers[i] ? *buffers[i] : *unused_)));
     const std::size_t global = (std::size_t{item_count} + k.local - 1) / k.local * k.local;
     FVP_CL(queue_.enqueueNDRangeKernel(k.kernel, cl::NullRange, cl::NDRange(global),
                                        cl::NDRange(k.local)));
@@ -177,18 +198,20 @@ class OpenClBackend final : public Backend {
     const cl_uint args = FVP_CL(k.kernel.getInfo<CL_KERNEL_NUM_ARGS>());
     if (args != descriptor.bindings.size() + 2)
       throw BackendError("opencl: kernel " + name + " takes " + std::to_string(args) +
-                         " arguments; its descriptor has " + std::to_string(descriptor.bindings.size()) +
+                         " arguments; its descriptor has " +
+                         std::to_string(descriptor.bindings.size()) +
                          " bindings after the parameters and the item count");
     for (std::size_t i = 0; i < descriptor.bindings.size(); ++i) {
       std::string arg_name;
       // Argument names are optional in OpenCL 1.2 (CL_KERNEL_ARG_INFO_NOT_AVAILABLE).
-      if (k.kernel.getArgInfo(static_cast<cl_uint>(2 + i), CL_KERNEL_ARG_NAME, &arg_name) != CL_SUCCESS)
+      if (k.kernel.getArgInfo(static_cast<cl_uint>(2 + i), CL_KERNEL_ARG_NAME, &arg_name) !=
+          CL_SUCCESS)
         break;
       arg_name = arg_name.c_str();  // some drivers count the terminating NUL
       if (arg_name != descriptor.bindings[i].name)
-        throw BackendError("opencl: kernel " + name + " argument " + std::to_string(2 + i) + " is '" +
-                           arg_name + "', its descriptor's binding " + std::to_string(i) + " is '" +
-                           std::string(descriptor.bindings[i].name) + "'");
+        throw BackendError("opencl: kernel " + name + " argument " + std::to_string(2 + i) +
+                           " is '" + arg_name + "', its descriptor's binding " + std::to_string(i) +
+                           " is '" + std::string(descriptor.bindings[i].name) + "'");
     }
     k.local = workGroupSize(k.kernel);
     return k;
@@ -217,7 +240,9 @@ class OpenClBackend final : public Backend {
 
 }  // namespace
 
-std::unique_ptr<Backend> createOpenClBackend() { return std::make_unique<OpenClBackend>(); }
+std::unique_ptr<Backend> createOpenClBackend() {
+  return std::make_unique<OpenClBackend>();
+}
 
 bool openClDeviceIsGpu(const Backend& backend) {
   return static_cast<const OpenClBackend&>(backend).isGpu();

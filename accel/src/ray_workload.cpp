@@ -15,8 +15,8 @@ struct Vec3 {
 
 std::size_t linearIndex(const GridParams& g, int x, int y, int z) {
   return static_cast<std::size_t>(x) +
-         static_cast<std::size_t>(g.dim_x) * (static_cast<std::size_t>(y) +
-                                              static_cast<std::size_t>(g.dim_y) * z);
+         static_cast<std::size_t>(g.dim_x) *
+             (static_cast<std::size_t>(y) + static_cast<std::size_t>(g.dim_y) * z);
 }
 
 // Marks as occupied every voxel whose centre satisfies `inside`, within a box of voxels.
@@ -26,9 +26,12 @@ void rasterize(DenseGrid& grid, Vec3 lo, Vec3 hi, Inside&& inside) {
   auto toVoxel = [&](float v, float origin) {
     return static_cast<int>(std::floor((v - origin) / g.voxel_size_m));
   };
-  const int x0 = std::max(0, toVoxel(lo.x, g.origin_x_m)), x1 = std::min(g.dim_x - 1, toVoxel(hi.x, g.origin_x_m));
-  const int y0 = std::max(0, toVoxel(lo.y, g.origin_y_m)), y1 = std::min(g.dim_y - 1, toVoxel(hi.y, g.origin_y_m));
-  const int z0 = std::max(0, toVoxel(lo.z, g.origin_z_m)), z1 = std::min(g.dim_z - 1, toVoxel(hi.z, g.origin_z_m));
+  const int x0 = std::max(0, toVoxel(lo.x, g.origin_x_m)),
+            x1 = std::min(g.dim_x - 1, toVoxel(hi.x, g.origin_x_m));
+  const int y0 = std::max(0, toVoxel(lo.y, g.origin_y_m)),
+            y1 = std::min(g.dim_y - 1, toVoxel(hi.y, g.origin_y_m));
+  const int z0 = std::max(0, toVoxel(lo.z, g.origin_z_m)),
+            z1 = std::min(g.dim_z - 1, toVoxel(hi.z, g.origin_z_m));
   for (int z = z0; z <= z1; ++z)
     for (int y = y0; y <= y1; ++y)
       for (int x = x0; x <= x1; ++x) {
@@ -45,8 +48,8 @@ void rasterize(DenseGrid& grid, Vec3 lo, Vec3 hi, Inside&& inside) {
 DenseGrid makeCanopyGrid(int side_voxels, float voxel_size_m, std::uint64_t seed) {
   const float half = 0.5f * side_voxels * voxel_size_m;
   DenseGrid grid;
-  grid.params = makeGridParams({side_voxels, side_voxels, side_voxels}, {-half, -half, -half},
-                               voxel_size_m);
+  grid.params =
+      makeGridParams({side_voxels, side_voxels, side_voxels}, {-half, -half, -half}, voxel_size_m);
   const GridParams& g = grid.params;
   const auto n = static_cast<std::size_t>(voxelCount(g));
   grid.occupancy.assign(n, 0.0f);
@@ -138,7 +141,8 @@ std::vector<RayResult> traverseOnBackend(Backend& backend, const DenseGrid& grid
   auto field = backend.createBufferFrom(grid.field);
   auto ray_buffer = backend.createBufferFrom(rays);
   auto results = backend.createBuffer(rays.size() * sizeof(RayResult));
-  backend.run(kernels::rayTraverse(), params, {ray_buffer.get(), occupancy.get(), field.get(), results.get()});
+  backend.run(kernels::rayTraverse(), params,
+              {ray_buffer.get(), occupancy.get(), field.get(), results.get()});
   return backend.downloadAll<RayResult>(*results);
 }
 

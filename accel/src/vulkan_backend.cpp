@@ -8,11 +8,11 @@
 
 #include <algorithm>
 #include <array>
-#include <map>
-#include <set>
 #include <cstdlib>
 #include <cstring>
+#include <map>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -59,7 +59,8 @@ void pinObjectsLoadedSince(const std::set<std::string>& before) noexcept {
     for (const auto& name : loadedObjects()) {
       if (before.count(name)) continue;
       // RTLD_NOLOAD only flags what is already loaded; dlclose drops just our reference.
-      if (void* handle = dlopen(name.c_str(), RTLD_LAZY | RTLD_NOLOAD | RTLD_NODELETE)) dlclose(handle);
+      if (void* handle = dlopen(name.c_str(), RTLD_LAZY | RTLD_NOLOAD | RTLD_NODELETE))
+        dlclose(handle);
     }
   } catch (...) {
   }
@@ -72,11 +73,16 @@ bool deviceIsGpu(vk::PhysicalDeviceType type) {
 
 int deviceRank(vk::PhysicalDeviceType type) {
   switch (type) {
-    case vk::PhysicalDeviceType::eDiscreteGpu: return 0;
-    case vk::PhysicalDeviceType::eIntegratedGpu: return 1;
-    case vk::PhysicalDeviceType::eVirtualGpu: return 2;
-    case vk::PhysicalDeviceType::eCpu: return 3;
-    default: return 4;
+    case vk::PhysicalDeviceType::eDiscreteGpu:
+      return 0;
+    case vk::PhysicalDeviceType::eIntegratedGpu:
+      return 1;
+    case vk::PhysicalDeviceType::eVirtualGpu:
+      return 2;
+    case vk::PhysicalDeviceType::eCpu:
+      return 3;
+    default:
+      return 4;
   }
 }
 
@@ -100,7 +106,9 @@ class VkBuffer final : public DeviceBuffer {
   std::byte* mapped_;
 };
 
-const VkBuffer& vkBuf(const DeviceBuffer& b) { return static_cast<const VkBuffer&>(b); }
+const VkBuffer& vkBuf(const DeviceBuffer& b) {
+  return static_cast<const VkBuffer&>(b);
+}
 
 // One compute pipeline: storage buffers at bindings 0..n-1 of set 0, push constants,
 // work-group size as specialisation constant 0.
@@ -136,7 +144,8 @@ class VulkanBackend final : public Backend {
     pickDevice();
     createDevice();
     // Every kernel up front: a pipeline that cannot be created fails here.
-    for (const KernelDescriptor* kernel : allKernels()) pipelines_.emplace(kernel, createPipeline(*kernel));
+    for (const KernelDescriptor* kernel : allKernels())
+      pipelines_.emplace(kernel, createPipeline(*kernel));
     // Bound where a dispatch does not use a binding: every binding needs a valid buffer.
     unused_ = createBuffer(16);
   }
@@ -207,8 +216,10 @@ class VulkanBackend final : public Backend {
                          " bytes exceeds the device's maxMemoryAllocationSize (" +
                          std::to_string(max_allocation_bytes_) + ")");
     const auto usage = vk::BufferUsageFlagBits::eStorageBuffer |
-                       vk::BufferUsageFlagBits::eTransferSrc | vk::BufferUsageFlagBits::eTransferDst;
-    vk::raii::Buffer buffer = FVP_VK(vk::raii::Buffer(device_, vk::BufferCreateInfo({}, bytes, usage)));
+                       vk::BufferUsageFlagBits::eTransferSrc |
+                       vk::BufferUsageFlagBits::eTransferDst;
+    vk::raii::Buffer buffer =
+        FVP_VK(vk::raii::Buffer(device_, vk::BufferCreateInfo({}, bytes, usage)));
     const vk::MemoryRequirements req = buffer.getMemoryRequirements();
     using M = vk::MemoryPropertyFlagBits;
     const vk::MemoryPropertyFlags host = M::eHostVisible | M::eHostCoherent;
@@ -229,7 +240,9 @@ class VulkanBackend final : public Backend {
         if (!type) type = findMemoryType(req, host);
         break;
     }
-    if (!type) throw BackendError("vulkan: no suitable memory type for a buffer of " + std::to_string(bytes) + " bytes");
+    if (!type)
+      throw BackendError("vulkan: no suitable memory type for a buffer of " +
+                         std::to_string(bytes) + " bytes");
     vk::raii::DeviceMemory memory =
         FVP_VK(vk::raii::DeviceMemory(device_, vk::MemoryAllocateInfo(req.size, *type)));
     FVP_VK(buffer.bindMemory(*memory, 0));
@@ -263,7 +276,8 @@ class VulkanBackend final : public Backend {
         rejected += std::string(" ") + props.deviceName.data() + " (no compute queue);";
         continue;
       }
-      if (!best || deviceRank(props.deviceType) < deviceRank(devices[*best].getProperties().deviceType))
+      if (!best ||
+          deviceRank(props.deviceType) < deviceRank(devices[*best].getProperties().deviceType))
         best = i;
     }
     if (!best)
@@ -302,20 +316,22 @@ class VulkanBackend final : public Backend {
     vk::DeviceQueueCreateInfo queue_info({}, queue_family_, 1, &priority);
     vk::PhysicalDeviceFeatures features;
     features.shaderInt64 = VK_TRUE;  // the exact DDA walks in 64-bit integers
-    device_ = FVP_VK(vk::raii::Device(physical_, vk::DeviceCreateInfo({}, queue_info, {}, {}, &features)));
+    device_ = FVP_VK(
+        vk::raii::Device(physical_, vk::DeviceCreateInfo({}, queue_info, {}, {}, &features)));
     queue_ = FVP_VK(vk::raii::Queue(device_, queue_family_, 0));
     command_pool_ = FVP_VK(vk::raii::CommandPool(
         device_, vk::CommandPoolCreateInfo(vk::CommandPoolCreateFlagBits::eResetCommandBuffer,
                                            queue_family_)));
     vk::raii::CommandBuffers buffers = FVP_VK(vk::raii::CommandBuffers(
-        device_, vk::CommandBufferAllocateInfo(*command_pool_, vk::CommandBufferLevel::ePrimary, 1)));
+        device_,
+        vk::CommandBufferAllocateInfo(*command_pool_, vk::CommandBufferLevel::ePrimary, 1)));
     command_buffer_ = std::move(buffers.front());
     fence_ = FVP_VK(vk::raii::Fence(device_, vk::FenceCreateInfo()));
     // One dispatch at a time: its buffers' set and the parameter buffer's set.
     vk::DescriptorPoolSize pool_size(vk::DescriptorType::eStorageBuffer, 32);
     descriptor_pool_ = FVP_VK(vk::raii::DescriptorPool(
-        device_, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 4,
-                                              pool_size)));
+        device_, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet,
+                                              4, pool_size)));
     work_group_size_ = std::min({kPreferredWorkGroupSize, limits_.maxComputeWorkGroupSize[0],
                                  limits_.maxComputeWorkGroupInvocations});
   }
@@ -334,32 +350,42 @@ class VulkanBackend final : public Backend {
     // FVP_VULKAN_PARAMS_IN_BUFFER=1 forces the path of devices with little push-constant
     // space (tests run it on any device).
     const char* force_buffer = std::getenv("FVP_VULKAN_PARAMS_IN_BUFFER");
-    p.params_in_buffer = kDispatchHeaderBytes + kernel.params_bytes > limits_.maxPushConstantsSize ||
-                         (force_buffer && std::string(force_buffer) == "1");
-    const SpirvCode& code = p.params_in_buffer ? kernel.spirv_params_buffer : kernel.spirv_push_constants;
+    p.params_in_buffer =
+        kDispatchHeaderBytes + kernel.params_bytes > limits_.maxPushConstantsSize ||
+        (force_buffer && std::string(force_buffer) == "1");
+    const SpirvCode& code =
+        p.params_in_buffer ? kernel.spirv_params_buffer : kernel.spirv_push_constants;
     if (!code.words)
-      throw BackendError("vulkan: kernel " + std::string(kernel.name) + " has no SPIR-V in this build");
+      throw BackendError("vulkan: kernel " + std::string(kernel.name) +
+                         " has no SPIR-V in this build");
     std::vector<vk::DescriptorSetLayoutBinding> bindings;
     for (uint32_t b = 0; b < kernel.bindings.size(); ++b)
-      bindings.emplace_back(b, vk::DescriptorType::eStorageBuffer, 1, vk::ShaderStageFlagBits::eCompute);
-    p.set_layout = FVP_VK(vk::raii::DescriptorSetLayout(device_, vk::DescriptorSetLayoutCreateInfo({}, bindings)));
+      bindings.emplace_back(b, vk::DescriptorType::eStorageBuffer, 1,
+                            vk::ShaderStageFlagBits::eCompute);
+    p.set_layout = FVP_VK(
+        vk::raii::DescriptorSetLayout(device_, vk::DescriptorSetLayoutCreateInfo({}, bindings)));
     std::vector<vk::DescriptorSetLayout> set_layouts{*p.set_layout};
     if (p.params_in_buffer) {
       vk::DescriptorSetLayoutBinding params_binding(0, vk::DescriptorType::eStorageBuffer, 1,
                                                     vk::ShaderStageFlagBits::eCompute);
-      p.params_set_layout =
-          FVP_VK(vk::raii::DescriptorSetLayout(device_, vk::DescriptorSetLayoutCreateInfo({}, params_binding)));
+      p.params_set_layout = FVP_VK(vk::raii::DescriptorSetLayout(
+          device_, vk::DescriptorSetLayoutCreateInfo({}, params_binding)));
       set_layouts.push_back(*p.params_set_layout);
     }
     const uint32_t push_bytes =
-        kDispatchHeaderBytes + (p.params_in_buffer ? 0 : static_cast<uint32_t>(kernel.params_bytes));
+        kDispatchHeaderBytes +
+        (p.params_in_buffer ? 0 : static_cast<uint32_t>(kernel.params_bytes));
     vk::PushConstantRange push(vk::ShaderStageFlagBits::eCompute, 0, push_bytes);
-    p.layout = FVP_VK(vk::raii::PipelineLayout(device_, vk::PipelineLayoutCreateInfo({}, set_layouts, push)));
-    p.module = FVP_VK(vk::raii::ShaderModule(device_, vk::ShaderModuleCreateInfo({}, code.bytes, code.words)));
+    p.layout = FVP_VK(
+        vk::raii::PipelineLayout(device_, vk::PipelineLayoutCreateInfo({}, set_layouts, push)));
+    p.module = FVP_VK(
+        vk::raii::ShaderModule(device_, vk::ShaderModuleCreateInfo({}, code.bytes, code.words)));
     vk::SpecializationMapEntry entry(0, 0, sizeof(uint32_t));
     vk::SpecializationInfo spec(1, &entry, sizeof(work_group_size_), &work_group_size_);
-    vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, *p.module, "main", &spec);
-    p.pipeline = FVP_VK(vk::raii::Pipeline(device_, nullptr, vk::ComputePipelineCreateInfo({}, stage, *p.layout)));
+    vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, *p.module,
+                                            "main", &spec);
+    p.pipeline = FVP_VK(
+        vk::raii::Pipeline(device_, nullptr, vk::ComputePipelineCreateInfo({}, stage, *p.layout)));
     return p;
   }
 
@@ -370,17 +396,20 @@ class VulkanBackend final : public Backend {
     FVP_VK(cmd.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit)));
     // Earlier submissions' device writes must be visible to this one's reads and writes:
     // a fence wait only makes them available.
-    vk::MemoryBarrier from_before(vk::AccessFlagBits::eShaderWrite | vk::AccessFlagBits::eTransferWrite,
-                                  vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite |
-                                      vk::AccessFlagBits::eTransferRead | vk::AccessFlagBits::eTransferWrite);
-    const auto stages = vk::PipelineStageFlagBits::eComputeShader | vk::PipelineStageFlagBits::eTransfer;
+    vk::MemoryBarrier from_before(
+        vk::AccessFlagBits::eShaderWrite | vk::AccessFlagBits::eTransferWrite,
+        vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite |
+            vk::AccessFlagBits::eTransferRead | vk::AccessFlagBits::eTransferWrite);
+    const auto stages =
+        vk::PipelineStageFlagBits::eComputeShader | vk::PipelineStageFlagBits::eTransfer;
     cmd.pipelineBarrier(stages, stages, {}, from_before, {}, {});
     record(cmd);
     // Make shader and transfer writes visible to the host reads that follow the fence.
     vk::MemoryBarrier to_host(vk::AccessFlagBits::eShaderWrite | vk::AccessFlagBits::eTransferWrite,
                               vk::AccessFlagBits::eHostRead);
-    cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader | vk::PipelineStageFlagBits::eTransfer,
-                        vk::PipelineStageFlagBits::eHost, {}, to_host, {}, {});
+    cmd.pipelineBarrier(
+        vk::PipelineStageFlagBits::eComputeShader | vk::PipelineStageFlagBits::eTransfer,
+        vk::PipelineStageFlagBits::eHost, {}, to_host, {}, {});
     FVP_VK(cmd.end());
     vk::CommandBuffer handle = *cmd;
     FVP_VK(queue_.submit(vk::SubmitInfo({}, {}, handle), *fence_));
@@ -405,16 +434,18 @@ class VulkanBackend final : public Backend {
                   uint32_t items) {
     std::vector<vk::DescriptorSetLayout> layouts{*p.set_layout};
     if (p.params_in_buffer) layouts.push_back(*p.params_set_layout);
-    vk::raii::DescriptorSets sets =
-        FVP_VK(vk::raii::DescriptorSets(device_, vk::DescriptorSetAllocateInfo(*descriptor_pool_, layouts)));
+    vk::raii::DescriptorSets sets = FVP_VK(vk::raii::DescriptorSets(
+        device_, vk::DescriptorSetAllocateInfo(*descriptor_pool_, layouts)));
     std::vector<vk::DescriptorBufferInfo> infos;
     for (const DeviceBuffer* b : buffers) infos.push_back(bufferInfo(*b));
     if (params_buffer) infos.push_back(bufferInfo(*params_buffer));
     std::vector<vk::WriteDescriptorSet> writes;
     for (uint32_t i = 0; i < buffers.size(); ++i)
-      writes.emplace_back(*sets[0], i, 0, 1, vk::DescriptorType::eStorageBuffer, nullptr, &infos[i]);
+      writes.emplace_back(*sets[0], i, 0, 1, vk::DescriptorType::eStorageBuffer, nullptr,
+                          &infos[i]);
     if (params_buffer)
-      writes.emplace_back(*sets[1], 0, 0, 1, vk::DescriptorType::eStorageBuffer, nullptr, &infos.back());
+      writes.emplace_back(*sets[1], 0, 0, 1, vk::DescriptorType::eStorageBuffer, nullptr,
+                          &infos.back());
     device_.updateDescriptorSets(writes, {});
     std::vector<vk::DescriptorSet> bound_sets;
     for (const auto& set : sets) bound_sets.push_back(*set);
@@ -460,7 +491,9 @@ class VulkanBackend final : public Backend {
 
 }  // namespace
 
-std::unique_ptr<Backend> createVulkanBackend() { return std::make_unique<VulkanBackend>(); }
+std::unique_ptr<Backend> createVulkanBackend() {
+  return std::make_unique<VulkanBackend>();
+}
 
 bool vulkanDeviceIsGpu(const Backend& backend) {
   return static_cast<const VulkanBackend&>(backend).isGpu();

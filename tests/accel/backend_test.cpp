@@ -25,7 +25,8 @@ class BackendTest : public ::testing::TestWithParam<BackendKind> {
     try {
       backend_ = createBackend(GetParam());
     } catch (const BackendUnavailable& e) {
-      if (fvp::testing::allBackendsRequired()) FAIL() << "required backend unavailable: " << e.what();
+      if (fvp::testing::allBackendsRequired())
+        FAIL() << "required backend unavailable: " << e.what();
       GTEST_SKIP() << e.what();
     }
     cpu_ = createBackend(BackendKind::kCpu);
@@ -67,7 +68,8 @@ TEST_P(BackendTest, UploadDownloadRoundTripsAndChecksRanges) {
   EXPECT_EQ(back[0], 4.5f);
   EXPECT_EQ(back[1], -1.0f);
   EXPECT_EQ(back[2], -2.0f);
-  EXPECT_THROW(backend_->upload(*buf, patch, sizeof(patch), 999 * sizeof(float)), std::out_of_range);
+  EXPECT_THROW(backend_->upload(*buf, patch, sizeof(patch), 999 * sizeof(float)),
+               std::out_of_range);
   EXPECT_THROW(backend_->download(*buf, back, 4001), std::out_of_range);
 }
 
@@ -79,7 +81,7 @@ TEST_P(BackendTest, TraverseRejectsShortBuffers) {
   auto results = backend_->createBuffer(sizeof(RayResult));
   TraverseParams params{grid.params, kDefaultOccupiedThreshold, 1};
   EXPECT_THROW(backend_->run(kernels::rayTraverse(), params,
-                            {rays.get(), occupancy.get(), field.get(), results.get()}),
+                             {rays.get(), occupancy.get(), field.get(), results.get()}),
                std::out_of_range);
 }
 
@@ -90,10 +92,11 @@ TEST_P(BackendTest, DispatchChecksTheBindings) {
   auto results = backend_->createBuffer(sizeof(RayResult));
   TraverseParams params{grid.params, kDefaultOccupiedThreshold, 1};
   // One buffer short, and a used binding left null.
-  EXPECT_THROW(backend_->run(kernels::rayTraverse(), params, {rays.get(), occupancy.get(), results.get()}),
-               std::invalid_argument);
+  EXPECT_THROW(
+      backend_->run(kernels::rayTraverse(), params, {rays.get(), occupancy.get(), results.get()}),
+      std::invalid_argument);
   EXPECT_THROW(backend_->run(kernels::rayTraverse(), params,
-                            {rays.get(), occupancy.get(), nullptr, results.get()}),
+                             {rays.get(), occupancy.get(), nullptr, results.get()}),
                std::invalid_argument);
 }
 
@@ -105,7 +108,8 @@ TEST(KernelDescriptors, EveryKernelHasItsCodeAndDistinctBindingNames) {
     EXPECT_NE(kernel->item_count, nullptr);
     for (std::size_t i = 0; i < kernel->bindings.size(); ++i) {
       EXPECT_NE(kernel->bindings[i].required_elements, nullptr);
-      for (std::size_t j = 0; j < i; ++j) EXPECT_NE(kernel->bindings[i].name, kernel->bindings[j].name);
+      for (std::size_t j = 0; j < i; ++j)
+        EXPECT_NE(kernel->bindings[i].name, kernel->bindings[j].name);
     }
   }
 }
@@ -144,7 +148,8 @@ TEST_P(BackendTest, MatchesCpuOnBoundaryCases) {
       makeRay({lo + 2.5f * v, 0, 0}, {hi - 0.5f * v, 0, 0}),
       makeRay({0, hi - 0.5f * v, 0}, {0, lo + 0.5f * v, 0}),
       makeRay({0, 0, lo + 0.5f * v}, {0, 0, hi - 0.5f * v}),
-      makeRay({lo + 2.5f * v, lo + 2.5f * v, lo + 2.5f * v}, {hi - 2.5f * v, hi - 2.5f * v, hi - 2.5f * v}),
+      makeRay({lo + 2.5f * v, lo + 2.5f * v, lo + 2.5f * v},
+              {hi - 2.5f * v, hi - 2.5f * v, hi - 2.5f * v}),
       makeRay({lo - 2 * v, lo - 2 * v, 0.5f * v}, {hi, hi, 0.5f * v}),
       makeRay({0.3f * v, 0.3f * v, 0.3f * v}, {0.3f * v, 0.3f * v, 0.3f * v}),
       makeRay({lo - 1.0f, 0, 0}, {lo - 2.0f, 0, 0}),
@@ -173,7 +178,8 @@ TEST(BackendFactory, NamesAndErrors) {
     FAIL() << "an unknown backend name must throw";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("cuda"), std::string::npos);
-    EXPECT_NE(std::string(e.what()).find("expected cpu, opencl, vulkan or auto"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("expected cpu, opencl, vulkan or auto"),
+              std::string::npos);
   }
   // auto always yields a working backend: a GPU where there is one, else the reference.
   auto backend = createBackend("auto");

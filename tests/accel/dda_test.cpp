@@ -178,10 +178,12 @@ TEST(Dda, EndPointOnABoundaryBelongsToTheUpperVoxel) {
   // voxel 20 whichever way the ray travels; with 1/64 m voxels every value is exact.
   const float v = 1.0f / 64.0f;
   const GridParams g = makeGridParams({40, 40, 40}, {0, 0, 0}, v);
-  const Walk up = walkSkipping(g, makeRay({17.5f * v, 5.5f * v, 5.5f * v}, {20.0f * v, 5.5f * v, 5.5f * v}));
+  const Walk up =
+      walkSkipping(g, makeRay({17.5f * v, 5.5f * v, 5.5f * v}, {20.0f * v, 5.5f * v, 5.5f * v}));
   ASSERT_EQ(up.voxels.size(), 4u);  // 17, 18, 19, 20
   EXPECT_EQ(up.voxels.back(), (Key{20, 5, 5}));
-  const Walk down = walkSkipping(g, makeRay({22.5f * v, 5.5f * v, 5.5f * v}, {20.0f * v, 5.5f * v, 5.5f * v}));
+  const Walk down =
+      walkSkipping(g, makeRay({22.5f * v, 5.5f * v, 5.5f * v}, {20.0f * v, 5.5f * v, 5.5f * v}));
   ASSERT_EQ(down.voxels.size(), 3u);  // 22, 21, 20
   EXPECT_EQ(down.voxels.back(), (Key{20, 5, 5}));
 }
@@ -191,12 +193,14 @@ TEST(Dda, SimultaneousCrossingsStepZThenYThenX) {
   // OctoMap's order is z first, then y, then x.
   const float v = 1.0f / 64.0f;
   const GridParams g = makeGridParams({16, 16, 16}, {0, 0, 0}, v);
-  const Walk w = walkSkipping(g, makeRay({2.5f * v, 2.5f * v, 2.5f * v}, {4.5f * v, 4.5f * v, 4.5f * v}));
+  const Walk w =
+      walkSkipping(g, makeRay({2.5f * v, 2.5f * v, 2.5f * v}, {4.5f * v, 4.5f * v, 4.5f * v}));
   const std::vector<Key> expected{{2, 2, 2}, {2, 2, 3}, {2, 3, 3}, {3, 3, 3},
                                   {3, 3, 4}, {3, 4, 4}, {4, 4, 4}};
   EXPECT_EQ(w.voxels, expected);
   // x-y tie only: y before x.
-  const Walk xy = walkSkipping(g, makeRay({2.5f * v, 2.5f * v, 2.25f * v}, {3.5f * v, 3.5f * v, 2.25f * v}));
+  const Walk xy =
+      walkSkipping(g, makeRay({2.5f * v, 2.5f * v, 2.25f * v}, {3.5f * v, 3.5f * v, 2.25f * v}));
   EXPECT_EQ(xy.voxels, (std::vector<Key>{{2, 2, 2}, {2, 3, 2}, {3, 3, 2}}));
 }
 
@@ -204,9 +208,10 @@ TEST(Dda, EntryThroughAnEdgeMatchesTheWalkFromOutside) {
   // The ray enters exactly through a grid edge (x and y slabs at the same parameter).
   const float v = 1.0f / 64.0f;
   const GridParams g = makeGridParams({16, 16, 16}, {0, 0, 0}, v);
-  for (const Ray& ray : {makeRay({-2.0f * v, -2.0f * v, 3.5f * v}, {5.0f * v, 5.0f * v, 3.5f * v}),
-                         makeRay({-2.0f * v, -2.0f * v, -2.0f * v}, {5.0f * v, 5.0f * v, 5.0f * v}),
-                         makeRay({18.0f * v, -2.0f * v, 3.5f * v}, {11.0f * v, 5.0f * v, 3.5f * v})}) {
+  for (const Ray& ray :
+       {makeRay({-2.0f * v, -2.0f * v, 3.5f * v}, {5.0f * v, 5.0f * v, 3.5f * v}),
+        makeRay({-2.0f * v, -2.0f * v, -2.0f * v}, {5.0f * v, 5.0f * v, 5.0f * v}),
+        makeRay({18.0f * v, -2.0f * v, 3.5f * v}, {11.0f * v, 5.0f * v, 3.5f * v})}) {
     const Walk fast = walkSkipping(g, ray);
     const Walk slow = walkFromOrigin(g, ray);
     EXPECT_EQ(fast.status, slow.status);
@@ -219,7 +224,8 @@ TEST(Dda, EntryThroughAnEdgeMatchesTheWalkFromOutside) {
 // opposite order at their first difference (computed from the float end points in long
 // double, independent of either walk's arithmetic).
 long double crossingGapVoxels(const std::vector<Key>& a, const std::vector<Key>& b,
-                              const std::array<long double, 3>& o, const std::array<long double, 3>& e) {
+                              const std::array<long double, 3>& o,
+                              const std::array<long double, 3>& e) {
   std::size_t k = 1;
   while (k < a.size() && k < b.size() && a[k] == b[k]) ++k;
   if (k >= a.size() || k >= b.size()) return 1e9L;
@@ -235,7 +241,8 @@ long double crossingGapVoxels(const std::vector<Key>& a, const std::vector<Key>&
     return (boundary - o[axis]) / (e[axis] - o[axis]);
   };
   const long double length =
-      std::sqrt((e[0] - o[0]) * (e[0] - o[0]) + (e[1] - o[1]) * (e[1] - o[1]) + (e[2] - o[2]) * (e[2] - o[2]));
+      std::sqrt((e[0] - o[0]) * (e[0] - o[0]) + (e[1] - o[1]) * (e[1] - o[1]) +
+                (e[2] - o[2]) * (e[2] - o[2]));
   return std::abs(crossing(axis_a, a[k - 1], a[k]) - crossing(axis_b, b[k - 1], b[k])) * length;
 }
 
@@ -290,8 +297,8 @@ TEST(Dda, VoxelSequenceEqualsOctomapComputeRayKeys) {
   }
   EXPECT_LE(near_ties, kRays / 500) << "near-tie differences must stay below 0.2 % of rays";
   EXPECT_GT(compared, kRays * 50);
-  std::cout << "identical walks: " << kRays - near_ties << " of " << kRays
-            << " rays (" << compared << " voxels); near-tie order differences: " << near_ties << "\n";
+  std::cout << "identical walks: " << kRays - near_ties << " of " << kRays << " rays (" << compared
+            << " voxels); near-tie order differences: " << near_ties << "\n";
 }
 
 TEST(Dda, TraverseStopsAtFirstOccupiedVoxelAndSumsTheField) {

@@ -8,9 +8,9 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <cstdlib>
 #include <random>
 #include <string>
 
@@ -152,7 +152,8 @@ TEST_F(GridEngineSemantics, ASensorTooFarForTheExactWalkIsAnErrorNotADroppedScan
     map.integrate({9.0, 0.0, 0.3}, {}, {Eigen::Vector3f(8.5f, 0.0f, 0.3f)});
     FAIL() << "a sensor 9 m from a 1 mm grid must be rejected";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("voxels from a map's corner"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("voxels from a map's corner"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -335,7 +336,6 @@ INSTANTIATE_TEST_SUITE_P(AllBackends, GridEngineBackends,
                                            BackendKind::kVulkan),
                          backendName);
 
-
 TEST(MapConfigYaml, TheDefaultsFileHoldsTheDefaults) {
   const MapConfig read = MapConfig::fromYamlFile(FVP_SOURCE_DIR "/host/config/map_default.yaml");
   const MapConfig defaults;
@@ -349,9 +349,11 @@ TEST(MapConfigYaml, TheDefaultsFileHoldsTheDefaults) {
 }
 
 TEST(MapConfigYaml, ErrorsNameTheFileAndTheKey) {
-  const auto dir = std::filesystem::temp_directory_path() / ("fvp_map_config_" + std::to_string(::getpid()));
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("fvp_map_config_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
-  auto expectError = [&](const std::string& yaml, const std::string& key, const std::string& expected) {
+  auto expectError = [&](const std::string& yaml, const std::string& key,
+                         const std::string& expected) {
     const auto path = dir / "map.yaml";
     std::ofstream(path) << yaml;
     try {
@@ -372,7 +374,6 @@ TEST(MapConfigYaml, ErrorsNameTheFileAndTheKey) {
   expectError("sensor_max_range_m: 5.0\n", "sensor_max_range_m", "fewer than 4096 voxels per ray");
   std::filesystem::remove_all(dir);
 }
-
 
 // Review finding: with bricks allocated on touch, the separable distance passes lost
 // values carried through voxels of unallocated bricks. Here the ROI voxel's brick and a

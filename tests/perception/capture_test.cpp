@@ -177,7 +177,8 @@ TEST(PlyIo, ReadsExtraPropertiesAndEmptyClouds) {
 TEST(PlyIo, HeadersThatDoNotFitTheDataAreErrorsNamingTheFile) {
   const fs::path dir = freshDir("ply_bad");
   fs::create_directories(dir);
-  auto expectError = [&](const std::string& name, const std::string& header, const std::string& needle) {
+  auto expectError = [&](const std::string& name, const std::string& header,
+                         const std::string& needle) {
     std::ofstream(dir / name, std::ios::binary) << header << std::string(12, '\0');
     try {
       readPlyPoints(dir / name);
@@ -189,12 +190,16 @@ TEST(PlyIo, HeadersThatDoNotFitTheDataAreErrorsNamingTheFile) {
     }
   };
   const std::string xyz = "property float x\nproperty float y\nproperty float z\nend_header\n";
-  expectError("huge.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000000\n" + xyz,
+  expectError("huge.ply",
+              "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000000\n" + xyz,
               "truncated");
-  expectError("word.ply", "ply\nformat binary_little_endian 1.0\nelement vertex abc\n" + xyz, "element vertex");
-  expectError("face.ply",
-              "ply\nformat binary_little_endian 1.0\nelement face 1\nproperty float a\nelement vertex 1\n" + xyz,
-              "element face");
+  expectError("word.ply", "ply\nformat binary_little_endian 1.0\nelement vertex abc\n" + xyz,
+              "element vertex");
+  expectError(
+      "face.ply",
+      "ply\nformat binary_little_endian 1.0\nelement face 1\nproperty float a\nelement vertex 1\n" +
+          xyz,
+      "element face");
 }
 
 }  // namespace

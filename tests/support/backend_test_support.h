@@ -23,7 +23,8 @@ inline std::uint64_t freshSeed() {
 }
 
 inline std::string replayHint(std::uint64_t seed) {
-  return "seed " + std::to_string(seed) + " (rerun with FVP_TEST_SEED=" + std::to_string(seed) + ")";
+  return "seed " + std::to_string(seed) + " (rerun with FVP_TEST_SEED=" + std::to_string(seed) +
+         ")";
 }
 
 }  // namespace fvp::testing

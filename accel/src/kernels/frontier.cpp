@@ -11,8 +11,12 @@ namespace {
 
 using detail::paramsOf;
 
-const FrontierParams& fp(const void* p) { return paramsOf<FrontierParams>(p); }
-std::size_t slots(const void* p) { return fp(p).slot_count; }
+const FrontierParams& fp(const void* p) {
+  return paramsOf<FrontierParams>(p);
+}
+std::size_t slots(const void* p) {
+  return fp(p).slot_count;
+}
 
 void validate(const void* p) {
   checkBrickedGrid(fp(p).map, "frontier");
@@ -39,26 +43,29 @@ void cpuLoop(const void* p, void* const* buffers, std::uint32_t count) {
 constexpr KernelBinding kBindings[] = {
     {"brick_coords", sizeof(int), Access::kRead,
      [](const void* p) { return slots(p) / kBrickVoxels * 3; }},
-    {"brick_table", sizeof(int), Access::kRead, [](const void* p) { return brickCount(fp(p).map); }},
+    {"brick_table", sizeof(int), Access::kRead,
+     [](const void* p) { return brickCount(fp(p).map); }},
     {"occupancy", sizeof(float), Access::kRead, slots},
     {"roi", sizeof(float), Access::kRead, slots},
     {"frontiers", sizeof(Frontier), Access::kWrite,
      [](const void* p) -> std::size_t { return fp(p).capacity; }},
-    {"count", sizeof(std::uint32_t), Access::kReadWrite, [](const void*) -> std::size_t { return 1; }},
+    {"count", sizeof(std::uint32_t), Access::kReadWrite,
+     [](const void*) -> std::size_t { return 1; }},
 };
 
-const KernelDescriptor kDescriptor{
-    "frontier",
-    sizeof(FrontierParams),
-    kBindings,
-    [](const void* p) { return fp(p).slot_count; },
-    validate,
-    cpuLoop,
-    FVP_OPENCL_CODE(frontier, "fvp_extract_frontiers"),
-    FVP_SPIRV_CODE(frontier)};
+const KernelDescriptor kDescriptor{"frontier",
+                                   sizeof(FrontierParams),
+                                   kBindings,
+                                   [](const void* p) { return fp(p).slot_count; },
+                                   validate,
+                                   cpuLoop,
+                                   FVP_OPENCL_CODE(frontier, "fvp_extract_frontiers"),
+                                   FVP_SPIRV_CODE(frontier)};
 
 }  // namespace
 
-Kernel<FrontierParams> frontier() { return {&kDescriptor}; }
+Kernel<FrontierParams> frontier() {
+  return {&kDescriptor};
+}
 
 }  // namespace fvp::accel::kernels

@@ -18,21 +18,23 @@
 #endif
 
 #ifdef FVP_WITH_VULKAN
-#define FVP_DECLARE_SPIRV_CODE(name)                                \
-  extern const std::uint32_t* const kSpirvWords_##name;             \
-  extern const std::size_t kSpirvBytes_##name;                      \
+#define FVP_DECLARE_SPIRV_CODE(name)                                    \
+  extern const std::uint32_t* const kSpirvWords_##name;                 \
+  extern const std::size_t kSpirvBytes_##name;                          \
   extern const std::uint32_t* const kSpirvWords_##name##_params_buffer; \
   extern const std::size_t kSpirvBytes_##name##_params_buffer;
-#define FVP_SPIRV_CODE(name)                                   \
-  ::fvp::accel::SpirvCode{kSpirvWords_##name, kSpirvBytes_##name}, \
-      ::fvp::accel::SpirvCode{kSpirvWords_##name##_params_buffer, kSpirvBytes_##name##_params_buffer}
+#define FVP_SPIRV_CODE(name)                                                                 \
+  ::fvp::accel::SpirvCode{kSpirvWords_##name, kSpirvBytes_##name}, ::fvp::accel::SpirvCode { \
+    kSpirvWords_##name##_params_buffer, kSpirvBytes_##name##_params_buffer                   \
+  }
 #else
 #define FVP_DECLARE_SPIRV_CODE(name)
-#define FVP_SPIRV_CODE(name) ::fvp::accel::SpirvCode{}, ::fvp::accel::SpirvCode {}
+#define FVP_SPIRV_CODE(name) \
+  ::fvp::accel::SpirvCode{}, ::fvp::accel::SpirvCode {}
 #endif
 
 /// At global scope: declares what the build generates for kernel `name`.
-#define FVP_KERNEL_CODE(name)     \
+#define FVP_KERNEL_CODE(name)   \
   FVP_DECLARE_OPENCL_CODE(name) \
   FVP_DECLARE_SPIRV_CODE(name)
 

@@ -11,7 +11,9 @@ namespace {
 
 using detail::paramsOf;
 
-std::size_t rayCount(const void* p) { return paramsOf<TraverseParams>(p).ray_count; }
+std::size_t rayCount(const void* p) {
+  return paramsOf<TraverseParams>(p).ray_count;
+}
 std::size_t gridVoxels(const void* p) {
   return static_cast<std::size_t>(voxelCount(paramsOf<TraverseParams>(p).grid));
 }
@@ -53,6 +55,8 @@ const KernelDescriptor kDescriptor{
 
 }  // namespace
 
-Kernel<TraverseParams> rayTraverse() { return {&kDescriptor}; }
+Kernel<TraverseParams> rayTraverse() {
+  return {&kDescriptor};
+}
 
 }  // namespace fvp::accel::kernels

@@ -11,8 +11,12 @@ namespace {
 
 using detail::paramsOf;
 
-const EdtParams& edt(const void* p) { return paramsOf<EdtParams>(p); }
-std::size_t slots(const void* p) { return edt(p).slot_count; }
+const EdtParams& edt(const void* p) {
+  return paramsOf<EdtParams>(p);
+}
+std::size_t slots(const void* p) {
+  return edt(p).slot_count;
+}
 
 void validate(const void* p) {
   const EdtParams& params = edt(p);
@@ -54,18 +58,19 @@ constexpr KernelBinding kBindings[] = {
      [](const void* p) { return edt(p).axis == 2 ? slots(p) : 0; }},
 };
 
-const KernelDescriptor kDescriptor{
-    "roi_distance",
-    sizeof(EdtParams),
-    kBindings,
-    [](const void* p) { return edt(p).slot_count; },
-    validate,
-    cpuLoop,
-    FVP_OPENCL_CODE(roi_distance, "fvp_roi_distance"),
-    FVP_SPIRV_CODE(roi_distance)};
+const KernelDescriptor kDescriptor{"roi_distance",
+                                   sizeof(EdtParams),
+                                   kBindings,
+                                   [](const void* p) { return edt(p).slot_count; },
+                                   validate,
+                                   cpuLoop,
+                                   FVP_OPENCL_CODE(roi_distance, "fvp_roi_distance"),
+                                   FVP_SPIRV_CODE(roi_distance)};
 
 }  // namespace
 
-Kernel<EdtParams> roiDistance() { return {&kDescriptor}; }
+Kernel<EdtParams> roiDistance() {
+  return {&kDescriptor};
+}
 
 }  // namespace fvp::accel::kernels

@@ -21,7 +21,8 @@ void validate(const void* p) {
   checkBrickedGrid(params.map, "scan_mark");
   if (params.slot_count % kBrickVoxels != 0)
     throw std::invalid_argument("scan_mark: slot_count must be a multiple of 512");
-  if (params.brick_count < 0 || static_cast<std::size_t>(params.brick_count) != brickCount(params.map))
+  if (params.brick_count < 0 ||
+      static_cast<std::size_t>(params.brick_count) != brickCount(params.map))
     throw std::invalid_argument("scan_mark: brick_count differs from the grid's brick dims");
 }
 
@@ -59,6 +60,8 @@ const KernelDescriptor kDescriptor{
 
 }  // namespace
 
-Kernel<ScanParams> scanMark() { return {&kDescriptor}; }
+Kernel<ScanParams> scanMark() {
+  return {&kDescriptor};
+}
 
 }  // namespace fvp::accel::kernels

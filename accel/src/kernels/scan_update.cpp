@@ -11,7 +11,9 @@ namespace {
 
 using detail::paramsOf;
 
-std::size_t slots(const void* p) { return paramsOf<UpdateParams>(p).slot_count; }
+std::size_t slots(const void* p) {
+  return paramsOf<UpdateParams>(p).slot_count;
+}
 
 void validate(const void* p) {
   if (paramsOf<UpdateParams>(p).slot_count % kBrickVoxels != 0)
@@ -37,7 +39,8 @@ constexpr KernelBinding kBindings[] = {
     {"occupancy", sizeof(float), Access::kReadWrite, slots},
     {"roi", sizeof(float), Access::kReadWrite,
      [](const void* p) -> std::size_t { return paramsOf<UpdateParams>(p).has_roi ? slots(p) : 0; }},
-    {"updated", sizeof(std::uint32_t), Access::kReadWrite, [](const void*) -> std::size_t { return 1; }},
+    {"updated", sizeof(std::uint32_t), Access::kReadWrite,
+     [](const void*) -> std::size_t { return 1; }},
 };
 
 const KernelDescriptor kDescriptor{
@@ -52,6 +55,8 @@ const KernelDescriptor kDescriptor{
 
 }  // namespace
 
-Kernel<UpdateParams> scanUpdate() { return {&kDescriptor}; }
+Kernel<UpdateParams> scanUpdate() {
+  return {&kDescriptor};
+}
 
 }  // namespace fvp::accel::kernels

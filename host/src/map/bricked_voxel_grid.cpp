@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <stdexcept>
 #include <tuple>
-#include <mutex>
 
 namespace fvp::host::map {
 namespace {
@@ -80,12 +80,14 @@ void BrickedVoxelGrid::ensurePoolCapacity(std::size_t bricks) {
   if (occupancy_ && bricks <= pool_bricks_) return;
   // Kernels index slots with 32-bit ints: brick * 512 + local must stay below 2^31.
   if (bricks > kMaxBricks) {
-    throw std::length_error("voxel map: " + std::to_string(bricks) + " bricks of 512 voxels needed, at most " +
-                            std::to_string(kMaxBricks) + " fit the kernels' 32-bit slot indices; "
+    throw std::length_error("voxel map: " + std::to_string(bricks) +
+                            " bricks of 512 voxels needed, at most " + std::to_string(kMaxBricks) +
+                            " fit the kernels' 32-bit slot indices; "
                             "use a coarser voxel size or a smaller box");
   }
   // Grow geometrically; keep what is there (download, then upload into the new pools).
-  const std::size_t capacity = std::min(std::max<std::size_t>({bricks, pool_bricks_ * 2, 8}), kMaxBricks);
+  const std::size_t capacity =
+      std::min(std::max<std::size_t>({bricks, pool_bricks_ * 2, 8}), kMaxBricks);
   const std::size_t old_slots = allocatedBricks() * accel::kBrickVoxels;
   const std::size_t slots = capacity * accel::kBrickVoxels;
   std::vector<float> occ(slots, kUnknown), roi(with_roi_ ? slots : 1, kUnknown);
@@ -103,7 +105,8 @@ void BrickedVoxelGrid::ensurePoolCapacity(std::size_t bricks) {
 
 void BrickedVoxelGrid::uploadTables() {
   uploadVector(backend_, *table_buf_, table_);
-  coords_buf_ = backend_.createBufferFrom(brick_coords_.empty() ? std::vector<int>(3, 0) : brick_coords_);
+  coords_buf_ =
+      backend_.createBufferFrom(brick_coords_.empty() ? std::vector<int>(3, 0) : brick_coords_);
 }
 
 void BrickedVoxelGrid::allocate(const std::vector<int>& brick_ids) {
@@ -114,7 +117,8 @@ void BrickedVoxelGrid::allocate(const std::vector<int>& brick_ids) {
     const int bx = id % params_.bricks_x;
     const int by = (id / params_.bricks_x) % params_.bricks_y;
     const int bz = id / (params_.bricks_x * params_.bricks_y);
-    table_[id] = static_cast<int>(allocatedBricks()) | (brickInsideRegion(bx, by, bz) ? FVP_BRICK_INSIDE : 0);
+    table_[id] = static_cast<int>(allocatedBricks()) |
+                 (brickInsideRegion(bx, by, bz) ? FVP_BRICK_INSIDE : 0);
     brick_coords_.insert(brick_coords_.end(), {bx, by, bz});
   }
   uploadTables();
@@ -123,7 +127,8 @@ void BrickedVoxelGrid::allocate(const std::vector<int>& brick_ids) {
 }
 
 std::size_t BrickedVoxelGrid::integrate(accel::DeviceBuffer& points, std::uint32_t point_count,
-                                        const Eigen::Vector3f& sensor_m, const OccupancyModel& model) {
+                                        const Eigen::Vector3f& sensor_m,
+                                        const OccupancyModel& model) {
   accel::ScanParams scan{};
   scan.map = params_;
   scan.sensor_x_m = sensor_m.x();
@@ -138,9 +143,11 @@ std::size_t BrickedVoxelGrid::integrate(accel::DeviceBuffer& points, std::uint32
                  {&points, table_buf_.get(), marks_.get(), missing_.get()});
     if (allocation_ == Allocation::kUpFront) break;
     std::uint32_t any_missing = 0;
-    backend_.download(*missing_, &any_missing, sizeof(any_missing), brick_count * sizeof(std::uint32_t));
+    backend_.download(*missing_, &any_missing, sizeof(any_missing),
+                      brick_count * sizeof(std::uint32_t));
     if (!any_missing) break;
-    if (attempt > 0) throw std::logic_error("BrickedVoxelGrid: bricks still missing after allocation");
+    if (attempt > 0)
+      throw std::logic_error("BrickedVoxelGrid: bricks still missing after allocation");
     // Allocate every brick the rays reached, in ascending order (the same on every
     // backend), then mark again: marks are idempotent.
     std::vector<std::uint32_t> flags(brick_count + 1);
@@ -190,7 +197,8 @@ std::int64_t BrickedVoxelGrid::slotOf(const std::array<int, 3>& index) const {
     if (index[a] < 0 || index[a] >= geometry_.dims[a]) return -1;
   const int entry = table_[brickIndex(index[0] >> 3, index[1] >> 3, index[2] >> 3)];
   if (entry == accel::kNoBrick) return -1;
-  return std::int64_t{entry & FVP_BRICK_INDEX_MASK} * accel::kBrickVoxels + (index[0] & 7) + 8 * ((index[1] & 7) + 8 * (index[2] & 7));
+  return std::int64_t{entry & FVP_BRICK_INDEX_MASK} * accel::kBrickVoxels + (index[0] & 7) +
+         8 * ((index[1] & 7) + 8 * (index[2] & 7));
 }
 
 float BrickedVoxelGrid::occupancyAt(const std::array<int, 3>& index) const {
@@ -207,10 +215,12 @@ float BrickedVoxelGrid::roiAt(const std::array<int, 3>& index) const {
   return host_roi_[slot];
 }
 
-void BrickedVoxelGrid::assignDense(const std::vector<float>& occupancy, const std::vector<float>& roi) {
+void BrickedVoxelGrid::assignDense(const std::vector<float>& occupancy,
+                                   const std::vector<float>& roi) {
   const auto voxels = static_cast<std::size_t>(geometry_.voxelCount());
   if (occupancy.size() != voxels || (with_roi_ && roi.size() != voxels))
-    throw std::invalid_argument("BrickedVoxelGrid::assignDense: arrays must hold one value per grid voxel");
+    throw std::invalid_argument(
+        "BrickedVoxelGrid::assignDense: arrays must hold one value per grid voxel");
   std::vector<int> all;
   for (std::size_t id = 0; id < table_.size(); ++id) all.push_back(static_cast<int>(id));
   allocate(all);
@@ -219,7 +229,8 @@ void BrickedVoxelGrid::assignDense(const std::vector<float>& occupancy, const st
   for (int z = 0; z < geometry_.dims[2]; ++z)
     for (int y = 0; y < geometry_.dims[1]; ++y)
       for (int x = 0; x < geometry_.dims[0]; ++x) {
-        const std::size_t dense = x + geometry_.dims[0] * (y + static_cast<std::size_t>(geometry_.dims[1]) * z);
+        const std::size_t dense =
+            x + geometry_.dims[0] * (y + static_cast<std::size_t>(geometry_.dims[1]) * z);
         const auto slot = static_cast<std::size_t>(slotOf({x, y, z}));
         occ[slot] = occupancy[dense];
         if (with_roi_) roi_pool[slot] = roi[dense];
@@ -244,7 +255,8 @@ void BrickedVoxelGrid::allocateRoiHalo(int radius_vox) {
     const int* c = &brick_coords_[3 * b];
     for (int z = std::max(0, c[2] - halo); z <= std::min(params_.bricks_z - 1, c[2] + halo); ++z)
       for (int y = std::max(0, c[1] - halo); y <= std::min(params_.bricks_y - 1, c[1] + halo); ++y)
-        for (int x = std::max(0, c[0] - halo); x <= std::min(params_.bricks_x - 1, c[0] + halo); ++x) {
+        for (int x = std::max(0, c[0] - halo); x <= std::min(params_.bricks_x - 1, c[0] + halo);
+             ++x) {
           const int id = brickIndex(x, y, z);
           if (table_[id] == accel::kNoBrick) wanted[id] = any = true;
         }
@@ -270,11 +282,15 @@ void BrickedVoxelGrid::computeRoiDistance(int radius_vox) {
   // x pass: roi -> sq_a; y pass: sq_a -> sq_b; z pass: sq_b -> distance.
   const auto kernel = accel::kernels::roiDistance();
   edt.axis = 0;
-  backend_.run(kernel, edt, {coords_buf_.get(), table_buf_.get(), roi_.get(), nullptr, sq_a.get(), nullptr});
+  backend_.run(kernel, edt,
+               {coords_buf_.get(), table_buf_.get(), roi_.get(), nullptr, sq_a.get(), nullptr});
   edt.axis = 1;
-  backend_.run(kernel, edt, {coords_buf_.get(), table_buf_.get(), nullptr, sq_a.get(), sq_b.get(), nullptr});
+  backend_.run(kernel, edt,
+               {coords_buf_.get(), table_buf_.get(), nullptr, sq_a.get(), sq_b.get(), nullptr});
   edt.axis = 2;
-  backend_.run(kernel, edt, {coords_buf_.get(), table_buf_.get(), nullptr, sq_b.get(), nullptr, distance_.get()});
+  backend_.run(
+      kernel, edt,
+      {coords_buf_.get(), table_buf_.get(), nullptr, sq_b.get(), nullptr, distance_.get()});
   distance_radius_vox_ = radius_vox;
   std::lock_guard<std::mutex> lock(host_mutex_);
   host_distance_.clear();  // downloaded on the first query
@@ -287,7 +303,8 @@ float BrickedVoxelGrid::roiDistanceVoxAt(const std::array<int, 3>& index) const 
   std::lock_guard<std::mutex> lock(host_mutex_);
   if (host_distance_.empty()) {
     host_distance_.resize(std::max<std::size_t>(slotCount(), 1));
-    if (slotCount()) backend_.download(*distance_, host_distance_.data(), slotCount() * sizeof(float));
+    if (slotCount())
+      backend_.download(*distance_, host_distance_.data(), slotCount() * sizeof(float));
   }
   return host_distance_[static_cast<std::size_t>(slot)];
 }
@@ -316,7 +333,8 @@ std::vector<FrontierVoxel> BrickedVoxelGrid::extractFrontiers(float occupied_log
     const std::uint32_t zero = 0;
     backend_.upload(*counter_, &zero, sizeof(zero));
     backend_.run(accel::kernels::frontier(), params,
-                 {coords_buf_.get(), table_buf_.get(), occupancy_.get(), roi_.get(), out.get(), counter_.get()});
+                 {coords_buf_.get(), table_buf_.get(), occupancy_.get(), roi_.get(), out.get(),
+                  counter_.get()});
     std::uint32_t found = 0;
     backend_.download(*counter_, &found, sizeof(found));
     if (found <= capacity) {

@@ -36,11 +36,11 @@ GridGeometry boxGeometry(const Eigen::Vector3d& min_m, const Eigen::Vector3d& ma
 }  // namespace
 
 accel::GridParams GridGeometry::params() const {
-  return accel::makeGridParams(
-      dims,
-      {static_cast<float>(first_voxel[0] * voxel_size_m), static_cast<float>(first_voxel[1] * voxel_size_m),
-       static_cast<float>(first_voxel[2] * voxel_size_m)},
-      static_cast<float>(voxel_size_m));
+  return accel::makeGridParams(dims,
+                               {static_cast<float>(first_voxel[0] * voxel_size_m),
+                                static_cast<float>(first_voxel[1] * voxel_size_m),
+                                static_cast<float>(first_voxel[2] * voxel_size_m)},
+                               static_cast<float>(voxel_size_m));
 }
 
 std::array<std::int64_t, 3> GridGeometry::latticeIndex(const Eigen::Vector3d& p_m) const {
@@ -61,7 +61,8 @@ bool GridGeometry::gridIndex(const Eigen::Vector3d& p_m, std::array<int, 3>& ind
 }
 
 Eigen::Vector3d GridGeometry::voxelCenter_m(const std::array<int, 3>& index) const {
-  return {(first_voxel[0] + index[0] + 0.5) * voxel_size_m, (first_voxel[1] + index[1] + 0.5) * voxel_size_m,
+  return {(first_voxel[0] + index[0] + 0.5) * voxel_size_m,
+          (first_voxel[1] + index[1] + 0.5) * voxel_size_m,
           (first_voxel[2] + index[2] + 0.5) * voxel_size_m};
 }
 

@@ -79,8 +79,9 @@ ScanStats GridMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
           std::abs(sensor_origin_m[a] / g.voxel_size_m - static_cast<double>(g.first_voxel[a])) +
           config().sensor_max_range_m / g.voxel_size_m;
       if (!(from_corner_vox < 8000.0)) {
-        throw std::invalid_argument("map integration: sensor origin " + std::to_string(sensor_origin_m[a]) +
-                                    " m (axis " + std::to_string(a) + ") plus sensor_max_range_m lies " +
+        throw std::invalid_argument("map integration: sensor origin " +
+                                    std::to_string(sensor_origin_m[a]) + " m (axis " +
+                                    std::to_string(a) + ") plus sensor_max_range_m lies " +
                                     std::to_string(from_corner_vox) +
                                     " voxels from a map's corner; at most 8000 are walked exactly");
       }
@@ -159,7 +160,8 @@ void GridMapEngine::updateRoiDistance(double max_d_m) {
 }
 
 double GridMapEngine::roiDistance_m(const std::array<int, 3>& fine_index) const {
-  if (distance_max_d_m_ < 0.0) throw std::logic_error("roiDistance_m: call updateRoiDistance() first");
+  if (distance_max_d_m_ < 0.0)
+    throw std::logic_error("roiDistance_m: call updateRoiDistance() first");
   const GridGeometry& g = fine_->geometry();
   for (int a = 0; a < 3; ++a)
     if (fine_index[a] < 0 || fine_index[a] >= g.dims[a]) return distance_max_d_m_;

@@ -16,8 +16,8 @@ void requireRange(double value, double lo, double hi, const std::string& field, 
   const bool ok = open ? (value > lo && value < hi) : (value >= lo && value <= hi);
   if (!ok) {
     throw std::invalid_argument(field + " = " + std::to_string(value) + ": expected a value in " +
-                                (open ? "(" : "[") + std::to_string(lo) + ", " + std::to_string(hi) +
-                                (open ? ")" : "]"));
+                                (open ? "(" : "[") + std::to_string(lo) + ", " +
+                                std::to_string(hi) + (open ? ")" : "]"));
   }
 }
 
@@ -44,7 +44,8 @@ void MapConfig::validate(const std::string& source) const {
   }
   // The exact DDA walks end points within 8192 voxels of a grid's corner; rays up to
   // max range from a sensor near the box must stay well inside that.
-  const double max_range_vox = sensor_max_range_m / std::min(coarse_voxel_size_m, fine_voxel_size_m);
+  const double max_range_vox =
+      sensor_max_range_m / std::min(coarse_voxel_size_m, fine_voxel_size_m);
   if (max_range_vox >= 4096.0) {
     throw std::invalid_argument(source + ".sensor_max_range_m / " + source +
                                 ".fine_voxel_size_m = " + std::to_string(max_range_vox) +

@@ -64,7 +64,8 @@ struct OccupiedVoxelScene::Impl {
     }
     device = FVP_RTC(nullptr, rtcNewDevice(nullptr));
     try {
-      FVP_RTC(device, rtcSetDeviceErrorFunction(device, accel::detail::embreeErrorCallback, nullptr));
+      FVP_RTC(device,
+              rtcSetDeviceErrorFunction(device, accel::detail::embreeErrorCallback, nullptr));
       scene = FVP_RTC(device, rtcNewScene(device));
       // Dynamic: bricks change every scan; robust: rays through the shared edges of
       // neighbouring faces must not slip between them.

@@ -67,7 +67,7 @@ float decodeRoiColor(const octomap::ColorOcTreeNode::Color& color) {
 
 void writeCoarseBt(const octomap::OcTree& tree, const std::filesystem::path& bt_path) {
   writeFileAtomically(bt_path, "coarse map (.bt)",
-                          [&](std::ostream& out) { return tree.writeBinaryConst(out); });
+                      [&](std::ostream& out) { return tree.writeBinaryConst(out); });
 }
 
 std::unique_ptr<octomap::OcTree> readCoarseBt(const std::filesystem::path& bt_path) {
@@ -108,7 +108,7 @@ std::unique_ptr<RoiOcTree> fromColorOcTree(const octomap::ColorOcTree& tree) {
 void writeFineOt(const RoiOcTree& tree, const std::filesystem::path& ot_path) {
   const std::unique_ptr<octomap::ColorOcTree> color = toColorOcTree(tree);
   writeFileAtomically(ot_path, "fine map (.ot)",
-                          [&](std::ostream& out) { return color->write(out); });
+                      [&](std::ostream& out) { return color->write(out); });
 }
 
 std::unique_ptr<RoiOcTree> readFineOt(const std::filesystem::path& ot_path) {

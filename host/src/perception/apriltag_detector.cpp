@@ -72,8 +72,8 @@ std::vector<TagDetection> AprilTagDetector::detectAll(
   std::lock_guard lock(mutex_);
   zarray_t* detections = apriltag_detector_detect(impl_->detector, &im);
   // Freed however this scope is left (a throwing push_back included).
-  const std::unique_ptr<zarray_t, void (*)(zarray_t*)> detections_owner(detections,
-                                                                        apriltag_detections_destroy);
+  const std::unique_ptr<zarray_t, void (*)(zarray_t*)> detections_owner(
+      detections, apriltag_detections_destroy);
   for (int i = 0; i < zarray_size(detections); ++i) {
     apriltag_detection_t* det = nullptr;
     zarray_get(detections, i, &det);

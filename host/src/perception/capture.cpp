@@ -211,7 +211,9 @@ void writeCapture(const fs::path& dir, const Capture& c) {
   if (ec) throw std::runtime_error(dir.string() + ": cannot create directory: " + ec.message());
   // First: an old camera.yaml beside new images would make a mixed capture look complete.
   fs::remove(dir / kCamera, ec);
-  if (ec) throw std::runtime_error((dir / kCamera).string() + ": cannot remove the old file: " + ec.message());
+  if (ec)
+    throw std::runtime_error((dir / kCamera).string() +
+                             ": cannot remove the old file: " + ec.message());
 
   writePng(dir / kLeft, c.left_bgr);
   writePng(dir / kRight, c.right_bgr);

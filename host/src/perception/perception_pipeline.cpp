@@ -15,7 +15,8 @@ double secondsSince(std::chrono::steady_clock::time_point t0) {
 cv::Mat disparityFromDepth(const cv::Mat& depth_m, const StereoIntrinsics& K) {
   if (depth_m.type() != CV_32F || depth_m.cols != K.width_px || depth_m.rows != K.height_px)
     throw std::invalid_argument(
-        "use_exact_depth: the frame's gt_depth_m must be CV_32F of the image size (simulated frames only)");
+        "use_exact_depth: the frame's gt_depth_m must be CV_32F of the image size (simulated "
+        "frames only)");
   cv::Mat d = cv::Mat::zeros(depth_m.size(), CV_32F);
   for (int v = 0; v < depth_m.rows; ++v)
     for (int u = 0; u < depth_m.cols; ++u) {

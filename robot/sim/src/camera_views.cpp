@@ -29,7 +29,8 @@ std::vector<Eigen::Isometry3d> orbitViews(const World& world, int count, double 
   for (int i = 0; i < count; ++i) {
     const double t = count == 1 ? 0.0 : static_cast<double>(i) / (count - 1) - 0.5;
     const double angle = t * arc_deg * M_PI / 180.0;
-    const Eigen::Vector3d eye = target + Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()) * offset;
+    const Eigen::Vector3d eye =
+        target + Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()) * offset;
     views.push_back(lookAt(eye, target));
   }
   return views;

@@ -10,7 +10,8 @@ double secondsSince(std::chrono::steady_clock::time_point t0) {
 }  // namespace
 
 SimulatedMapping mapSimulatedViews(const World& world, const std::vector<Eigen::Isometry3d>& poses,
-                                   const SimulatedMappingOptions& options, accel::Backend* backend) {
+                                   const SimulatedMappingOptions& options,
+                                   accel::Backend* backend) {
   SimulatedMapping out;
   const StereoRenderer renderer(world, options.render);
   const host::PerceptionPipeline perception(options.perception);
@@ -40,8 +41,9 @@ SimulatedMapping mapSimulatedViews(const World& world, const std::vector<Eigen::
       pending.clear();
     }
     if (out.map) {
-      view.scan = out.map->integrate(perceived.clouds.sensor_origin_m, perceived.clouds.roi_points_m,
-                                     perceived.clouds.other_points_m);
+      view.scan =
+          out.map->integrate(perceived.clouds.sensor_origin_m, perceived.clouds.roi_points_m,
+                             perceived.clouds.other_points_m);
     } else {
       pending.emplace_back(out.views.size(), std::move(perceived.clouds));
     }

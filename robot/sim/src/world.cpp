@@ -316,14 +316,17 @@ World World::generate(const WorldConfig& config, std::uint64_t seed) {
   bool tag_placed = false;
   for (int tries = 0; tries < kPlacementAttempts && !tag_placed; ++tries) {
     // tag_side is right (+1) or left (-1) of the cluster as the start view sees it.
-    const double rightward = branch_dir.dot(world.T_world_start_camera_.linear().col(0)) >= 0.0 ? 1.0 : -1.0;
-    const double sign = config.tag_side != 0 ? config.tag_side * rightward : (rng.coin() ? 1.0 : -1.0);
+    const double rightward =
+        branch_dir.dot(world.T_world_start_camera_.linear().col(0)) >= 0.0 ? 1.0 : -1.0;
+    const double sign =
+        config.tag_side != 0 ? config.tag_side * rightward : (rng.coin() ? 1.0 : -1.0);
     const double t = rng.uniform(0.0, config.max_tag_distance_m + config.cluster_spread_m);
     const double tilt = config.max_tag_tilt_deg * kDegToRad;
     const double yaw_t = rng.uniform(-tilt, tilt), pitch_t = rng.uniform(-tilt, tilt);
     const double roll_t = rng.uniform(-tilt, tilt);
     // Yaw and pitch swing the plate's edges back towards the branch: stand off that much more.
-    const double swing_m = 0.5 * tag.plate_size_m * (std::abs(std::sin(yaw_t)) + std::abs(std::sin(pitch_t)));
+    const double swing_m =
+        0.5 * tag.plate_size_m * (std::abs(std::sin(yaw_t)) + std::abs(std::sin(pitch_t)));
     const Eigen::Vector3d centre = branch_point + sign * t * branch_dir +
                                    (config.branch_radius_m + kTagStandoffM + swing_m) * toward_view;
     const double distance = (centre - cluster).norm();

@@ -50,7 +50,8 @@ const std::vector<KeySpec>& keySpecs() {
       {"max_tag_distance_m", &WorldConfig::max_tag_distance_m, 0.0, 0.2, "min_tag_distance_m"},
       {"max_tag_tilt_deg", &WorldConfig::max_tag_tilt_deg, 0.0, 60.0},
       {"tag_side", &WorldConfig::tag_side, -1, 1},
-      {"trunk_radius_m", &WorldConfig::trunk_radius_m, 0.005, 0.15},  // the cluster hangs 0.2 m+ out
+      {"trunk_radius_m", &WorldConfig::trunk_radius_m, 0.005,
+       0.15},  // the cluster hangs 0.2 m+ out
       {"trunk_height_m", &WorldConfig::trunk_height_m, 0.1, 10.0},
       {"cluster_height_m", &WorldConfig::cluster_height_m, 0.05, 10.0},
       {"branch_radius_m", &WorldConfig::branch_radius_m, 0.001, 0.1},
@@ -116,7 +117,8 @@ void WorldConfig::validate(const std::string& source) const {
   }
   if (cluster_height_m > trunk_height_m) {
     throw std::invalid_argument(source + ": cluster_height_m = " + formatNumber(cluster_height_m) +
-                                ": expected at most trunk_height_m (" + formatNumber(trunk_height_m) +
+                                ": expected at most trunk_height_m (" +
+                                formatNumber(trunk_height_m) +
                                 "): the fruiting branch leaves the trunk");
   }
 }

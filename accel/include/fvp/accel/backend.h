@@ -7,9 +7,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <initializer_list>
-#include <span>
 #include <memory>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -113,8 +113,7 @@ class Backend {
   /// Runs item_count > 0 work items; arguments are checked (Backend::dispatch). Buffers
   /// unused by this dispatch are null.
   virtual void dispatchKernel(const KernelDescriptor& kernel, const void* params,
-                              std::span<DeviceBuffer* const> buffers,
-                              std::uint32_t item_count) = 0;
+                              std::span<DeviceBuffer* const> buffers, std::uint32_t item_count) = 0;
 };
 
 struct BackendInfo {

@@ -68,6 +68,6 @@ auto checkedEmbreeCall(RTCDevice device, const char* text, const char* file, int
 }  // namespace fvp::accel::detail
 
 /// FVP_RTC(device, rtcSomething(...)): runs the call, then checks device's error state.
-#define FVP_RTC(device, ...)                                                            \
+#define FVP_RTC(device, ...)                                                          \
   ::fvp::accel::detail::checkedEmbreeCall((device), #__VA_ARGS__, __FILE__, __LINE__, \
                                           [&] { return __VA_ARGS__; })

@@ -3,8 +3,8 @@
 // information-gain kernel reads these buffers directly.
 #pragma once
 
-#include <memory>
 #include <octomap/OcTree.h>
+#include <memory>
 
 #include "fvp/accel/backend.h"
 #include "fvp/host/map/bricked_voxel_grid.h"

@@ -13,10 +13,12 @@ namespace fvp::host {
 inline constexpr int kBackgroundId = 0;
 inline constexpr int kFirstFruitletId = 1;  ///< fruitlet i has id kFirstFruitletId + i
 inline constexpr int kMaxFruitlets = 64;
-inline constexpr int kFirstLeafId = 100;    ///< leaf k has id kFirstLeafId + k
-inline constexpr int kTreeId = 10000;       ///< trunk and branches
-inline constexpr int kTagId = 20000;        ///< the AprilTag and its backing plate
-inline bool isFruitletId(int id) { return id >= kFirstFruitletId && id < kFirstFruitletId + kMaxFruitlets; }
+inline constexpr int kFirstLeafId = 100;  ///< leaf k has id kFirstLeafId + k
+inline constexpr int kTreeId = 10000;     ///< trunk and branches
+inline constexpr int kTagId = 20000;      ///< the AprilTag and its backing plate
+inline bool isFruitletId(int id) {
+  return id >= kFirstFruitletId && id < kFirstFruitletId + kMaxFruitlets;
+}
 
 struct StereoFrame {
   cv::Mat left_bgr;   ///< CV_8UC3, rectified left image

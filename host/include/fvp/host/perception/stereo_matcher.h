@@ -2,9 +2,9 @@
 // needed: a full-resolution pass over the requested fine rectangle (the Cluster Region's image
 // band) and a cheaper reduced-resolution pass for everything else (the coarse map). Both are
 // split into a fixed number of overlapping row strips run on all cores (OpenCV's MODE_SGBM is
-// single-threaded; a fixed count keeps the result the same on every machine). Pitfalls handled (DESIGN.md §10): saturated disparities at the top of the
-// search range (objects nearer than ~0.17 m) are rejected, and the left band where SGBM has no
-// match is marked invalid; both are counted.
+// single-threaded; a fixed count keeps the result the same on every machine). Pitfalls handled
+// (DESIGN.md §10): saturated disparities at the top of the search range (objects nearer than ~0.17
+// m) are rejected, and the left band where SGBM has no match is marked invalid; both are counted.
 #pragma once
 
 #include <opencv2/calib3d.hpp>
@@ -26,8 +26,9 @@ inline constexpr int kDefaultSpeckleRange = 2;
 inline constexpr int kDefaultSgbmMode = cv::StereoSGBM::MODE_SGBM;
 /// Disparities >= num_disparities - margin are saturated (SGBM clamps near objects there).
 inline constexpr int kDefaultSaturationMarginPx = 2;
-inline constexpr int kDefaultCoarseScale = 2;      ///< coarse pass at 1/2 resolution
-inline constexpr int kDefaultStripOverlapPx = 24;  ///< rows above and below each strip for SGBM's paths to settle
+inline constexpr int kDefaultCoarseScale = 2;  ///< coarse pass at 1/2 resolution
+inline constexpr int kDefaultStripOverlapPx =
+    24;  ///< rows above and below each strip for SGBM's paths to settle
 
 /// OpenCV StereoSGBM parameters at full resolution.
 struct SgbmConfig {

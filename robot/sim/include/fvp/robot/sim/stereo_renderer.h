@@ -44,7 +44,6 @@ struct RenderOptions {
   bool images = true;        ///< false: skip the pair (left_bgr/right_bgr stay empty)
 };
 
-
 class StereoRenderer {
  public:
   /// Builds the Embree scene from a copy of the world; throws std::runtime_error naming the
