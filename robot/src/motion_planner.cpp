@@ -1,6 +1,7 @@
 #include "fvp/robot/motion_planner.h"
 
 #include <ompl/base/StateValidityChecker.h>
+#include <ompl/base/goals/GoalStates.h>
 #include <ompl/base/spaces/RealVectorStateSpace.h>
 #include <ompl/geometric/SimpleSetup.h>
 #include <ompl/geometric/planners/est/EST.h>
@@ -14,6 +15,7 @@
 #include <ompl/geometric/planners/sbl/SBL.h>
 #include <ompl/util/Console.h>
 
+#include <algorithm>
 #include <chrono>
 #include <stdexcept>
 
@@ -24,6 +26,12 @@ namespace ob = ompl::base;
 namespace og = ompl::geometric;
 
 using Clock = std::chrono::steady_clock;
+
+// Distinct IK goals: at most this many, at least this far apart in joint space.
+constexpr int kMaxGoals = 8;
+constexpr double kDistinctGoalRad = 0.5;
+// The nearest goal's share of planning_time_s before all distinct goals are tried.
+constexpr double kNearestShare = 0.25;
 
 JointVector toJoints(const ob::State* state) {
   const double* v = state->as<ob::RealVectorStateSpace::StateType>()->values;
@@ -94,31 +102,45 @@ MotionPlan MotionPlanner::moveToPose(const JointVector& current,
     plan.planning_wall_s = secondsSince(start);
     return plan;
   }
-  const JointVector* goal = nullptr;
-  for (const JointVector& q : solutions) {  // nearest first
-    if (checker_.isValid(q)) {
-      goal = &q;
-      break;
-    }
+  // Valid solutions, nearest first, keeping only ones distinct from those already kept
+  // (the slider samples give many near-copies of each IK branch).
+  std::vector<JointVector> goals;
+  for (const JointVector& q : solutions) {
+    if (static_cast<int>(goals.size()) >= kMaxGoals) break;
+    const bool distinct = std::all_of(goals.begin(), goals.end(), [&](const JointVector& g) {
+      return jointDistance(g, q) > kDistinctGoalRad;
+    });
+    if (distinct && checker_.isValid(q)) goals.push_back(q);
   }
-  if (goal == nullptr) {
+  if (goals.empty()) {
     plan.status = MotionStatus::kNoCollisionFreeIk;
     plan.planning_wall_s = secondsSince(start);
     return plan;
   }
-  plan = planToJoints(current, *goal);
+  // The nearest solution first, for a share of the time: most plans take a few tens of ms.
+  // A goal in a pocket of the map cannot be reached at all, so then every distinct solution
+  // becomes a goal state of one more query for the rest of the time.
+  const double time_s = checker_.arm().config().planning_time_s;
+  plan = plan_(current, {goals.front()}, goals.size() > 1 ? kNearestShare * time_s : time_s);
+  if (!plan.ok() && plan.status != MotionStatus::kStartInvalid && goals.size() > 1) {
+    plan = plan_(current, goals, (1.0 - kNearestShare) * time_s);
+  }
   plan.ik_solutions = static_cast<int>(solutions.size());
   plan.planning_wall_s = secondsSince(start);
   return plan;
 }
 
 MotionPlan MotionPlanner::planToJoints(const JointVector& current, const JointVector& goal) const {
+  return plan_(current, {goal}, checker_.arm().config().planning_time_s);
+}
+
+MotionPlan MotionPlanner::plan_(const JointVector& current, const std::vector<JointVector>& goals,
+                                double time_s) const {
   const auto start_time = Clock::now();
   const ArmModel& arm = checker_.arm();
   const ArmConfig& config = arm.config();
   const std::uint64_t checks_before = checker_.checks();
   MotionPlan plan;
-  plan.goal = goal;
   const auto finish = [&](MotionStatus status) {
     plan.status = status;
     plan.validity_checks = checker_.checks() - checks_before;
@@ -126,7 +148,9 @@ MotionPlan MotionPlanner::planToJoints(const JointVector& current, const JointVe
     return plan;
   };
   if (!checker_.isValid(current)) return finish(MotionStatus::kStartInvalid);
-  if (!checker_.isValid(goal)) return finish(MotionStatus::kNoCollisionFreeIk);
+  for (const JointVector& goal : goals) {
+    if (!checker_.isValid(goal)) return finish(MotionStatus::kNoCollisionFreeIk);
+  }
 
   auto space = std::make_shared<ob::RealVectorStateSpace>(kArmJoints);
   ob::RealVectorBounds bounds(kArmJoints);
@@ -142,13 +166,17 @@ MotionPlan MotionPlanner::planToJoints(const JointVector& current, const JointVe
   si->setStateValidityCheckingResolution(config.validity_step_rad / space->getMaximumExtent());
   setup.setPlanner(makePlanner(config.planner, si));
 
-  ob::ScopedState<> start(space), goal_state(space);
-  for (int j = 0; j < kArmJoints; ++j) {
-    start[j] = current[j];
-    goal_state[j] = goal[j];
+  ob::ScopedState<> start(space);
+  for (int j = 0; j < kArmJoints; ++j) start[j] = current[j];
+  setup.setStartState(start);
+  auto goal_states = std::make_shared<ob::GoalStates>(si);
+  for (const JointVector& goal : goals) {
+    ob::ScopedState<> state(space);
+    for (int j = 0; j < kArmJoints; ++j) state[j] = goal[j];
+    goal_states->addState(state);
   }
-  setup.setStartAndGoalStates(start, goal_state);
-  const ob::PlannerStatus solved = setup.solve(config.planning_time_s);
+  setup.setGoal(goal_states);
+  const ob::PlannerStatus solved = setup.solve(time_s);
   if (solved != ob::PlannerStatus::EXACT_SOLUTION) {
     const bool out_of_time =
         solved == ob::PlannerStatus::TIMEOUT || solved == ob::PlannerStatus::APPROXIMATE_SOLUTION;
@@ -160,6 +188,7 @@ MotionPlan MotionPlanner::planToJoints(const JointVector& current, const JointVe
   waypoints.reserve(path.getStateCount());
   for (std::size_t i = 0; i < path.getStateCount(); ++i)
     waypoints.push_back(toJoints(path.getState(i)));
+  plan.goal = waypoints.back();
   plan.trajectory = Trajectory(std::move(waypoints), arm.maxVelocity(), arm.maxAcceleration());
   return finish(MotionStatus::kSuccess);
 }

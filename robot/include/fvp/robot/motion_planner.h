@@ -1,12 +1,15 @@
 // moveToPose (DESIGN.md section 7): IK along the slider's travel -> the valid, collision-free
 // solution nearest the current configuration -> OMPL (RRTConnect by default) in the 7-D
 // joint space with an ArmCollisionChecker behind OMPL's StateValidityChecker -> path
-// simplification -> a Trajectory within the velocity and acceleration limits. Expected
+// simplification -> a Trajectory within the velocity and acceleration limits. The nearest
+// solution gets a quarter of planning_time_s; when it cannot be reached (a goal in a pocket
+// of the map), every distinct valid solution becomes a goal state for the rest. Expected
 // failures come back as a MotionStatus; exceptions are for misconfiguration only.
 #pragma once
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <vector>
 
 #include "fvp/robot/arm_collision_checker.h"
 #include "fvp/robot/trajectory.h"
@@ -26,7 +29,7 @@ const char* toString(MotionStatus status);
 
 struct MotionPlan {
   MotionStatus status = MotionStatus::kNoPath;
-  JointVector goal = JointVector::Zero();  ///< the chosen IK solution (when there was one)
+  JointVector goal = JointVector::Zero();  ///< the configuration reached (on success)
   Trajectory trajectory;                   ///< empty unless kSuccess
   double planning_wall_s = 0.0;            ///< IK + planning + simplification + timing
   int ik_solutions = 0;                    ///< within limits, before collision checks
@@ -45,6 +48,10 @@ class MotionPlanner {
   MotionPlan planToJoints(const JointVector& current, const JointVector& goal) const;
 
  private:
+  /// One OMPL query to any of `goals` (all valid) within time_s.
+  MotionPlan plan_(const JointVector& current, const std::vector<JointVector>& goals,
+                   double time_s) const;
+
   const ArmCollisionChecker& checker_;
 };
 
