@@ -1,5 +1,7 @@
 #include "fvp/robot/arm_config.h"
 
+#include "fvp/host/core/yaml_config.h"
+
 #include <yaml-cpp/yaml.h>
 
 #include <nlohmann/json.hpp>
@@ -9,6 +11,8 @@
 
 namespace fvp::robot {
 namespace {
+
+using host::formatNumber;
 
 using Member = std::variant<double ArmConfig::*, int ArmConfig::*, std::int64_t ArmConfig::*,
                             std::string ArmConfig::*, Eigen::Vector3d ArmConfig::*>;
@@ -57,12 +61,6 @@ const std::vector<KeySpec>& keySpecs() {
   return specs;
 }
 
-std::string formatNumber(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
-
 void checkRange(const std::string& source, const KeySpec& spec, double value) {
   // `!(a <= b)` also rejects NaN.
   if (!(value >= spec.lo) || !(value <= spec.hi)) {
@@ -70,13 +68,6 @@ void checkRange(const std::string& source, const KeySpec& spec, double value) {
                                 " is out of range; expected " + formatNumber(spec.lo) +
                                 " <= " + spec.name + " <= " + formatNumber(spec.hi));
   }
-}
-
-std::string knownKeysList() {
-  std::string list;
-  for (const KeySpec& spec : keySpecs())
-    list += (list.empty() ? "" : ", ") + std::string(spec.name);
-  return list;
 }
 
 }  // namespace
@@ -125,28 +116,15 @@ void ArmConfig::validate(const std::string& source) const {
 
 ArmConfig ArmConfig::fromYamlFile(const std::filesystem::path& path) {
   const std::string source = "arm config '" + path.string() + "'";
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path.string());
-  } catch (const YAML::Exception& e) {
-    throw std::invalid_argument(source + ": cannot read YAML: " + e.what());
-  }
+  const YAML::Node root = host::readYamlMapping(path, source);
   ArmConfig config;
   if (root.IsNull()) {
     config.validate(source);
     return config;
   }
-  if (!root.IsMap()) throw std::invalid_argument(source + ": expected a mapping of key: value");
   for (const auto& entry : root) {
     const std::string key = entry.first.as<std::string>();
-    const KeySpec* spec = nullptr;
-    for (const KeySpec& candidate : keySpecs()) {
-      if (key == candidate.name) spec = &candidate;
-    }
-    if (spec == nullptr) {
-      throw std::invalid_argument(source + ": unknown key '" + key +
-                                  "' (known keys: " + knownKeysList() + ")");
-    }
+    const KeySpec* spec = &host::findKeySpec(keySpecs(), key, source);
     const YAML::Node& value = entry.second;
     std::visit(
         [&](auto field) {

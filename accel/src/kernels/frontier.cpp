@@ -20,8 +20,7 @@ std::size_t slots(const void* p) {
 
 void validate(const void* p) {
   checkBrickedGrid(fp(p).map, "frontier");
-  if (fp(p).slot_count % kBrickVoxels != 0)
-    throw std::invalid_argument("frontier: slot_count must be a multiple of 512");
+  checkSlotCount(fp(p).slot_count, "frontier");
 }
 
 void cpuLoop(const void* p, void* const* buffers, std::uint32_t count) {

@@ -21,8 +21,7 @@ std::size_t slots(const void* p) {
 void validate(const void* p) {
   const EdtParams& params = edt(p);
   checkBrickedGrid(params.map, "roi_distance");
-  if (params.slot_count % kBrickVoxels != 0)
-    throw std::invalid_argument("roi_distance: slot_count must be a multiple of 512");
+  checkSlotCount(params.slot_count, "roi_distance");
   if (params.axis < 0 || params.axis > 2)
     throw std::invalid_argument("roi_distance: axis must be 0, 1 or 2");
   if (params.radius_vox < 1 || params.radius_vox > 1000)

@@ -12,15 +12,10 @@ namespace {
 
 using detail::paramsOf;
 
-std::size_t brickCount(const BrickedGridParams& m) {
-  return static_cast<std::size_t>(m.bricks_x) * m.bricks_y * m.bricks_z;
-}
-
 void validate(const void* p) {
   const auto& params = paramsOf<ScanParams>(p);
   checkBrickedGrid(params.map, "scan_mark");
-  if (params.slot_count % kBrickVoxels != 0)
-    throw std::invalid_argument("scan_mark: slot_count must be a multiple of 512");
+  checkSlotCount(params.slot_count, "scan_mark");
   if (params.brick_count < 0 ||
       static_cast<std::size_t>(params.brick_count) != brickCount(params.map))
     throw std::invalid_argument("scan_mark: brick_count differs from the grid's brick dims");

@@ -16,8 +16,7 @@ std::size_t slots(const void* p) {
 }
 
 void validate(const void* p) {
-  if (paramsOf<UpdateParams>(p).slot_count % kBrickVoxels != 0)
-    throw std::invalid_argument("scan_update: slot_count must be a multiple of 512");
+  checkSlotCount(paramsOf<UpdateParams>(p).slot_count, "scan_update");
 }
 
 void cpuLoop(const void* p, void* const* buffers, std::uint32_t count) {

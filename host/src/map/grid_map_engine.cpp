@@ -162,10 +162,9 @@ void GridMapEngine::updateRoiDistance(double max_d_m) {
 double GridMapEngine::roiDistance_m(const std::array<int, 3>& fine_index) const {
   if (distance_max_d_m_ < 0.0)
     throw std::logic_error("roiDistance_m: call updateRoiDistance() first");
-  const GridGeometry& g = fine_->geometry();
-  for (int a = 0; a < 3; ++a)
-    if (fine_index[a] < 0 || fine_index[a] >= g.dims[a]) return distance_max_d_m_;
-  return std::min(fine_->roiDistanceVoxAt(fine_index) * g.voxel_size_m, distance_max_d_m_);
+  // Outside the grid roiDistanceVoxAt gives the cap radius, ceil(max_d / voxel): max_d here.
+  return std::min(fine_->roiDistanceVoxAt(fine_index) * fine_->geometry().voxel_size_m,
+                  distance_max_d_m_);
 }
 
 std::vector<FrontierVoxel> GridMapEngine::frontiers() {

@@ -1,5 +1,7 @@
 #include "fvp/robot/sim/world_config.h"
 
+#include "fvp/host/core/yaml_config.h"
+
 #include <yaml-cpp/yaml.h>
 
 #include <nlohmann/json.hpp>
@@ -11,6 +13,8 @@
 
 namespace fvp::robot::sim {
 namespace {
+
+using host::formatNumber;
 
 using Member = std::variant<int WorldConfig::*, double WorldConfig::*>;
 
@@ -72,19 +76,6 @@ const KeySpec& specNamed(const std::string& name) {
   throw std::logic_error("world config: no key spec named '" + name + "'");
 }
 
-std::string formatNumber(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
-
-std::string knownKeysList() {
-  std::string list;
-  for (const KeySpec& spec : keySpecs())
-    list += (list.empty() ? "" : ", ") + std::string(spec.name);
-  return list;
-}
-
 }  // namespace
 
 const std::vector<std::string>& WorldConfig::keyNames() {
@@ -125,28 +116,15 @@ void WorldConfig::validate(const std::string& source) const {
 
 WorldConfig WorldConfig::fromYamlFile(const std::filesystem::path& path) {
   const std::string source = "world config '" + path.string() + "'";
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path.string());
-  } catch (const YAML::Exception& e) {
-    throw std::invalid_argument(source + ": cannot read YAML: " + e.what());
-  }
+  const YAML::Node root = host::readYamlMapping(path, source);
   WorldConfig config;
   if (root.IsNull()) {
     config.validate(source);
     return config;
   }
-  if (!root.IsMap()) throw std::invalid_argument(source + ": expected a mapping of key: value");
   for (const auto& entry : root) {
     const std::string key = entry.first.as<std::string>();
-    const KeySpec* spec = nullptr;
-    for (const KeySpec& candidate : keySpecs()) {
-      if (key == candidate.name) spec = &candidate;
-    }
-    if (spec == nullptr) {
-      throw std::invalid_argument(source + ": unknown key '" + key +
-                                  "' (known keys: " + knownKeysList() + ")");
-    }
+    const KeySpec* spec = &host::findKeySpec(keySpecs(), key, source);
     const YAML::Node& value = entry.second;
     const bool is_int = std::holds_alternative<int WorldConfig::*>(spec->member);
     const std::string expected = is_int ? "an integer" : "a number";

@@ -64,6 +64,12 @@ inline void checkBrickedGrid(const BrickedGridParams& m, const char* what) {
     throw std::invalid_argument(std::string(what) + ": grid dims must be 8 x the brick dims");
 }
 
+/// Throws std::invalid_argument (naming `what`) unless slot_count is whole bricks of slots.
+inline void checkSlotCount(std::uint32_t slot_count, const char* what) {
+  if (slot_count % kBrickVoxels != 0)
+    throw std::invalid_argument(std::string(what) + ": slot_count must be a multiple of 512");
+}
+
 inline std::int64_t voxelCount(const GridParams& g) {
   return std::int64_t{g.dim_x} * g.dim_y * g.dim_z;
 }

@@ -3,6 +3,8 @@
 
 #include <Eigen/Core>
 
+#include "fvp/host/core/segment_distance.h"
+
 namespace fvp::robot {
 
 struct Capsule {
@@ -11,9 +13,7 @@ struct Capsule {
   double radius_m = 0.0;
 };
 
-/// Shortest distance between segments [p0, p1] and [q0, q1].
-double segmentSegmentDistance(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
-                              const Eigen::Vector3d& q0, const Eigen::Vector3d& q1);
+using host::segmentSegmentDistance;
 
 /// True when the two capsules overlap (surfaces closer than 0).
 inline bool capsulesOverlap(const Capsule& c, const Capsule& d) {

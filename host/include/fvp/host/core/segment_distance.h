@@ -1,0 +1,18 @@
+// Distances between points and segments, for the simulator's placement checks and the arm's
+// capsule collision checks.
+#pragma once
+
+#include <Eigen/Core>
+
+namespace fvp::host {
+
+/// Shortest distance from p to the segment [a, b].
+double pointSegmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                            const Eigen::Vector3d& b);
+
+/// Shortest distance between the segments [p1, q1] and [p2, q2] (Ericson, Real-Time
+/// Collision Detection, 5.1.9).
+double segmentSegmentDistance(const Eigen::Vector3d& p1, const Eigen::Vector3d& q1,
+                              const Eigen::Vector3d& p2, const Eigen::Vector3d& q2);
+
+}  // namespace fvp::host

@@ -1,0 +1,48 @@
+// What the YAML config readers (world, arm) share: reading the file as a mapping, finding a
+// key in a table of key specs, and printing numbers in error messages. Errors name the
+// source (e.g. "arm config 'F'") and what was expected.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <filesystem>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace fvp::host {
+
+/// The file's top-level node: null for an empty file, else a mapping. Throws
+/// std::invalid_argument when the file cannot be read as YAML or is not a mapping.
+inline YAML::Node readYamlMapping(const std::filesystem::path& path, const std::string& source) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path.string());
+  } catch (const YAML::Exception& e) {
+    throw std::invalid_argument(source + ": cannot read YAML: " + e.what());
+  }
+  if (!root.IsNull() && !root.IsMap())
+    throw std::invalid_argument(source + ": expected a mapping of key: value");
+  return root;
+}
+
+/// The spec whose `name` is key; throws std::invalid_argument listing the known keys.
+template <typename KeySpec>
+const KeySpec& findKeySpec(const std::vector<KeySpec>& specs, const std::string& key,
+                           const std::string& source) {
+  for (const KeySpec& spec : specs)
+    if (key == spec.name) return spec;
+  std::string known;
+  for (const KeySpec& spec : specs) known += (known.empty() ? "" : ", ") + std::string(spec.name);
+  throw std::invalid_argument(source + ": unknown key '" + key + "' (known keys: " + known + ")");
+}
+
+/// A number as an error message shows it (shortest stream form).
+inline std::string formatNumber(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+}  // namespace fvp::host
