@@ -80,7 +80,7 @@ void BM_ScanIntegrateGrid(benchmark::State& state, BackendKind kind) {
     state.ResumeTiming();
     stats = map->integrate(f.sensor_m, f.roi_m, f.other_m);
     state.PauseTiming();
-    map_bytes = map->coarse().deviceBytes() + map->fine().deviceBytes();
+    map_bytes = map->coarse().bricks().deviceBytes() + map->fine().bricks().deviceBytes();
     map.reset();
     state.ResumeTiming();
   }
@@ -145,15 +145,15 @@ void BM_ScanIntegrateFineBoxGrid(benchmark::State& state, BackendKind kind) {
   std::size_t updated = 0, bricks = 0, bytes = 0;
   for (auto _ : state) {
     state.PauseTiming();
-    auto grid = std::make_unique<host::map::BrickedVoxelGrid>(
-        *backend, fineBoxGeometry(), true, std::nullopt,
-        host::map::BrickedVoxelGrid::Allocation::kOnTouch);
+    auto grid = std::make_unique<host::map::OccupancyLayer>(
+        *backend, fineBoxGeometry(), true, std::nullopt, host::map::BrickAllocation::kOnTouch);
+    host::map::ScanIntegrator integrator(*grid);
     state.ResumeTiming();
-    updated = grid->integrate(*buffer, static_cast<std::uint32_t>(points.size()),
-                              f.sensor_m.cast<float>(), model);
+    updated = integrator.integrate(*buffer, static_cast<std::uint32_t>(points.size()),
+                                   f.sensor_m.cast<float>(), model);
     state.PauseTiming();
-    bricks = grid->allocatedBricks();
-    bytes = grid->deviceBytes();
+    bricks = grid->bricks().allocatedBricks();
+    bytes = grid->bricks().deviceBytes();
     grid.reset();
     state.ResumeTiming();
   }

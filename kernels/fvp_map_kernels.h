@@ -18,12 +18,14 @@
 
 #ifdef __OPENCL_VERSION__
 #define FVP_ATOMIC_OR(ptr, v) atomic_or((ptr), (v))
+#define FVP_ATOMIC_ADD(ptr, v) atomic_add((ptr), (v))
 #define FVP_ATOMIC_INC(ptr) atomic_inc(ptr)
 #define FVP_LOAD(ptr) (*(ptr))
 #define FVP_FLAG(ptr) (*(ptr) = 1u)
 #define FVP_SQRTF sqrt
 #else
 #define FVP_ATOMIC_OR(ptr, v) __atomic_fetch_or((ptr), (v), __ATOMIC_RELAXED)
+#define FVP_ATOMIC_ADD(ptr, v) __atomic_fetch_add((ptr), (v), __ATOMIC_RELAXED)
 #define FVP_ATOMIC_INC(ptr) __atomic_fetch_add((ptr), 1u, __ATOMIC_RELAXED)
 #define FVP_LOAD(ptr) __atomic_load_n((ptr), __ATOMIC_RELAXED)
 /* Racing stores of the same constant: relaxed atomics keep them well defined in C++. */
@@ -162,6 +164,20 @@ FVP_FN unsigned int fvp_scan_update_chunk(const fvp_update_params* p, unsigned i
     marks[w] = 0u;
   }
   return updated;
+}
+
+/* One work item of the update pass: chunk `item` of FVP_UPDATE_CHUNK slots. Adds the number
+ * of updated voxels to *updated and flags the chunk's brick in changed_bricks (one uint per
+ * allocated brick), so the host refreshes only what changed. */
+FVP_FN void fvp_scan_update_item(const fvp_update_params* p, unsigned int item,
+                                 FVP_GLOBAL unsigned int* marks, FVP_GLOBAL float* occupancy,
+                                 FVP_GLOBAL float* roi, FVP_GLOBAL unsigned int* updated,
+                                 FVP_GLOBAL unsigned int* changed_bricks) {
+  unsigned int first = item * FVP_UPDATE_CHUNK;
+  unsigned int n = fvp_scan_update_chunk(p, first, marks, occupancy, roi);
+  if (n == 0u) return;
+  FVP_ATOMIC_ADD(updated, n);
+  FVP_FLAG(&changed_bricks[first / FVP_BRICK_VOXELS]);
 }
 
 /* ROI distance field, one separable pass for one voxel (exact squared Euclidean distance

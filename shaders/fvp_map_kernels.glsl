@@ -130,6 +130,18 @@ uint fvp_scan_update_chunk(FvpUpdateParams p, uint first) {
 }
 #endif
 
+#if defined(FVP_SCAN_UPDATE_GLSL) && defined(FVP_HAS_UPDATED) && defined(FVP_HAS_CHANGED_BRICKS) && \
+    !defined(FVP_SCAN_UPDATE_ITEM_GLSL)
+#define FVP_SCAN_UPDATE_ITEM_GLSL
+void fvp_scan_update_item(FvpUpdateParams p, uint item) {
+  uint first = item * FVP_UPDATE_CHUNK;
+  uint n = fvp_scan_update_chunk(p, first);
+  if (n == 0u) return;
+  atomicAdd(updated[0], n);
+  changed_bricks[first / uint(FVP_BRICK_VOXELS)] = 1u;
+}
+#endif
+
 #if defined(FVP_HAS_BRICK_TABLE) && defined(FVP_HAS_ROI) && defined(FVP_HAS_SQ_IN) && \
     defined(FVP_HAS_BRICK_COORDS) && defined(FVP_HAS_SQ_OUT) && defined(FVP_HAS_DISTANCE_VOX) && \
     !defined(FVP_EDT_GLSL)

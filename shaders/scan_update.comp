@@ -12,14 +12,16 @@ layout(std430, set = 0, binding = 0) buffer Marks { uint marks[]; };
 layout(std430, set = 0, binding = 1) buffer Occupancy { float occupancy[]; };
 layout(std430, set = 0, binding = 2) buffer Roi { float roi[]; };
 layout(std430, set = 0, binding = 3) buffer Updated { uint updated[]; };
+layout(std430, set = 0, binding = 4) buffer ChangedBricks { uint changed_bricks[]; };
 #define FVP_HAS_MARKS
 #define FVP_HAS_OCCUPANCY
 #define FVP_HAS_ROI
+#define FVP_HAS_UPDATED
+#define FVP_HAS_CHANGED_BRICKS
+#include "fvp_map.glsl"
 #include "fvp_map_kernels.glsl"
 
 void main() {
   uint i = FVP_ITEM_INDEX;
-  if (i >= FVP_ITEM_COUNT) return;
-  uint n = fvp_scan_update_chunk(fvp_params.p, i * FVP_UPDATE_CHUNK);
-  if (n != 0u) atomicAdd(updated[0], n);
+  if (i < FVP_ITEM_COUNT) fvp_scan_update_item(fvp_params.p, i);
 }

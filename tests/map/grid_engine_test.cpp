@@ -157,6 +157,27 @@ TEST_F(GridEngineSemantics, ASensorTooFarForTheExactWalkIsAnErrorNotADroppedScan
   }
 }
 
+TEST_F(GridEngineSemantics, CoarseOcTreeFollowsTheScansBrickByBrick) {
+  // coarseOcTree() is updated from changed bricks only; it must equal a tree built from
+  // every known coarse voxel after each scan.
+  GridMapEngine map(smallConfig(), kRegion, *cpu_);
+  for (int view = 0; view < 3; ++view) {
+    const auto scan = viewOfCluster(40 + view, 100);
+    map.integrate(scan.origin_m, scan.roi_points_m, scan.other_points_m);
+    const octomap::OcTree& tree = map.coarseOcTree();
+    std::size_t known = 0;
+    map.coarse().forEachVoxel([&](const std::array<int, 3>& index, float occupancy, float) {
+      if (std::isnan(occupancy)) return;
+      ++known;
+      const Eigen::Vector3d c = map.coarse().geometry().voxelCenter_m(index);
+      const octomap::OcTreeNode* node = tree.search(c.x(), c.y(), c.z());
+      ASSERT_NE(node, nullptr);
+      EXPECT_FLOAT_EQ(node->getLogOdds(), occupancy);
+    });
+    EXPECT_EQ(tree.getNumLeafNodes(), known);
+  }
+}
+
 TEST(GridEngine, RequiresABackendAndAKnownEngineName) {
   EXPECT_THROW(createMapEngine("grid", smallConfig(), kRegion, nullptr), std::invalid_argument);
   EXPECT_THROW(createMapEngine("voxblox", smallConfig(), kRegion, nullptr), std::invalid_argument);
@@ -186,8 +207,8 @@ class GridEngineBackends : public ::testing::TestWithParam<BackendKind> {
     cpu_ = accel::createBackend(BackendKind::kCpu);
   }
 
-  static void expectSameVoxels(const BrickedVoxelGrid& got, const BrickedVoxelGrid& want) {
-    ASSERT_EQ(got.allocatedBricks(), want.allocatedBricks());
+  static void expectSameVoxels(const OccupancyLayer& got, const OccupancyLayer& want) {
+    ASSERT_EQ(got.bricks().allocatedBricks(), want.bricks().allocatedBricks());
     std::size_t compared = 0;
     want.forEachVoxel([&](const std::array<int, 3>& index, float occupancy, float roi) {
       const float o = got.occupancyAt(index), r = got.roiAt(index);
@@ -226,8 +247,9 @@ TEST_P(GridEngineBackends, OnTouchBrickAllocationMatchesCpu) {
   g.voxel_size_m = 0.001;
   g.first_voxel = {-400, -400, -100};
   g.dims = {800, 800, 800};
-  BrickedVoxelGrid got(*backend_, g, true, std::nullopt, BrickedVoxelGrid::Allocation::kOnTouch);
-  BrickedVoxelGrid want(*cpu_, g, true, std::nullopt, BrickedVoxelGrid::Allocation::kOnTouch);
+  OccupancyLayer got(*backend_, g, true, std::nullopt, BrickAllocation::kOnTouch);
+  OccupancyLayer want(*cpu_, g, true, std::nullopt, BrickAllocation::kOnTouch);
+  ScanIntegrator got_integrator(got), want_integrator(want);
   const auto scan = viewOfCluster(17, 70);
   ScanStats stats;
   const auto points =
@@ -236,11 +258,13 @@ TEST_P(GridEngineBackends, OnTouchBrickAllocationMatchesCpu) {
   auto on_cpu = cpu_->createBufferFrom(points);
   const OccupancyModel model;
   for (int i = 0; i < 2; ++i) {
-    EXPECT_EQ(got.integrate(*on_backend, points.size(), scan.origin_m.cast<float>(), model),
-              want.integrate(*on_cpu, points.size(), scan.origin_m.cast<float>(), model));
+    EXPECT_EQ(
+        got_integrator.integrate(*on_backend, points.size(), scan.origin_m.cast<float>(), model),
+        want_integrator.integrate(*on_cpu, points.size(), scan.origin_m.cast<float>(), model));
   }
-  EXPECT_GT(want.allocatedBricks(), 100u);
-  EXPECT_LT(want.allocatedBricks(), 100u * 100u * 100u / 4);  // far fewer than the 10^6 of the box
+  EXPECT_GT(want.bricks().allocatedBricks(), 100u);
+  EXPECT_LT(want.bricks().allocatedBricks(),
+            100u * 100u * 100u / 4);  // far fewer than the 10^6 of the box
   expectSameVoxels(got, want);
 }
 
@@ -262,10 +286,12 @@ TEST_P(GridEngineBackends, RoiDistanceFieldEqualsBruteForce) {
     roi_voxels.push_back({i % g.dims[0], (i / g.dims[0]) % g.dims[1], i / (g.dims[0] * g.dims[1])});
   }
   for (int k = 0; k < 30; ++k) roi[pick(rng)] = -0.4f;  // known, not ROI: must not count
-  BrickedVoxelGrid grid(*backend_, g, true, std::nullopt, BrickedVoxelGrid::Allocation::kUpFront);
+  OccupancyLayer grid(*backend_, g, true, std::nullopt, BrickAllocation::kUpFront);
   grid.assignDense(occupancy, roi);
   const int radius = 9;
-  const std::vector<float> d = grid.roiDistanceVox(radius);
+  RoiDistanceField field(grid);
+  field.compute(radius);
+  const std::vector<float> d = field.dense();
   for (int z = 0; z < g.dims[2]; ++z)
     for (int y = 0; y < g.dims[1]; ++y)
       for (int x = 0; x < g.dims[0]; ++x) {
@@ -295,9 +321,9 @@ TEST_P(GridEngineBackends, FrontiersFollowTheirDefinitions) {
   roi[at(5, 5, 7)] = 0.85f;  // ROI at the top face: next to unknown
   occupancy[at(9, 9, 3)] = 0.85f;
   roi[at(9, 9, 3)] = 0.85f;  // ROI buried in known space: not a frontier
-  BrickedVoxelGrid grid(*backend_, g, true, std::nullopt, BrickedVoxelGrid::Allocation::kUpFront);
+  OccupancyLayer grid(*backend_, g, true, std::nullopt, BrickAllocation::kUpFront);
   grid.assignDense(occupancy, roi);
-  const auto frontiers = grid.extractFrontiers(0.0f);
+  const auto frontiers = FrontierExtractor(grid).extract(0.0f);
   std::size_t roi_count = 0, explore = 0;
   for (const auto& f : frontiers) {
     if (f.roi_frontier) {
@@ -317,9 +343,9 @@ TEST_P(GridEngineBackends, FrontiersFollowTheirDefinitions) {
   EXPECT_EQ(roi_count, 1u);
   EXPECT_EQ(explore, 16u * 16u - 1u);  // the top layer minus the occupied ROI voxel
   // Sorted by index and identical to the cpu reference.
-  BrickedVoxelGrid reference(*cpu_, g, true, std::nullopt, BrickedVoxelGrid::Allocation::kUpFront);
+  OccupancyLayer reference(*cpu_, g, true, std::nullopt, BrickAllocation::kUpFront);
   reference.assignDense(occupancy, roi);
-  const auto want = reference.extractFrontiers(0.0f);
+  const auto want = FrontierExtractor(reference).extract(0.0f);
   ASSERT_EQ(frontiers.size(), want.size());
   for (std::size_t i = 0; i < want.size(); ++i) {
     EXPECT_EQ(frontiers[i].index, want[i].index);
@@ -329,6 +355,50 @@ TEST_P(GridEngineBackends, FrontiersFollowTheirDefinitions) {
 
 std::string backendName(const ::testing::TestParamInfo<BackendKind>& info) {
   return std::string(accel::toString(info.param));
+}
+
+TEST_P(GridEngineBackends, ChangedBricksAreExactlyTheBricksWhoseVoxelsChanged) {
+  // Readers (host mirror, Embree scenes, the coarse OcTree) refresh only the bricks a scan
+  // reports changed: compare the report with a full before/after comparison.
+  GridMapEngine map(smallConfig(), kRegion, *backend_);
+  const auto first = viewOfCluster(5, 120);
+  map.integrate(first.origin_m, first.roi_points_m, first.other_points_m);
+  for (OccupancyLayer* layer : {&map.coarse(), &map.fine()}) {
+    std::vector<float> before_occ, before_roi;
+    layer->forEachVoxel([&](const std::array<int, 3>&, float o, float r) {
+      before_occ.push_back(o);
+      before_roi.push_back(r);
+    });
+    const std::uint64_t count_before = layer->bricks().changeCount();
+    const auto scan = viewOfCluster(6, 120);
+    map.integrate(scan.origin_m, scan.roi_points_m, scan.other_points_m);
+    // Compare against a mirror read from scratch: download every slot.
+    const std::size_t slots = layer->bricks().slotCount();
+    std::vector<float> occ(slots), roi(slots, std::nanf(""));
+    backend_->download(layer->occupancy(), occ.data(), slots * sizeof(float));
+    if (layer->hasRoi()) backend_->download(layer->roi(), roi.data(), slots * sizeof(float));
+    const auto same = [](float a, float b) { return (std::isnan(a) && std::isnan(b)) || a == b; };
+    std::size_t changed = 0;
+    for (std::size_t b = 0; b < layer->bricks().allocatedBricks(); ++b) {
+      bool differs = false;
+      for (int v = 0; v < accel::kBrickVoxels; ++v) {
+        const std::size_t slot = b * accel::kBrickVoxels + v;
+        const float o0 = slot < before_occ.size() ? before_occ[slot] : std::nanf("");
+        const float r0 = slot < before_roi.size() ? before_roi[slot] : std::nanf("");
+        differs = differs || !same(o0, occ[slot]) || (layer->hasRoi() && !same(r0, roi[slot]));
+      }
+      EXPECT_EQ(layer->bricks().brickChangeStamps()[b] > count_before, differs) << "brick " << b;
+      changed += differs;
+    }
+    EXPECT_GT(changed, 0u);
+    // The incrementally refreshed mirror equals the full download.
+    std::size_t slot = 0;
+    layer->forEachVoxel([&](const std::array<int, 3>&, float o, float r) {
+      EXPECT_TRUE(same(o, occ[slot]));
+      if (layer->hasRoi()) EXPECT_TRUE(same(r, roi[slot]));
+      ++slot;
+    });
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(AllBackends, GridEngineBackends,
@@ -384,15 +454,18 @@ TEST(GridEngineDistance, DistancesCrossUnallocatedBricksExactly) {
   g.voxel_size_m = 0.001;
   g.first_voxel = {0, 0, 0};
   g.dims = {32, 32, 32};
-  BrickedVoxelGrid grid(*cpu, g, true, std::nullopt, BrickedVoxelGrid::Allocation::kOnTouch);
+  OccupancyLayer grid(*cpu, g, true, std::nullopt, BrickAllocation::kOnTouch);
   // One ROI ray ending in voxel (7, 0, 0) from a sensor at voxel (15.5, 15.5, 0.5): it
   // touches bricks (0,0,0), (1,0,0), (0,1,0) or (1,1,0) only.
   const accel::ScanPoint end{0.0075f, 0.0005f, 0.0005f, FVP_POINT_HIT | FVP_POINT_ROI};
   auto points = cpu->createBufferFrom(std::vector<accel::ScanPoint>{end});
-  grid.integrate(*points, 1, Eigen::Vector3f(0.0155f, 0.0155f, 0.0005f), OccupancyModel{});
-  ASSERT_LT(grid.allocatedBricks(), 5u);
+  ScanIntegrator(grid).integrate(*points, 1, Eigen::Vector3f(0.0155f, 0.0155f, 0.0005f),
+                                 OccupancyModel{});
+  ASSERT_LT(grid.bricks().allocatedBricks(), 5u);
   const int radius = 10;
-  const std::vector<float> d = grid.roiDistanceVox(radius);
+  RoiDistanceField field(grid);
+  field.compute(radius);
+  const std::vector<float> d = field.dense();
   for (int z = 0; z < 32; ++z)
     for (int y = 0; y < 32; ++y)
       for (int x = 0; x < 32; ++x) {

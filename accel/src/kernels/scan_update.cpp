@@ -24,12 +24,12 @@ void cpuLoop(const void* p, void* const* buffers, std::uint32_t count) {
   auto* marks = static_cast<unsigned int*>(buffers[0]);
   auto* occupancy = static_cast<float*>(buffers[1]);
   auto* roi = static_cast<float*>(buffers[2]);
-  unsigned long long total = 0;
-#pragma omp parallel for schedule(static) reduction(+ : total)
+  auto* updated = static_cast<unsigned int*>(buffers[3]);
+  auto* changed_bricks = static_cast<unsigned int*>(buffers[4]);
+#pragma omp parallel for schedule(static)
   for (std::int64_t c = 0; c < count; ++c)
-    total += fvp_scan_update_chunk(&params, static_cast<unsigned>(c) * FVP_UPDATE_CHUNK, marks,
-                                   occupancy, roi);
-  static_cast<std::uint32_t*>(buffers[3])[0] += static_cast<std::uint32_t>(total);
+    fvp_scan_update_item(&params, static_cast<unsigned>(c), marks, occupancy, roi, updated,
+                         changed_bricks);
 }
 
 constexpr KernelBinding kBindings[] = {
@@ -40,6 +40,8 @@ constexpr KernelBinding kBindings[] = {
      [](const void* p) -> std::size_t { return paramsOf<UpdateParams>(p).has_roi ? slots(p) : 0; }},
     {"updated", sizeof(std::uint32_t), Access::kReadWrite,
      [](const void*) -> std::size_t { return 1; }},
+    {"changed_bricks", sizeof(std::uint32_t), Access::kReadWrite,
+     [](const void* p) { return slots(p) / kBrickVoxels; }},
 };
 
 const KernelDescriptor kDescriptor{

@@ -16,9 +16,15 @@ VoxelClass classify(float logodds, float occupied_logodds) {
   return logodds > occupied_logodds ? VoxelClass::kOccupied : VoxelClass::kFree;
 }
 
-BrickedVoxelGrid::Allocation allocationFor(const GridGeometry& g) {
-  return g.voxelCount() <= kDefaultUpFrontVoxelLimit ? BrickedVoxelGrid::Allocation::kUpFront
-                                                     : BrickedVoxelGrid::Allocation::kOnTouch;
+BrickAllocation allocationFor(const GridGeometry& g) {
+  return g.voxelCount() <= kDefaultUpFrontVoxelLimit ? BrickAllocation::kUpFront
+                                                     : BrickAllocation::kOnTouch;
+}
+
+// Validates before any member is built from the config.
+const MapConfig& validated(const MapConfig& config) {
+  config.validate();
+  return config;
 }
 
 }  // namespace
@@ -55,15 +61,17 @@ std::vector<accel::ScanPoint> prepareScanPoints(const Eigen::Vector3d& sensor_or
 
 GridMapEngine::GridMapEngine(const MapConfig& config, const ClusterRegion& region,
                              accel::Backend& backend)
-    : MapEngine(config, region), backend_(backend) {
-  config.validate();
-  const GridGeometry coarse = coarseGridGeometry(config);
-  const GridGeometry fine = fineGridGeometry(config, region);
-  coarse_ = std::make_unique<BrickedVoxelGrid>(backend, coarse, /*with_roi=*/false, std::nullopt,
-                                               allocationFor(coarse));
-  fine_ = std::make_unique<BrickedVoxelGrid>(backend, fine, /*with_roi=*/true,
-                                             regionInGrid(fine, region), allocationFor(fine));
-}
+    : MapEngine(validated(config), region),
+      backend_(backend),
+      coarse_(backend, coarseGridGeometry(config), /*with_roi=*/false, std::nullopt,
+              allocationFor(coarseGridGeometry(config))),
+      fine_(backend, fineGridGeometry(config, region), /*with_roi=*/true,
+            regionInGrid(fineGridGeometry(config, region), region),
+            allocationFor(fineGridGeometry(config, region))),
+      coarse_integrator_(coarse_),
+      fine_integrator_(fine_),
+      fine_distance_(fine_),
+      fine_frontiers_(fine_) {}
 
 ScanStats GridMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
                                        const std::vector<Eigen::Vector3f>& roi_points_m,
@@ -72,8 +80,8 @@ ScanStats GridMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
   ScanStats stats;
   // Every end point lies within max range of the sensor; the exact walk needs it within
   // 8192 voxels of each grid's corner (fvp_dda.h), else its rays would be dropped.
-  for (const BrickedVoxelGrid* grid : {coarse_.get(), fine_.get()}) {
-    const GridGeometry& g = grid->geometry();
+  for (const OccupancyLayer* layer : {&coarse_, &fine_}) {
+    const GridGeometry& g = layer->geometry();
     for (int a = 0; a < 3; ++a) {
       const double from_corner_vox =
           std::abs(sensor_origin_m[a] / g.voxel_size_m - static_cast<double>(g.first_voxel[a])) +
@@ -93,8 +101,8 @@ ScanStats GridMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
     auto buffer = backend_.createBufferFrom(points);
     const Eigen::Vector3f sensor = sensor_origin_m.cast<float>();
     const auto n = static_cast<std::uint32_t>(points.size());
-    stats.coarse_voxels_updated = coarse_->integrate(*buffer, n, sensor, config().model);
-    stats.fine_voxels_updated = fine_->integrate(*buffer, n, sensor, config().model);
+    stats.coarse_voxels_updated = coarse_integrator_.integrate(*buffer, n, sensor, config().model);
+    stats.fine_voxels_updated = fine_integrator_.integrate(*buffer, n, sensor, config().model);
   }
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return stats;
@@ -102,31 +110,34 @@ ScanStats GridMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
 
 VoxelClass GridMapEngine::coarseClass(const Eigen::Vector3d& p_m) const {
   std::array<int, 3> index;
-  if (!coarse_->geometry().gridIndex(p_m, index)) return VoxelClass::kUnknown;
-  return classify(coarse_->occupancyAt(index), config().model.occupiedLogOdds());
+  if (!coarse_.geometry().gridIndex(p_m, index)) return VoxelClass::kUnknown;
+  return classify(coarse_.occupancyAt(index), config().model.occupiedLogOdds());
 }
 
 VoxelState GridMapEngine::fineState(const Eigen::Vector3d& p_m) const {
   std::array<int, 3> index;
-  if (!fine_->geometry().gridIndex(p_m, index)) return {};
+  if (!fine_.geometry().gridIndex(p_m, index)) return {};
   VoxelState s;
-  s.occupancy = classify(fine_->occupancyAt(index), config().model.occupiedLogOdds());
-  s.roi = s.occupancy != VoxelClass::kUnknown && fine_->roiAt(index) > 0.0f;
+  s.occupancy = classify(fine_.occupancyAt(index), config().model.occupiedLogOdds());
+  s.roi = s.occupancy != VoxelClass::kUnknown && fine_.roiAt(index) > 0.0f;
   return s;
 }
 
 // Exports build the same OctoMap trees the octomap engine holds and write them with its
 // writers (octomap_io.h), so both engines produce interchangeable files.
 void GridMapEngine::exportCoarse(const std::filesystem::path& bt_path) const {
-  writeCoarseBt(*buildCoarseTree(), bt_path);
+  octomap::OcTree tree(config().coarse_voxel_size_m);
+  tree.setOccupancyThres(config().model.occupied_prob);
+  writeCoarseBricks(tree, 0);
+  writeCoarseBt(tree, bt_path);
 }
 
 void GridMapEngine::exportFine(const std::filesystem::path& ot_path) const {
   RoiOcTree tree(config().fine_voxel_size_m);
   tree.setOccupancyThres(config().model.occupied_prob);
-  fine_->forEachVoxel([&](const std::array<int, 3>& index, float occupancy, float roi) {
+  fine_.forEachVoxel([&](const std::array<int, 3>& index, float occupancy, float roi) {
     if (std::isnan(occupancy)) return;
-    const Eigen::Vector3d c = fine_->geometry().voxelCenter_m(index);
+    const Eigen::Vector3d c = fine_.geometry().voxelCenter_m(index);
     RoiOcTreeNode* node =
         tree.setNodeValue(octomap::point3d(c.x(), c.y(), c.z()), occupancy, /*lazy_eval=*/true);
     node->setRoiLogOdds(std::isnan(roi) ? 0.0f : roi);
@@ -136,11 +147,11 @@ void GridMapEngine::exportFine(const std::filesystem::path& ot_path) const {
 }
 
 const GridGeometry& GridMapEngine::gridGeometry(MapLevel level) const {
-  return level == MapLevel::kCoarse ? coarse_->geometry() : fine_->geometry();
+  return level == MapLevel::kCoarse ? coarse_.geometry() : fine_.geometry();
 }
 
 std::vector<std::array<int, 3>> GridMapEngine::occupiedVoxels(MapLevel level) const {
-  const BrickedVoxelGrid& grid = level == MapLevel::kCoarse ? *coarse_ : *fine_;
+  const OccupancyLayer& grid = level == MapLevel::kCoarse ? coarse_ : fine_;
   const float occupied = config().model.occupiedLogOdds();
   std::vector<std::array<int, 3>> voxels;
   grid.forEachVoxel([&](const std::array<int, 3>& index, float occupancy, float) {
@@ -151,43 +162,65 @@ std::vector<std::array<int, 3>> GridMapEngine::occupiedVoxels(MapLevel level) co
 
 void GridMapEngine::updateRoiDistance(double max_d_m) {
   if (!(max_d_m > 0.0)) throw std::invalid_argument("updateRoiDistance: max_d_m must be positive");
-  if (distance_max_d_m_ == max_d_m && distance_scans_ == scanCount()) return;
-  const double voxel = fine_->geometry().voxel_size_m;
+  if (distance_max_d_m_ == max_d_m && fine_distance_.current()) return;
+  const double voxel = fine_.geometry().voxel_size_m;
   const int radius_vox = std::max(1, static_cast<int>(std::ceil(max_d_m / voxel)));
-  fine_->computeRoiDistance(radius_vox);
+  fine_distance_.compute(radius_vox);
   distance_max_d_m_ = max_d_m;
-  distance_scans_ = scanCount();
 }
 
 double GridMapEngine::roiDistance_m(const std::array<int, 3>& fine_index) const {
   if (distance_max_d_m_ < 0.0)
     throw std::logic_error("roiDistance_m: call updateRoiDistance() first");
-  // Outside the grid roiDistanceVoxAt gives the cap radius, ceil(max_d / voxel): max_d here.
-  return std::min(fine_->roiDistanceVoxAt(fine_index) * fine_->geometry().voxel_size_m,
+  // Outside the grid distanceVoxAt gives the cap radius, ceil(max_d / voxel): max_d here.
+  return std::min(fine_distance_.distanceVoxAt(fine_index) * fine_.geometry().voxel_size_m,
                   distance_max_d_m_);
 }
 
 std::vector<FrontierVoxel> GridMapEngine::frontiers() {
-  return fine_->extractFrontiers(config().model.occupiedLogOdds());
+  return fine_frontiers_.extract(config().model.occupiedLogOdds());
 }
 
-std::unique_ptr<octomap::OcTree> GridMapEngine::buildCoarseTree() const {
-  auto tree = std::make_unique<octomap::OcTree>(config().coarse_voxel_size_m);
-  tree->setOccupancyThres(config().model.occupied_prob);
-  coarse_->forEachVoxel([&](const std::array<int, 3>& index, float occupancy, float) {
-    if (std::isnan(occupancy)) return;
-    const Eigen::Vector3d c = coarse_->geometry().voxelCenter_m(index);
-    tree->setNodeValue(octomap::point3d(c.x(), c.y(), c.z()), occupancy, /*lazy_eval=*/true);
-  });
-  tree->updateInnerOccupancy();
-  return tree;
+void GridMapEngine::writeCoarseBricks(octomap::OcTree& tree, std::uint64_t since) const {
+  const auto& stamps = coarse_.bricks().brickChangeStamps();
+  for (std::size_t b = 0; b < stamps.size(); ++b) {
+    if (stamps[b] <= since) continue;
+    coarse_.forEachVoxelOfBrick(b, [&](const std::array<int, 3>& index, float occupancy, float) {
+      if (std::isnan(occupancy)) return;
+      const Eigen::Vector3d c = coarse_.geometry().voxelCenter_m(index);
+      tree.setNodeValue(octomap::point3d(c.x(), c.y(), c.z()), occupancy, /*lazy_eval=*/true);
+    });
+  }
+  tree.updateInnerOccupancy();
 }
 
 const octomap::OcTree& GridMapEngine::coarseOcTree() {
-  if (coarse_tree_ && coarse_tree_scans_ == scanCount()) return *coarse_tree_;
-  coarse_tree_ = buildCoarseTree();
-  coarse_tree_scans_ = scanCount();
+  if (!coarse_tree_) {
+    coarse_tree_ = std::make_unique<octomap::OcTree>(config().coarse_voxel_size_m);
+    coarse_tree_->setOccupancyThres(config().model.occupied_prob);
+    coarse_tree_change_ = 0;
+  }
+  // Known voxels stay known: changed bricks only overwrite values.
+  if (coarse_tree_change_ != coarse_.bricks().changeCount()) {
+    writeCoarseBricks(*coarse_tree_, coarse_tree_change_);
+    coarse_tree_change_ = coarse_.bricks().changeCount();
+  }
   return *coarse_tree_;
+}
+
+void GridMapEngine::refreshScene(MapLevel level, OccupiedVoxelScene& scene, bool fresh) {
+  const OccupancyLayer& layer = level == MapLevel::kCoarse ? coarse_ : fine_;
+  std::uint64_t& synced = scene_change_[level == MapLevel::kCoarse ? 0 : 1];
+  if (fresh) synced = 0;
+  const float occupied = config().model.occupiedLogOdds();
+  const auto& stamps = layer.bricks().brickChangeStamps();
+  for (std::size_t b = 0; b < stamps.size(); ++b) {
+    if (stamps[b] <= synced) continue;
+    layer.forEachVoxelOfBrick(b, [&](const std::array<int, 3>& index, float occupancy, float) {
+      scene.setOccupiedUnchecked(index, occupancy > occupied);  // NaN (unknown) fails
+    });
+  }
+  synced = layer.bricks().changeCount();
 }
 
 }  // namespace fvp::host::map

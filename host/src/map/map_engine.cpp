@@ -19,15 +19,18 @@ ScanStats MapEngine::integrate(const Eigen::Vector3d& sensor_origin_m,
 
 const OccupiedVoxelScene& MapEngine::occupiedScene(MapLevel level) {
   SceneState& state = scenes_[level == MapLevel::kCoarse ? 0 : 1];
-  if (!state.scene) {
-    state.scene = std::make_unique<OccupiedVoxelScene>(gridGeometry(level), occupiedVoxels(level));
-    state.synced_scans = scans_;
-  } else if (state.synced_scans != scans_) {
-    state.scene->assignOccupied(occupiedVoxels(level));
+  const bool fresh = !state.scene;
+  if (fresh) state.scene = std::make_unique<OccupiedVoxelScene>(gridGeometry(level));
+  if (fresh || state.synced_scans != scans_) {
+    refreshScene(level, *state.scene, fresh);
     state.scene->commit();
     state.synced_scans = scans_;
   }
   return *state.scene;
+}
+
+void MapEngine::refreshScene(MapLevel level, OccupiedVoxelScene& scene, bool) {
+  scene.assignOccupied(occupiedVoxels(level));
 }
 
 std::unique_ptr<MapEngine> createMapEngine(std::string_view engine, const MapConfig& config,

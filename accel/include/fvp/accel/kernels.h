@@ -20,7 +20,8 @@ Kernel<ScanParams> scanMark();
 
 /// Scan integration, update pass (fvp_scan_update_chunk): one item per 64 slots. Bindings:
 /// marks (slot_count / 4 uint), occupancy (slot_count float), roi (slot_count float, unused
-/// unless has_roi), updated (1 uint; the number of updated voxels is added to it).
+/// unless has_roi), updated (1 uint; the number of updated voxels is added to it),
+/// changed_bricks (slot_count / 512 uint: set to 1 for each brick with an updated voxel).
 Kernel<UpdateParams> scanUpdate();
 
 /// One pass (params.axis) of the ROI distance field (fvp_roi_distance_slot): one item per

@@ -1,14 +1,19 @@
-// The "grid" map engine: coarse and fine maps as bricked voxel storage on a compute backend
-// (cpu, opencl or vulkan), integrated by the scan kernels. Default for FVP: the planner's
-// information-gain kernel reads these buffers directly.
+// The "grid" map engine: coarse and fine maps as occupancy brick layers on a compute backend
+// (cpu, opencl or vulkan), with the operations over them (scan integration, the fine map's
+// ROI distance field and frontiers) as kernels. Default for FVP: the planner's
+// information-gain kernels read these device buffers directly. Host-side views (voxel
+// queries, Embree scenes, the coarse OcTree) are refreshed from changed bricks only.
 #pragma once
 
 #include <octomap/OcTree.h>
 #include <memory>
 
 #include "fvp/accel/backend.h"
-#include "fvp/host/map/bricked_voxel_grid.h"
+#include "fvp/host/map/frontier_extractor.h"
 #include "fvp/host/map/map_engine.h"
+#include "fvp/host/map/occupancy_layer.h"
+#include "fvp/host/map/roi_distance_field.h"
+#include "fvp/host/map/scan_integrator.h"
 
 namespace fvp::host::map {
 
@@ -29,10 +34,12 @@ class GridMapEngine final : public MapEngine {
   std::vector<std::array<int, 3>> occupiedVoxels(MapLevel level) const override;
 
   accel::Backend& backend() const { return backend_; }
-  BrickedVoxelGrid& coarse() { return *coarse_; }
-  BrickedVoxelGrid& fine() { return *fine_; }
-  const BrickedVoxelGrid& coarse() const { return *coarse_; }
-  const BrickedVoxelGrid& fine() const { return *fine_; }
+  OccupancyLayer& coarse() { return coarse_; }
+  OccupancyLayer& fine() { return fine_; }
+  const OccupancyLayer& coarse() const { return coarse_; }
+  const OccupancyLayer& fine() const { return fine_; }
+  /// The fine map's ROI distance field (device-resident per slot; see updateRoiDistance).
+  RoiDistanceField& fineRoiDistance() { return fine_distance_; }
 
   void updateRoiDistance(double max_d_m) override;
   double roiDistance_m(const std::array<int, 3>& fine_index) const override;
@@ -43,17 +50,21 @@ class GridMapEngine final : public MapEngine {
   ScanStats integrateScan(const Eigen::Vector3d& sensor_origin_m,
                           const std::vector<Eigen::Vector3f>& roi_points_m,
                           const std::vector<Eigen::Vector3f>& other_points_m) override;
+  void refreshScene(MapLevel level, OccupiedVoxelScene& scene, bool fresh) override;
 
  private:
-  std::unique_ptr<octomap::OcTree> buildCoarseTree() const;
+  /// Writes the coarse voxels of bricks changed after change count `since` into tree.
+  void writeCoarseBricks(octomap::OcTree& tree, std::uint64_t since) const;
 
   accel::Backend& backend_;
-  std::unique_ptr<BrickedVoxelGrid> coarse_, fine_;
-  // The fine map's ROI distance is as of distance_scans_ scans with cap distance_max_d_m_.
-  double distance_max_d_m_ = -1.0;
-  std::size_t distance_scans_ = 0;
+  OccupancyLayer coarse_, fine_;
+  ScanIntegrator coarse_integrator_, fine_integrator_;
+  RoiDistanceField fine_distance_;
+  FrontierExtractor fine_frontiers_;
+  double distance_max_d_m_ = -1.0;  ///< the cap of the last updateRoiDistance()
   std::unique_ptr<octomap::OcTree> coarse_tree_;
-  std::size_t coarse_tree_scans_ = 0;
+  std::uint64_t coarse_tree_change_ = 0;    ///< coarse change count the tree reflects
+  std::uint64_t scene_change_[2] = {0, 0};  ///< change count each level's scene reflects
 };
 
 /// Turns two clouds into kernel scan points: non-finite points are skipped and counted,

@@ -95,6 +95,10 @@ class MapEngine {
   virtual ScanStats integrateScan(const Eigen::Vector3d& sensor_origin_m,
                                   const std::vector<Eigen::Vector3f>& roi_points_m,
                                   const std::vector<Eigen::Vector3f>& other_points_m) = 0;
+  /// Brings `scene` up to date with the scans integrated so far (fresh: it is new and
+  /// empty). The default sets every occupied voxel (occupiedVoxels()); engines that know
+  /// which parts changed update only those.
+  virtual void refreshScene(MapLevel level, OccupiedVoxelScene& scene, bool fresh);
 
  private:
   struct SceneState {

@@ -1,0 +1,102 @@
+#include "fvp/host/map/roi_distance_field.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "fvp/accel/kernels.h"
+
+namespace fvp::host::map {
+
+RoiDistanceField::RoiDistanceField(OccupancyLayer& layer) : layer_(layer) {
+  if (!layer.hasRoi()) throw std::logic_error("RoiDistanceField needs a map with ROI");
+  distance_ = layer.bricks().addChannel("roi_distance_vox", sizeof(float), 0u);
+}
+
+bool RoiDistanceField::current() const {
+  return computed_ && computed_change_ == layer_.bricks().changeCount() &&
+         computed_layout_ == layer_.bricks().layoutVersion();
+}
+
+void RoiDistanceField::allocateRoiHalo(int radius_vox) {
+  // The passes need every voxel within radius_vox (Chebyshev) of an ROI voxel to have a
+  // slot: the x pass result at (qx, py, pz) is what carries p's distance to q.
+  BrickLayer& bricks = layer_.bricks();
+  const accel::BrickedGridParams& m = bricks.params();
+  const int halo = (radius_vox + accel::kBrickEdge - 1) / accel::kBrickEdge;
+  std::vector<int> ids;
+  std::vector<char> wanted(bricks.gridBricks(), 0);
+  for (std::size_t b = 0; b < bricks.allocatedBricks(); ++b) {
+    bool has_roi = false;
+    layer_.forEachVoxelOfBrick(
+        b, [&](const std::array<int, 3>&, float, float roi) { has_roi = has_roi || roi > 0.0f; });
+    if (!has_roi) continue;
+    const int* c = &bricks.brickCoords()[3 * b];
+    for (int z = std::max(0, c[2] - halo); z <= std::min(m.bricks_z - 1, c[2] + halo); ++z)
+      for (int y = std::max(0, c[1] - halo); y <= std::min(m.bricks_y - 1, c[1] + halo); ++y)
+        for (int x = std::max(0, c[0] - halo); x <= std::min(m.bricks_x - 1, c[0] + halo); ++x) {
+          const int id = bricks.brickIndex(x, y, z);
+          if (bricks.table()[id] == accel::kNoBrick) wanted[id] = 1;
+        }
+  }
+  for (std::size_t id = 0; id < wanted.size(); ++id)
+    if (wanted[id]) ids.push_back(static_cast<int>(id));
+  bricks.allocate(ids);
+}
+
+void RoiDistanceField::compute(int radius_vox) {
+  BrickLayer& bricks = layer_.bricks();
+  if (bricks.allocation() == BrickAllocation::kOnTouch) allocateRoiHalo(radius_vox);
+  accel::Backend& backend = bricks.backend();
+  const std::size_t slots = bricks.slotCount();
+  accel::EdtParams edt{};
+  edt.map = bricks.params();
+  edt.radius_vox = radius_vox;
+  edt.slot_count = static_cast<std::uint32_t>(slots);
+  auto sq_a = backend.createBuffer(std::max<std::size_t>(slots, 1) * sizeof(std::uint32_t));
+  auto sq_b = backend.createBuffer(std::max<std::size_t>(slots, 1) * sizeof(std::uint32_t));
+  // x pass: roi -> sq_a; y pass: sq_a -> sq_b; z pass: sq_b -> distance.
+  const auto kernel = accel::kernels::roiDistance();
+  auto* coords = &bricks.coordsBuffer();
+  auto* table = &bricks.tableBuffer();
+  edt.axis = 0;
+  backend.run(kernel, edt, {coords, table, &layer_.roi(), nullptr, sq_a.get(), nullptr});
+  edt.axis = 1;
+  backend.run(kernel, edt, {coords, table, nullptr, sq_a.get(), sq_b.get(), nullptr});
+  edt.axis = 2;
+  backend.run(kernel, edt, {coords, table, nullptr, sq_b.get(), nullptr, &distanceVox()});
+  radius_vox_ = radius_vox;
+  computed_slots_ = slots;
+  computed_ = true;
+  computed_change_ = bricks.changeCount();
+  computed_layout_ = bricks.layoutVersion();
+  std::lock_guard<std::mutex> lock(mirror_mutex_);
+  mirror_.clear();  // downloaded on the first read
+}
+
+float RoiDistanceField::distanceVoxAt(const std::array<int, 3>& index) const {
+  if (!computed_) throw std::logic_error("RoiDistanceField: call compute() first");
+  const BrickLayer& bricks = layer_.bricks();
+  const std::int64_t slot = bricks.slotOf(index);
+  // Bricks allocated after compute() were not in it: the cap, as for unallocated ones.
+  if (slot < 0 || static_cast<std::size_t>(slot) >= computed_slots_)
+    return static_cast<float>(radius_vox_);
+  std::lock_guard<std::mutex> lock(mirror_mutex_);
+  if (mirror_.empty()) {
+    mirror_.resize(computed_slots_);
+    bricks.backend().download(bricks.channel(distance_), mirror_.data(),
+                              mirror_.size() * sizeof(float));
+  }
+  return mirror_[static_cast<std::size_t>(slot)];
+}
+
+std::vector<float> RoiDistanceField::dense() const {
+  const GridGeometry& g = layer_.geometry();
+  std::vector<float> out(static_cast<std::size_t>(g.voxelCount()));
+  std::size_t i = 0;
+  for (int z = 0; z < g.dims[2]; ++z)
+    for (int y = 0; y < g.dims[1]; ++y)
+      for (int x = 0; x < g.dims[0]; ++x) out[i++] = distanceVoxAt({x, y, z});
+  return out;
+}
+
+}  // namespace fvp::host::map
