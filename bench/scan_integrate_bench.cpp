@@ -188,6 +188,79 @@ void BM_ScanIntegrateFineBoxOctomap(benchmark::State& state) {
   state.SetLabel("octomap::OcTree 1 mm insertPointCloud (no ROI), 1 thread");
 }
 
+// One planning iteration's map work after a view (DESIGN.md section 5): integrate the view,
+// recompute the ROI distance field (paper Eq. 1, max_d 2 cm), extract the frontiers and
+// bring both Embree scenes up to date. Steady state: the map already holds the start view
+// (set up untimed), and the step integrates it again, as a robot holding still would.
+constexpr double kMapStepMaxDM = 0.02;
+
+struct MapStepResult {
+  host::map::ScanStats scan;
+  std::size_t frontiers = 0, coarse_occupied = 0, fine_occupied = 0;
+};
+
+MapStepResult mapStep(host::map::MapEngine& map, const Frame& f) {
+  MapStepResult r;
+  r.scan = map.integrate(f.sensor_m, f.roi_m, f.other_m);
+  map.updateRoiDistance(kMapStepMaxDM);
+  r.frontiers = map.frontiers().size();
+  r.coarse_occupied = map.occupiedScene(host::map::MapLevel::kCoarse).occupiedCount();
+  r.fine_occupied = map.occupiedScene(host::map::MapLevel::kFine).occupiedCount();
+  return r;
+}
+
+const MapStepResult& mapStepReference() {
+  static const MapStepResult r = [] {
+    auto cpu = accel::createBackend(BackendKind::kCpu);
+    GridMapEngine map(frame().config, frame().region, *cpu);
+    mapStep(map, frame());
+    return mapStep(map, frame());
+  }();
+  return r;
+}
+
+void BM_MapStep(benchmark::State& state, const std::string& engine, BackendKind kind) {
+  std::unique_ptr<accel::Backend> backend;
+  if (engine == "grid") {
+    backend = backendOrSkip(state, kind);
+    if (!backend) return;
+  }
+  const Frame& f = frame();
+  MapStepResult result;
+  accel::TransferCounters moved{};
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto map = host::map::createMapEngine(engine, f.config, f.region, backend.get());
+    mapStep(*map, f);
+    if (backend) backend->resetTransfers();
+    state.ResumeTiming();
+    result = mapStep(*map, f);
+    state.PauseTiming();
+    if (backend) moved = backend->transfers();
+    map.reset();
+    state.ResumeTiming();
+  }
+  const MapStepResult& want = mapStepReference();
+  // The grid engine matches the cpu reference exactly; the octomap engine within near-ties.
+  const auto close = [&](std::size_t got, std::size_t ref) {
+    const double tolerance = engine == "grid" ? 0.0 : 1e-3 * static_cast<double>(ref);
+    return std::abs(static_cast<double>(got) - static_cast<double>(ref)) <= tolerance;
+  };
+  if (!close(result.scan.fine_voxels_updated, want.scan.fine_voxels_updated) ||
+      !close(result.frontiers, want.frontiers) ||
+      !close(result.fine_occupied, want.fine_occupied) ||
+      !close(result.coarse_occupied, want.coarse_occupied)) {
+    state.SkipWithError("map step differs from the cpu grid engine's");
+    return;
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(f.points()) * state.iterations());
+  state.counters["frontiers"] = static_cast<double>(result.frontiers);
+  state.counters["upload_MB"] = moved.upload_bytes / 1e6;
+  state.counters["download_MB"] = moved.download_bytes / 1e6;
+  state.counters["transfers"] = static_cast<double>(moved.uploads + moved.downloads);
+  state.SetLabel(backend ? backend->deviceName() : "OcTree + RoiOcTree + DynamicEDTOctomap");
+}
+
 void registerAll() {
   for (BackendKind kind : {BackendKind::kCpu, BackendKind::kOpenCl, BackendKind::kVulkan}) {
     const std::string b(accel::toString(kind));
@@ -211,6 +284,16 @@ void registerAll() {
       ->Unit(benchmark::kMillisecond)
       ->UseRealTime()
       ->Iterations(1);
+  for (BackendKind kind : {BackendKind::kCpu, BackendKind::kOpenCl, BackendKind::kVulkan}) {
+    const std::string b(accel::toString(kind));
+    benchmark::RegisterBenchmark(("BM_MapStep/grid/" + b).c_str(), BM_MapStep, "grid", kind)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+  }
+  benchmark::RegisterBenchmark("BM_MapStep/octomap/cpu", BM_MapStep, "octomap", BackendKind::kCpu)
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime()
+      ->Iterations(2);
 }
 
 const bool registered = (registerAll(), true);

@@ -61,13 +61,27 @@ void checkRange(const DeviceBuffer& buf, std::size_t size_bytes, std::size_t off
 void Backend::upload(DeviceBuffer& buf, const void* src, std::size_t size_bytes,
                      std::size_t offset_bytes) {
   checkRange(buf, size_bytes, offset_bytes, "upload");
-  if (size_bytes) uploadBytes(buf, src, size_bytes, offset_bytes);
+  if (!size_bytes) return;
+  uploadBytes(buf, src, size_bytes, offset_bytes);
+  upload_bytes_ += size_bytes;
+  ++uploads_;
 }
 
 void Backend::download(const DeviceBuffer& buf, void* dst, std::size_t size_bytes,
                        std::size_t offset_bytes) {
   checkRange(buf, size_bytes, offset_bytes, "download");
-  if (size_bytes) downloadBytes(buf, dst, size_bytes, offset_bytes);
+  if (!size_bytes) return;
+  downloadBytes(buf, dst, size_bytes, offset_bytes);
+  download_bytes_ += size_bytes;
+  ++downloads_;
+}
+
+TransferCounters Backend::transfers() const {
+  return {upload_bytes_.load(), download_bytes_.load(), uploads_.load(), downloads_.load()};
+}
+
+void Backend::resetTransfers() {
+  upload_bytes_ = download_bytes_ = uploads_ = downloads_ = 0;
 }
 
 void Backend::dispatch(const KernelDescriptor& kernel, const void* params, std::size_t params_bytes,

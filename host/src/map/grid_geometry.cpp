@@ -27,7 +27,7 @@ GridGeometry boxGeometry(const Eigen::Vector3d& min_m, const Eigen::Vector3d& ma
     voxels *= g.dims[a];
   }
   // The brick table holds an int per brick of the box, allocated or not: keep it below
-  // 256 MiB. (Allocated bricks are limited separately, BrickedVoxelGrid::kMaxBricks.)
+  // 256 MiB. (Allocated bricks are limited separately, BrickLayer::kMaxBricks.)
   if (voxels / FVP_BRICK_VOXELS >= (std::int64_t{1} << 26))
     throw std::invalid_argument(std::string(what) + ": a box of 2^26 bricks (8^3 voxels) or more");
   return g;

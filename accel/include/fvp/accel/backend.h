@@ -4,6 +4,7 @@
 // dispatch returns when its results are ready.
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <initializer_list>
@@ -56,6 +57,12 @@ class DeviceBuffer {
   std::size_t size_bytes_;
 };
 
+/// Bytes and calls between host and device through Backend::upload / download.
+struct TransferCounters {
+  std::uint64_t upload_bytes = 0, download_bytes = 0;
+  std::uint64_t uploads = 0, downloads = 0;
+};
+
 class Backend {
  public:
   virtual ~Backend() = default;
@@ -73,6 +80,10 @@ class Backend {
               std::size_t offset_bytes = 0);
   void download(const DeviceBuffer& buf, void* dst, std::size_t size_bytes,
                 std::size_t offset_bytes = 0);
+  /// What upload() and download() moved since construction or resetTransfers() (buffer
+  /// creation from host data counts as an upload).
+  TransferCounters transfers() const;
+  void resetTransfers();
 
   /// Runs a kernel (fvp/accel/kernels.h) over the work items its parameters define, with
   /// buffers in the kernel's binding order; returns when its results are ready. A buffer
@@ -105,6 +116,11 @@ class Backend {
 
  protected:
   Backend() = default;
+
+ private:
+  std::atomic<std::uint64_t> upload_bytes_{0}, download_bytes_{0}, uploads_{0}, downloads_{0};
+
+ protected:
   // Implementations: arguments are validated by the public twins above; size_bytes > 0.
   virtual void uploadBytes(DeviceBuffer& buf, const void* src, std::size_t size_bytes,
                            std::size_t offset_bytes) = 0;
