@@ -9,7 +9,11 @@ namespace fvp::host::map {
 
 RoiDistanceField::RoiDistanceField(OccupancyLayer& layer) : layer_(layer) {
   if (!layer.hasRoi()) throw std::logic_error("RoiDistanceField needs a map with ROI");
-  distance_ = layer.bricks().addChannel("roi_distance_vox", sizeof(float), 0u);
+}
+
+accel::DeviceBuffer& RoiDistanceField::distanceVox() {
+  if (!distance_) throw std::logic_error("RoiDistanceField: call compute() first");
+  return layer_.bricks().channel(*distance_);
 }
 
 bool RoiDistanceField::current() const {
@@ -45,6 +49,8 @@ void RoiDistanceField::allocateRoiHalo(int radius_vox) {
 
 void RoiDistanceField::compute(int radius_vox) {
   BrickLayer& bricks = layer_.bricks();
+  // The channel costs 4 bytes per slot: added when first needed.
+  if (!distance_) distance_ = bricks.addChannel("roi_distance_vox", sizeof(float), 0u);
   if (bricks.allocation() == BrickAllocation::kOnTouch) allocateRoiHalo(radius_vox);
   accel::Backend& backend = bricks.backend();
   const std::size_t slots = bricks.slotCount();
@@ -83,7 +89,7 @@ float RoiDistanceField::distanceVoxAt(const std::array<int, 3>& index) const {
   std::lock_guard<std::mutex> lock(mirror_mutex_);
   if (mirror_.empty()) {
     mirror_.resize(computed_slots_);
-    bricks.backend().download(bricks.channel(distance_), mirror_.data(),
+    bricks.backend().download(bricks.channel(*distance_), mirror_.data(),
                               mirror_.size() * sizeof(float));
   }
   return mirror_[static_cast<std::size_t>(slot)];

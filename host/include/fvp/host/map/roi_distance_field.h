@@ -7,6 +7,7 @@
 
 #include <array>
 #include <mutex>
+#include <optional>
 #include <vector>
 
 #include "fvp/host/map/occupancy_layer.h"
@@ -15,7 +16,8 @@ namespace fvp::host::map {
 
 class RoiDistanceField {
  public:
-  /// Adds the distance channel to the layer. Throws std::logic_error without ROI.
+  /// Throws std::logic_error without ROI. The distance channel is added to the layer by the
+  /// first compute().
   explicit RoiDistanceField(OccupancyLayer& layer);
 
   /// Computes the field for the layer's current contents; with on-touch allocation, first
@@ -25,8 +27,9 @@ class RoiDistanceField {
   /// True when compute() ran after the layer's last change and allocation.
   bool current() const;
   int radiusVox() const { return radius_vox_; }
-  /// The per-slot distances on the device (valid while current()).
-  accel::DeviceBuffer& distanceVox() { return layer_.bricks().channel(distance_); }
+  /// The per-slot distances on the device (valid while current()); throws std::logic_error
+  /// before the first compute().
+  accel::DeviceBuffer& distanceVox();
   /// d_i of one voxel as of the last compute(): the cap where no brick is allocated.
   /// Throws std::logic_error before the first compute().
   float distanceVoxAt(const std::array<int, 3>& index) const;
@@ -37,7 +40,7 @@ class RoiDistanceField {
   void allocateRoiHalo(int radius_vox);
 
   OccupancyLayer& layer_;
-  BrickLayer::ChannelId distance_;
+  std::optional<BrickLayer::ChannelId> distance_;
   int radius_vox_ = 0;
   std::size_t computed_slots_ = 0;
   std::uint64_t computed_change_ = 0, computed_layout_ = 0;
