@@ -40,9 +40,8 @@ class GridMapEngine final : public MapEngine {
   const octomap::OcTree& coarseOcTree() override;
 
  protected:
-  ScanStats integrateScan(const Eigen::Vector3d& sensor_origin_m,
-                          const std::vector<Eigen::Vector3f>& roi_points_m,
-                          const std::vector<Eigen::Vector3f>& other_points_m) override;
+  void integrateScan(const Eigen::Vector3d& sensor_origin_m,
+                     const std::vector<accel::ScanPoint>& points, ScanStats& stats) override;
 
  private:
   std::unique_ptr<octomap::OcTree> buildCoarseTree() const;
@@ -55,12 +54,5 @@ class GridMapEngine final : public MapEngine {
   std::unique_ptr<octomap::OcTree> coarse_tree_;
   std::size_t coarse_tree_scans_ = 0;
 };
-
-/// Turns two clouds into kernel scan points: non-finite points are skipped and counted,
-/// points beyond max_range_m cut the ray at that range with no hit (counted).
-std::vector<accel::ScanPoint> prepareScanPoints(const Eigen::Vector3d& sensor_origin_m,
-                                                const std::vector<Eigen::Vector3f>& roi_points_m,
-                                                const std::vector<Eigen::Vector3f>& other_points_m,
-                                                double max_range_m, ScanStats& stats);
 
 }  // namespace fvp::host::map
