@@ -30,11 +30,10 @@ constexpr std::uint64_t kWorldSeed = 1;
 constexpr double kObservationHalfExtentM = 0.6;  // around the cluster: camera and canopy
 
 struct Frame {
-  Eigen::Vector3d sensor_m;
-  std::vector<Eigen::Vector3f> roi_m, other_m;
+  host::LabeledClouds clouds;
   host::ClusterRegion region;
   MapConfig config;
-  std::size_t points() const { return roi_m.size() + other_m.size(); }
+  std::size_t points() const { return clouds.roi_points_m.size() + clouds.other_points_m.size(); }
 };
 
 const Frame& frame() {
@@ -46,9 +45,7 @@ const Frame& frame() {
     if (!perceived.region)
       throw std::runtime_error("benchmark frame: no Cluster Region (tag not seen)");
     Frame out;
-    out.sensor_m = perceived.clouds.sensor_origin_m;
-    out.roi_m = perceived.clouds.roi_points_m;
-    out.other_m = perceived.clouds.other_points_m;
+    out.clouds = perceived.clouds;
     out.region = *perceived.region;
     const Eigen::Vector3d c = world.clusterCenter_m();
     out.config.observation_min_m = c.array() - kObservationHalfExtentM;
@@ -63,7 +60,7 @@ const host::map::ScanStats& reference() {
   static const host::map::ScanStats stats = [] {
     auto cpu = accel::createBackend(BackendKind::kCpu);
     GridMapEngine map(frame().config, frame().region, *cpu);
-    return map.integrate(frame().sensor_m, frame().roi_m, frame().other_m);
+    return map.integrate(frame().clouds);
   }();
   return stats;
 }
@@ -78,7 +75,7 @@ void BM_ScanIntegrateGrid(benchmark::State& state, BackendKind kind) {
     state.PauseTiming();
     auto map = std::make_unique<GridMapEngine>(f.config, f.region, *backend);
     state.ResumeTiming();
-    stats = map->integrate(f.sensor_m, f.roi_m, f.other_m);
+    stats = map->integrate(f.clouds);
     state.PauseTiming();
     map_bytes = map->coarse().bricks().deviceBytes() + map->fine().bricks().deviceBytes();
     map.reset();
@@ -105,7 +102,7 @@ void BM_ScanIntegrateOctomap(benchmark::State& state) {
     state.PauseTiming();
     auto map = std::make_unique<OctomapMapEngine>(f.config, f.region);
     state.ResumeTiming();
-    stats = map->integrate(f.sensor_m, f.roi_m, f.other_m);
+    stats = map->integrate(f.clouds);
     state.PauseTiming();
     map_bytes = map->coarseTree().memoryUsage() + map->fineTree().memoryUsage();
     map.reset();
@@ -138,8 +135,7 @@ void BM_ScanIntegrateFineBoxGrid(benchmark::State& state, BackendKind kind) {
   if (!backend) return;
   const Frame& f = frame();
   host::map::ScanStats prep;
-  const auto points = host::map::prepareScanPoints(f.sensor_m, f.roi_m, f.other_m,
-                                                   f.config.sensor_max_range_m, prep);
+  const auto points = host::map::prepareScanPoints(f.clouds, f.config.sensor_max_range_m, prep);
   auto buffer = backend->createBufferFrom(points);
   const host::map::OccupancyModel model;
   std::size_t updated = 0, bricks = 0, bytes = 0;
@@ -150,7 +146,7 @@ void BM_ScanIntegrateFineBoxGrid(benchmark::State& state, BackendKind kind) {
     host::map::ScanIntegrator integrator(*grid);
     state.ResumeTiming();
     updated = integrator.integrate(*buffer, static_cast<std::uint32_t>(points.size()),
-                                   f.sensor_m.cast<float>(), model);
+                                   f.clouds.sensor_origin_m.cast<float>(), model);
     state.PauseTiming();
     bricks = grid->bricks().allocatedBricks();
     bytes = grid->bricks().deviceBytes();
@@ -167,9 +163,10 @@ void BM_ScanIntegrateFineBoxGrid(benchmark::State& state, BackendKind kind) {
 void BM_ScanIntegrateFineBoxOctomap(benchmark::State& state) {
   const Frame& f = frame();
   octomap::Pointcloud cloud;
-  for (const auto* c : {&f.roi_m, &f.other_m})
+  for (const auto* c : {&f.clouds.roi_points_m, &f.clouds.other_points_m})
     for (const auto& p : *c) cloud.push_back(p.x(), p.y(), p.z());
-  const octomap::point3d origin(f.sensor_m.x(), f.sensor_m.y(), f.sensor_m.z());
+  const octomap::point3d origin(f.clouds.sensor_origin_m.x(), f.clouds.sensor_origin_m.y(),
+                                f.clouds.sensor_origin_m.z());
   std::size_t leaves = 0, bytes = 0;
   for (auto _ : state) {
     state.PauseTiming();
@@ -201,7 +198,7 @@ struct MapStepResult {
 
 MapStepResult mapStep(host::map::MapEngine& map, const Frame& f) {
   MapStepResult r;
-  r.scan = map.integrate(f.sensor_m, f.roi_m, f.other_m);
+  r.scan = map.integrate(f.clouds);
   map.updateRoiDistance(kMapStepMaxDM);
   r.frontiers = map.frontiers().size();
   r.coarse_occupied = map.occupiedScene(host::map::MapLevel::kCoarse).occupiedCount();

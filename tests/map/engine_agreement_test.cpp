@@ -205,8 +205,8 @@ TEST_F(SyntheticEnginePair, AgreeOnSyntheticScansOfACluster) {
     const Eigen::Vector3d dir(gauss(rng), gauss(rng), -std::abs(gauss(rng)) - 0.7);
     const Eigen::Vector3d origin = region.center_m() + dir.normalized() * 0.3;
     const auto scan = testing::renderScan(world, origin, 320, 240, 0.8, view);
-    grid.integrate(scan.origin_m, scan.roi_points_m, scan.other_points_m);
-    octo.integrate(scan.origin_m, scan.roi_points_m, scan.other_points_m);
+    grid.integrate(scan.clouds());
+    octo.integrate(scan.clouds());
   }
   const EngineComparison c = compareEngines(grid, octo);
   EXPECT_GT(c.fine.known_either, 100000u);
@@ -236,8 +236,8 @@ TEST_F(SyntheticEnginePair, OccupiedScenesFollowTheScansAndAgree) {
   const auto world = testing::makeWorld(99, region.center_m());
   const Eigen::Vector3d origin = region.center_m() + Eigen::Vector3d(0.05, 0.02, -0.3);
   const auto scan = testing::renderScan(world, origin, 200, 150, 0.8, 1);
-  grid.integrate(scan.origin_m, scan.roi_points_m, scan.other_points_m);
-  octo.integrate(scan.origin_m, scan.roi_points_m, scan.other_points_m);
+  grid.integrate(scan.clouds());
+  octo.integrate(scan.clouds());
 
   for (MapLevel level : {MapLevel::kCoarse, MapLevel::kFine}) {
     const auto grid_voxels = grid.occupiedVoxels(level);
@@ -271,7 +271,7 @@ TEST_F(SyntheticEnginePair, OccupiedScenesFollowTheScansAndAgree) {
   const std::size_t before = grid.occupiedScene(MapLevel::kFine).occupiedCount();
   const auto scan2 = testing::renderScan(
       world, region.center_m() + Eigen::Vector3d(-0.1, 0.05, -0.28), 200, 150, 0.8, 2);
-  grid.integrate(scan2.origin_m, scan2.roi_points_m, scan2.other_points_m);
+  grid.integrate(scan2.clouds());
   const OccupiedVoxelScene& updated = grid.occupiedScene(MapLevel::kFine);
   EXPECT_EQ(updated.occupiedCount(), grid.occupiedVoxels(MapLevel::kFine).size());
   EXPECT_NE(updated.occupiedCount(), before);
@@ -301,8 +301,8 @@ TEST(EngineAgreement, AgreeOnASimulatedCaptureSequence) {
       octo = std::make_unique<OctomapMapEngine>(config, *region);
     }
     const auto& c = seen.clouds;
-    grid->integrate(c.sensor_origin_m, c.roi_points_m, c.other_points_m);
-    octo->integrate(c.sensor_origin_m, c.roi_points_m, c.other_points_m);
+    grid->integrate(c);
+    octo->integrate(c);
   }
   const EngineComparison c = compareEngines(*grid, *octo);
   EXPECT_GT(c.fine.known_either, 100000u);

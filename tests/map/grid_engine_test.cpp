@@ -56,7 +56,7 @@ TEST_F(GridEngineSemantics, OneRayFreesItsPathAndHitsItsEnd) {
   GridMapEngine map(smallConfig(), kRegion, *cpu_);
   const Eigen::Vector3d sensor(0.0, 0.0, 0.0);
   const Eigen::Vector3f end(0.0105f, -0.0195f, 0.3005f);  // inside the region
-  const ScanStats stats = map.integrate(sensor, {end}, {});
+  const ScanStats stats = map.integrate(testing::makeClouds(sensor, {end}, {}));
   EXPECT_EQ(stats.points, 1u);
   EXPECT_GT(stats.coarse_voxels_updated, 20u);
   EXPECT_GT(stats.fine_voxels_updated, 20u);
@@ -82,14 +82,14 @@ TEST_F(GridEngineSemantics, EachVoxelIsUpdatedOncePerScan) {
   const Eigen::Vector3d sensor(0.0, 0.0, 0.0);
   // Two points in the same fine voxel, one ROI and one not: one hit, and the ROI wins.
   const Eigen::Vector3f a(0.0102f, -0.0198f, 0.3002f), b(0.0107f, -0.0193f, 0.3008f);
-  map.integrate(sensor, {a}, {b});
+  map.integrate(testing::makeClouds(sensor, {a}, {b}));
   std::array<int, 3> index;
   ASSERT_TRUE(map.fine().geometry().gridIndex(a.cast<double>(), index));
   const OccupancyModel& m = map.config().model;
   EXPECT_FLOAT_EQ(map.fine().occupancyAt(index), m.hitLogOdds());
   EXPECT_FLOAT_EQ(map.fine().roiAt(index), m.hitLogOdds());
   // A non-ROI end point alone: ROI miss.
-  map.integrate(sensor, {}, {b});
+  map.integrate(testing::makeClouds(sensor, {}, {b}));
   EXPECT_FLOAT_EQ(map.fine().occupancyAt(index), 2 * m.hitLogOdds());
   EXPECT_FLOAT_EQ(map.fine().roiAt(index), m.hitLogOdds() + m.missLogOdds());
 }
@@ -100,7 +100,7 @@ TEST_F(GridEngineSemantics, EndPointVoxelsAreHitsEvenWhereOtherRaysPass) {
   const Eigen::Vector3f near_end(0.0100f, -0.0190f, 0.2800f);
   const Eigen::Vector3f far_end =
       (near_end.cast<double>() * (0.31 / 0.28)).cast<float>();  // same line, behind
-  map.integrate(sensor, {}, {near_end, far_end});
+  map.integrate(testing::makeClouds(sensor, {}, {near_end, far_end}));
   EXPECT_EQ(map.fineState(near_end.cast<double>()).occupancy, VoxelClass::kOccupied);
   EXPECT_EQ(map.fineState(far_end.cast<double>()).occupancy, VoxelClass::kOccupied);
 }
@@ -110,8 +110,8 @@ TEST_F(GridEngineSemantics, BadAndFarPointsAreCountedNotWritten) {
   const Eigen::Vector3d sensor(0.0, 0.0, 0.0);
   const float nan = std::nanf(""), inf = INFINITY;
   const Eigen::Vector3f far(0.0f, 0.0f, 0.9f);  // beyond the 0.6 m max range
-  const ScanStats stats =
-      map.integrate(sensor, {Eigen::Vector3f(nan, 0, 0.3f)}, {Eigen::Vector3f(0, inf, 0.3f), far});
+  const ScanStats stats = map.integrate(testing::makeClouds(sensor, {Eigen::Vector3f(nan, 0, 0.3f)},
+                                                            {Eigen::Vector3f(0, inf, 0.3f), far}));
   EXPECT_EQ(stats.points, 3u);
   EXPECT_EQ(stats.skipped_invalid, 2u);
   EXPECT_EQ(stats.truncated, 1u);
@@ -124,7 +124,7 @@ TEST_F(GridEngineSemantics, BadAndFarPointsAreCountedNotWritten) {
 TEST_F(GridEngineSemantics, LogOddsClampAfterManyScans) {
   GridMapEngine map(smallConfig(), kRegion, *cpu_);
   const Eigen::Vector3f end(0.0105f, -0.0195f, 0.3005f);
-  for (int i = 0; i < 12; ++i) map.integrate({0, 0, 0}, {}, {end});
+  for (int i = 0; i < 12; ++i) map.integrate(testing::makeClouds({0, 0, 0}, {}, {end}));
   std::array<int, 3> index;
   ASSERT_TRUE(map.fine().geometry().gridIndex(end.cast<double>(), index));
   EXPECT_FLOAT_EQ(map.fine().occupancyAt(index), map.config().model.clampMaxLogOdds());
@@ -134,7 +134,7 @@ TEST_F(GridEngineSemantics, LogOddsClampAfterManyScans) {
 TEST_F(GridEngineSemantics, FineVoxelsOutsideTheRegionAreNeverMapped) {
   GridMapEngine map(smallConfig(), kRegion, *cpu_);
   const auto scan = viewOfCluster(3, 150);
-  map.integrate(scan.origin_m, scan.roi_points_m, scan.other_points_m);
+  map.integrate(scan.clouds());
   std::size_t known = 0;
   map.fine().forEachVoxel([&](const std::array<int, 3>& index, float occupancy, float) {
     if (std::isnan(occupancy)) return;
@@ -149,7 +149,7 @@ TEST_F(GridEngineSemantics, FineVoxelsOutsideTheRegionAreNeverMapped) {
 TEST_F(GridEngineSemantics, ASensorTooFarForTheExactWalkIsAnErrorNotADroppedScan) {
   GridMapEngine map(smallConfig(), kRegion, *cpu_);
   try {
-    map.integrate({9.0, 0.0, 0.3}, {}, {Eigen::Vector3f(8.5f, 0.0f, 0.3f)});
+    map.integrate(testing::makeClouds({9.0, 0.0, 0.3}, {}, {Eigen::Vector3f(8.5f, 0.0f, 0.3f)}));
     FAIL() << "a sensor 9 m from a 1 mm grid must be rejected";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("voxels from a map's corner"), std::string::npos)
@@ -163,7 +163,7 @@ TEST_F(GridEngineSemantics, CoarseOcTreeFollowsTheScansBrickByBrick) {
   GridMapEngine map(smallConfig(), kRegion, *cpu_);
   for (int view = 0; view < 3; ++view) {
     const auto scan = viewOfCluster(40 + view, 100);
-    map.integrate(scan.origin_m, scan.roi_points_m, scan.other_points_m);
+    map.integrate(scan.clouds());
     const octomap::OcTree& tree = map.coarseOcTree();
     std::size_t known = 0;
     map.coarse().forEachVoxel([&](const std::array<int, 3>& index, float occupancy, float) {
@@ -232,8 +232,8 @@ TEST_P(GridEngineBackends, ScanIntegrationMatchesCpuExactly) {
   GridMapEngine got(smallConfig(), kRegion, *backend_), want(smallConfig(), kRegion, *cpu_);
   for (int view = 0; view < 3; ++view) {
     const auto scan = viewOfCluster(seed + view, 170);
-    const ScanStats a = got.integrate(scan.origin_m, scan.roi_points_m, scan.other_points_m);
-    const ScanStats b = want.integrate(scan.origin_m, scan.roi_points_m, scan.other_points_m);
+    const ScanStats a = got.integrate(scan.clouds());
+    const ScanStats b = want.integrate(scan.clouds());
     EXPECT_EQ(a.coarse_voxels_updated, b.coarse_voxels_updated);
     EXPECT_EQ(a.fine_voxels_updated, b.fine_voxels_updated);
   }
@@ -252,8 +252,7 @@ TEST_P(GridEngineBackends, OnTouchBrickAllocationMatchesCpu) {
   ScanIntegrator got_integrator(got), want_integrator(want);
   const auto scan = viewOfCluster(17, 70);
   ScanStats stats;
-  const auto points =
-      prepareScanPoints(scan.origin_m, scan.roi_points_m, scan.other_points_m, 0.6, stats);
+  const auto points = prepareScanPoints(scan.clouds(), 0.6, stats);
   auto on_backend = backend_->createBufferFrom(points);
   auto on_cpu = cpu_->createBufferFrom(points);
   const OccupancyModel model;
@@ -362,7 +361,7 @@ TEST_P(GridEngineBackends, ChangedBricksAreExactlyTheBricksWhoseVoxelsChanged) {
   // reports changed: compare the report with a full before/after comparison.
   GridMapEngine map(smallConfig(), kRegion, *backend_);
   const auto first = viewOfCluster(5, 120);
-  map.integrate(first.origin_m, first.roi_points_m, first.other_points_m);
+  map.integrate(first.clouds());
   for (OccupancyLayer* layer : {&map.coarse(), &map.fine()}) {
     std::vector<float> before_occ, before_roi;
     layer->forEachVoxel([&](const std::array<int, 3>&, float o, float r) {
@@ -371,7 +370,7 @@ TEST_P(GridEngineBackends, ChangedBricksAreExactlyTheBricksWhoseVoxelsChanged) {
     });
     const std::uint64_t count_before = layer->bricks().changeCount();
     const auto scan = viewOfCluster(6, 120);
-    map.integrate(scan.origin_m, scan.roi_points_m, scan.other_points_m);
+    map.integrate(scan.clouds());
     // Compare against a mirror read from scratch: download every slot.
     const std::size_t slots = layer->bricks().slotCount();
     std::vector<float> occ(slots), roi(slots, std::nanf(""));

@@ -18,7 +18,7 @@ TEST(OctomapEngineFrame, FullResolutionFrame) {
   const Eigen::Vector3d origin = region.center_m() + Eigen::Vector3d(0.2, -0.15, -0.15);
   // A field of view just wider than the region, as the camera frames the cluster.
   const auto scan = testing::renderScan(world, origin, 1440, 1080, 0.45, 5);
-  const ScanStats stats = engine.integrate(scan.origin_m, scan.roi_points_m, scan.other_points_m);
+  const ScanStats stats = engine.integrate(scan.clouds());
   std::cout << "[ octomap frame ] points " << stats.points << " (roi " << scan.roi_points_m.size()
             << "), coarse voxels " << stats.coarse_voxels_updated << ", fine voxels "
             << stats.fine_voxels_updated << ", " << stats.seconds << " s, "

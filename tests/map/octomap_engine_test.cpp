@@ -99,7 +99,8 @@ TEST(OctomapEngine, KeysAreLatticeIndicesPlusTreeMaxVal) {
 TEST(OctomapEngine, SingleRayMarksFreeVoxelsThenTheHit) {
   OctomapMapEngine e(smallConfig(), kRegion);
   const Eigen::Vector3d origin(0.0051, 0.0052, 0.0053);
-  const ScanStats stats = e.integrate(origin, {Vec3f(0.0051f, 0.0052f, 0.2103f)}, {});
+  const ScanStats stats =
+      e.integrate(testing::makeClouds(origin, {Vec3f(0.0051f, 0.0052f, 0.2103f)}, {}));
   EXPECT_EQ(stats.points, 1u);
   EXPECT_EQ(stats.skipped_invalid, 0u);
   EXPECT_EQ(stats.truncated, 0u);
@@ -140,8 +141,8 @@ TEST(OctomapEngine, SingleRayMarksFreeVoxelsThenTheHit) {
 TEST(OctomapEngine, TwoPointsInOneVoxelUpdateItOnce) {
   OctomapMapEngine e(smallConfig(), kRegion);
   const Eigen::Vector3d origin(0.0051, 0.0052, 0.0053);
-  const ScanStats stats =
-      e.integrate(origin, {Vec3f(0.0051f, 0.0052f, 0.2103f), Vec3f(0.0053f, 0.0054f, 0.2106f)}, {});
+  const ScanStats stats = e.integrate(testing::makeClouds(
+      origin, {Vec3f(0.0051f, 0.0052f, 0.2103f), Vec3f(0.0053f, 0.0054f, 0.2106f)}, {}));
   EXPECT_EQ(stats.coarse_voxels_updated, 22u);
   const OccupancyModel& m = e.config().model;
   EXPECT_EQ(coarseLogOdds(e, coarseCenter(0, 0, 21)), m.hitLogOdds());
@@ -157,7 +158,8 @@ TEST(OctomapEngine, HitWinsOverFreeWithinOneScan) {
   OctomapMapEngine e(smallConfig(), kRegion);
   const Eigen::Vector3d origin(0.0051, 0.0052, 0.0053);
   // The second ray passes through the first one's end voxel and ends farther on.
-  e.integrate(origin, {Vec3f(0.0051f, 0.0052f, 0.1003f)}, {Vec3f(0.0051f, 0.0052f, 0.2003f)});
+  e.integrate(testing::makeClouds(origin, {Vec3f(0.0051f, 0.0052f, 0.1003f)},
+                                  {Vec3f(0.0051f, 0.0052f, 0.2003f)}));
   EXPECT_EQ(coarseLogOdds(e, coarseCenter(0, 0, 10)), e.config().model.hitLogOdds());
   EXPECT_EQ(e.coarseClass(coarseCenter(0, 0, 10)), VoxelClass::kOccupied);
   EXPECT_EQ(e.coarseClass(coarseCenter(0, 0, 15)), VoxelClass::kFree);
@@ -169,9 +171,10 @@ TEST(OctomapEngine, RoiEndPointMakesTheVoxelAnRoiHit) {
   const Eigen::Vector3d origin(0.0051, 0.0052, 0.0053);
   const OccupancyModel& m = e.config().model;
   // Voxel (5,5,210): one ROI and one other end point. Voxel (8,5,205): other points only.
-  e.integrate(origin, {Vec3f(0.0051f, 0.0052f, 0.2103f)},
-              {Vec3f(0.0055f, 0.0056f, 0.2107f), Vec3f(0.0085f, 0.0052f, 0.2053f),
-               Vec3f(0.0082f, 0.0058f, 0.2051f)});
+  e.integrate(
+      testing::makeClouds(origin, {Vec3f(0.0051f, 0.0052f, 0.2103f)},
+                          {Vec3f(0.0055f, 0.0056f, 0.2107f), Vec3f(0.0085f, 0.0052f, 0.2053f),
+                           Vec3f(0.0082f, 0.0058f, 0.2051f)}));
   const RoiOcTreeNode* mixed = fineNode(e, fineCenter(5, 5, 210));
   ASSERT_NE(mixed, nullptr);
   EXPECT_EQ(mixed->getRoiLogOdds(), m.hitLogOdds());
@@ -188,7 +191,8 @@ TEST(OctomapEngine, MaxRangeCutsTheRayWithoutAHit) {
   c.sensor_max_range_m = 0.1;
   OctomapMapEngine e(c, kRegion);
   const Eigen::Vector3d origin(0.0051, 0.0052, 0.0053);
-  const ScanStats stats = e.integrate(origin, {Vec3f(0.0051f, 0.0052f, 0.3053f)}, {});
+  const ScanStats stats =
+      e.integrate(testing::makeClouds(origin, {Vec3f(0.0051f, 0.0052f, 0.3053f)}, {}));
   EXPECT_EQ(stats.truncated, 1u);
   EXPECT_EQ(stats.points, 1u);
   // The cut lies at z = 0.1053 (voxel 10): free before it, the cut voxel itself untouched
@@ -201,8 +205,8 @@ TEST(OctomapEngine, MaxRangeCutsTheRayWithoutAHit) {
 
   // A point just within max range is a measurement (OctoMap: norm <= maxrange).
   OctomapMapEngine e2(c, kRegion);
-  const ScanStats s2 =
-      e2.integrate(Eigen::Vector3d(0.0051, 0.0052, 0.0), {Vec3f(0.0051f, 0.0052f, 0.0995f)}, {});
+  const ScanStats s2 = e2.integrate(testing::makeClouds(Eigen::Vector3d(0.0051, 0.0052, 0.0),
+                                                        {Vec3f(0.0051f, 0.0052f, 0.0995f)}, {}));
   EXPECT_EQ(s2.truncated, 0u);
   EXPECT_EQ(e2.coarseClass(coarseCenter(0, 0, 9)), VoxelClass::kOccupied);
 }
@@ -213,17 +217,18 @@ TEST(OctomapEngine, NonFinitePointsAreSkippedAndCounted) {
   const Eigen::Vector3d origin(0.0051, 0.0052, 0.0053);
   const Vec3f good(0.0051f, 0.0052f, 0.2103f);
   OctomapMapEngine e(smallConfig(), kRegion);
-  const ScanStats stats = e.integrate(origin, {Vec3f(nan, 0.0f, 0.2f), good},
-                                      {Vec3f(0.0f, inf, 0.2f), Vec3f(0.0f, 0.0f, -inf)});
+  const ScanStats stats = e.integrate(testing::makeClouds(
+      origin, {Vec3f(nan, 0.0f, 0.2f), good}, {Vec3f(0.0f, inf, 0.2f), Vec3f(0.0f, 0.0f, -inf)}));
   EXPECT_EQ(stats.points, 4u);
   EXPECT_EQ(stats.skipped_invalid, 3u);
   OctomapMapEngine reference(smallConfig(), kRegion);
-  const ScanStats ref_stats = reference.integrate(origin, {good}, {});
+  const ScanStats ref_stats = reference.integrate(testing::makeClouds(origin, {good}, {}));
   EXPECT_EQ(stats.coarse_voxels_updated, ref_stats.coarse_voxels_updated);
   EXPECT_EQ(stats.fine_voxels_updated, ref_stats.fine_voxels_updated);
   EXPECT_EQ(e.coarseTree().getNumLeafNodes(), reference.coarseTree().getNumLeafNodes());
   EXPECT_EQ(e.fineTree().getNumLeafNodes(), reference.fineTree().getNumLeafNodes());
-  EXPECT_THROW(e.integrate(Eigen::Vector3d(nan, 0, 0), {good}, {}), std::invalid_argument);
+  EXPECT_THROW(e.integrate(testing::makeClouds(Eigen::Vector3d(nan, 0, 0), {good}, {})),
+               std::invalid_argument);
 }
 
 TEST(OctomapEngine, LogOddsClampAfterManyScans) {
@@ -231,7 +236,8 @@ TEST(OctomapEngine, LogOddsClampAfterManyScans) {
   const Eigen::Vector3d origin(0.0051, 0.0052, 0.0053);
   const OccupancyModel& m = e.config().model;
   for (int i = 0; i < 30; ++i) {
-    e.integrate(origin, {Vec3f(0.0051f, 0.0052f, 0.2103f)}, {Vec3f(0.0085f, 0.0052f, 0.2053f)});
+    e.integrate(testing::makeClouds(origin, {Vec3f(0.0051f, 0.0052f, 0.2103f)},
+                                    {Vec3f(0.0085f, 0.0052f, 0.2053f)}));
   }
   EXPECT_EQ(coarseLogOdds(e, coarseCenter(0, 0, 21)), m.clampMaxLogOdds());
   EXPECT_EQ(coarseLogOdds(e, coarseCenter(0, 0, 5)), m.clampMinLogOdds());
@@ -248,15 +254,16 @@ TEST(OctomapEngine, LogOddsClampAfterManyScans) {
 TEST(OctomapEngine, FineMapOnlyInsideTheClusterRegion) {
   OctomapMapEngine e(smallConfig(), kRegion);
   // Inside the fine grid's cube but outside the sphere (distance 0.035 > 0.03 from the axis).
-  const ScanStats stats =
-      e.integrate(Eigen::Vector3d(0.0251, 0.0252, 0.0053), {Vec3f(0.0251f, 0.0252f, 0.2003f)}, {});
+  const ScanStats stats = e.integrate(testing::makeClouds(Eigen::Vector3d(0.0251, 0.0252, 0.0053),
+                                                          {Vec3f(0.0251f, 0.0252f, 0.2003f)}, {}));
   EXPECT_EQ(stats.fine_voxels_updated, 0u);
   EXPECT_EQ(e.fineTree().getRoot(), nullptr);
   EXPECT_EQ(e.fineState(Eigen::Vector3d(0.0251, 0.0252, 0.2003)), VoxelState{});
   EXPECT_EQ(e.coarseClass(Eigen::Vector3d(0.0251, 0.0252, 0.2003)), VoxelClass::kOccupied);
 
   // A ray crossing the sphere: every fine voxel it made known lies inside the region.
-  e.integrate(Eigen::Vector3d(0.2, 0.1, 0.05), {Vec3f(-0.01f, 0.005f, 0.21f)}, {});
+  e.integrate(
+      testing::makeClouds(Eigen::Vector3d(0.2, 0.1, 0.05), {Vec3f(-0.01f, 0.005f, 0.21f)}, {}));
   std::size_t leaves = 0;
   for (auto it = e.fineTree().begin_leafs(), end = e.fineTree().end_leafs(); it != end; ++it) {
     ASSERT_EQ(it.getDepth(), e.fineTree().getTreeDepth());
@@ -271,8 +278,8 @@ TEST(OctomapEngine, FineMapOnlyInsideTheClusterRegion) {
 TEST(OctomapEngine, CoarseMapOnlyInsideTheObservationBox) {
   OctomapMapEngine e(smallConfig(), kRegion);
   // From below the box to above it: free inside the box only, the end outside is no hit.
-  const ScanStats stats =
-      e.integrate(Eigen::Vector3d(0.0051, 0.0052, -0.2053), {}, {Vec3f(0.0051f, 0.0052f, 0.7053f)});
+  const ScanStats stats = e.integrate(testing::makeClouds(Eigen::Vector3d(0.0051, 0.0052, -0.2053),
+                                                          {}, {Vec3f(0.0051f, 0.0052f, 0.7053f)}));
   const GridGeometry& g = e.coarseGrid();
   for (auto it = e.coarseTree().begin_leafs(), end = e.coarseTree().end_leafs(); it != end; ++it) {
     const auto c = it.getCoordinate();
@@ -365,7 +372,7 @@ std::unique_ptr<OctomapMapEngine> mappedEngine(int views = 3) {
       {0.2, 0.05, 0.1}, {-0.15, 0.2, 0.15}, {0.0, -0.2, 0.05}, {0.1, 0.1, 0.45}};
   for (int v = 0; v < views; ++v) {
     const auto scan = testing::renderScan(world, origins[v % 4], 160, 120, 0.5, 100 + v);
-    e->integrate(scan.origin_m, scan.roi_points_m, scan.other_points_m);
+    e->integrate(scan.clouds());
   }
   return e;
 }
@@ -609,12 +616,14 @@ TEST(OctomapEnginePlannerReads, RoiDistanceOnAHandMadeMapEqualsBruteForce) {
   const Eigen::Vector3d origin(0.0051, 0.0052, 0.0053);
   // Three ROI voxels (one on the sphere's edge), a known non-ROI voxel, and a voxel whose
   // one ROI hit three later other hits outweigh (ROI log-odds 0.85 - 3 * 0.4 < 0).
-  e.integrate(origin,
-              {Vec3f(0.0051f, 0.0052f, 0.2103f), Vec3f(-0.0103f, 0.0071f, 0.1952f),
-               Vec3f(0.0152f, -0.0121f, 0.2204f), Vec3f(0.0263f, 0.0025f, 0.2031f),
-               Vec3f(-0.0041f, -0.0182f, 0.1857f)},
-              {Vec3f(0.0085f, 0.0052f, 0.2053f)});
-  for (int i = 0; i < 3; ++i) e.integrate(origin, {}, {Vec3f(-0.0041f, -0.0182f, 0.1857f)});
+  e.integrate(
+      testing::makeClouds(origin,
+                          {Vec3f(0.0051f, 0.0052f, 0.2103f), Vec3f(-0.0103f, 0.0071f, 0.1952f),
+                           Vec3f(0.0152f, -0.0121f, 0.2204f), Vec3f(0.0263f, 0.0025f, 0.2031f),
+                           Vec3f(-0.0041f, -0.0182f, 0.1857f)},
+                          {Vec3f(0.0085f, 0.0052f, 0.2053f)}));
+  for (int i = 0; i < 3; ++i)
+    e.integrate(testing::makeClouds(origin, {}, {Vec3f(-0.0041f, -0.0182f, 0.1857f)}));
   std::size_t roi_voxels = 0;
   for (const VoxelState& s : denseFineStates(e)) roi_voxels += s.roi;
   ASSERT_EQ(roi_voxels, 4u);
@@ -644,7 +653,7 @@ TEST(OctomapEnginePlannerReads, RoiDistanceOnAHandMadeMapEqualsBruteForce) {
   // A new scan with a new ROI voxel: the next update recomputes.
   const std::array<int, 3> fresh = fineIndex(e, Eigen::Vector3d(0.0005, 0.0005, 0.2005));
   EXPECT_GT(e.roiDistance_m(fresh), 0.0);
-  e.integrate(origin, {Vec3f(0.0005f, 0.0005f, 0.2005f)}, {});
+  e.integrate(testing::makeClouds(origin, {Vec3f(0.0005f, 0.0005f, 0.2005f)}, {}));
   e.updateRoiDistance(0.02);
   EXPECT_EQ(e.roiDistance_m(fresh), 0.0);
 }
@@ -681,8 +690,9 @@ TEST(OctomapEnginePlannerReads, FrontiersOfOneRayByHand) {
   const Eigen::Vector3d origin(0.0051, 0.0052, 0.0053);
   // Column x = 5, y = 5 (world lattice): an ROI hit at z = 205, then three scans whose rays
   // pass it to end at z = 215: voxel 205 turns free (0.85 - 3 * 0.4) but stays ROI.
-  e.integrate(origin, {Vec3f(0.0051f, 0.0052f, 0.2053f)}, {});
-  for (int i = 0; i < 3; ++i) e.integrate(origin, {}, {Vec3f(0.0051f, 0.0052f, 0.2153f)});
+  e.integrate(testing::makeClouds(origin, {Vec3f(0.0051f, 0.0052f, 0.2053f)}, {}));
+  for (int i = 0; i < 3; ++i)
+    e.integrate(testing::makeClouds(origin, {}, {Vec3f(0.0051f, 0.0052f, 0.2153f)}));
   const auto frontiers = e.frontiers();
   expectSameFrontiers(frontiers, bruteForceFrontiers(e));
 
@@ -718,7 +728,7 @@ TEST(OctomapEnginePlannerReads, FrontiersOfOneRayByHand) {
   // The ROI end voxel alone on top of its column: unknown above and around, so the normal
   // points down the known column: -(9 * (+z) + 8 * (-z)) = -z.
   OctomapMapEngine top(smallConfig(), kRegion);
-  top.integrate(origin, {Vec3f(0.0051f, 0.0052f, 0.2103f)}, {});
+  top.integrate(testing::makeClouds(origin, {Vec3f(0.0051f, 0.0052f, 0.2103f)}, {}));
   const auto tf = top.frontiers();
   expectSameFrontiers(tf, bruteForceFrontiers(top));
   ASSERT_FALSE(tf.empty());

@@ -10,12 +10,26 @@
 #include <random>
 #include <vector>
 
+#include "fvp/host/core/labeled_clouds.h"
+
 namespace fvp::host::map::testing {
+
+/// The clouds of one view as MapEngine::integrate takes them.
+inline LabeledClouds makeClouds(const Eigen::Vector3d& origin_m,
+                                std::vector<Eigen::Vector3f> roi_points_m,
+                                std::vector<Eigen::Vector3f> other_points_m) {
+  LabeledClouds clouds;
+  clouds.sensor_origin_m = origin_m;
+  clouds.roi_points_m = std::move(roi_points_m);
+  clouds.other_points_m = std::move(other_points_m);
+  return clouds;
+}
 
 struct SyntheticScan {
   Eigen::Vector3d origin_m;
   std::vector<Eigen::Vector3f> roi_points_m;
   std::vector<Eigen::Vector3f> other_points_m;
+  LabeledClouds clouds() const { return makeClouds(origin_m, roi_points_m, other_points_m); }
 };
 
 struct SyntheticWorld {

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <iostream>
 
-#include "fvp/host/perception/cluster_region.h"
+#include "fvp/host/perception/cluster_region_image.h"
 #include "synthetic_scenes.h"
 
 namespace fvp::host {
@@ -70,16 +70,16 @@ TEST(ClusterRegion, FromTagAndImageBounds) {
   // Seen from 0.3 m straight on: about 2 * 0.04 / 0.3 * 1100 = 293 px wide, centred.
   StereoIntrinsics K;
   const ClusterRegion ahead(Eigen::Vector3d(0, 0, 0.3), 0.04);
-  const cv::Rect r = ahead.imageBounds(K, Eigen::Isometry3d::Identity());
+  const cv::Rect r = clusterRegionImageBounds(ahead, K, Eigen::Isometry3d::Identity());
   EXPECT_NEAR(r.width, 2 * 1100 * std::tan(std::asin(0.04 / 0.3)), 3);  // exact tangents
   EXPECT_NEAR(r.height, r.width, 2);
   EXPECT_NEAR(r.x + 0.5 * r.width, K.cx_px, 2);
-  EXPECT_EQ(
-      ClusterRegion(Eigen::Vector3d(0, 0, -1), 0.1).imageBounds(K, Eigen::Isometry3d::Identity()),
-      cv::Rect());
-  EXPECT_EQ(
-      ClusterRegion(Eigen::Vector3d(0, 0, 0.05), 0.1).imageBounds(K, Eigen::Isometry3d::Identity()),
-      cv::Rect(0, 0, K.width_px, K.height_px));
+  EXPECT_EQ(clusterRegionImageBounds(ClusterRegion(Eigen::Vector3d(0, 0, -1), 0.1), K,
+                                     Eigen::Isometry3d::Identity()),
+            cv::Rect());
+  EXPECT_EQ(clusterRegionImageBounds(ClusterRegion(Eigen::Vector3d(0, 0, 0.05), 0.1), K,
+                                     Eigen::Isometry3d::Identity()),
+            cv::Rect(0, 0, K.width_px, K.height_px));
   config.radius_m = -1;
   EXPECT_THROW(ClusterRegion::fromTag(T_world_tag, config), std::invalid_argument);
 }

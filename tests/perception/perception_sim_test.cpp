@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fvp/host/perception/apriltag_detector.h"
+#include "fvp/host/perception/cluster_region_image.h"
 #include "fvp/host/perception/fruitlet_segmenter.h"
 #include "fvp/host/perception/occlusion_statistic.h"
 #include "fvp/host/perception/perception_pipeline.h"
@@ -152,7 +153,7 @@ TEST(PerceptionSim, DisparityDepthErrorOnFruitletsAtPointThreeMetres) {
     const StereoRenderer renderer(world, rc);
     const StereoFrame frame = renderer.render(world.startCameraPose());
     const ClusterRegion region(world.clusterCenter_m(), 0.05);
-    const cv::Rect band = region.imageBounds(K, frame.T_world_camera);
+    const cv::Rect band = clusterRegionImageBounds(region, K, frame.T_world_camera);
     const DisparityResult r = StereoMatcher().compute(frame.left_bgr, frame.right_bgr, band);
     sgbm_s += r.stats.sgbm_s;
     for (int v = 0; v < K.height_px; ++v)

@@ -2,7 +2,6 @@
 
 #include <octomap/OcTree.h>
 
-#include <chrono>
 #include <cmath>
 
 #include "fvp/host/map/octomap_io.h"
@@ -10,11 +9,6 @@
 
 namespace fvp::host::map {
 namespace {
-
-VoxelClass classify(float logodds, float occupied_logodds) {
-  if (std::isnan(logodds)) return VoxelClass::kUnknown;
-  return logodds > occupied_logodds ? VoxelClass::kOccupied : VoxelClass::kFree;
-}
 
 BrickAllocation allocationFor(const GridGeometry& g) {
   return g.voxelCount() <= kDefaultUpFrontVoxelLimit ? BrickAllocation::kUpFront
@@ -28,36 +22,6 @@ const MapConfig& validated(const MapConfig& config) {
 }
 
 }  // namespace
-
-std::vector<accel::ScanPoint> prepareScanPoints(const Eigen::Vector3d& sensor_origin_m,
-                                                const std::vector<Eigen::Vector3f>& roi_points_m,
-                                                const std::vector<Eigen::Vector3f>& other_points_m,
-                                                double max_range_m, ScanStats& stats) {
-  std::vector<accel::ScanPoint> points;
-  points.reserve(roi_points_m.size() + other_points_m.size());
-  auto add = [&](const std::vector<Eigen::Vector3f>& cloud, unsigned flags) {
-    for (const Eigen::Vector3f& p : cloud) {
-      ++stats.points;
-      if (!p.allFinite()) {
-        ++stats.skipped_invalid;
-        continue;
-      }
-      const Eigen::Vector3d d = p.cast<double>() - sensor_origin_m;
-      const double range = d.norm();
-      if (range > max_range_m) {
-        ++stats.truncated;
-        const Eigen::Vector3d end = sensor_origin_m + d * (max_range_m / range);
-        points.push_back({static_cast<float>(end.x()), static_cast<float>(end.y()),
-                          static_cast<float>(end.z()), 0u});
-        continue;
-      }
-      points.push_back({p.x(), p.y(), p.z(), FVP_POINT_HIT | flags});
-    }
-  };
-  add(roi_points_m, FVP_POINT_ROI);
-  add(other_points_m, 0u);
-  return points;
-}
 
 GridMapEngine::GridMapEngine(const MapConfig& config, const ClusterRegion& region,
                              accel::Backend& backend)
@@ -73,11 +37,8 @@ GridMapEngine::GridMapEngine(const MapConfig& config, const ClusterRegion& regio
       fine_distance_(fine_),
       fine_frontiers_(fine_) {}
 
-ScanStats GridMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
-                                       const std::vector<Eigen::Vector3f>& roi_points_m,
-                                       const std::vector<Eigen::Vector3f>& other_points_m) {
-  const auto t0 = std::chrono::steady_clock::now();
-  ScanStats stats;
+void GridMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
+                                  const std::vector<accel::ScanPoint>& points, ScanStats& stats) {
   // Every end point lies within max range of the sensor; the exact walk needs it within
   // 8192 voxels of each grid's corner (fvp_dda.h), else its rays would be dropped.
   for (const OccupancyLayer* layer : {&coarse_, &fine_}) {
@@ -95,8 +56,6 @@ ScanStats GridMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
       }
     }
   }
-  const auto points = prepareScanPoints(sensor_origin_m, roi_points_m, other_points_m,
-                                        config().sensor_max_range_m, stats);
   if (!points.empty() && sensor_origin_m.allFinite()) {
     auto buffer = backend_.createBufferFrom(points);
     const Eigen::Vector3f sensor = sensor_origin_m.cast<float>();
@@ -104,21 +63,19 @@ ScanStats GridMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
     stats.coarse_voxels_updated = coarse_integrator_.integrate(*buffer, n, sensor, config().model);
     stats.fine_voxels_updated = fine_integrator_.integrate(*buffer, n, sensor, config().model);
   }
-  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return stats;
 }
 
 VoxelClass GridMapEngine::coarseClass(const Eigen::Vector3d& p_m) const {
   std::array<int, 3> index;
   if (!coarse_.geometry().gridIndex(p_m, index)) return VoxelClass::kUnknown;
-  return classify(coarse_.occupancyAt(index), config().model.occupiedLogOdds());
+  return classifyLogOdds(coarse_.occupancyAt(index), config().model.occupiedLogOdds());
 }
 
 VoxelState GridMapEngine::fineState(const Eigen::Vector3d& p_m) const {
   std::array<int, 3> index;
   if (!fine_.geometry().gridIndex(p_m, index)) return {};
   VoxelState s;
-  s.occupancy = classify(fine_.occupancyAt(index), config().model.occupiedLogOdds());
+  s.occupancy = classifyLogOdds(fine_.occupancyAt(index), config().model.occupiedLogOdds());
   s.roi = s.occupancy != VoxelClass::kUnknown && fine_.roiAt(index) > 0.0f;
   return s;
 }
@@ -155,7 +112,7 @@ std::vector<std::array<int, 3>> GridMapEngine::occupiedVoxels(MapLevel level) co
   const float occupied = config().model.occupiedLogOdds();
   std::vector<std::array<int, 3>> voxels;
   grid.forEachVoxel([&](const std::array<int, 3>& index, float occupancy, float) {
-    if (occupancy > occupied) voxels.push_back(index);  // NaN (unknown) fails
+    if (classifyLogOdds(occupancy, occupied) == VoxelClass::kOccupied) voxels.push_back(index);
   });
   return voxels;
 }

@@ -1,5 +1,6 @@
 #include "fvp/host/map/map_engine.h"
 
+#include <chrono>
 #include <stdexcept>
 #include <string>
 
@@ -10,11 +11,14 @@ namespace fvp::host::map {
 
 MapEngine::~MapEngine() = default;
 
-ScanStats MapEngine::integrate(const Eigen::Vector3d& sensor_origin_m,
-                               const std::vector<Eigen::Vector3f>& roi_points_m,
-                               const std::vector<Eigen::Vector3f>& other_points_m) {
+ScanStats MapEngine::integrate(const LabeledClouds& clouds) {
+  const auto t0 = std::chrono::steady_clock::now();
   ++scans_;
-  return integrateScan(sensor_origin_m, roi_points_m, other_points_m);
+  ScanStats stats;
+  const auto points = prepareScanPoints(clouds, config_.sensor_max_range_m, stats);
+  integrateScan(clouds.sensor_origin_m, points, stats);
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return stats;
 }
 
 const OccupiedVoxelScene& MapEngine::occupiedScene(MapLevel level) {

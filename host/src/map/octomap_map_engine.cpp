@@ -3,7 +3,6 @@
 #include <omp.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -22,12 +21,6 @@ namespace {
 // segment's first and last voxels lie outside the updatable set: the start voxel
 // (included by computeRayKeys) and the cut end voxel (excluded by it) never matter.
 constexpr double kClipMarginVoxels = 2.0;
-
-struct PreparedRay {
-  octomap::point3d end;  ///< the point, or the max-range cut (float, as OctoMap computes it)
-  bool hit = false;      ///< end is a measured point (not cut at max range)
-  bool roi = false;
-};
 
 struct Interval {
   double t0 = 0.0, t1 = 1.0;
@@ -74,10 +67,6 @@ bool inGrid(const GridGeometry& g, int key_offset, const octomap::OcTreeKey& key
     index[a] = static_cast<int>(i);
   }
   return true;
-}
-
-VoxelClass classify(float log_odds, float occupied_log_odds) {
-  return log_odds > occupied_log_odds ? VoxelClass::kOccupied : VoxelClass::kFree;
 }
 
 template <typename Tree>
@@ -155,42 +144,16 @@ octomap::OcTreeKey OctomapMapEngine::fineKey(const std::array<int, 3>& index) co
   return key;
 }
 
-ScanStats OctomapMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
-                                          const std::vector<Eigen::Vector3f>& roi_points_m,
-                                          const std::vector<Eigen::Vector3f>& other_points_m) {
-  const auto start = std::chrono::steady_clock::now();
+void OctomapMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
+                                     const std::vector<accel::ScanPoint>& points,
+                                     ScanStats& stats) {
   if (!sensor_origin_m.allFinite()) {
     throw std::invalid_argument("octomap engine: the sensor origin is not finite");
   }
-  ScanStats stats;
-  stats.points = roi_points_m.size() + other_points_m.size();
-
-  // 1. Validate and cut the rays (OctoMap's maxrange: the cut end lies on the ray at
-  //    exactly max range, computed in float as computeUpdate does).
+  // 1. The rays were validated and cut by prepareScanPoints (MapEngine::integrate).
   const octomap::point3d origin(static_cast<float>(sensor_origin_m.x()),
                                 static_cast<float>(sensor_origin_m.y()),
                                 static_cast<float>(sensor_origin_m.z()));
-  const double max_range = config().sensor_max_range_m;
-  std::vector<PreparedRay> rays;
-  rays.reserve(stats.points);
-  auto prepare = [&](const std::vector<Eigen::Vector3f>& points, bool roi) {
-    for (const Eigen::Vector3f& p : points) {
-      if (!p.allFinite()) {
-        ++stats.skipped_invalid;
-        continue;
-      }
-      const octomap::point3d end(p.x(), p.y(), p.z());
-      if ((end - origin).norm() <= max_range) {
-        rays.push_back({end, true, roi});
-      } else {
-        ++stats.truncated;
-        const octomap::point3d direction = (end - origin).normalized();
-        rays.push_back({origin + direction * static_cast<float>(max_range), false, roi});
-      }
-    }
-  };
-  prepare(roi_points_m, true);
-  prepare(other_points_m, false);
 
   // 2. Key sets (computeUpdate), one per thread, merged.
   const double cs = coarse_grid_.voxel_size_m, fs = fine_grid_.voxel_size_m;
@@ -242,27 +205,28 @@ ScanStats OctomapMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m
   // The ray as OctoMap sees it: float end points (clipping is done in double from them).
   const Eigen::Vector3d of(origin.x(), origin.y(), origin.z());
   ScanKeys keys;
-  const auto ray_count = static_cast<std::int64_t>(rays.size());
+  const auto ray_count = static_cast<std::int64_t>(points.size());
 #pragma omp parallel
   {
     ScanKeys local;
     octomap::KeyRay key_ray;
 #pragma omp for schedule(dynamic, 1024)
     for (std::int64_t r = 0; r < ray_count; ++r) {
-      const PreparedRay& ray = rays[static_cast<std::size_t>(r)];
-      const Eigen::Vector3d dd = Eigen::Vector3d(ray.end.x(), ray.end.y(), ray.end.z()) - of;
-      addFreeKeys(coarse, origin, ray.end, clipToBox(of, dd, coarse_lo, coarse_hi, {}), key_ray,
+      const accel::ScanPoint& point = points[static_cast<std::size_t>(r)];
+      const octomap::point3d end(point.x_m, point.y_m, point.z_m);
+      const Eigen::Vector3d dd = Eigen::Vector3d(end.x(), end.y(), end.z()) - of;
+      addFreeKeys(coarse, origin, end, clipToBox(of, dd, coarse_lo, coarse_hi, {}), key_ray,
                   inCoarseGrid, local.coarse_free);
       const Interval fine_clip = clipToSphere(of, dd, region_center, region_clip_radius,
                                               clipToBox(of, dd, fine_lo, fine_hi, {}));
-      addFreeKeys(fine, origin, ray.end, fine_clip, key_ray, inFineRegion, local.fine_free);
-      if (ray.hit) {
+      addFreeKeys(fine, origin, end, fine_clip, key_ray, inFineRegion, local.fine_free);
+      if (point.flags & FVP_POINT_HIT) {
         octomap::OcTreeKey key;
-        if (coarse.coordToKeyChecked(ray.end, key) && inCoarseGrid(key)) {
+        if (coarse.coordToKeyChecked(end, key) && inCoarseGrid(key)) {
           local.coarse_hit.insert(key);
         }
-        if (fine.coordToKeyChecked(ray.end, key) && inFineRegion(key)) {
-          (ray.roi ? local.fine_roi_hit : local.fine_other_hit).insert(key);
+        if (fine.coordToKeyChecked(end, key) && inFineRegion(key)) {
+          (point.flags & FVP_POINT_ROI ? local.fine_roi_hit : local.fine_other_hit).insert(key);
         }
       }
     }
@@ -293,8 +257,6 @@ ScanStats OctomapMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m
   stats.coarse_voxels_updated = keys.coarse_free.size() + keys.coarse_hit.size();
   stats.fine_voxels_updated =
       keys.fine_free.size() + keys.fine_roi_hit.size() + keys.fine_other_hit.size();
-  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return stats;
 }
 
 VoxelClass OctomapMapEngine::coarseClassAt(const std::array<int, 3>& index) const {
@@ -303,7 +265,7 @@ VoxelClass OctomapMapEngine::coarseClassAt(const std::array<int, 3>& index) cons
   }
   const octomap::OcTreeNode* node = coarse_->search(coarseKey(index));
   if (node == nullptr) return VoxelClass::kUnknown;
-  return classify(node->getLogOdds(), config().model.occupiedLogOdds());
+  return classifyLogOdds(node->getLogOdds(), config().model.occupiedLogOdds());
 }
 
 VoxelState OctomapMapEngine::fineStateAt(const std::array<int, 3>& index) const {
@@ -313,7 +275,7 @@ VoxelState OctomapMapEngine::fineStateAt(const std::array<int, 3>& index) const 
   if (!fvp_region_contains(&fine_region_, index[0], index[1], index[2])) return {};
   const RoiOcTreeNode* node = fine_->search(fineKey(index));
   if (node == nullptr) return {};
-  return {classify(node->getLogOdds(), config().model.occupiedLogOdds()), node->isRoi()};
+  return {classifyLogOdds(node->getLogOdds(), config().model.occupiedLogOdds()), node->isRoi()};
 }
 
 VoxelClass OctomapMapEngine::coarseClass(const Eigen::Vector3d& p_m) const {
@@ -345,7 +307,7 @@ std::vector<std::array<int, 3>> occupiedLeaves(const Tree& tree, const GridGeome
   std::vector<std::array<int, 3>> voxels;
   const double res = tree.getResolution();
   for (auto it = tree.begin_leafs(); it != tree.end_leafs(); ++it) {
-    if (!(it->getLogOdds() > occupied_logodds)) continue;  // the strict rule of both engines
+    if (classifyLogOdds(it->getLogOdds(), occupied_logodds) != VoxelClass::kOccupied) continue;
     const auto n = static_cast<std::int64_t>(std::llround(it.getSize() / res));
     std::array<std::int64_t, 3> lo;
     for (int a = 0; a < 3; ++a)
@@ -487,7 +449,7 @@ std::vector<FrontierVoxel> OctomapMapEngine::frontiers() {
     for (std::int64_t k = 0; k < count; ++k) {
       const KnownVoxel& v = known[static_cast<std::size_t>(k)];
       const bool is_roi = v.node->isRoi();
-      const bool is_free = !(v.node->getLogOdds() > occupied);
+      const bool is_free = classifyLogOdds(v.node->getLogOdds(), occupied) == VoxelClass::kFree;
       if (!is_roi && !is_free) continue;
       const auto [x, y, z] = v.index;
       // Face neighbours first: most known voxels have none unknown, and then the 26-sum

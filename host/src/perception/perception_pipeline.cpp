@@ -4,6 +4,8 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "fvp/host/perception/cluster_region_image.h"
+
 namespace fvp::host {
 namespace {
 
@@ -73,7 +75,7 @@ PerceptionResult PerceptionPipeline::process(
   // rectangle; without a region (no tag yet), around every segmented fruitlet pixel.
   cv::Rect fine;
   if (result.region) {
-    fine = result.region->imageBounds(K, frame.T_world_camera);
+    fine = clusterRegionImageBounds(*result.region, K, frame.T_world_camera);
   } else {
     fine = cv::boundingRect(result.fruitlet_mask);
   }

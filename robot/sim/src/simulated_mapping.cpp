@@ -14,41 +14,26 @@ SimulatedMapping mapSimulatedViews(const World& world, const std::vector<Eigen::
                                    accel::Backend* backend) {
   SimulatedMapping out;
   const StereoRenderer renderer(world, options.render);
-  const host::PerceptionPipeline perception(options.perception);
-  // Clouds seen before the region was known, with the index of their view.
-  std::vector<std::pair<std::size_t, host::LabeledClouds>> pending;
+  host::MappingSession session(options.perception, options.engine, options.map, backend);
   for (const Eigen::Isometry3d& pose : poses) {
     MappedView view;
     view.T_world_camera = pose;
-    auto t0 = std::chrono::steady_clock::now();
+    const auto t0 = std::chrono::steady_clock::now();
     RenderOptions render_options;
     render_options.ground_truth = false;
     const host::StereoFrame frame = renderer.render(pose, render_options);
     view.render_s = secondsSince(t0);
-    t0 = std::chrono::steady_clock::now();
-    host::PerceptionResult perceived = perception.process(frame, out.region);
-    view.perceive_s = secondsSince(t0);
-    view.tag_detected = perceived.tag.has_value();
-    view.roi_points = perceived.clouds.roi_points_m.size();
-    view.other_points = perceived.clouds.other_points_m.size();
-    if (!out.region && perceived.region) {
-      out.region = perceived.region;
-      out.map = host::map::createMapEngine(options.engine, options.map, *out.region, backend);
-      for (const auto& [index, clouds] : pending) {
-        out.views[index].scan =
-            out.map->integrate(clouds.sensor_origin_m, clouds.roi_points_m, clouds.other_points_m);
-      }
-      pending.clear();
-    }
-    if (out.map) {
-      view.scan =
-          out.map->integrate(perceived.clouds.sensor_origin_m, perceived.clouds.roi_points_m,
-                             perceived.clouds.other_points_m);
-    } else {
-      pending.emplace_back(out.views.size(), std::move(perceived.clouds));
-    }
+    const host::ViewResult seen = session.addView(frame);
+    view.perceive_s = seen.perceive_s;
+    view.tag_detected = seen.tag_detected;
+    view.roi_points = seen.roi_points;
+    view.other_points = seen.other_points;
     out.views.push_back(view);
   }
+  // Views seen before the tag got their scans later: take every scan from the session.
+  for (std::size_t i = 0; i < out.views.size(); ++i) out.views[i].scan = session.views()[i].scan;
+  out.region = session.region();
+  out.map = std::move(session).releaseMap();
   return out;
 }
 

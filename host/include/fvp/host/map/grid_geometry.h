@@ -8,8 +8,8 @@
 #include <cstdint>
 
 #include "fvp/accel/kernel_types.h"
+#include "fvp/host/core/cluster_region.h"
 #include "fvp/host/map/map_config.h"
-#include "fvp/host/perception/cluster_region.h"
 
 extern "C" {
 #include "fvp_map.h"

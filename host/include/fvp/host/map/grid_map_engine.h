@@ -47,9 +47,8 @@ class GridMapEngine final : public MapEngine {
   const octomap::OcTree& coarseOcTree() override;
 
  protected:
-  ScanStats integrateScan(const Eigen::Vector3d& sensor_origin_m,
-                          const std::vector<Eigen::Vector3f>& roi_points_m,
-                          const std::vector<Eigen::Vector3f>& other_points_m) override;
+  void integrateScan(const Eigen::Vector3d& sensor_origin_m,
+                     const std::vector<accel::ScanPoint>& points, ScanStats& stats) override;
   void refreshScene(MapLevel level, OccupiedVoxelScene& scene, bool fresh) override;
 
  private:
@@ -66,12 +65,5 @@ class GridMapEngine final : public MapEngine {
   std::uint64_t coarse_tree_change_ = 0;    ///< coarse change count the tree reflects
   std::uint64_t scene_change_[2] = {0, 0};  ///< change count each level's scene reflects
 };
-
-/// Turns two clouds into kernel scan points: non-finite points are skipped and counted,
-/// points beyond max_range_m cut the ray at that range with no hit (counted).
-std::vector<accel::ScanPoint> prepareScanPoints(const Eigen::Vector3d& sensor_origin_m,
-                                                const std::vector<Eigen::Vector3f>& roi_points_m,
-                                                const std::vector<Eigen::Vector3f>& other_points_m,
-                                                double max_range_m, ScanStats& stats);
 
 }  // namespace fvp::host::map

@@ -16,13 +16,15 @@
 #include <string_view>
 #include <vector>
 
+#include "fvp/host/core/cluster_region.h"
+#include "fvp/host/core/labeled_clouds.h"
 #include "fvp/host/map/frontier_voxel.h"
 #include "fvp/host/map/grid_geometry.h"
 #include "fvp/host/map/map_config.h"
 #include "fvp/host/map/occupied_voxel_scene.h"
+#include "fvp/host/map/scan_points.h"
 #include "fvp/host/map/scan_stats.h"
 #include "fvp/host/map/voxel_state.h"
-#include "fvp/host/perception/cluster_region.h"
 
 namespace fvp::accel {
 class Backend;
@@ -48,10 +50,9 @@ class MapEngine {
   /// Scans integrated so far.
   std::size_t scanCount() const { return scans_; }
 
-  /// Integrates one view: rays from sensor_origin_m to every point (world frame).
-  ScanStats integrate(const Eigen::Vector3d& sensor_origin_m,
-                      const std::vector<Eigen::Vector3f>& roi_points_m,
-                      const std::vector<Eigen::Vector3f>& other_points_m);
+  /// Integrates one view: rays from clouds.sensor_origin_m to every point (world frame),
+  /// cut and counted by prepareScanPoints (scan_points.h), the same for both engines.
+  ScanStats integrate(const LabeledClouds& clouds);
 
   /// State of the coarse voxel containing p (unknown outside the observation box).
   virtual VoxelClass coarseClass(const Eigen::Vector3d& p_m) const = 0;
@@ -92,9 +93,9 @@ class MapEngine {
  protected:
   MapEngine(const MapConfig& config, const ClusterRegion& region)
       : config_(config), region_(region) {}
-  virtual ScanStats integrateScan(const Eigen::Vector3d& sensor_origin_m,
-                                  const std::vector<Eigen::Vector3f>& roi_points_m,
-                                  const std::vector<Eigen::Vector3f>& other_points_m) = 0;
+  /// Applies one view's prepared points; sets the voxel counts of stats.
+  virtual void integrateScan(const Eigen::Vector3d& sensor_origin_m,
+                             const std::vector<accel::ScanPoint>& points, ScanStats& stats) = 0;
   /// Brings `scene` up to date with the scans integrated so far (fresh: it is new and
   /// empty). The default sets every occupied voxel (occupiedVoxels()); engines that know
   /// which parts changed update only those.

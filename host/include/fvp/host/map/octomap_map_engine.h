@@ -16,15 +16,16 @@
 //   segment lies on the same line, but computeRayKeys starts from the clipped point in
 //   float, so crossings that nearly tie may be ordered differently: a voxel touched only at
 //   a corner can differ. The grid engine agreement target is >= 99.9 %, not 100 %.
-// - NaN / infinite points are skipped and counted; points beyond sensor_max_range_m are cut
-//   there as OctoMap's maxrange does (free up to the cut, the cut voxel itself not updated,
-//   no hit) and counted.
+// - Points are prepared by prepareScanPoints (scan_points.h), as for the grid engine: NaN /
+//   infinite points are skipped and counted; points beyond sensor_max_range_m are cut there
+//   as OctoMap's maxrange does (free up to the cut, the cut voxel itself not updated, no
+//   hit) and counted. The cut is computed in double and rounded to float, where OctoMap's
+//   computeUpdate computes it in float: the end may differ in the last bits.
 // - ROI (fine map): +hit where any ROI point ends, +miss where only other points end,
 //   unchanged in free voxels; clamped like occupancy.
 //
-// Voxel classes: occupied when log-odds > logOdds(occupied_prob) (strict, the grid engine's
-// rule; OctoMap's isNodeOccupied uses >=, which differs only at exactly 0), free when
-// updated but not occupied, unknown when never updated; ROI when ROI log-odds > 0.
+// Voxel classes: classifyLogOdds (voxel_state.h), the grid engine's rule, on the nodes the
+// tree has (unknown when it has none); ROI when ROI log-odds > 0.
 #pragma once
 
 #include <octomap/OcTree.h>
@@ -53,9 +54,8 @@ class OctomapMapEngine : public MapEngine {
   std::vector<std::array<int, 3>> occupiedVoxels(MapLevel level) const override;
 
  protected:
-  ScanStats integrateScan(const Eigen::Vector3d& sensor_origin_m,
-                          const std::vector<Eigen::Vector3f>& roi_points_m,
-                          const std::vector<Eigen::Vector3f>& other_points_m) override;
+  void integrateScan(const Eigen::Vector3d& sensor_origin_m,
+                     const std::vector<accel::ScanPoint>& points, ScanStats& stats) override;
 
  public:
   VoxelClass coarseClass(const Eigen::Vector3d& p_m) const override;

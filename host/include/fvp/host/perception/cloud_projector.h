@@ -6,8 +6,8 @@
 #include <limits>
 #include <opencv2/core.hpp>
 
+#include "fvp/host/core/labeled_clouds.h"
 #include "fvp/host/core/stereo_intrinsics.h"
-#include "fvp/host/perception/labeled_clouds.h"
 
 namespace fvp::host {
 

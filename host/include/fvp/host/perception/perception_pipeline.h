@@ -7,11 +7,11 @@
 #include <opencv2/core.hpp>
 #include <optional>
 
+#include "fvp/host/core/cluster_region.h"
+#include "fvp/host/core/labeled_clouds.h"
 #include "fvp/host/perception/apriltag_detector.h"
 #include "fvp/host/perception/cloud_projector.h"
-#include "fvp/host/perception/cluster_region.h"
 #include "fvp/host/perception/fruitlet_segmenter.h"
-#include "fvp/host/perception/labeled_clouds.h"
 #include "fvp/host/perception/stereo_frame.h"
 #include "fvp/host/perception/stereo_matcher.h"
 

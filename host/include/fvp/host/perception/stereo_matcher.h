@@ -10,7 +10,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 
-#include "fvp/host/perception/perception_stats.h"
+#include "fvp/host/core/perception_stats.h"
 
 namespace fvp::host {
 

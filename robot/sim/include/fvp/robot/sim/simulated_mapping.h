@@ -1,7 +1,7 @@
-// Maps a simulated world from a sequence of camera poses: render each stereo pair, run the
-// perception chain, integrate the clouds into a coarse + fine map pair. The Cluster Region
-// comes from the first view whose AprilTag is detected. Used by `fvp map`, tests and
-// benchmarks; the planner drives the same steps one view at a time.
+// Maps a simulated world from a sequence of camera poses: render each stereo pair and hand
+// it to a host::MappingSession (perception, Cluster Region from the first view whose
+// AprilTag is detected, coarse + fine maps). Used by `fvp map`, tests and benchmarks; the
+// planner drives the same session one view at a time.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -11,6 +11,7 @@
 
 #include "fvp/host/map/map_engine.h"
 #include "fvp/host/perception/perception_pipeline.h"
+#include "fvp/host/session/mapping_session.h"
 #include "fvp/robot/sim/stereo_renderer.h"
 #include "fvp/robot/sim/world.h"
 

@@ -1,12 +1,10 @@
 // The Cluster Region (paper, "Viewpoint Sampling"): a sphere of fixed size placed around the
 // cluster from the detected AprilTag pose. Its centre is the tag pose applied to a fixed
-// offset (in the tag frame, see tag_detection.h).
+// offset (in the tag frame, see perception/tag_detection.h). Free of OpenCV so that the map
+// library can hold it; its image rectangle is perception's clusterRegionImageBounds().
 #pragma once
 
 #include <Eigen/Geometry>
-#include <opencv2/core.hpp>
-
-#include "fvp/host/core/stereo_intrinsics.h"
 
 namespace fvp::host {
 
@@ -38,10 +36,6 @@ class ClusterRegion {
   bool contains(const Eigen::Vector3d& p_world_m) const {
     return (p_world_m - center_m_).squaredNorm() <= radius_m_ * radius_m_;
   }
-  /// Bounding rectangle of the sphere's image in the left camera (exact tangents; clipped;
-  /// the whole image if the sphere reaches the camera plane; empty if it is out of view).
-  cv::Rect imageBounds(const StereoIntrinsics& intrinsics,
-                       const Eigen::Isometry3d& T_world_camera) const;
 
  private:
   Eigen::Vector3d center_m_ = Eigen::Vector3d::Zero();

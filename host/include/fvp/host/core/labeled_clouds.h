@@ -5,7 +5,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "fvp/host/perception/perception_stats.h"
+#include "fvp/host/core/perception_stats.h"
 
 namespace fvp::host {
 

@@ -1,23 +1,9 @@
-#include "fvp/host/perception/cluster_region.h"
+#include "fvp/host/perception/cluster_region_image.h"
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 
 namespace fvp::host {
-
-void ClusterRegionConfig::validate() const {
-  if (!(radius_m > 0.0) || !std::isfinite(radius_m))
-    throw std::invalid_argument("cluster region config: radius_m: expected a positive radius");
-  if (!center_offset_tag_m.allFinite())
-    throw std::invalid_argument("cluster region config: center_offset_tag_m: expected finite");
-}
-
-ClusterRegion ClusterRegion::fromTag(const Eigen::Isometry3d& T_world_tag,
-                                     const ClusterRegionConfig& config) {
-  config.validate();
-  return ClusterRegion(T_world_tag * config.center_offset_tag_m, config.radius_m);
-}
 
 namespace {
 
@@ -35,14 +21,14 @@ bool tangentInterval(double c_x, double c_z, double r, double& k_min, double& k_
 
 }  // namespace
 
-cv::Rect ClusterRegion::imageBounds(const StereoIntrinsics& K,
-                                    const Eigen::Isometry3d& T_world_camera) const {
+cv::Rect clusterRegionImageBounds(const ClusterRegion& region, const StereoIntrinsics& K,
+                                  const Eigen::Isometry3d& T_world_camera) {
   const cv::Rect image(0, 0, K.width_px, K.height_px);
-  const Eigen::Vector3d c = T_world_camera.inverse() * center_m_;
-  if (c.z() + radius_m_ <= 0.0) return {};  // entirely behind the camera
+  const Eigen::Vector3d c = T_world_camera.inverse() * region.center_m();
+  if (c.z() + region.radius_m() <= 0.0) return {};  // entirely behind the camera
   double kx0, kx1, ky0, ky1;
-  if (!tangentInterval(c.x(), c.z(), radius_m_, kx0, kx1) ||
-      !tangentInterval(c.y(), c.z(), radius_m_, ky0, ky1))
+  if (!tangentInterval(c.x(), c.z(), region.radius_m(), kx0, kx1) ||
+      !tangentInterval(c.y(), c.z(), region.radius_m(), ky0, ky1))
     return image;  // the sphere reaches the camera plane: it may fill the view
   const double lim = 1e6;
   auto px = [&](double k, double f, double c0) { return std::clamp(f * k + c0, -lim, lim); };

@@ -1,4 +1,4 @@
-#include "fvp/host/perception/perception_stats.h"
+#include "fvp/host/core/perception_stats.h"
 
 #include <ostream>
 

@@ -1,0 +1,80 @@
+// The per-view mapping session (DESIGN.md section 5): one stereo view at a time through
+// perception into the maps, so that the trial loop, `fvp map` and capture replay share one
+// path. The session owns the perception pipeline, the Cluster Region (from the first view
+// whose AprilTag is detected) and the map engine, created once the region is known. Views
+// seen before that are kept and integrated, in order, as soon as the region is known.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "fvp/host/core/cluster_region.h"
+#include "fvp/host/core/labeled_clouds.h"
+#include "fvp/host/map/map_engine.h"
+#include "fvp/host/perception/perception_pipeline.h"
+#include "fvp/host/perception/stereo_frame.h"
+
+namespace fvp::accel {
+class Backend;
+}
+
+namespace fvp::host {
+
+/// What one view did. scan stays empty until the view is in the map: a view seen before
+/// the region was known gets its scan when a later view detects the tag (see views()).
+struct ViewResult {
+  std::size_t index = 0;  ///< position of the view in the session
+  bool tag_detected = false;
+  std::size_t roi_points = 0, other_points = 0;
+  double perceive_s = 0.0;  ///< wall time of the perception pipeline alone
+  PerceptionStats perception;
+  bool integrated = false;  ///< the view's clouds are in the map
+  map::ScanStats scan;
+  /// Earlier views this call integrated (the region became known with this view).
+  std::size_t earlier_views_integrated = 0;
+};
+
+class MappingSession {
+ public:
+  /// engine: "grid" (needs backend, which must outlive the session) or "octomap" (backend
+  /// ignored). Throws std::invalid_argument for an unknown engine, a grid engine without a
+  /// backend or a bad config, before any view is processed.
+  MappingSession(PerceptionConfig perception, std::string engine, map::MapConfig map_config,
+                 accel::Backend* backend);
+
+  /// Perceives one view and integrates it (and any views kept from before the region was
+  /// known) into the map.
+  ViewResult addView(const StereoFrame& frame);
+
+  /// Null / empty until a view's tag was detected.
+  const std::optional<ClusterRegion>& region() const { return region_; }
+  map::MapEngine* map() { return map_.get(); }
+  const map::MapEngine* map() const { return map_.get(); }
+  /// Every view so far, with the scans of views integrated after they were added.
+  const std::vector<ViewResult>& views() const { return views_; }
+  /// Views waiting for the region.
+  std::size_t pendingViews() const { return pending_.size(); }
+  const PerceptionPipeline& perception() const { return perception_; }
+
+  /// Hands the map over; the session is done with it.
+  std::unique_ptr<map::MapEngine> releaseMap() && { return std::move(map_); }
+
+ private:
+  void integrate(std::size_t index, const LabeledClouds& clouds);
+
+  PerceptionPipeline perception_;
+  std::string engine_;
+  map::MapConfig map_config_;
+  accel::Backend* backend_;
+  std::optional<ClusterRegion> region_;
+  std::unique_ptr<map::MapEngine> map_;
+  std::vector<ViewResult> views_;
+  // Clouds of views seen before the region was known, with the index of their view.
+  std::vector<std::pair<std::size_t, LabeledClouds>> pending_;
+};
+
+}  // namespace fvp::host

@@ -1,0 +1,58 @@
+#include "fvp/host/session/mapping_session.h"
+
+#include <chrono>
+#include <stdexcept>
+
+namespace fvp::host {
+
+MappingSession::MappingSession(PerceptionConfig perception, std::string engine,
+                               map::MapConfig map_config, accel::Backend* backend)
+    : perception_(std::move(perception)),
+      engine_(std::move(engine)),
+      map_config_(std::move(map_config)),
+      backend_(backend) {
+  // The engine is only created with the region, possibly many views later: check now what
+  // createMapEngine would reject then.
+  if (engine_ != "grid" && engine_ != "octomap")
+    throw std::invalid_argument("unknown map engine '" + engine_ + "': expected grid or octomap");
+  if (engine_ == "grid" && backend_ == nullptr)
+    throw std::invalid_argument("map engine 'grid' needs a compute backend");
+  map_config_.validate();
+}
+
+ViewResult MappingSession::addView(const StereoFrame& frame) {
+  ViewResult view;
+  view.index = views_.size();
+  const auto t0 = std::chrono::steady_clock::now();
+  PerceptionResult perceived = perception_.process(frame, region_);
+  view.perceive_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  view.tag_detected = perceived.tag.has_value();
+  view.roi_points = perceived.clouds.roi_points_m.size();
+  view.other_points = perceived.clouds.other_points_m.size();
+  view.perception = perceived.clouds.stats;
+  views_.push_back(view);
+
+  if (!region_ && perceived.region) {
+    region_ = perceived.region;
+    map_ = map::createMapEngine(engine_, map_config_, *region_, backend_);
+    for (const auto& [index, clouds] : pending_) integrate(index, clouds);
+    views_.back().earlier_views_integrated = pending_.size();
+    pending_.clear();
+  }
+  if (map_) {
+    integrate(view.index, perceived.clouds);
+  } else {
+    pending_.emplace_back(view.index, std::move(perceived.clouds));
+  }
+  return views_.back();
+}
+
+void MappingSession::integrate(std::size_t index, const LabeledClouds& clouds) {
+  ViewResult& view = views_[index];
+  view.scan = map_->integrate(clouds);
+  view.integrated = true;
+  // The TSDF of the fine map (DESIGN.md section 5) is fed here next: the same clouds, in the
+  // same order, once the region is known.
+}
+
+}  // namespace fvp::host

@@ -1,0 +1,123 @@
+// MappingSession on rendered stereo pairs: the map appears with the first view whose tag is
+// detected, and views seen before it are integrated, in order, once the region is known.
+#include "fvp/host/session/mapping_session.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <optional>
+#include <vector>
+
+#include "fvp/accel/backend.h"
+#include "fvp/robot/sim/camera_views.h"
+#include "fvp/robot/sim/stereo_renderer.h"
+#include "fvp/robot/sim/world.h"
+
+namespace fvp::host {
+namespace {
+
+// Seed 2's orbit over 60 degrees: the first view does not see the tag, the middle one (the
+// start view's direction) does. Full resolution (the tag detector's working point); each
+// view is rendered once per test program, when a test first needs it (ctest runs every
+// test in its own process).
+class MappingSessionTest : public ::testing::Test {
+ protected:
+  static const StereoFrame& untagged() { return frame(0); }
+  static const StereoFrame& tagged() { return frame(1); }
+
+ private:
+  static const StereoFrame& frame(std::size_t i) {
+    static const auto world = robot::sim::World::generate(robot::sim::WorldConfig{}, 2);
+    static const robot::sim::StereoRenderer renderer(world);
+    static const auto poses = robot::sim::orbitViews(world, 3, 60.0);
+    static std::optional<StereoFrame> frames[2];
+    if (!frames[i]) {
+      robot::sim::RenderOptions options;
+      options.ground_truth = false;
+      frames[i] = renderer.render(poses[i], options);
+    }
+    return *frames[i];
+  }
+};
+
+std::vector<std::array<int, 3>> sorted(std::vector<std::array<int, 3>> v) {
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
+TEST_F(MappingSessionTest, AViewWithTheTagCreatesTheMapAndIntegratesIt) {
+  auto cpu = accel::createBackend(accel::BackendKind::kCpu);
+  MappingSession session({}, "grid", map::MapConfig{}, cpu.get());
+  EXPECT_FALSE(session.region().has_value());
+  EXPECT_EQ(session.map(), nullptr);
+
+  const ViewResult view = session.addView(tagged());
+  ASSERT_TRUE(view.tag_detected);
+  ASSERT_TRUE(session.region().has_value());
+  ASSERT_NE(session.map(), nullptr);
+  EXPECT_EQ(session.map()->engineName(), "grid");
+  EXPECT_EQ(session.map()->scanCount(), 1u);
+  EXPECT_EQ(session.map()->region().center_m(), session.region()->center_m());
+  EXPECT_TRUE(view.integrated);
+  EXPECT_EQ(view.index, 0u);
+  EXPECT_EQ(view.earlier_views_integrated, 0u);
+  EXPECT_GT(view.roi_points, 100u);
+  EXPECT_GT(view.other_points, 10000u);
+  EXPECT_EQ(view.scan.points, view.roi_points + view.other_points);
+  EXPECT_EQ(view.perception.roi_points, static_cast<std::int64_t>(view.roi_points));
+  EXPECT_GT(view.perceive_s, 0.0);
+  EXPECT_GT(view.scan.fine_voxels_updated, 1000u);
+  EXPECT_FALSE(session.map()->occupiedVoxels(map::MapLevel::kFine).empty());
+  EXPECT_EQ(session.views().size(), 1u);
+  EXPECT_EQ(session.pendingViews(), 0u);
+}
+
+TEST_F(MappingSessionTest, ViewsBeforeTheTagAreIntegratedInOrderOnceItIsSeen) {
+  MappingSession session({}, "octomap", map::MapConfig{}, nullptr);
+  const ViewResult first = session.addView(untagged());
+  ASSERT_FALSE(first.tag_detected) << "the test needs a first view without the tag";
+  EXPECT_FALSE(first.integrated);
+  EXPECT_EQ(first.scan.points, 0u);
+  EXPECT_GT(first.other_points, 10000u);
+  EXPECT_EQ(session.map(), nullptr);
+  EXPECT_EQ(session.pendingViews(), 1u);
+
+  const ViewResult second = session.addView(tagged());
+  ASSERT_TRUE(second.tag_detected);
+  ASSERT_NE(session.map(), nullptr);
+  EXPECT_EQ(second.earlier_views_integrated, 1u);
+  EXPECT_EQ(session.pendingViews(), 0u);
+  EXPECT_EQ(session.map()->scanCount(), 2u);
+  ASSERT_EQ(session.views().size(), 2u);
+  const ViewResult& first_now = session.views()[0];
+  EXPECT_TRUE(first_now.integrated);
+  EXPECT_EQ(first_now.scan.points, first.roi_points + first.other_points);
+  EXPECT_TRUE(session.views()[1].integrated);
+
+  // The same as perceiving the views as the session did (the first without a region) and
+  // integrating them in order into a map made from the second view's region.
+  const PerceptionPipeline perception;
+  const PerceptionResult a = perception.process(untagged());
+  const PerceptionResult b = perception.process(tagged());
+  ASSERT_TRUE(b.region.has_value());
+  auto reference = map::createMapEngine("octomap", map::MapConfig{}, *b.region, nullptr);
+  reference->integrate(a.clouds);
+  reference->integrate(b.clouds);
+  for (const map::MapLevel level : {map::MapLevel::kCoarse, map::MapLevel::kFine}) {
+    const auto got = sorted(session.map()->occupiedVoxels(level));
+    EXPECT_GT(got.size(), 100u);
+    EXPECT_EQ(got, sorted(reference->occupiedVoxels(level)));
+  }
+}
+
+TEST(MappingSession, RejectsABadEngineBeforeAnyView) {
+  EXPECT_THROW(MappingSession({}, "voxblox", map::MapConfig{}, nullptr), std::invalid_argument);
+  EXPECT_THROW(MappingSession({}, "grid", map::MapConfig{}, nullptr), std::invalid_argument);
+  map::MapConfig bad;
+  bad.fine_voxel_size_m = -1.0;
+  EXPECT_THROW(MappingSession({}, "octomap", bad, nullptr), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace fvp::host
