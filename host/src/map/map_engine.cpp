@@ -37,15 +37,19 @@ void MapEngine::refreshScene(MapLevel level, OccupiedVoxelScene& scene, bool) {
   scene.assignOccupied(occupiedVoxels(level));
 }
 
+void checkMapEngineChoice(std::string_view engine, const accel::Backend* backend) {
+  if (engine != "grid" && engine != "octomap")
+    throw std::invalid_argument("unknown map engine '" + std::string(engine) +
+                                "': expected grid or octomap");
+  if (engine == "grid" && !backend)
+    throw std::invalid_argument("map engine 'grid' needs a compute backend");
+}
+
 std::unique_ptr<MapEngine> createMapEngine(std::string_view engine, const MapConfig& config,
                                            const ClusterRegion& region, accel::Backend* backend) {
-  if (engine == "grid") {
-    if (!backend) throw std::invalid_argument("map engine 'grid' needs a compute backend");
-    return std::make_unique<GridMapEngine>(config, region, *backend);
-  }
-  if (engine == "octomap") return std::make_unique<OctomapMapEngine>(config, region);
-  throw std::invalid_argument("unknown map engine '" + std::string(engine) +
-                              "': expected grid or octomap");
+  checkMapEngineChoice(engine, backend);
+  if (engine == "grid") return std::make_unique<GridMapEngine>(config, region, *backend);
+  return std::make_unique<OctomapMapEngine>(config, region);
 }
 
 }  // namespace fvp::host::map

@@ -13,10 +13,7 @@ MappingSession::MappingSession(PerceptionConfig perception, std::string engine,
       backend_(backend) {
   // The engine is only created with the region, possibly many views later: check now what
   // createMapEngine would reject then.
-  if (engine_ != "grid" && engine_ != "octomap")
-    throw std::invalid_argument("unknown map engine '" + engine_ + "': expected grid or octomap");
-  if (engine_ == "grid" && backend_ == nullptr)
-    throw std::invalid_argument("map engine 'grid' needs a compute backend");
+  map::checkMapEngineChoice(engine_, backend_);
   map_config_.validate();
 }
 
