@@ -88,6 +88,17 @@ Eigen::Isometry3d ArmModel::T_world_camera(const JointVector& q) const {
   return T_world_base(q[0]) * Ur5Kinematics::forward(q.tail<6>()) * T_flange_camera_;
 }
 
+double ArmModel::sweepBound_m(const JointVector& dq) const {
+  // Farthest capsule point from each joint's axis: the UR5 links after the joint (DH a2 =
+  // 0.425, a3 = 0.392, d4 = 0.109, d5 = 0.095, d6 = 0.082 m), the shoulder offset (0.136),
+  // the camera (hand-eye offset, setback and baseline, <= 0.17) and the thickest capsule
+  // radius after the joint, rounded up. tests/robot/arm_kinematics_test.cpp checks them.
+  static constexpr double kReachM[kArmJoints] = {1.0, 1.5, 1.5, 1.05, 0.55, 0.45, 0.35};
+  double bound = 0.0;
+  for (int j = 0; j < kArmJoints; ++j) bound += kReachM[j] * std::abs(dq[j]);
+  return bound;
+}
+
 LinkCapsules ArmModel::linkCapsules(const JointVector& q, Eigen::Isometry3d* T_world_camera) const {
   std::array<Eigen::Isometry3d, 6> frames;
   const Eigen::Isometry3d T_wb = T_world_base(q[0]);

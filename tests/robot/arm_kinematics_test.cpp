@@ -1,6 +1,7 @@
 // Forward/inverse kinematics of the UR5 and the slider-mounted arm.
 #include <gtest/gtest.h>
 
+#include <iostream>
 #include <random>
 
 #include "fvp/robot/arm_controller.h"
@@ -65,6 +66,35 @@ TEST(Ur5Kinematics, UnreachablePosesHaveNoSolution) {
     std::array<Ur5Kinematics::Joints, Ur5Kinematics::kMaxSolutions> ik;
     EXPECT_EQ(Ur5Kinematics::inverse(T, ik), 0);
   }
+}
+
+TEST(ArmModel, SweepBoundCoversEveryCapsulePoint) {
+  // Motion checks rely on sweepBound_m: no capsule point moves farther than it. A capsule's
+  // points move at most as far as its farthest end point plus its radius times the link's
+  // rotation, itself at most the sum of the revolute joints' angles.
+  const ArmModel arm{ArmConfig{}};
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> unit(0.0, 1.0), small(-0.05, 0.05);
+  double tightest = 0.0;
+  for (int i = 0; i < 5000; ++i) {
+    JointVector q, dq;
+    for (int j = 0; j < kArmJoints; ++j) {
+      q[j] = arm.lowerLimits()[j] + unit(rng) * (arm.upperLimits()[j] - arm.lowerLimits()[j]);
+      dq[j] = unit(rng) < 0.3 ? 0.0 : small(rng);  // some joints still, as on real motions
+    }
+    const LinkCapsules before = arm.linkCapsules(q), after = arm.linkCapsules(q + dq);
+    const double rotation = dq.tail<6>().cwiseAbs().sum();
+    const double bound = arm.sweepBound_m(dq);
+    for (std::size_t k = 0; k < before.size(); ++k) {
+      const double moved =
+          std::max((after[k].a_m - before[k].a_m).norm(), (after[k].b_m - before[k].b_m).norm()) +
+          before[k].radius_m * rotation;
+      // A slider-only motion moves every point by exactly the bound: allow rounding.
+      ASSERT_LE(moved, bound * (1.0 + 1e-9)) << "capsule " << k << ", configuration " << i;
+      tightest = std::max(tightest, moved / bound);
+    }
+  }
+  std::cout << "largest capsule sweep / bound: " << tightest << "\n";
 }
 
 TEST(ArmModel, RoundTripWithSliderAndLimits) {

@@ -58,10 +58,14 @@ inline bool pathValid(const ArmCollisionChecker& checker, const Trajectory& traj
   return true;
 }
 
-inline QueryStats runPlanningQueries(int worlds, int queries_per_world, std::uint64_t seed) {
+/// planning_time_s: OMPL's limit per query (default: the config's).
+inline QueryStats runPlanningQueries(int worlds, int queries_per_world, std::uint64_t seed,
+                                     double planning_time_s = ArmConfig{}.planning_time_s) {
   QueryStats stats;
-  const ArmModel arm{ArmConfig{}};
-  ArmConfig unpadded_config;
+  ArmConfig config;
+  config.planning_time_s = planning_time_s;
+  const ArmModel arm{config};
+  ArmConfig unpadded_config = config;
   unpadded_config.collision_padding_m = 0.0;
   const ArmModel unpadded(unpadded_config);
   std::mt19937_64 rng(seed);

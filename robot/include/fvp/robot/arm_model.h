@@ -37,6 +37,12 @@ class ArmModel {
   Eigen::Isometry3d T_world_base(double slider_m) const;
   Eigen::Isometry3d T_world_camera(const JointVector& q) const;
   /// The link capsules (and, when asked, the camera pose from the same forward pass).
+  /// An upper bound on how far any point of the arm's capsules (surfaces included) moves
+  /// when the joints move by dq, in any way: sum_j reach_j * |dq_j|, with reach_j the
+  /// farthest any capsule point can lie from joint j's axis (1 for the slider, in metres
+  /// per metre). Motion checks use it to keep the sweep between two checks inside the
+  /// collision padding.
+  double sweepBound_m(const JointVector& dq) const;
   LinkCapsules linkCapsules(const JointVector& q,
                             Eigen::Isometry3d* T_world_camera = nullptr) const;
 
