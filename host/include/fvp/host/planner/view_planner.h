@@ -1,0 +1,75 @@
+// The one interface the trial loop drives a viewpoint planner through (DESIGN.md section 6):
+// FVP (ours, Algorithm 1 over ROI-targeted + exploration candidates scored by paper Eq. 1-3)
+// and RVP (Zaenker et al. 2020) both implement it, so `fvp run --planner fvp|rvp` and
+// `fvp plan` share one path. The arm is reached through two callbacks, so the host planner
+// does not depend on robot/: a cheap reachability filter (the workspace tree) and the move
+// itself (IK + motion planning + execution), whose failure is an expected outcome.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace fvp::host::map {
+class MapEngine;
+}
+
+namespace fvp::host::planner {
+
+enum class CandidateKind { kRoi, kExploration };
+/// "roi" or "exploration" (plan.json's "kind").
+const char* toString(CandidateKind kind);
+
+/// One viewpoint candidate: a full camera pose (OpenCV optical frame of the left camera,
+/// z forward) looking at its target.
+struct Candidate {
+  CandidateKind kind = CandidateKind::kRoi;
+  Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d target_m = Eigen::Vector3d::Zero();
+  double ig = 0.0;       ///< information gain (planner-specific definition)
+  double utility = 0.0;  ///< ig - cost (paper Eq. 3 for FVP)
+  bool reachable = false;
+  Eigen::Vector3d position_m() const { return T_world_camera.translation(); }
+};
+
+/// Whether the arm can put the camera at this pose (workspace tree); cheap, may be optimistic.
+using ReachabilityFn = std::function<bool(const Eigen::Isometry3d& T_world_camera)>;
+/// Plans and executes a move; false when it failed (no IK, no path, timeout: counted).
+using MoveToPoseFn = std::function<bool(const Eigen::Isometry3d& T_world_camera)>;
+
+/// Named wall-time parts of one planning iteration (e.g. "snapshot", "sample", "cull",
+/// "info_gain", "select"), in seconds, in the order they ran.
+using StageTimings = std::vector<std::pair<std::string, double>>;
+
+/// What one planning iteration did.
+struct PlanStep {
+  /// Every candidate scored this iteration (the last sampling round), reachable or not.
+  std::vector<Candidate> candidates;
+  /// Index into candidates of the view moved to; empty when no move succeeded.
+  std::optional<std::size_t> chosen;
+  std::size_t move_attempts = 0;  ///< moveToPose calls this iteration
+  std::size_t failed_moves = 0;   ///< of which failed
+  std::size_t sampling_rounds = 0;
+  StageTimings timings_s;
+  bool moved() const { return chosen.has_value(); }
+};
+
+class ViewPlanner {
+ public:
+  virtual ~ViewPlanner() = default;
+  /// "fvp" or "rvp".
+  virtual std::string_view name() const = 0;
+  /// One planning iteration on the current maps: sample, score, and try moves in order of
+  /// utility until one succeeds or the planner's own rule gives up for this iteration.
+  /// T_world_camera_now is the camera pose the motion cost is measured from.
+  virtual PlanStep planAndMove(map::MapEngine& map, const Eigen::Isometry3d& T_world_camera_now,
+                               const ReachabilityFn& reachable, const MoveToPoseFn& move) = 0;
+  /// The planner's configuration as JSON text (printed into every result).
+  virtual std::string configJson() const = 0;
+};
+
+}  // namespace fvp::host::planner
