@@ -1,0 +1,48 @@
+// One simulated trial (DESIGN.md section 9, `fvp run`): a world from a seed, the start view,
+// the AprilTag -> Cluster Region, then planning iterations until the simulated budget is
+// spent (capture -> perceive -> maps + TSDF -> sample -> score -> move), then sizing and
+// scoring against ground truth. The experiment runner (`fvp experiment`) calls it once per
+// planner and seed.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+namespace fvp::robot::sim {
+
+/// Where a running trial is, for progress displays.
+struct TrialProgress {
+  int views = 0;           ///< views captured so far
+  double sim_time_s = 0;   ///< simulated clock
+  double budget_s = 0;     ///< simulated budget
+  double wall_time_s = 0;  ///< wall time since the trial started
+};
+
+struct TrialOptions {
+  std::string planner = "fvp";  ///< "fvp" or "rvp"
+  std::uint64_t seed = 1;
+  std::filesystem::path world_config;    ///< empty: robot/sim/config/world_default.yaml
+  std::filesystem::path planner_config;  ///< empty: the planner's default config
+  double budget_s = 180.0;               ///< simulated seconds (paper: 180)
+  std::string backend = "auto";          ///< cpu | opencl | vulkan | auto
+  std::string engine;                    ///< grid | octomap; empty: the planner's default
+  std::optional<int> max_views;          ///< stop after this many views (tests)
+  std::string clock = "wall";            ///< wall | fixed
+  /// Where result.json, the maps, the TSDF surface, the clusters and report.md go; empty:
+  /// nothing is written (the result is only returned).
+  std::filesystem::path out_dir;
+  std::function<void(const TrialProgress&)> on_progress;  ///< called after every view
+};
+
+/// Runs one trial and returns its result.json object (the contract of DESIGN.md section 9),
+/// also written atomically to out_dir/result.json when out_dir is set. Throws
+/// std::invalid_argument / std::runtime_error for bad options or files (misconfiguration);
+/// expected events (failed motions, IK failures, dropped disparities, empty clusters) are
+/// counted in the result, never thrown.
+nlohmann::json runTrial(const TrialOptions& options);
+
+}  // namespace fvp::robot::sim
