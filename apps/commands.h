@@ -10,5 +10,6 @@ void addBackendsCommand(CLI::App& app);
 void addCaptureCommand(CLI::App& app);
 void addTraverseCommand(CLI::App& app);
 void addMapCommand(CLI::App& app);
+void addRunCommand(CLI::App& app);
 
 }  // namespace fvp::apps

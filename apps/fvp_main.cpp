@@ -11,6 +11,7 @@ int main(int argc, char** argv) {
   fvp::apps::addCaptureCommand(app);
   fvp::apps::addTraverseCommand(app);
   fvp::apps::addMapCommand(app);
+  fvp::apps::addRunCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,22 +1,14 @@
 #include "fvp/robot/sim/camera_views.h"
 
+#include "fvp/host/core/look_at.h"
+
 #include <cmath>
 #include <stdexcept>
 
 namespace fvp::robot::sim {
 
 Eigen::Isometry3d lookAt(const Eigen::Vector3d& eye_m, const Eigen::Vector3d& target_m) {
-  const Eigen::Vector3d z = (target_m - eye_m).normalized();
-  Eigen::Vector3d y = -Eigen::Vector3d::UnitZ() + z.z() * z;
-  if (y.norm() < 1e-9) y = Eigen::Vector3d::UnitY();  // looking straight up or down
-  y.normalize();
-  const Eigen::Vector3d x = y.cross(z);
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear().col(0) = x;
-  T.linear().col(1) = y;
-  T.linear().col(2) = z;
-  T.translation() = eye_m;
-  return T;
+  return host::lookAtPose(eye_m, target_m);
 }
 
 std::vector<Eigen::Isometry3d> orbitViews(const World& world, int count, double arc_deg) {

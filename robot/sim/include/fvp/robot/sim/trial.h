@@ -45,4 +45,8 @@ struct TrialOptions {
 /// counted in the result, never thrown.
 nlohmann::json runTrial(const TrialOptions& options);
 
+/// A short, readable summary of a result.json object: sizes against ground truth, views,
+/// simulated and wall time (what `fvp run` and scripts/demo print).
+std::string trialSummary(const nlohmann::json& result);
+
 }  // namespace fvp::robot::sim

@@ -1,0 +1,66 @@
+// `fvp run`: one simulated trial (DESIGN.md section 9); writes result.json, the maps, the
+// TSDF surface, the clusters and report.md to --out and prints a short summary.
+#include <unistd.h>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "commands.h"
+#include "fvp/robot/sim/trial.h"
+
+namespace fvp::apps {
+
+void addRunCommand(CLI::App& app) {
+  struct Options {
+    robot::sim::TrialOptions trial;
+    std::string world, config, out;
+    int max_views = 0;
+  };
+  auto opt = std::make_shared<Options>();
+  auto* cmd = app.add_subcommand("run",
+                                 "Run one simulated trial; write result.json and report.md "
+                                 "to --out");
+  cmd->add_option("--planner", opt->trial.planner, "viewpoint planner: fvp | rvp")
+      ->check(CLI::IsMember({"fvp", "rvp"}))
+      ->capture_default_str();
+  cmd->add_option("--seed", opt->trial.seed, "world seed")->capture_default_str();
+  cmd->add_option("--world", opt->world, "world config YAML (default: built-in defaults)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--config", opt->config, "planner config YAML (default: the planner's)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--budget-s", opt->trial.budget_s, "simulated time budget, seconds")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--backend", opt->trial.backend, "compute backend: cpu | opencl | vulkan | auto")
+      ->capture_default_str();
+  cmd->add_option("--engine", opt->trial.engine,
+                  "map engine: grid | octomap (default: grid for fvp, octomap for rvp)")
+      ->check(CLI::IsMember({"grid", "octomap"}));
+  cmd->add_option("--max-views", opt->max_views, "stop after this many views (0: no limit)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--clock", opt->trial.clock,
+                  "simulated clock: wall (charge measured compute time) | fixed (a constant)")
+      ->check(CLI::IsMember({"wall", "fixed"}))
+      ->capture_default_str();
+  cmd->add_option("--out", opt->out, "output directory")->required();
+  cmd->callback([opt] {
+    robot::sim::TrialOptions trial = opt->trial;
+    trial.world_config = opt->world;
+    trial.planner_config = opt->config;
+    trial.out_dir = opt->out;
+    if (opt->max_views > 0) trial.max_views = opt->max_views;
+    const bool tty = isatty(STDERR_FILENO);
+    trial.on_progress = [tty](const robot::sim::TrialProgress& p) {
+      std::cerr << (tty ? "\r" : "") << "view " << p.views << "  sim " << std::fixed
+                << std::setprecision(1) << p.sim_time_s << " / " << p.budget_s << " s  wall "
+                << p.wall_time_s << " s" << (tty ? "   " : "\n") << std::flush;
+    };
+    const nlohmann::json result = robot::sim::runTrial(trial);
+    if (tty) std::cerr << "\n";
+    std::cout << robot::sim::trialSummary(result)
+              << "report: " << (std::filesystem::path(opt->out) / "report.md").string() << "\n";
+  });
+}
+
+}  // namespace fvp::apps

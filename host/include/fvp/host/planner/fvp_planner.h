@@ -1,0 +1,46 @@
+// The FVP planner (paper, "Viewpoint Planning", Algorithm 1): ROI-targeted + exploration
+// candidates, scored by information gain (Eq. 1-2) minus alpha times the distance the camera
+// moves (Eq. 3), all in one heap; candidates are popped while their utility exceeds the
+// threshold u_t until the motion planner reaches one. A round without a move decays u_t by b
+// and samples again; a move resets u_t to u_t0. u_t persists across calls.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "fvp/host/planner/info_gain_evaluator.h"
+#include "fvp/host/planner/planner_config.h"
+#include "fvp/host/planner/view_planner.h"
+#include "fvp/host/planner/viewpoint_sampler.h"
+
+namespace fvp::host::planner {
+
+class FvpPlanner : public ViewPlanner {
+ public:
+  /// seed: the trial's; mixed with config.seed so trials differ and repeat.
+  FvpPlanner(const PlannerConfig& config, std::uint64_t seed, GainMode mode = GainMode::kSingleRay);
+
+  std::string_view name() const override { return "fvp"; }
+  PlanStep planAndMove(map::MapEngine& map, const Eigen::Isometry3d& T_world_camera_now,
+                       const ReachabilityFn& reachable, const MoveToPoseFn& move) override;
+  std::string configJson() const override;
+
+  /// The current threshold u_t.
+  double utilityThreshold() const { return u_t_; }
+  const PlannerConfig& config() const { return config_; }
+
+  /// Scores candidates in place (IG of the reachable ones in one batch; Eq. 3), using the
+  /// snapshot of the last refresh. Unreachable candidates keep IG 0 and utility -infinity.
+  void score(std::vector<Candidate>& candidates, const Eigen::Vector3d& camera_m) const;
+  /// Rebuilds the distance field and the gain snapshot; returns its wall time.
+  double refresh(map::MapEngine& map) { return gain_.refresh(map); }
+
+ private:
+  PlannerConfig config_;
+  GainMode mode_;
+  ViewpointSampler sampler_;
+  InfoGainEvaluator gain_;
+  double u_t_;
+};
+
+}  // namespace fvp::host::planner

@@ -1,0 +1,94 @@
+// Information gain of viewpoint candidates (paper Eq. 1-2, DESIGN.md section 6) over a
+// compact read-only snapshot of the maps, rebuilt once per planning iteration:
+// 2 bytes per fine voxel (in-region bit, occupied bit, Eq. 1 weight quantised to 1/8192)
+// and 1 byte per coarse voxel (occupied), instead of the maps' 8-byte integration voxels,
+// because the gain walks are memory bound.
+//
+// One ray from the camera centre to the target. The coarse map is walked from the camera to
+// where the ray enters the Cluster Region sphere: an occupied coarse voxel there blocks the
+// view (IG 0, N_c 0). Inside, the fine map is walked to the target voxel: every voxel inside
+// the region counts in N_c; unknown ones add Eq. 1's weight of their distance to the
+// nearest known ROI, known ones 0; the walk stops at the first occupied voxel (counted) or
+// the target. IG = sum of weights / N_c, 0 when N_c = 0. Frustum mode (our extension):
+// rays_x x rays_y rays through pixel-grid directions over the field of view, each ending at
+// the target's depth, IG the mean of the per-ray IGs. Walks use the exact fixed-point DDA
+// of kernels/fvp_dda.h, so they visit the same voxels as every map kernel.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "fvp/host/map/grid_geometry.h"
+
+namespace fvp::host::map {
+class MapEngine;
+}
+
+namespace fvp::host::planner {
+
+enum class GainMode { kSingleRay, kFrustum };
+
+// The simulated camera: 1440 x 1080 px at fx = fy = 1100 px.
+inline constexpr double kDefaultFovXRad = 1.1632;  // 2 atan(720 / 1100)
+inline constexpr double kDefaultFovYRad = 0.9130;  // 2 atan(540 / 1100)
+
+struct InfoGainConfig {
+  double max_d_m = 0.02;  ///< Eq. 1 max_d
+  GainMode mode = GainMode::kSingleRay;
+  int frustum_rays_x = 16, frustum_rays_y = 12;
+  double fov_x_rad = kDefaultFovXRad, fov_y_rad = kDefaultFovYRad;
+  /// Throws std::invalid_argument naming the field.
+  void validate() const;
+};
+
+struct ViewQuery {
+  Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d target_m = Eigen::Vector3d::Zero();
+};
+
+struct GainResult {
+  double ig = 0.0;
+  std::uint32_t region_voxels = 0;  ///< N_c (summed over rays in frustum mode)
+  std::uint64_t voxel_steps = 0;    ///< coarse + fine voxels visited
+  bool blocked = false;             ///< single ray: an occupied coarse voxel before the region
+};
+
+class InfoGainEvaluator {
+ public:
+  explicit InfoGainEvaluator(const InfoGainConfig& config);
+  const InfoGainConfig& config() const { return config_; }
+
+  /// After each integration: the ROI distance field (map.updateRoiDistance(max_d_m)) and
+  /// the snapshot. Returns the wall time it took, seconds.
+  double refresh(map::MapEngine& map);
+  /// IG of every query (OpenMP over queries; the same result for any thread count).
+  /// Throws std::logic_error before the first refresh().
+  std::vector<GainResult> evaluate(std::span<const ViewQuery> queries) const;
+  /// IG of one ray segment origin -> end (the per-ray step of both modes).
+  GainResult evaluateRay(const Eigen::Vector3d& origin_m, const Eigen::Vector3d& end_m) const;
+  std::size_t snapshotBytes() const;
+
+  // Snapshot codes of a fine voxel.
+  static constexpr std::uint16_t kInRegion = 0x8000;
+  static constexpr std::uint16_t kOccupied = 0x4000;
+  static constexpr std::uint16_t kWeightMask = 0x3FFF;
+  static constexpr double kWeightScale = 8192.0;  ///< weight 1 = 8192
+
+ private:
+  InfoGainConfig config_;
+  bool ready_ = false;
+  map::GridGeometry fine_, coarse_;
+  Eigen::Vector3d region_center_m_ = Eigen::Vector3d::Zero();
+  double region_radius_m_ = 0.0;
+  std::vector<std::uint16_t> fine_codes_;
+  std::vector<std::uint8_t> coarse_occupied_;
+};
+
+/// Eq. 1: the weight of an unknown voxel at distance d_m from the nearest known ROI.
+inline double roiProximityWeight(double d_m, double max_d_m) {
+  return d_m < max_d_m ? 0.5 + 0.5 * (max_d_m - d_m) / max_d_m : 0.5;
+}
+
+}  // namespace fvp::host::planner

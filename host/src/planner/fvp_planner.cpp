@@ -1,0 +1,120 @@
+#include "fvp/host/planner/fvp_planner.h"
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <numeric>
+
+#include "fvp/host/map/map_engine.h"
+
+namespace fvp::host::planner {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+void addTiming(StageTimings& timings, const std::string& stage, double s) {
+  for (auto& [name, value] : timings)
+    if (name == stage) {
+      value += s;
+      return;
+    }
+  timings.emplace_back(stage, s);
+}
+
+InfoGainConfig gainConfig(const PlannerConfig& config, GainMode mode) {
+  InfoGainConfig g;
+  g.max_d_m = config.max_d_m;
+  g.mode = mode;
+  return g;
+}
+
+}  // namespace
+
+FvpPlanner::FvpPlanner(const PlannerConfig& config, std::uint64_t seed, GainMode mode)
+    : config_(config),
+      mode_(mode),
+      sampler_(config, seed * 0x9E3779B97F4A7C15ull ^ static_cast<std::uint64_t>(config.seed)),
+      gain_(gainConfig(config, mode)),
+      u_t_(config.utility_threshold) {
+  config_.validate();
+}
+
+void FvpPlanner::score(std::vector<Candidate>& candidates, const Eigen::Vector3d& camera_m) const {
+  std::vector<ViewQuery> queries;
+  std::vector<std::size_t> index;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    candidates[i].ig = 0.0;
+    candidates[i].utility = -std::numeric_limits<double>::infinity();
+    if (!candidates[i].reachable) continue;
+    queries.push_back({candidates[i].T_world_camera, candidates[i].target_m});
+    index.push_back(i);
+  }
+  const std::vector<GainResult> gains = gain_.evaluate(queries);
+  for (std::size_t k = 0; k < index.size(); ++k) {
+    Candidate& c = candidates[index[k]];
+    c.ig = gains[k].ig;
+    c.utility = c.ig - config_.alpha_per_m * (c.position_m() - camera_m).norm();
+  }
+}
+
+PlanStep FvpPlanner::planAndMove(map::MapEngine& map, const Eigen::Isometry3d& T_world_camera_now,
+                                 const ReachabilityFn& reachable, const MoveToPoseFn& move) {
+  PlanStep step;
+  auto t = Clock::now();
+  gain_.refresh(map);
+  addTiming(step.timings_s, "snapshot", since(t));
+  t = Clock::now();
+  const std::vector<map::FrontierVoxel> frontiers = map.frontiers();
+  addTiming(step.timings_s, "frontiers", since(t));
+
+  for (int round = 0; round < config_.max_sampling_rounds; ++round) {
+    ++step.sampling_rounds;
+    t = Clock::now();
+    std::vector<Candidate> candidates =
+        sampler_.sampleRoi(frontiers, config_.roi_samples, reachable);
+    std::vector<Candidate> exploration =
+        sampler_.sampleExploration(frontiers, config_.exploration_samples, reachable);
+    candidates.insert(candidates.end(), exploration.begin(), exploration.end());
+    addTiming(step.timings_s, "sample", since(t));
+    t = Clock::now();
+    score(candidates, T_world_camera_now.translation());
+    addTiming(step.timings_s, "info_gain", since(t));
+
+    // Algorithm 1, lines 6-14: the heap as a sort by utility (ties by index: deterministic).
+    std::vector<std::size_t> order(candidates.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return candidates[a].utility > candidates[b].utility;
+    });
+    step.candidates = std::move(candidates);
+    for (std::size_t i : order) {
+      const Candidate& c = step.candidates[i];
+      if (!c.reachable || !(c.utility > u_t_)) break;
+      ++step.move_attempts;
+      if (move(c.T_world_camera)) {
+        step.chosen = i;
+        u_t_ = config_.utility_threshold;  // line 16
+        return step;
+      }
+      ++step.failed_moves;
+    }
+    u_t_ *= config_.threshold_decay;  // line 18
+  }
+  return step;
+}
+
+std::string FvpPlanner::configJson() const {
+  nlohmann::ordered_json j = nlohmann::ordered_json::parse(config_.toJson());
+  j["gain_mode"] = mode_ == GainMode::kSingleRay ? "single_ray" : "frustum";
+  if (mode_ == GainMode::kFrustum) {
+    j["frustum_rays_x"] = gain_.config().frustum_rays_x;
+    j["frustum_rays_y"] = gain_.config().frustum_rays_y;
+  }
+  return j.dump();
+}
+
+}  // namespace fvp::host::planner

@@ -1,0 +1,178 @@
+#include "fvp/host/planner/info_gain_evaluator.h"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include "fvp/host/map/map_engine.h"
+
+extern "C" {
+#include "fvp_dda.h"
+}
+
+namespace fvp::host::planner {
+namespace {
+
+// Parameter of the first intersection of origin + t (end - origin), t in [0, 1], with the
+// sphere; 0 when origin is inside; negative when the segment misses it.
+double sphereEntry(const Eigen::Vector3d& o, const Eigen::Vector3d& e, const Eigen::Vector3d& c,
+                   double r) {
+  const Eigen::Vector3d d = e - o, f = o - c;
+  const double a = d.squaredNorm(), b = 2.0 * f.dot(d), cc = f.squaredNorm() - r * r;
+  if (cc <= 0.0) return 0.0;
+  if (a == 0.0) return -1.0;
+  const double disc = b * b - 4.0 * a * cc;
+  if (disc < 0.0) return -1.0;
+  const double t = (-b - std::sqrt(disc)) / (2.0 * a);
+  return (t >= 0.0 && t <= 1.0) ? t : -1.0;
+}
+
+void toFloat3(const Eigen::Vector3d& v, float* out) {
+  out[0] = static_cast<float>(v.x());
+  out[1] = static_cast<float>(v.y());
+  out[2] = static_cast<float>(v.z());
+}
+
+}  // namespace
+
+void InfoGainConfig::validate() const {
+  if (!(max_d_m > 0.0)) throw std::invalid_argument("info gain: max_d_m must be > 0");
+  if (frustum_rays_x < 1 || frustum_rays_y < 1 || frustum_rays_x * frustum_rays_y > 4096)
+    throw std::invalid_argument("info gain: frustum_rays_x * frustum_rays_y must be 1 to 4096");
+  if (!(fov_x_rad > 0.0 && fov_x_rad < 3.0) || !(fov_y_rad > 0.0 && fov_y_rad < 3.0))
+    throw std::invalid_argument("info gain: fov_x_rad and fov_y_rad must be in (0, 3) rad");
+}
+
+InfoGainEvaluator::InfoGainEvaluator(const InfoGainConfig& config) : config_(config) {
+  config_.validate();
+}
+
+double InfoGainEvaluator::refresh(map::MapEngine& map) {
+  const auto start = std::chrono::steady_clock::now();
+  map.updateRoiDistance(config_.max_d_m);
+  fine_ = map.gridGeometry(map::MapLevel::kFine);
+  coarse_ = map.gridGeometry(map::MapLevel::kCoarse);
+  region_center_m_ = map.region().center_m();
+  region_radius_m_ = map.region().radius_m();
+
+  coarse_occupied_.assign(static_cast<std::size_t>(coarse_.voxelCount()), 0);
+  const auto cstride = [&](const std::array<int, 3>& v) {
+    return v[0] + std::size_t(coarse_.dims[0]) * (v[1] + std::size_t(coarse_.dims[1]) * v[2]);
+  };
+  for (const auto& v : map.occupiedVoxels(map::MapLevel::kCoarse)) coarse_occupied_[cstride(v)] = 1;
+
+  fine_codes_.assign(static_cast<std::size_t>(fine_.voxelCount()), 0);
+  const fvp_region region = map::regionInGrid(fine_, map.region());
+  for (int z = 0; z < fine_.dims[2]; ++z)
+    for (int y = 0; y < fine_.dims[1]; ++y)
+      for (int x = 0; x < fine_.dims[0]; ++x) {
+        if (!fvp_region_contains(&region, x, y, z)) continue;
+        const std::array<int, 3> index{x, y, z};
+        const map::VoxelState s = map.fineState(fine_.voxelCenter_m(index));
+        std::uint16_t code = kInRegion;
+        if (s.occupancy == map::VoxelClass::kOccupied) {
+          code |= kOccupied;
+        } else if (s.occupancy == map::VoxelClass::kUnknown) {
+          const double w = roiProximityWeight(map.roiDistance_m(index), config_.max_d_m);
+          code |= static_cast<std::uint16_t>(std::lround(w * kWeightScale));
+        }
+        fine_codes_[x + std::size_t(fine_.dims[0]) * (y + std::size_t(fine_.dims[1]) * z)] = code;
+      }
+  ready_ = true;
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+std::size_t InfoGainEvaluator::snapshotBytes() const {
+  return fine_codes_.size() * sizeof(std::uint16_t) + coarse_occupied_.size();
+}
+
+GainResult InfoGainEvaluator::evaluateRay(const Eigen::Vector3d& origin_m,
+                                          const Eigen::Vector3d& end_m) const {
+  GainResult r;
+  const double t_enter = sphereEntry(origin_m, end_m, region_center_m_, region_radius_m_);
+  if (t_enter < 0.0) return r;  // never enters the region: nothing to gain
+  const Eigen::Vector3d entry_m = origin_m + t_enter * (end_m - origin_m);
+  float o[3], e[3];
+
+  // Coarse map up to the region: the first occupied voxel blocks the view.
+  if (t_enter > 0.0) {
+    const fvp_grid_params g = coarse_.params();
+    fvp_dda d;
+    toFloat3(origin_m, o);
+    toFloat3(entry_m, e);
+    if (fvp_dda_init(&d, &g, o, e) == 0) {
+      for (;;) {
+        ++r.voxel_steps;
+        if (coarse_occupied_[d.key[0] +
+                             std::size_t(g.dim_x) * (d.key[1] + std::size_t(g.dim_y) * d.key[2])]) {
+          r.blocked = true;
+          return r;
+        }
+        const int axis = fvp_dda_next_axis(&d);
+        if (axis < 0) break;
+        fvp_dda_advance(&d, axis);
+        if (d.key[axis] < 0 || d.key[axis] >= (&g.dim_x)[axis]) break;
+      }
+    }
+  }
+
+  // Fine map from the region's surface to the end point.
+  const fvp_grid_params g = fine_.params();
+  fvp_dda d;
+  toFloat3(entry_m, o);
+  toFloat3(end_m, e);
+  if (fvp_dda_init(&d, &g, o, e) != 0) return r;
+  std::uint64_t weight_sum = 0;
+  for (;;) {
+    ++r.voxel_steps;
+    const std::uint16_t code =
+        fine_codes_[d.key[0] + std::size_t(g.dim_x) * (d.key[1] + std::size_t(g.dim_y) * d.key[2])];
+    if (code & kInRegion) {
+      ++r.region_voxels;
+      if (code & kOccupied) break;
+      weight_sum += code & kWeightMask;
+    }
+    const int axis = fvp_dda_next_axis(&d);
+    if (axis < 0) break;
+    fvp_dda_advance(&d, axis);
+    if (d.key[axis] < 0 || d.key[axis] >= (&g.dim_x)[axis]) break;
+  }
+  if (r.region_voxels > 0) r.ig = double(weight_sum) / kWeightScale / r.region_voxels;
+  return r;
+}
+
+std::vector<GainResult> InfoGainEvaluator::evaluate(std::span<const ViewQuery> queries) const {
+  if (!ready_) throw std::logic_error("InfoGainEvaluator::evaluate before refresh()");
+  std::vector<GainResult> out(queries.size());
+  const double tx = std::tan(0.5 * config_.fov_x_rad), ty = std::tan(0.5 * config_.fov_y_rad);
+  const int nx = config_.frustum_rays_x, ny = config_.frustum_rays_y;
+#pragma omp parallel for schedule(dynamic, 16)
+  for (std::ptrdiff_t i = 0; i < std::ptrdiff_t(queries.size()); ++i) {
+    const ViewQuery& q = queries[i];
+    const Eigen::Vector3d c = q.T_world_camera.translation();
+    if (config_.mode == GainMode::kSingleRay) {
+      out[i] = evaluateRay(c, q.target_m);
+      continue;
+    }
+    // Frustum: rays end on the plane through the target parallel to the image.
+    const double depth = (q.T_world_camera.inverse() * q.target_m).z();
+    GainResult sum;
+    double ig_sum = 0.0;
+    if (depth > 0.0) {
+      for (int v = 0; v < ny; ++v)
+        for (int u = 0; u < nx; ++u) {
+          const Eigen::Vector3d dir_camera(((u + 0.5) / nx * 2.0 - 1.0) * tx,
+                                           ((v + 0.5) / ny * 2.0 - 1.0) * ty, 1.0);
+          const GainResult ray = evaluateRay(c, q.T_world_camera * (depth * dir_camera));
+          ig_sum += ray.ig;
+          sum.region_voxels += ray.region_voxels;
+          sum.voxel_steps += ray.voxel_steps;
+        }
+    }
+    sum.ig = ig_sum / (nx * ny);
+    out[i] = sum;
+  }
+  return out;
+}
+
+}  // namespace fvp::host::planner

@@ -1,0 +1,69 @@
+#include "fvp/host/planner/viewpoint_sampler.h"
+
+#include "fvp/host/core/look_at.h"
+
+namespace fvp::host::planner {
+
+const char* toString(CandidateKind kind) {
+  return kind == CandidateKind::kRoi ? "roi" : "exploration";
+}
+
+ViewpointSampler::ViewpointSampler(const PlannerConfig& config, std::uint64_t seed)
+    : config_(config), rng_(seed) {}
+
+Eigen::Vector3d ViewpointSampler::randomUnitVector() {
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (;;) {
+    const Eigen::Vector3d v(normal(rng_), normal(rng_), normal(rng_));
+    const double n = v.norm();
+    if (n > 1e-9) return v / n;
+  }
+}
+
+Candidate ViewpointSampler::make(CandidateKind kind, const Eigen::Vector3d& target_m,
+                                 const Eigen::Vector3d& direction,
+                                 const ReachabilityFn& reachable) {
+  std::uniform_real_distribution<double> distance(config_.sensor_min_m, config_.sensor_max_m);
+  Candidate c;
+  c.kind = kind;
+  c.target_m = target_m;
+  c.T_world_camera = lookAtPose(target_m + distance(rng_) * direction, target_m);
+  c.reachable = !reachable || reachable(c.T_world_camera);
+  return c;
+}
+
+std::vector<Candidate> ViewpointSampler::sampleRoi(const std::vector<map::FrontierVoxel>& frontiers,
+                                                   int count, const ReachabilityFn& reachable) {
+  std::vector<const map::FrontierVoxel*> targets;
+  for (const auto& f : frontiers)
+    if (f.roi_frontier) targets.push_back(&f);
+  std::vector<Candidate> out;
+  if (targets.empty()) return out;
+  std::uniform_int_distribution<std::size_t> pick(0, targets.size() - 1);
+  out.reserve(count);
+  for (int i = 0; i < count; ++i) {
+    const map::FrontierVoxel& t = *targets[pick(rng_)];
+    out.push_back(make(CandidateKind::kRoi, t.center_m, randomUnitVector(), reachable));
+  }
+  return out;
+}
+
+std::vector<Candidate> ViewpointSampler::sampleExploration(
+    const std::vector<map::FrontierVoxel>& frontiers, int count, const ReachabilityFn& reachable) {
+  std::vector<const map::FrontierVoxel*> targets;
+  for (const auto& f : frontiers)
+    if (f.exploration_frontier) targets.push_back(&f);
+  std::vector<Candidate> out;
+  if (targets.empty()) return out;
+  std::uniform_int_distribution<std::size_t> pick(0, targets.size() - 1);
+  out.reserve(count);
+  for (int i = 0; i < count; ++i) {
+    const map::FrontierVoxel& t = *targets[pick(rng_)];
+    const Eigen::Vector3d dir =
+        t.normal.squaredNorm() > 0.0 ? t.normal.normalized() : randomUnitVector();
+    out.push_back(make(CandidateKind::kExploration, t.center_m, dir, reachable));
+  }
+  return out;
+}
+
+}  // namespace fvp::host::planner

@@ -1,0 +1,66 @@
+// The parts of one simulated trial that change with the planner and the pipeline stages:
+// the per-view mapping session (perception -> maps -> TSDF), the viewpoint planner, the
+// views kept for sizing, the sizing and scoring against ground truth, and the files a
+// trial writes. trial.cpp holds the loop and the clock; this holds what the loop drives.
+#pragma once
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "fvp/host/perception/stereo_frame.h"
+#include "fvp/host/planner/view_planner.h"
+#include "fvp/host/session/mapping_session.h"
+#include "fvp/robot/sim/trial.h"
+#include "fvp/robot/sim/world.h"
+
+namespace fvp::accel {
+class Backend;
+}
+
+namespace fvp::robot::sim {
+
+/// The map engine a planner runs on unless --engine says otherwise (FVP: grid, RVP: octomap,
+/// as the original did).
+std::string defaultEngine(const std::string& planner);
+/// Where the workspace tree is cached between trials: $FVP_CACHE_DIR, else
+/// $XDG_CACHE_HOME/fvp, else ~/.cache/fvp, else a directory under the system temp dir.
+std::string defaultCacheDir();
+
+/// What one view did, with the wall times the clock charges.
+struct ViewOutcome {
+  host::ViewResult result;
+  double mapping_s = 0.0;  ///< map integration (charged as mapping)
+  double tsdf_s = 0.0;     ///< TSDF integration (charged as TSDF)
+};
+
+class TrialParts {
+ public:
+  TrialParts(const TrialOptions& options, const std::string& engine, accel::Backend* backend);
+  ~TrialParts();
+
+  ViewOutcome addView(const host::StereoFrame& frame);
+  /// Null until a view detected the tag.
+  host::map::MapEngine* map();
+  host::planner::ViewPlanner& planner();
+  /// The trial-level configuration (engine, map, perception, sizing) as JSON.
+  nlohmann::json configJson() const;
+  /// Writes a small PNG of the view's left image for the report.
+  void keepViewImage(int index, const host::StereoFrame& frame) const;
+  /// Sizes the fruitlets from the views so far and scores them against the world's ground
+  /// truth: {"fruitlets", "detections", "metrics", ...} of result.json.
+  nlohmann::json sizeAndScore(const World& world, const std::filesystem::path& out_dir);
+  /// Maps, surface, clusters, report.md and result.json (atomically) into out_dir.
+  void writeOutputs(const nlohmann::json& result, const World& world,
+                    const std::vector<Eigen::Vector3d>& camera_path,
+                    const std::filesystem::path& out_dir) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace fvp::robot::sim
