@@ -31,6 +31,27 @@ void writePlyPoints(const std::filesystem::path& path, const std::vector<Eigen::
   writeFileAtomically(path, "point cloud (PLY)", bytes);
 }
 
+void writePlyColoredPoints(const std::filesystem::path& path,
+                           const std::vector<Eigen::Vector3f>& points,
+                           const std::vector<std::array<std::uint8_t, 3>>& colors_rgb,
+                           const std::string& comment) {
+  if (colors_rgb.size() != points.size())
+    throw std::invalid_argument("writePlyColoredPoints: one colour per point expected");
+  std::string bytes = "ply\nformat binary_little_endian 1.0\ncomment " + comment +
+                      "\nelement vertex " + std::to_string(points.size()) +
+                      "\nproperty float x\nproperty float y\nproperty float z\n"
+                      "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
+  const std::size_t offset = bytes.size();
+  bytes.resize(offset + points.size() * (3 * sizeof(float) + 3));
+  char* dst = bytes.data() + offset;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    std::memcpy(dst, points[i].data(), 3 * sizeof(float));
+    std::memcpy(dst + 3 * sizeof(float), colors_rgb[i].data(), 3);
+    dst += 3 * sizeof(float) + 3;
+  }
+  writeFileAtomically(path, "coloured point cloud (PLY)", bytes);
+}
+
 std::vector<Eigen::Vector3f> readPlyPoints(const std::filesystem::path& path) {
   const std::string name = path.string();
   auto fail = [&](const std::string& field, const std::string& expected) -> void {

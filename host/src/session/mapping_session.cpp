@@ -17,7 +17,7 @@ MappingSession::MappingSession(PerceptionConfig perception, std::string engine,
   map_config_.validate();
 }
 
-ViewResult MappingSession::addView(const StereoFrame& frame) {
+ViewResult MappingSession::addView(const StereoFrame& frame, PerceptionResult* perceived_out) {
   ViewResult view;
   view.index = views_.size();
   const auto t0 = std::chrono::steady_clock::now();
@@ -39,8 +39,9 @@ ViewResult MappingSession::addView(const StereoFrame& frame) {
   if (map_) {
     integrate(view.index, perceived.clouds);
   } else {
-    pending_.emplace_back(view.index, std::move(perceived.clouds));
+    pending_.emplace_back(view.index, perceived.clouds);
   }
+  if (perceived_out) *perceived_out = std::move(perceived);
   return views_.back();
 }
 

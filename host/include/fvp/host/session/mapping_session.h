@@ -47,8 +47,9 @@ class MappingSession {
                  accel::Backend* backend);
 
   /// Perceives one view and integrates it (and any views kept from before the region was
-  /// known) into the map.
-  ViewResult addView(const StereoFrame& frame);
+  /// known) into the map. perceived (optional) receives the view's perception result (the
+  /// mask and disparity that TSDF integration and sizing use), its clouds moved out.
+  ViewResult addView(const StereoFrame& frame, PerceptionResult* perceived = nullptr);
 
   /// Null / empty until a view's tag was detected.
   const std::optional<ClusterRegion>& region() const { return region_; }

@@ -1,0 +1,225 @@
+#include "fvp/host/sizing/fruitlet_sizer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+#include "fvp/host/sizing/point_filters.h"
+
+namespace fvp::host::sizing {
+namespace {
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/// Connected fruitlet segments of one image (8-connected), computed once per image.
+struct Segments {
+  cv::Mat labels;  ///< CV_32S, 0 = background
+  cv::Mat stats, centroids;
+};
+
+Segments segment(const cv::Mat& mask) {
+  Segments s;
+  cv::Mat binary = mask != 0;
+  cv::connectedComponentsWithStats(binary, s.labels, s.stats, s.centroids, 8, CV_32S);
+  return s;
+}
+
+/// Max valid disparity in the (2h+1)^2 window at (u, v); 0 when none.
+double windowMaxDisparity(const cv::Mat& disparity, int u, int v, int h) {
+  double best = 0.0;
+  for (int y = std::max(0, v - h); y <= std::min(disparity.rows - 1, v + h); ++y) {
+    const float* d = disparity.ptr<float>(y);
+    for (int x = std::max(0, u - h); x <= std::min(disparity.cols - 1, u + h); ++x)
+      if (std::isfinite(d[x]) && d[x] > best) best = d[x];
+  }
+  return best;
+}
+
+}  // namespace
+
+const char* toString(SizingEstimator estimator) {
+  return estimator == SizingEstimator::kOurs ? "ours" : "paper";
+}
+
+void SizingConfig::validate() const {
+  if (outlier_neighbours < 1) throw std::invalid_argument("sizing: outlier_neighbours >= 1");
+  if (!(dbscan_eps_m > 0.0)) throw std::invalid_argument("sizing: dbscan_eps_m > 0");
+  if (dbscan_min_samples < 1) throw std::invalid_argument("sizing: dbscan_min_samples >= 1");
+  if (disparity_window_half_px < 0) throw std::invalid_argument("sizing: window half >= 0");
+}
+
+bool fitSphere(const std::vector<Eigen::Vector3f>& points, Eigen::Vector3d& center_m,
+               double& radius_m) {
+  if (points.size() < 4) return false;
+  // |p|^2 = 2 c.p + (r^2 - |c|^2): linear in (c, k); centred for conditioning.
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& p : points) mean += p.cast<double>();
+  mean /= double(points.size());
+  Eigen::MatrixXd A(points.size(), 4);
+  Eigen::VectorXd b(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d q = points[i].cast<double>() - mean;
+    A.row(i) << 2.0 * q.x(), 2.0 * q.y(), 2.0 * q.z(), 1.0;
+    b[i] = q.squaredNorm();
+  }
+  const Eigen::Vector4d x = A.colPivHouseholderQr().solve(b);
+  if (!x.allFinite()) return false;
+  const Eigen::Vector3d c = x.head<3>();
+  const double r2 = x[3] + c.squaredNorm();
+  if (!(r2 > 0.0)) return false;
+  center_m = c + mean;
+  radius_m = std::sqrt(r2);
+  return true;
+}
+
+SizingResult sizeFruitlets(const std::vector<SizingView>& views,
+                           const std::vector<Eigen::Vector3f>& surface_points_m,
+                           const std::function<bool(const Eigen::Vector3f&)>& in_roi_voxel,
+                           const SizingConfig& config) {
+  config.validate();
+  SizingResult result;
+  result.surface_points = surface_points_m.size();
+  std::vector<Eigen::Vector3f> roi;
+  for (const auto& p : surface_points_m)
+    if (!in_roi_voxel || in_roi_voxel(p)) roi.push_back(p);
+  result.in_roi_points = roi.size();
+  for (std::size_t i :
+       statisticalOutlierInliers(roi, config.outlier_neighbours, config.outlier_std_ratio))
+    result.points.push_back(roi[i]);
+  result.inlier_points = result.points.size();
+  result.labels = dbscan(result.points, config.dbscan_eps_m, config.dbscan_min_samples);
+
+  std::map<int, std::vector<Eigen::Vector3f>> clusters;
+  for (std::size_t i = 0; i < result.points.size(); ++i)
+    if (result.labels[i] != kDbscanNoise) clusters[result.labels[i]].push_back(result.points[i]);
+
+  std::vector<Segments> segments;
+  segments.reserve(views.size());
+  for (const auto& v : views) segments.push_back(segment(v.fruitlet_mask));
+
+  for (const auto& [label, pts] : clusters) {
+    if (int(pts.size()) < config.min_cluster_points) {
+      ++result.events.small_clusters;
+      continue;
+    }
+    FruitletEstimate f;
+    f.points = pts.size();
+    for (const auto& p : pts) f.centroid_m += p.cast<double>();
+    f.centroid_m /= double(pts.size());
+
+    for (std::size_t vi = 0; vi < views.size(); ++vi) {
+      const SizingView& view = views[vi];
+      const StereoIntrinsics& in = view.intrinsics;
+      const Eigen::Isometry3d T_camera_world = view.T_world_camera.inverse();
+      const cv::Mat& labels = segments[vi].labels;
+      std::map<int, int> votes;
+      int in_image = 0;
+      for (const auto& p : pts) {
+        const auto px = in.project(T_camera_world * p.cast<double>());
+        if (!px) continue;
+        const int u = int(std::lround(px->x())), v = int(std::lround(px->y()));
+        if (u < 0 || v < 0 || u >= labels.cols || v >= labels.rows) continue;
+        ++in_image;
+        if (const int l = labels.at<int>(v, u); l > 0) ++votes[l];
+      }
+      if (in_image == 0) continue;
+      int best = 0, best_votes = 0;
+      for (const auto& [l, n] : votes)
+        if (n > best_votes) best = l, best_votes = n;
+      const double visible = double(best_votes) / in_image;
+      if (best == 0 || visible < config.min_visible_fraction) {
+        ++result.events.not_visible;
+        continue;
+      }
+      const cv::Mat& stats = segments[vi].stats;
+      const int x0 = stats.at<int>(best, cv::CC_STAT_LEFT),
+                y0 = stats.at<int>(best, cv::CC_STAT_TOP);
+      const int w = stats.at<int>(best, cv::CC_STAT_WIDTH),
+                h = stats.at<int>(best, cv::CC_STAT_HEIGHT);
+      if (stats.at<int>(best, cv::CC_STAT_AREA) < config.min_segment_pixels) {
+        ++result.events.not_visible;
+        continue;
+      }
+      // Hull of the segment's pixel centres (as cv2.fitEllipse on the hull in the authors' code).
+      std::vector<cv::Point> pixels;
+      for (int y = y0; y < y0 + h; ++y)
+        for (int x = x0; x < x0 + w; ++x)
+          if (labels.at<int>(y, x) == best) pixels.emplace_back(x, y);
+      std::vector<cv::Point> hull;
+      cv::convexHull(pixels, hull);
+      if (hull.size() < 5) {
+        ++result.events.not_visible;
+        continue;
+      }
+      const cv::RotatedRect ellipse = cv::fitEllipse(hull);
+      const double minor_px = std::min(ellipse.size.width, ellipse.size.height);
+      const cv::Point2d c(segments[vi].centroids.at<double>(best, 0),
+                          segments[vi].centroids.at<double>(best, 1));
+      const double d_max =
+          windowMaxDisparity(view.disparity_px, int(std::lround(c.x)), int(std::lround(c.y)),
+                             config.disparity_window_half_px);
+      if (!(d_max > 0.0)) {
+        ++result.events.invalid_disparity_windows;
+        continue;
+      }
+      if (d_max >= config.saturated_disparity_px) {
+        ++result.events.saturated_windows;
+        continue;
+      }
+      ImageSize s;
+      s.view = int(vi);
+      s.minor_axis_px = minor_px;
+      s.max_disparity_px = d_max;
+      s.visible_fraction = visible;
+      s.touches_border = x0 <= 0 || y0 <= 0 || x0 + w >= labels.cols || y0 + h >= labels.rows;
+      s.size_paper_mm = 1000.0 * minor_px * in.baseline_m / d_max;
+      const double m = minor_px + 1.0;  // hull through pixel centres: half a pixel each side
+      const double z_near = in.fx_px * in.baseline_m / d_max;
+      s.size_ours_mm = 1000.0 * m * z_near / (in.fx_px - 0.5 * m);
+      f.per_image.push_back(s);
+    }
+    if (f.per_image.empty()) {
+      ++result.events.unsized_clusters;
+      continue;
+    }
+    if (f.per_image.size() == 1) ++result.events.single_image_fruitlets;
+
+    std::vector<double> all, good;
+    f.size_paper_mm = 0.0;
+    for (const auto& s : f.per_image) {
+      f.size_paper_mm = std::max(f.size_paper_mm, s.size_paper_mm);
+      all.push_back(s.size_ours_mm);
+      if (s.visible_fraction >= config.well_seen_fraction && !s.touches_border)
+        good.push_back(s.size_ours_mm);
+    }
+    f.size_ours_mm = median(good.empty() ? all : good);
+
+    double radius = 0.0;
+    f.sphere_center_m = f.centroid_m;
+    Eigen::Vector3d sphere;
+    // Accept a sphere only of a fruitlet's size near the points (3-8 mm radius and margin).
+    if (fitSphere(pts, sphere, radius) && radius > 0.0015 && radius < 0.012 &&
+        (sphere - f.centroid_m).norm() < 0.010)
+      f.sphere_center_m = sphere;
+    else
+      ++result.events.failed_sphere_fits;
+
+    if (config.estimator == SizingEstimator::kPaper) {
+      f.center_m = f.centroid_m;
+      f.size_mm = f.size_paper_mm;
+    } else {
+      f.center_m = f.sphere_center_m;
+      f.size_mm = f.size_ours_mm;
+    }
+    result.fruitlets.push_back(std::move(f));
+  }
+  return result;
+}
+
+}  // namespace fvp::host::sizing
