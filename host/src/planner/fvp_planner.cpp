@@ -65,7 +65,11 @@ PlanStep FvpPlanner::planAndMove(map::MapEngine& map, const Eigen::Isometry3d& T
                                  const ReachabilityFn& reachable, const MoveToPoseFn& move) {
   PlanStep step;
   auto t = Clock::now();
-  gain_.refresh(map);
+  // The snapshot holds until new scans arrive (planning again after failed moves reuses it).
+  if (!refreshed_ || gain_.snapshotScans() != map.scanCount()) {
+    gain_.refresh(map);
+    refreshed_ = true;
+  }
   addTiming(step.timings_s, "snapshot", since(t));
   t = Clock::now();
   const std::vector<map::FrontierVoxel> frontiers = map.frontiers();
@@ -79,6 +83,12 @@ PlanStep FvpPlanner::planAndMove(map::MapEngine& map, const Eigen::Isometry3d& T
     std::vector<Candidate> exploration =
         sampler_.sampleExploration(frontiers, config_.exploration_samples, reachable);
     candidates.insert(candidates.end(), exploration.begin(), exploration.end());
+    if (config_.camera_clearance_m > 0.0)
+      for (Candidate& c : candidates)
+        if (c.reachable && gain_.occupiedWithin(c.position_m(), config_.camera_clearance_m)) {
+          c.reachable = false;
+          ++step.rejected_clearance;
+        }
     addTiming(step.timings_s, "sample", since(t));
     t = Clock::now();
     score(candidates, T_world_camera_now.translation());

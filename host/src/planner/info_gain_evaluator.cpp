@@ -79,7 +79,28 @@ double InfoGainEvaluator::refresh(map::MapEngine& map) {
         fine_codes_[x + std::size_t(fine_.dims[0]) * (y + std::size_t(fine_.dims[1]) * z)] = code;
       }
   ready_ = true;
+  snapshot_scans_ = map.scanCount();
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+bool InfoGainEvaluator::occupiedWithin(const Eigen::Vector3d& p_m, double radius_m) const {
+  const double vs = coarse_.voxel_size_m;
+  const auto lo = coarse_.latticeIndex(p_m - Eigen::Vector3d::Constant(radius_m));
+  const auto hi = coarse_.latticeIndex(p_m + Eigen::Vector3d::Constant(radius_m));
+  for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
+    for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+      for (std::int64_t x = lo[0]; x <= hi[0]; ++x) {
+        const std::int64_t g[3] = {x - coarse_.first_voxel[0], y - coarse_.first_voxel[1],
+                                   z - coarse_.first_voxel[2]};
+        if (g[0] < 0 || g[1] < 0 || g[2] < 0 || g[0] >= coarse_.dims[0] ||
+            g[1] >= coarse_.dims[1] || g[2] >= coarse_.dims[2])
+          continue;
+        const Eigen::Vector3d c((x + 0.5) * vs, (y + 0.5) * vs, (z + 0.5) * vs);
+        if ((c - p_m).norm() > radius_m) continue;
+        if (coarse_occupied_[g[0] + std::size_t(coarse_.dims[0]) * (g[1] + std::size_t(coarse_.dims[1]) * g[2])])
+          return true;
+      }
+  return false;
 }
 
 std::size_t InfoGainEvaluator::snapshotBytes() const {

@@ -43,6 +43,8 @@ const std::vector<KeySpec>& keySpecs() {
       {"max_sampling_rounds",
        [](auto& c, auto& n, auto& w) { c.max_sampling_rounds = as<int>(n, w, "an integer"); }},
       {"seed", [](auto& c, auto& n, auto& w) { c.seed = as<std::int64_t>(n, w, "an integer"); }},
+      {"camera_clearance_m",
+       [](auto& c, auto& n, auto& w) { c.camera_clearance_m = as<double>(n, w, "a number"); }},
   };
   return specs;
 }
@@ -84,6 +86,8 @@ void PlannerConfig::validate(const std::string& source) const {
           "a utility in [-10, 10]");
   require(threshold_decay > 0.0 && threshold_decay < 1.0, source, "threshold_decay",
           "a factor b in (0, 1)");
+  require(camera_clearance_m >= 0.0 && camera_clearance_m < 1.0, source, "camera_clearance_m",
+          "a distance in [0, 1) m");
   require(max_sampling_rounds >= 1 && max_sampling_rounds <= 1000, source, "max_sampling_rounds",
           "1 to 1000 rounds");
 }
@@ -98,7 +102,8 @@ std::string PlannerConfig::toJson() const {
                                     {"utility_threshold", utility_threshold},
                                     {"threshold_decay", threshold_decay},
                                     {"max_sampling_rounds", max_sampling_rounds},
-                                    {"seed", seed}};
+                                    {"seed", seed},
+                                    {"camera_clearance_m", camera_clearance_m}};
   return j.dump();
 }
 

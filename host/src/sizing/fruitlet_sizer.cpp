@@ -11,6 +11,10 @@
 namespace fvp::host::sizing {
 namespace {
 
+// The hull runs through the centres of the segment's boundary pixels, inside the true
+// silhouette: measured ~0.6 px short across on rendered spheres (DESIGN.md section 10).
+constexpr double kHullShortfallPx = 0.6;
+
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
@@ -103,11 +107,44 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
   segments.reserve(views.size());
   for (const auto& v : views) segments.push_back(segment(v.fruitlet_mask));
 
+  // Which segment of each image every cluster falls on, first for all clusters, so that a
+  // segment two clusters fall on (touching fruitlets merged in 2-D) is known.
+  std::vector<std::pair<int, const std::vector<Eigen::Vector3f>*>> sized;
   for (const auto& [label, pts] : clusters) {
     if (int(pts.size()) < config.min_cluster_points) {
       ++result.events.small_clusters;
       continue;
     }
+    sized.emplace_back(label, &pts);
+  }
+  struct Fall {
+    bool in_image = false;
+    int segment = 0;
+    double visible = 0.0;
+  };
+  std::vector<std::vector<Fall>> falls(sized.size(), std::vector<Fall>(views.size()));
+  for (std::size_t ci = 0; ci < sized.size(); ++ci)
+    for (std::size_t vi = 0; vi < views.size(); ++vi) {
+      const Eigen::Isometry3d T_camera_world = views[vi].T_world_camera.inverse();
+      const cv::Mat& labels = segments[vi].labels;
+      std::map<int, int> votes;
+      int in_image = 0;
+      for (const auto& p : *sized[ci].second) {
+        const auto px = views[vi].intrinsics.project(T_camera_world * p.cast<double>());
+        if (!px) continue;
+        const int u = int(std::lround(px->x())), v = int(std::lround(px->y()));
+        if (u < 0 || v < 0 || u >= labels.cols || v >= labels.rows) continue;
+        ++in_image;
+        if (const int l = labels.at<int>(v, u); l > 0) ++votes[l];
+      }
+      int best = 0, best_votes = 0;
+      for (const auto& [l, n] : votes)
+        if (n > best_votes) best = l, best_votes = n;
+      if (in_image > 0) falls[ci][vi] = {true, best, double(best_votes) / in_image};
+    }
+
+  for (std::size_t ci = 0; ci < sized.size(); ++ci) {
+    const std::vector<Eigen::Vector3f>& pts = *sized[ci].second;
     FruitletEstimate f;
     f.points = pts.size();
     for (const auto& p : pts) f.centroid_m += p.cast<double>();
@@ -116,23 +153,14 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
     for (std::size_t vi = 0; vi < views.size(); ++vi) {
       const SizingView& view = views[vi];
       const StereoIntrinsics& in = view.intrinsics;
-      const Eigen::Isometry3d T_camera_world = view.T_world_camera.inverse();
       const cv::Mat& labels = segments[vi].labels;
-      std::map<int, int> votes;
-      int in_image = 0;
-      for (const auto& p : pts) {
-        const auto px = in.project(T_camera_world * p.cast<double>());
-        if (!px) continue;
-        const int u = int(std::lround(px->x())), v = int(std::lround(px->y()));
-        if (u < 0 || v < 0 || u >= labels.cols || v >= labels.rows) continue;
-        ++in_image;
-        if (const int l = labels.at<int>(v, u); l > 0) ++votes[l];
-      }
-      if (in_image == 0) continue;
-      int best = 0, best_votes = 0;
-      for (const auto& [l, n] : votes)
-        if (n > best_votes) best = l, best_votes = n;
-      const double visible = double(best_votes) / in_image;
+      const int best = falls[ci][vi].segment;
+      const double visible = falls[ci][vi].visible;
+      if (!falls[ci][vi].in_image) continue;
+      bool shared = false;
+      for (std::size_t other = 0; other < sized.size(); ++other)
+        shared |= other != ci && falls[other][vi].segment == best &&
+                  falls[other][vi].visible >= config.min_visible_fraction;
       if (best == 0 || visible < config.min_visible_fraction) {
         ++result.events.not_visible;
         continue;
@@ -177,9 +205,13 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
       s.minor_axis_px = minor_px;
       s.max_disparity_px = d_max;
       s.visible_fraction = visible;
+      s.shared_segment = shared;
+      s.axis_ratio = std::max(ellipse.size.width, ellipse.size.height) > 0
+                         ? minor_px / std::max(ellipse.size.width, ellipse.size.height)
+                         : 0.0;
       s.touches_border = x0 <= 0 || y0 <= 0 || x0 + w >= labels.cols || y0 + h >= labels.rows;
       s.size_paper_mm = 1000.0 * minor_px * in.baseline_m / d_max;
-      const double m = minor_px + 1.0;  // hull through pixel centres: half a pixel each side
+      const double m = minor_px + kHullShortfallPx;
       const double z_near = in.fx_px * in.baseline_m / d_max;
       s.size_ours_mm = 1000.0 * m * z_near / (in.fx_px - 0.5 * m);
       f.per_image.push_back(s);
@@ -195,7 +227,8 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
     for (const auto& s : f.per_image) {
       f.size_paper_mm = std::max(f.size_paper_mm, s.size_paper_mm);
       all.push_back(s.size_ours_mm);
-      if (s.visible_fraction >= config.well_seen_fraction && !s.touches_border)
+      if (s.visible_fraction >= config.well_seen_fraction && !s.touches_border &&
+          !s.shared_segment && s.axis_ratio >= config.min_axis_ratio)
         good.push_back(s.size_ours_mm);
     }
     f.size_ours_mm = median(good.empty() ? all : good);

@@ -328,7 +328,9 @@ nlohmann::json TrialParts::sizeAndScore(const World& world, const std::filesyste
                            {"minor_axis_px", s.minor_axis_px},
                            {"max_disparity_px", s.max_disparity_px},
                            {"visible_fraction", s.visible_fraction},
-                           {"touches_border", s.touches_border}});
+                           {"touches_border", s.touches_border},
+                           {"shared_segment", s.shared_segment},
+                           {"axis_ratio", s.axis_ratio}});
     detections.push_back({{"center_m", vec3(f.center_m)},
                           {"size_mm", f.size_mm},
                           {"centroid_m", vec3(f.centroid_m)},

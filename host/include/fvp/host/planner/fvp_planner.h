@@ -33,7 +33,10 @@ class FvpPlanner : public ViewPlanner {
   /// snapshot of the last refresh. Unreachable candidates keep IG 0 and utility -infinity.
   void score(std::vector<Candidate>& candidates, const Eigen::Vector3d& camera_m) const;
   /// Rebuilds the distance field and the gain snapshot; returns its wall time.
-  double refresh(map::MapEngine& map) { return gain_.refresh(map); }
+  double refresh(map::MapEngine& map) {
+    refreshed_ = true;
+    return gain_.refresh(map);
+  }
 
  private:
   PlannerConfig config_;
@@ -41,6 +44,7 @@ class FvpPlanner : public ViewPlanner {
   ViewpointSampler sampler_;
   InfoGainEvaluator gain_;
   double u_t_;
+  bool refreshed_ = false;
 };
 
 }  // namespace fvp::host::planner

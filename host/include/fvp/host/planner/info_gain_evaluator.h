@@ -69,6 +69,11 @@ class InfoGainEvaluator {
   /// IG of one ray segment origin -> end (the per-ray step of both modes).
   GainResult evaluateRay(const Eigen::Vector3d& origin_m, const Eigen::Vector3d& end_m) const;
   std::size_t snapshotBytes() const;
+  /// Whether any occupied coarse voxel lies within radius_m of p (voxel centres): a camera
+  /// body there would collide, so the motion planner need not be asked.
+  bool occupiedWithin(const Eigen::Vector3d& p_m, double radius_m) const;
+  /// Scans the snapshot was built from (MapEngine::scanCount at the last refresh).
+  std::size_t snapshotScans() const { return snapshot_scans_; }
 
   // Snapshot codes of a fine voxel.
   static constexpr std::uint16_t kInRegion = 0x8000;
@@ -79,6 +84,7 @@ class InfoGainEvaluator {
  private:
   InfoGainConfig config_;
   bool ready_ = false;
+  std::size_t snapshot_scans_ = 0;
   map::GridGeometry fine_, coarse_;
   Eigen::Vector3d region_center_m_ = Eigen::Vector3d::Zero();
   double region_radius_m_ = 0.0;

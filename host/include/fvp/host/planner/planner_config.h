@@ -28,6 +28,10 @@ inline constexpr double kDefaultThresholdDecay = 0.8;
 // the threshold once).
 inline constexpr int kDefaultMaxSamplingRounds = 8;
 inline constexpr std::int64_t kDefaultPlannerSeed = 1;
+// Candidates with an occupied coarse voxel this close to the camera are dropped before the
+// motion planner is asked: the camera body (3 cm) plus the collision padding (1 cm) would
+// stand in it. 0 disables the check.
+inline constexpr double kDefaultCameraClearanceM = 0.04;
 
 struct PlannerConfig {
   int roi_samples = kDefaultRoiSamples;
@@ -40,6 +44,7 @@ struct PlannerConfig {
   double threshold_decay = kDefaultThresholdDecay;      ///< b
   int max_sampling_rounds = kDefaultMaxSamplingRounds;
   std::int64_t seed = kDefaultPlannerSeed;  ///< mixed with the trial's seed
+  double camera_clearance_m = kDefaultCameraClearanceM;
 
   /// Reads a YAML file; missing keys keep their defaults; unknown keys, wrong types and
   /// out-of-range values throw std::invalid_argument naming the file and the key.

@@ -54,6 +54,9 @@ struct PlanStep {
   std::size_t move_attempts = 0;  ///< moveToPose calls this iteration
   std::size_t failed_moves = 0;   ///< of which failed
   std::size_t sampling_rounds = 0;
+  /// Reachable candidates dropped before scoring because the camera body would stand in
+  /// occupied space (counted, not sent to the motion planner).
+  std::size_t rejected_clearance = 0;
   StageTimings timings_s;
   bool moved() const { return chosen.has_value(); }
 };

@@ -7,9 +7,10 @@
 // Two estimators from the same per-image measurements (both are always computed and kept):
 // - paper: the cluster's centroid, and the largest per-image Eq. 4 size;
 // - ours (default): corrects Eq. 4's two known biases (the hull runs through boundary-pixel
-//   centres, ~1 px short across; the window's maximum disparity is the nearest surface, the
+//   centres, ~0.6 px short across; the window's maximum disparity is the nearest surface, the
 //   fruit's widest section is ~r farther: s = m z / (f - m / 2)), takes the median over the
-//   images where the segment is well seen (mostly unoccluded, off the image border) instead
+//   images where the segment is well seen (mostly unoccluded, off the image border, not
+//   shared with another cluster, round as a fruitlet projects) instead
 //   of the maximum, which turns per-image noise into an upward bias, and places the centre by
 //   a sphere fit to the surface points instead of the one-sided centroid.
 #pragma once
@@ -48,6 +49,9 @@ struct SizingConfig {
   double saturated_disparity_px = 318;  ///< window maxima at or above: rejected
   double min_visible_fraction = 0.2;    ///< of in-image points on the segment, to use an image
   double well_seen_fraction = 0.6;      ///< ours: images used for the median
+  /// Ours: minor / major axis at least this (a fruitlet's e <= 1.15 projects rounder; a
+  /// segment cut by an occluder or two fruitlets merged in 2-D does not).
+  double min_axis_ratio = 0.8;
   int min_segment_pixels = 12;
   void validate() const;
 };
@@ -59,6 +63,8 @@ struct ImageSize {
   double minor_axis_px = 0.0, max_disparity_px = 0.0;
   double visible_fraction = 0.0;  ///< of the cluster's in-image points on the segment
   bool touches_border = false;
+  bool shared_segment = false;  ///< another cluster falls on the same segment
+  double axis_ratio = 0.0;      ///< minor / major axis of the fitted ellipse
 };
 
 struct FruitletEstimate {

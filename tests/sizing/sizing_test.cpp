@@ -1,0 +1,217 @@
+// The sizing chain's parts: outlier removal and DBSCAN against brute force, matching and
+// metrics by hand, the TSDF surface of an ideal sphere, and Eq. 4 on a synthetic view.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <random>
+
+#include "backend_test_support.h"
+#include "fvp/host/eval/fruitlet_matching.h"
+#include "fvp/host/sizing/fruitlet_sizer.h"
+#include "fvp/host/sizing/point_filters.h"
+#include "fvp/host/tsdf/tsdf_volume.h"
+
+namespace fvp::host {
+namespace {
+
+std::vector<Eigen::Vector3f> blobs(std::uint64_t seed, int per_blob, int noise) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<float> n(0.0f, 0.0015f);
+  std::uniform_real_distribution<float> u(-0.05f, 0.05f);
+  std::vector<Eigen::Vector3f> pts;
+  const Eigen::Vector3f centres[3] = {{0, 0, 0}, {0.02f, 0, 0}, {0, 0.03f, 0.01f}};
+  for (const auto& c : centres)
+    for (int i = 0; i < per_blob; ++i) pts.push_back(c + Eigen::Vector3f(n(rng), n(rng), n(rng)));
+  for (int i = 0; i < noise; ++i) pts.emplace_back(u(rng), u(rng), u(rng));
+  return pts;
+}
+
+TEST(PointFilters, OutlierRemovalEqualsBruteForce) {
+  const std::uint64_t seed = testing::freshSeed();
+  const auto pts = blobs(seed, 300, 60);
+  const int k = 10;
+  const double ratio = 1.5;
+  std::vector<double> mean(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    std::vector<double> d;
+    for (const auto& q : pts) d.push_back((pts[i] - q).norm());
+    std::sort(d.begin(), d.end());
+    double s = 0;
+    for (int j = 0; j < k; ++j) s += d[j];
+    mean[i] = s / k;
+  }
+  double m = 0, v = 0;
+  for (double x : mean) m += x;
+  m /= mean.size();
+  for (double x : mean) v += (x - m) * (x - m);
+  const double limit = m + ratio * std::sqrt(v / (mean.size() - 1));
+  std::vector<std::size_t> want;
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    if (mean[i] <= limit) want.push_back(i);
+  const auto got = sizing::statisticalOutlierInliers(pts, k, ratio);
+  // Float distances: a point exactly at the limit could flip; allow none on random data.
+  EXPECT_EQ(got, want) << testing::replayHint(seed);
+  EXPECT_LT(got.size(), pts.size());
+}
+
+TEST(PointFilters, DbscanEqualsBruteForce) {
+  const std::uint64_t seed = testing::freshSeed();
+  const auto pts = blobs(seed, 200, 40);
+  const double eps = 0.003;
+  const int min_samples = 8;
+  const auto got = sizing::dbscan(pts, eps, min_samples);
+  // Brute force: core points by counting, clusters as connected components of cores.
+  const std::size_t n = pts.size();
+  std::vector<std::vector<std::size_t>> nb(n);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < n; ++j)
+      if ((pts[i] - pts[j]).squaredNorm() <= float(eps * eps)) nb[i].push_back(j);
+  std::vector<char> core(n);
+  for (std::size_t i = 0; i < n; ++i) core[i] = int(nb[i].size()) >= min_samples;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (core[i]) {
+      ASSERT_NE(got[i], sizing::kDbscanNoise) << i << " " << testing::replayHint(seed);
+      for (std::size_t j : nb[i])  // cores within eps share a cluster
+        if (core[j]) ASSERT_EQ(got[i], got[j]) << testing::replayHint(seed);
+    } else {
+      bool near_core = false;
+      for (std::size_t j : nb[i]) near_core |= bool(core[j]);
+      EXPECT_EQ(got[i] != sizing::kDbscanNoise, near_core) << i << " " << testing::replayHint(seed);
+    }
+  }
+}
+
+TEST(Matching, OneToOneWithinTheGateByHand) {
+  const std::vector<Eigen::Vector3d> gt = {{0, 0, 0}, {0.004, 0, 0}, {0.1, 0, 0}};
+  // d0 is 1 mm from gt0 and 3 mm from gt1; d1 is 1 mm from gt1 and 5 mm from gt0: the
+  // optimal pairing takes both; a spurious d2 is 6 mm from everything.
+  const std::vector<Eigen::Vector3d> det = {{0.001, 0, 0}, {0.005, 0, 0}, {0.1, 0.006, 0}};
+  const auto m = eval::matchFruitlets(det, gt);
+  EXPECT_EQ(m, (std::vector<int>{0, 1, -1}));
+  // Two detections near one fruitlet: only one matches.
+  const auto m2 = eval::matchFruitlets({{0.001, 0, 0}, {-0.001, 0, 0}}, {{0, 0, 0}});
+  EXPECT_EQ(m2.size(), 1u);
+  EXPECT_GE(m2[0], 0);
+  // Maximising matches beats the closest pair: d0 is closest to gt0 but only it reaches gt1.
+  const auto m3 = eval::matchFruitlets({{0.002, 0, 0}, {-0.001, 0, 0}}, {{0, 0, 0}, {0.006, 0, 0}});
+  EXPECT_EQ(m3, (std::vector<int>{1, 0}));
+}
+
+TEST(Matching, MetricsByHand) {
+  const auto m = eval::sizeMetrics({10.0, 8.0, 6.0}, {11.0, 7.0}, {0, 1, -1}, 2);
+  EXPECT_EQ(m.matched, 2u);
+  EXPECT_NEAR(m.match_percent, 200.0 / 3.0, 1e-12);
+  EXPECT_NEAR(*m.mae_mm, 1.0, 1e-12);
+  EXPECT_NEAR(*m.mape_percent, (10.0 + 12.5) / 2.0, 1e-12);
+  EXPECT_NEAR(*m.precision_percent, 100.0, 1e-12);
+  const auto none = eval::sizeMetrics({10.0}, {}, {-1}, 0);
+  EXPECT_FALSE(none.mae_mm.has_value());
+  EXPECT_FALSE(none.precision_percent.has_value());
+}
+
+TEST(SphereFit, RecoversCentreAndRadiusFromAHemisphere) {
+  std::mt19937_64 rng(3);
+  std::normal_distribution<float> n(0.0f, 1.0f);
+  const Eigen::Vector3f c(0.1f, -0.05f, 1.0f);
+  std::vector<Eigen::Vector3f> pts;
+  while (pts.size() < 2000) {
+    Eigen::Vector3f d(n(rng), n(rng), n(rng));
+    d.normalize();
+    if (d.y() < 0) pts.push_back(c + 0.005f * d);  // the side a camera sees
+  }
+  Eigen::Vector3d centre;
+  double r = 0;
+  ASSERT_TRUE(sizing::fitSphere(pts, centre, r));
+  EXPECT_LT((centre - c.cast<double>()).norm(), 1e-6);
+  EXPECT_NEAR(r, 0.005, 1e-6);
+}
+
+// An ideal view of a sphere: exact depth and mask, from a pinhole camera at the origin.
+struct SphereView {
+  cv::Mat depth, mask, disparity;
+  StereoIntrinsics in;
+};
+SphereView renderSphere(const Eigen::Vector3d& c, double r) {
+  SphereView v;
+  v.depth = cv::Mat(v.in.height_px, v.in.width_px, CV_32F, cv::Scalar(0));
+  v.mask = cv::Mat(v.in.height_px, v.in.width_px, CV_8U, cv::Scalar(0));
+  v.disparity = cv::Mat(v.in.height_px, v.in.width_px, CV_32F, cv::Scalar(0));
+  for (int y = 0; y < v.in.height_px; ++y)
+    for (int x = 0; x < v.in.width_px; ++x) {
+      const Eigen::Vector3d d((x - v.in.cx_px) / v.in.fx_px, (y - v.in.cy_px) / v.in.fy_px, 1.0);
+      const Eigen::Vector3d u = d.normalized();
+      const double b = u.dot(c), disc = b * b - (c.squaredNorm() - r * r);
+      if (disc < 0) continue;
+      const double t = b - std::sqrt(disc);
+      const double z = t * u.z();
+      v.depth.at<float>(y, x) = float(z);
+      v.mask.at<std::uint8_t>(y, x) = 255;
+      v.disparity.at<float>(y, x) = float(v.in.fx_px * v.in.baseline_m / z);
+    }
+  return v;
+}
+
+TEST(Tsdf, SurfaceOfAnIdealSphereLiesOnIt) {
+  const Eigen::Vector3d c(0.01, -0.005, 0.3);
+  const double r = 0.006;
+  const SphereView v = renderSphere(c, r);
+  tsdf::TsdfVolume volume;
+  const auto stats = volume.integrate(v.depth, v.mask, v.in, Eigen::Isometry3d::Identity());
+  EXPECT_GT(stats.roi_pixels, 1000u);
+  EXPECT_GT(volume.blockCount(), 0u);
+  const auto surface = volume.extractSurfacePoints();
+  ASSERT_GT(surface.size(), 1000u);
+  double worst = 0, sum = 0;
+  for (const auto& p : surface) {
+    const double e = std::abs((p.cast<double>() - c).norm() - r);
+    worst = std::max(worst, e);
+    sum += e;
+  }
+  // Projective distances along the ray are within a fraction of a 0.5 mm voxel at the front;
+  // at grazing angles more.
+  EXPECT_LT(sum / surface.size(), 0.0001);
+  EXPECT_LT(worst, 0.0008);
+}
+
+TEST(Sizing, Eq4OnAnIdealSphereViewPaperShortOursClose) {
+  const Eigen::Vector3d c(0.0, 0.0, 0.3);
+  const double r = 0.005;
+  const SphereView v = renderSphere(c, r);
+  // The visible cap as the cluster's surface points.
+  std::vector<Eigen::Vector3f> pts;
+  for (int i = 0; i < 4000; ++i) {
+    const double a = 2.0 * M_PI * i / 4000.0 * 37.0, z = -1.0 + 0.9 * (i % 1000) / 1000.0;
+    const Eigen::Vector3d d(std::sqrt(1 - z * z) * std::cos(a), std::sqrt(1 - z * z) * std::sin(a), z);
+    pts.push_back((c + r * d).cast<float>());
+  }
+  sizing::SizingView view{v.mask, v.disparity, v.in, Eigen::Isometry3d::Identity()};
+  sizing::SizingConfig config;
+  const auto result = sizing::sizeFruitlets({view, view}, pts, nullptr, config);
+  ASSERT_EQ(result.fruitlets.size(), 1u);
+  const auto& f = result.fruitlets[0];
+  // DESIGN.md section 10: the paper's Eq. 4 sizes ideal spheres a few percent small.
+  EXPECT_LT(f.size_paper_mm, 10.0);
+  EXPECT_GT(f.size_paper_mm, 9.0);
+  EXPECT_NEAR(f.size_ours_mm, 10.0, 0.15);
+  EXPECT_LT((f.sphere_center_m - c).norm(), 1e-4);
+  EXPECT_EQ(f.per_image.size(), 2u);
+}
+
+TEST(Sizing, EmptyInputsAreCountedNotErrors) {
+  sizing::SizingConfig config;
+  const auto empty = sizing::sizeFruitlets({}, {}, nullptr, config);
+  EXPECT_TRUE(empty.fruitlets.empty());
+  // A cluster no image sees.
+  std::vector<Eigen::Vector3f> pts;
+  for (int i = 0; i < 200; ++i) pts.emplace_back(0.001f * (i % 10), 0.001f * (i / 10 % 10), 1.0f);
+  sizing::SizingView blank{cv::Mat(1080, 1440, CV_8U, cv::Scalar(0)),
+                           cv::Mat(1080, 1440, CV_32F, cv::Scalar(0)), {}, Eigen::Isometry3d::Identity()};
+  const auto unseen = sizing::sizeFruitlets({blank}, pts, nullptr, config);
+  EXPECT_TRUE(unseen.fruitlets.empty());
+  EXPECT_EQ(unseen.events.unsized_clusters, 1u);
+  EXPECT_EQ(unseen.events.not_visible, 1u);
+}
+
+}  // namespace
+}  // namespace fvp::host
