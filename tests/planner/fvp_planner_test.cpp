@@ -59,13 +59,15 @@ TEST(ViewpointSampler, TargetsDistancesOrientationsAndReachability) {
       EXPECT_GE(d, config.sensor_min_m - 1e-12);
       EXPECT_LE(d, config.sensor_max_m + 1e-12);
       // The camera's z axis runs through the target; the rotation is proper.
-      EXPECT_LT((c.T_world_camera.linear().col(2) - (c.target_m - c.position_m()).normalized()).norm(),
-                1e-9);
+      EXPECT_LT(
+          (c.T_world_camera.linear().col(2) - (c.target_m - c.position_m()).normalized()).norm(),
+          1e-9);
       EXPECT_NEAR(c.T_world_camera.linear().determinant(), 1.0, 1e-9);
       EXPECT_EQ(c.reachable, inShell(c.T_world_camera));
       reachable += c.reachable;
       if (c.kind == CandidateKind::kExploration && it->normal.squaredNorm() > 0.0)
-        EXPECT_LT(((c.position_m() - c.target_m).normalized() - it->normal.normalized()).norm(), 1e-9);
+        EXPECT_LT(((c.position_m() - c.target_m).normalized() - it->normal.normalized()).norm(),
+                  1e-9);
     }
   }
   EXPECT_GT(reachable, 0u);
@@ -104,9 +106,8 @@ TEST(FvpPlanner, ThresholdDecaysWhenEveryMoveFailsAndResetsOnSuccess) {
   // The second attempt succeeds: the threshold resets to u_t0 and the chosen candidate is
   // the second best by utility.
   int attempt = 0;
-  const PlanStep moved = planner.planAndMove(*e, now, inShell, [&](const Eigen::Isometry3d&) {
-    return ++attempt == 2;
-  });
+  const PlanStep moved = planner.planAndMove(
+      *e, now, inShell, [&](const Eigen::Isometry3d&) { return ++attempt == 2; });
   ASSERT_TRUE(moved.moved());
   EXPECT_EQ(moved.move_attempts, 2u);
   EXPECT_EQ(moved.failed_moves, 1u);
@@ -131,9 +132,9 @@ TEST(FvpPlanner, OnlyCandidatesAboveTheThresholdAreTried) {
   config.max_sampling_rounds = 2;
   FvpPlanner planner(config, 2);
   std::size_t calls = 0;
-  const PlanStep step = planner.planAndMove(
-      *e, Eigen::Isometry3d(Eigen::Translation3d(0.0, -0.3, 0.35)), inShell,
-      [&](const Eigen::Isometry3d&) { return ++calls, true; });
+  const PlanStep step =
+      planner.planAndMove(*e, Eigen::Isometry3d(Eigen::Translation3d(0.0, -0.3, 0.35)), inShell,
+                          [&](const Eigen::Isometry3d&) { return ++calls, true; });
   EXPECT_EQ(calls, 0u);
   EXPECT_FALSE(step.moved());
   EXPECT_DOUBLE_EQ(planner.utilityThreshold(), 1.25);

@@ -109,7 +109,8 @@ TEST(InfoGain, TargetBehindAnOccupiedVoxelStopsThereByHand) {
   auto e = map::createMapEngine("octomap", smallConfig(), kRegion, nullptr);
   // An occupied (non-ROI) fine voxel at the region centre, seen from above: its ray marks
   // free voxels along +z only, off the viewing line below.
-  e->integrate(map::testing::makeClouds({0.0005, 0.0005, 0.45}, {}, {Vec3f(0.0005f, 0.0005f, 0.2005f)}));
+  e->integrate(
+      map::testing::makeClouds({0.0005, 0.0005, 0.45}, {}, {Vec3f(0.0005f, 0.0005f, 0.2005f)}));
   ASSERT_EQ(e->fineState({0.0005, 0.0005, 0.2005}).occupancy, map::VoxelClass::kOccupied);
   InfoGainEvaluator gain({});
   gain.refresh(*e);
@@ -121,7 +122,8 @@ TEST(InfoGain, TargetBehindAnOccupiedVoxelStopsThereByHand) {
   EXPECT_EQ(r[0].region_voxels, 31u);  // y voxels -30 .. 0: 30 unknown + the occupied one
   EXPECT_DOUBLE_EQ(r[0].ig, 0.5 * (r[0].region_voxels - 1) / r[0].region_voxels);
   // Stopping short of it: all unknown.
-  const auto before = gain.evaluate(std::vector{query({0.0005, -0.2, 0.2005}, {0.0005, -0.005, 0.2005})});
+  const auto before =
+      gain.evaluate(std::vector{query({0.0005, -0.2, 0.2005}, {0.0005, -0.005, 0.2005})});
   EXPECT_DOUBLE_EQ(before[0].ig, 0.5);
 }
 
@@ -139,7 +141,8 @@ TEST(InfoGain, SnapshotEqualsMapReadsOnRandomRays) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::size_t with_roi_weight = 0;
   for (int i = 0; i < 300; ++i) {
-    const Eigen::Vector3d target = kRegion.center_m() + 0.025 * Eigen::Vector3d(u(rng), u(rng), u(rng));
+    const Eigen::Vector3d target =
+        kRegion.center_m() + 0.025 * Eigen::Vector3d(u(rng), u(rng), u(rng));
     Eigen::Vector3d dir(u(rng), u(rng), u(rng));
     if (dir.norm() < 1e-3) continue;
     const Eigen::Vector3d eye = target + 0.25 * dir.normalized();
@@ -189,8 +192,10 @@ TEST(InfoGain, GridAndOctomapEnginesAgree) {
     std::mt19937_64 rng(3);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     for (int i = 0; i < 200; ++i) {
-      const Eigen::Vector3d target = kRegion.center_m() + 0.02 * Eigen::Vector3d(u(rng), u(rng), u(rng));
-      const Eigen::Vector3d eye = target + 0.25 * Eigen::Vector3d(u(rng), -1.0, u(rng)).normalized();
+      const Eigen::Vector3d target =
+          kRegion.center_m() + 0.02 * Eigen::Vector3d(u(rng), u(rng), u(rng));
+      const Eigen::Vector3d eye =
+          target + 0.25 * Eigen::Vector3d(u(rng), -1.0, u(rng)).normalized();
       ViewQuery q;
       q.T_world_camera = Eigen::Isometry3d::Identity();
       q.T_world_camera.translation() = eye;

@@ -182,7 +182,8 @@ TEST(Sizing, Eq4OnAnIdealSphereViewPaperShortOursClose) {
   std::vector<Eigen::Vector3f> pts;
   for (int i = 0; i < 4000; ++i) {
     const double a = 2.0 * M_PI * i / 4000.0 * 37.0, z = -1.0 + 0.9 * (i % 1000) / 1000.0;
-    const Eigen::Vector3d d(std::sqrt(1 - z * z) * std::cos(a), std::sqrt(1 - z * z) * std::sin(a), z);
+    const Eigen::Vector3d d(std::sqrt(1 - z * z) * std::cos(a), std::sqrt(1 - z * z) * std::sin(a),
+                            z);
     pts.push_back((c + r * d).cast<float>());
   }
   sizing::SizingView view{v.mask, v.disparity, v.in, Eigen::Isometry3d::Identity()};
@@ -206,7 +207,9 @@ TEST(Sizing, EmptyInputsAreCountedNotErrors) {
   std::vector<Eigen::Vector3f> pts;
   for (int i = 0; i < 200; ++i) pts.emplace_back(0.001f * (i % 10), 0.001f * (i / 10 % 10), 1.0f);
   sizing::SizingView blank{cv::Mat(1080, 1440, CV_8U, cv::Scalar(0)),
-                           cv::Mat(1080, 1440, CV_32F, cv::Scalar(0)), {}, Eigen::Isometry3d::Identity()};
+                           cv::Mat(1080, 1440, CV_32F, cv::Scalar(0)),
+                           {},
+                           Eigen::Isometry3d::Identity()};
   const auto unseen = sizing::sizeFruitlets({blank}, pts, nullptr, config);
   EXPECT_TRUE(unseen.fruitlets.empty());
   EXPECT_EQ(unseen.events.unsized_clusters, 1u);

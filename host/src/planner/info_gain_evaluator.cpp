@@ -97,7 +97,8 @@ bool InfoGainEvaluator::occupiedWithin(const Eigen::Vector3d& p_m, double radius
           continue;
         const Eigen::Vector3d c((x + 0.5) * vs, (y + 0.5) * vs, (z + 0.5) * vs);
         if ((c - p_m).norm() > radius_m) continue;
-        if (coarse_occupied_[g[0] + std::size_t(coarse_.dims[0]) * (g[1] + std::size_t(coarse_.dims[1]) * g[2])])
+        if (coarse_occupied_[g[0] + std::size_t(coarse_.dims[0]) *
+                                        (g[1] + std::size_t(coarse_.dims[1]) * g[2])])
           return true;
       }
   return false;
