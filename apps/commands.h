@@ -11,5 +11,6 @@ void addCaptureCommand(CLI::App& app);
 void addTraverseCommand(CLI::App& app);
 void addMapCommand(CLI::App& app);
 void addRunCommand(CLI::App& app);
+void addExperimentCommands(CLI::App& app);
 
 }  // namespace fvp::apps

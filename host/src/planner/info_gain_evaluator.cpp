@@ -83,6 +83,78 @@ double InfoGainEvaluator::refresh(map::MapEngine& map) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+InfoGainEvaluator::RayCensus InfoGainEvaluator::census(const Eigen::Vector3d& from_m,
+                                                       const Eigen::Vector3d& to_m) const {
+  if (!ready_) throw std::logic_error("InfoGainEvaluator::census before refresh()");
+  RayCensus r;
+  // The segment's part inside the sphere: [t_in, t_out] within [0, 1], if any.
+  const Eigen::Vector3d d = to_m - from_m, f = from_m - region_center_m_;
+  const double a = d.squaredNorm(), b = 2.0 * f.dot(d),
+               c = f.squaredNorm() - region_radius_m_ * region_radius_m_;
+  const double disc = b * b - 4.0 * a * c;
+  double t_in = 2.0, t_out = 2.0;
+  if (a > 0.0 && disc >= 0.0) {
+    t_in = std::max(0.0, (-b - std::sqrt(disc)) / (2.0 * a));
+    t_out = std::min(1.0, (-b + std::sqrt(disc)) / (2.0 * a));
+    if (t_in > t_out) t_in = t_out = 2.0;
+  }
+  const auto walkCoarse = [&](double t0, double t1) {
+    if (!(t1 > t0)) return;
+    const fvp_grid_params g = coarse_.params();
+    float o[3], e[3];
+    toFloat3(from_m + t0 * d, o);
+    toFloat3(from_m + t1 * d, e);
+    fvp_dda w;
+    if (fvp_dda_init(&w, &g, o, e) != 0) return;
+    for (;;) {
+      ++r.voxel_steps;
+      if (coarse_occupied_[w.key[0] +
+                           std::size_t(g.dim_x) * (w.key[1] + std::size_t(g.dim_y) * w.key[2])]) {
+        r.occluded = true;
+        return;
+      }
+      const int axis = fvp_dda_next_axis(&w);
+      if (axis < 0) return;
+      fvp_dda_advance(&w, axis);
+      if (w.key[axis] < 0 || w.key[axis] >= (&g.dim_x)[axis]) return;
+    }
+  };
+  const auto walkFine = [&](double t0, double t1) {
+    const fvp_grid_params g = fine_.params();
+    float o[3], e[3];
+    toFloat3(from_m + t0 * d, o);
+    toFloat3(from_m + t1 * d, e);
+    fvp_dda w;
+    if (fvp_dda_init(&w, &g, o, e) != 0) return;
+    for (;;) {
+      ++r.voxel_steps;
+      const std::uint16_t code =
+          fine_codes_[w.key[0] +
+                      std::size_t(g.dim_x) * (w.key[1] + std::size_t(g.dim_y) * w.key[2])];
+      if (code & kInRegion) {
+        if (code & kOccupied) {
+          r.occluded = true;
+          return;
+        }
+        ++r.region_voxels;
+        r.unknown_voxels += (code & kWeightMask) != 0;
+      }
+      const int axis = fvp_dda_next_axis(&w);
+      if (axis < 0) return;
+      fvp_dda_advance(&w, axis);
+      if (w.key[axis] < 0 || w.key[axis] >= (&g.dim_x)[axis]) return;
+    }
+  };
+  if (t_in > 1.0) {
+    walkCoarse(0.0, 1.0);
+    return r;
+  }
+  walkCoarse(0.0, t_in);
+  if (!r.occluded) walkFine(t_in, t_out);
+  if (!r.occluded) walkCoarse(t_out, 1.0);
+  return r;
+}
+
 bool InfoGainEvaluator::occupiedWithin(const Eigen::Vector3d& p_m, double radius_m) const {
   const double vs = coarse_.voxel_size_m;
   const auto lo = coarse_.latticeIndex(p_m - Eigen::Vector3d::Constant(radius_m));

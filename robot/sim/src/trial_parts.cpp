@@ -16,6 +16,7 @@
 #include "fvp/host/map/map_config.h"
 #include "fvp/host/perception/ply_io.h"
 #include "fvp/host/planner/fvp_planner.h"
+#include "fvp/host/planner/rvp_planner.h"
 #include "fvp/host/sizing/fruitlet_sizer.h"
 #include "fvp/host/tsdf/tsdf_volume.h"
 
@@ -53,7 +54,11 @@ struct TrialParts::Impl {
               : host::planner::PlannerConfig::fromYamlFile(options.planner_config);
       planner = std::make_unique<host::planner::FvpPlanner>(config, options.seed);
     } else {
-      throw std::invalid_argument("planner '" + options.planner + "' is not available");
+      const host::planner::RvpConfig config =
+          options.planner_config.empty()
+              ? host::planner::RvpConfig{}
+              : host::planner::RvpConfig::fromYamlFile(options.planner_config);
+      planner = std::make_unique<host::planner::RvpPlanner>(config, options.seed);
     }
   }
 

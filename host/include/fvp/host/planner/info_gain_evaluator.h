@@ -69,11 +69,21 @@ class InfoGainEvaluator {
   /// IG of one ray segment origin -> end (the per-ray step of both modes).
   GainResult evaluateRay(const Eigen::Vector3d& origin_m, const Eigen::Vector3d& end_m) const;
   std::size_t snapshotBytes() const;
+  /// What one segment crosses, for gains other than Eq. 1-2 (RVP): the coarse map outside
+  /// the region, the fine map inside; region voxels and the unknown ones among them, up to
+  /// the first occupied voxel (then occluded; that voxel is not counted).
+  struct RayCensus {
+    std::uint32_t region_voxels = 0, unknown_voxels = 0;
+    bool occluded = false;
+    std::uint64_t voxel_steps = 0;
+  };
+  RayCensus census(const Eigen::Vector3d& from_m, const Eigen::Vector3d& to_m) const;
   /// Whether any occupied coarse voxel lies within radius_m of p (voxel centres): a camera
   /// body there would collide, so the motion planner need not be asked.
   bool occupiedWithin(const Eigen::Vector3d& p_m, double radius_m) const;
   /// Scans the snapshot was built from (MapEngine::scanCount at the last refresh).
   std::size_t snapshotScans() const { return snapshot_scans_; }
+  double fineVoxelSize_m() const { return fine_.voxel_size_m; }
 
   // Snapshot codes of a fine voxel.
   static constexpr std::uint16_t kInRegion = 0x8000;

@@ -1,0 +1,254 @@
+#include "fvp/host/planner/rvp_planner.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <numeric>
+#include <set>
+
+#include "fvp/host/core/look_at.h"
+#include "fvp/host/core/yaml_config.h"
+#include "fvp/host/map/map_engine.h"
+
+namespace fvp::host::planner {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+struct KeySpec {
+  const char* name;
+  std::function<void(RvpConfig&, const YAML::Node&)> read;
+};
+
+const std::vector<KeySpec>& keySpecs() {
+  static const std::vector<KeySpec> specs = {
+      {"roi_samples", [](RvpConfig& c, const YAML::Node& n) { c.roi_samples = n.as<int>(); }},
+      {"exploration_samples",
+       [](RvpConfig& c, const YAML::Node& n) { c.exploration_samples = n.as<int>(); }},
+      {"sensor_min_m", [](RvpConfig& c, const YAML::Node& n) { c.sensor_min_m = n.as<double>(); }},
+      {"sensor_max_m", [](RvpConfig& c, const YAML::Node& n) { c.sensor_max_m = n.as<double>(); }},
+      {"alpha_per_m", [](RvpConfig& c, const YAML::Node& n) { c.alpha_per_m = n.as<double>(); }},
+      {"roi_utility_threshold",
+       [](RvpConfig& c, const YAML::Node& n) { c.roi_utility_threshold = n.as<double>(); }},
+      {"exploration_rays_x",
+       [](RvpConfig& c, const YAML::Node& n) { c.exploration_rays_x = n.as<int>(); }},
+      {"exploration_rays_y",
+       [](RvpConfig& c, const YAML::Node& n) { c.exploration_rays_y = n.as<int>(); }},
+      {"exploration_fov_x_deg",
+       [](RvpConfig& c, const YAML::Node& n) { c.exploration_fov_x_deg = n.as<double>(); }},
+      {"exploration_box_half_m",
+       [](RvpConfig& c, const YAML::Node& n) { c.exploration_box_half_m = n.as<double>(); }},
+      {"seed", [](RvpConfig& c, const YAML::Node& n) { c.seed = n.as<std::int64_t>(); }},
+  };
+  return specs;
+}
+
+void require(bool ok, const std::string& source, const char* key, const char* expected) {
+  if (!ok) throw std::invalid_argument(source + ": key '" + key + "': expected " + expected);
+}
+
+}  // namespace
+
+RvpConfig RvpConfig::fromYamlFile(const std::filesystem::path& path) {
+  const std::string source = "rvp config '" + path.string() + "'";
+  const YAML::Node root = readYamlMapping(path, source);
+  RvpConfig c;
+  if (root.IsNull()) return c;
+  for (const auto& item : root) {
+    const std::string key = item.first.as<std::string>();
+    const KeySpec& spec = findKeySpec(keySpecs(), key, source);
+    try {
+      spec.read(c, item.second);
+    } catch (const YAML::Exception&) {
+      throw std::invalid_argument(source + ": key '" + key + "': expected a number");
+    }
+  }
+  c.validate(source);
+  return c;
+}
+
+void RvpConfig::validate(const std::string& source) const {
+  require(roi_samples >= 0 && exploration_samples >= 0 && roi_samples + exploration_samples > 0,
+          source, "roi_samples", "non-negative sample counts, not both 0");
+  require(sensor_min_m > 0.0 && sensor_max_m >= sensor_min_m && sensor_max_m < 5.0, source,
+          "sensor_max_m", "0 < sensor_min_m <= sensor_max_m < 5 m");
+  require(alpha_per_m >= 0.0, source, "alpha_per_m", "a non-negative weight");
+  require(exploration_rays_x >= 1 && exploration_rays_y >= 1, source, "exploration_rays_x",
+          "at least one ray per axis");
+  require(exploration_fov_x_deg > 0.0 && exploration_fov_x_deg < 170.0, source,
+          "exploration_fov_x_deg", "an angle in (0, 170) degrees");
+  require(exploration_box_half_m > 0.0 && exploration_box_half_m < 5.0, source,
+          "exploration_box_half_m", "a distance in (0, 5) m");
+}
+
+std::string RvpConfig::toJson() const {
+  const nlohmann::ordered_json j = {{"roi_samples", roi_samples},
+                                    {"exploration_samples", exploration_samples},
+                                    {"sensor_min_m", sensor_min_m},
+                                    {"sensor_max_m", sensor_max_m},
+                                    {"alpha_per_m", alpha_per_m},
+                                    {"roi_utility_threshold", roi_utility_threshold},
+                                    {"exploration_rays_x", exploration_rays_x},
+                                    {"exploration_rays_y", exploration_rays_y},
+                                    {"exploration_fov_x_deg", exploration_fov_x_deg},
+                                    {"exploration_box_half_m", exploration_box_half_m},
+                                    {"seed", seed}};
+  return j.dump();
+}
+
+RvpPlanner::RvpPlanner(const RvpConfig& config, std::uint64_t seed)
+    : config_(config),
+      rng_(seed * 0xD1B54A32D192ED03ull ^ static_cast<std::uint64_t>(config.seed)),
+      snapshot_(InfoGainConfig{}) {
+  config_.validate();
+}
+
+std::vector<Eigen::Vector3d> RvpPlanner::roiContourTargets(map::MapEngine& map) {
+  const map::GridGeometry& g = map.gridGeometry(map::MapLevel::kFine);
+  const auto state = [&](const std::array<int, 3>& i) { return map.fineState(g.voxelCenter_m(i)); };
+  static constexpr int kFaces[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                       {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+  std::set<std::array<int, 3>> targets;
+  for (const auto& v : map.occupiedVoxels(map::MapLevel::kFine)) {
+    if (!state(v).roi) continue;
+    for (const auto& f : kFaces) {
+      const std::array<int, 3> n{v[0] + f[0], v[1] + f[1], v[2] + f[2]};
+      if (targets.count(n) || state(n).occupancy != map::VoxelClass::kFree) continue;
+      for (const auto& h : kFaces) {
+        const std::array<int, 3> m{n[0] + h[0], n[1] + h[1], n[2] + h[2]};
+        if (map.region().contains(g.voxelCenter_m(m)) &&
+            state(m).occupancy == map::VoxelClass::kUnknown) {
+          targets.insert(n);
+          break;
+        }
+      }
+    }
+  }
+  std::vector<Eigen::Vector3d> out;
+  for (const auto& t : targets) out.push_back(g.voxelCenter_m(t));
+  return out;
+}
+
+double RvpPlanner::roiGain(const Eigen::Vector3d& target_m, const Eigen::Vector3d& camera_m) const {
+  const InfoGainEvaluator::RayCensus c = snapshot_.census(target_m, camera_m);
+  if (c.occluded) return -1.0;
+  return c.region_voxels ? double(c.unknown_voxels) / c.region_voxels : 0.0;
+}
+
+double RvpPlanner::explorationGain(const Eigen::Isometry3d& T) const {
+  const int nx = config_.exploration_rays_x, ny = config_.exploration_rays_y;
+  const double tx = std::tan(0.5 * config_.exploration_fov_x_deg * M_PI / 180.0);
+  const double ty = tx * ny / nx;  // square pixels
+  double sum = 0.0;
+  for (int v = 0; v < ny; ++v)
+    for (int u = 0; u < nx; ++u) {
+      const Eigen::Vector3d dir(((u + 0.5) / nx * 2.0 - 1.0) * tx,
+                                ((v + 0.5) / ny * 2.0 - 1.0) * ty, 1.0);
+      const Eigen::Vector3d end = T * (config_.sensor_max_m * dir.normalized());
+      const InfoGainEvaluator::RayCensus c = snapshot_.census(T.translation(), end);
+      // Each ray: its unknown region voxels over its length in fine voxels.
+      const double length_voxels = config_.sensor_max_m / snapshot_.fineVoxelSize_m();
+      sum += c.unknown_voxels / length_voxels;
+    }
+  return sum / (nx * ny);
+}
+
+}  // namespace fvp::host::planner
+
+namespace fvp::host::planner {
+
+PlanStep RvpPlanner::planAndMove(map::MapEngine& map, const Eigen::Isometry3d& T_world_camera_now,
+                                 const ReachabilityFn& reachable, const MoveToPoseFn& move) {
+  PlanStep step;
+  step.sampling_rounds = 1;
+  auto t = Clock::now();
+  if (snapshot_.snapshotScans() != map.scanCount() || snapshot_.snapshotBytes() == 0)
+    snapshot_.refresh(map);
+  step.timings_s.emplace_back("snapshot", since(t));
+  t = Clock::now();
+  const std::vector<Eigen::Vector3d> contour = roiContourTargets(map);
+  step.timings_s.emplace_back("targets", since(t));
+
+  t = Clock::now();
+  const Eigen::Vector3d now = T_world_camera_now.translation();
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::uniform_real_distribution<double> distance(config_.sensor_min_m, config_.sensor_max_m);
+  const auto unit = [&] {
+    for (;;) {
+      const Eigen::Vector3d v(normal(rng_), normal(rng_), normal(rng_));
+      if (v.norm() > 1e-9) return Eigen::Vector3d(v.normalized());
+    }
+  };
+  std::vector<Candidate> roi, exploration;
+  if (!contour.empty()) {
+    std::uniform_int_distribution<std::size_t> pick(0, contour.size() - 1);
+    for (int i = 0; i < config_.roi_samples; ++i) {
+      Candidate c;
+      c.kind = CandidateKind::kRoi;
+      c.target_m = contour[pick(rng_)];
+      c.T_world_camera = lookAtPose(c.target_m + distance(rng_) * unit(), c.target_m);
+      c.reachable = !reachable || reachable(c.T_world_camera);
+      c.utility = -std::numeric_limits<double>::infinity();
+      if (c.reachable) {
+        c.ig = roiGain(c.target_m, c.position_m());
+        if (c.ig >= 0.0)
+          c.utility = c.ig - config_.alpha_per_m * (c.position_m() - now).norm();
+        else
+          c.ig = 0.0;  // occluded: dropped from the set
+      }
+      roi.push_back(c);
+    }
+  }
+  const Eigen::Vector3d centre = map.region().center_m();
+  const double r = map.region().radius_m(), h = config_.exploration_box_half_m;
+  std::uniform_real_distribution<double> in_box(-h, h), in_region_box(-r, r);
+  for (int i = 0; i < config_.exploration_samples; ++i) {
+    Candidate c;
+    c.kind = CandidateKind::kExploration;
+    const Eigen::Vector3d p = centre + Eigen::Vector3d(in_box(rng_), in_box(rng_), in_box(rng_));
+    c.target_m =
+        centre + Eigen::Vector3d(in_region_box(rng_), in_region_box(rng_), in_region_box(rng_));
+    c.T_world_camera = lookAtPose(p, c.target_m);
+    c.reachable = !reachable || reachable(c.T_world_camera);
+    c.utility = -std::numeric_limits<double>::infinity();
+    if (c.reachable) {
+      c.ig = explorationGain(c.T_world_camera);
+      c.utility = c.ig - config_.alpha_per_m * (c.position_m() - now).norm();
+    }
+    exploration.push_back(c);
+  }
+  step.timings_s.emplace_back("sample_and_gain", since(t));
+
+  // The ROI set when its best utility exceeds the threshold, else exploration.
+  double best_roi = -std::numeric_limits<double>::infinity();
+  for (const auto& c : roi) best_roi = std::max(best_roi, c.utility);
+  const bool use_roi = best_roi > config_.roi_utility_threshold;
+  step.candidates = use_roi ? roi : exploration;
+  const auto& other = use_roi ? exploration : roi;
+  const std::size_t chosen_set = step.candidates.size();
+  step.candidates.insert(step.candidates.end(), other.begin(), other.end());
+  std::vector<std::size_t> order(chosen_set);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return step.candidates[a].utility > step.candidates[b].utility;
+  });
+  for (std::size_t i : order) {
+    const Candidate& c = step.candidates[i];
+    if (!c.reachable || !std::isfinite(c.utility)) break;
+    ++step.move_attempts;
+    if (move(c.T_world_camera)) {
+      step.chosen = i;
+      return step;
+    }
+    ++step.failed_moves;
+  }
+  return step;
+}
+
+}  // namespace fvp::host::planner
