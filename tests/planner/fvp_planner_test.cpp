@@ -8,6 +8,7 @@
 #include "../map/synthetic_scan.h"
 #include "fvp/host/map/map_engine.h"
 #include "fvp/host/planner/fvp_planner.h"
+#include "fvp/host/planner/rvp_planner.h"
 #include "fvp/host/planner/viewpoint_sampler.h"
 
 namespace fvp::host::planner {
@@ -144,6 +145,12 @@ TEST(PlannerConfig, DefaultsFileMatchesBuiltInDefaults) {
   const PlannerConfig file =
       PlannerConfig::fromYamlFile(fs::path(FVP_SOURCE_DIR) / "host/config/planner_default.yaml");
   EXPECT_EQ(file.toJson(), PlannerConfig{}.toJson());
+}
+
+TEST(RvpConfig, DefaultsFileMatchesBuiltInDefaults) {
+  const RvpConfig file =
+      RvpConfig::fromYamlFile(fs::path(FVP_SOURCE_DIR) / "host/config/rvp_default.yaml");
+  EXPECT_EQ(file.toJson(), RvpConfig{}.toJson());
 }
 
 TEST(PlannerConfig, BadKeysAndValuesNameTheFileAndTheKey) {
