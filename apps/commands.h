@@ -11,6 +11,7 @@ void addCaptureCommand(CLI::App& app);
 void addTraverseCommand(CLI::App& app);
 void addMapCommand(CLI::App& app);
 void addRunCommand(CLI::App& app);
+void addPlanCommand(CLI::App& app);
 void addExperimentCommands(CLI::App& app);
 
 }  // namespace fvp::apps

@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   fvp::apps::addTraverseCommand(app);
   fvp::apps::addMapCommand(app);
   fvp::apps::addRunCommand(app);
+  fvp::apps::addPlanCommand(app);
   fvp::apps::addExperimentCommands(app);
   try {
     app.parse(argc, argv);

@@ -1,0 +1,142 @@
+#include "fvp/robot/sim/plan_once.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "fvp/accel/backend.h"
+#include "fvp/host/core/atomic_file.h"
+#include "fvp/host/perception/ply_io.h"
+#include "fvp/host/planner/fvp_planner.h"
+#include "fvp/host/planner/rvp_planner.h"
+#include "fvp/robot/arm_controller.h"
+#include "fvp/robot/sim/camera_views.h"
+#include "fvp/robot/sim/simulated_mapping.h"
+#include "fvp/robot/workspace_tree.h"
+#include "trial_parts.h"
+
+namespace fvp::robot::sim {
+namespace {
+
+nlohmann::json vec3(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
+
+/// Blue (low) -> red (high) over the utilities of the reachable candidates; grey for the
+/// unreachable.
+std::array<std::uint8_t, 3> colour(double t) {
+  t = std::clamp(t, 0.0, 1.0);
+  return {std::uint8_t(255 * t), std::uint8_t(255 * (1 - std::abs(2 * t - 1))),
+          std::uint8_t(255 * (1 - t))};
+}
+
+}  // namespace
+
+nlohmann::json planOnce(const PlanOnceOptions& o) {
+  if (o.planner != "fvp" && o.planner != "rvp")
+    throw std::invalid_argument("plan: --planner: expected fvp or rvp, got '" + o.planner + "'");
+  if (o.views < 1) throw std::invalid_argument("plan: --views: expected at least 1");
+  const std::string engine = o.engine.empty() ? defaultEngine(o.planner) : o.engine;
+  const WorldConfig world_config =
+      o.world_config.empty() ? WorldConfig{} : WorldConfig::fromYamlFile(o.world_config);
+  const World world = World::generate(world_config, o.seed);
+
+  std::unique_ptr<accel::Backend> backend;
+  if (engine == "grid" || o.backend != "auto") backend = accel::createBackend(o.backend);
+  SimulatedMappingOptions mapping;
+  mapping.engine = engine;
+  mapping.render.noise_seed = o.seed;
+  const auto t_map = std::chrono::steady_clock::now();
+  SimulatedMapping mapped =
+      mapSimulatedViews(world, orbitViews(world, o.views, 90.0), mapping, backend.get());
+  const double map_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_map).count();
+  if (!mapped.map)
+    throw std::runtime_error("plan: no view detected the AprilTag: no Cluster Region, no map");
+
+  ArmConfig arm_config;
+  arm_config.workspace_cache_dir = defaultCacheDir();
+  const ArmModel arm(arm_config);
+  std::ostringstream log;
+  const WorkspaceTree workspace = WorkspaceTree::loadOrBuild(arm, log);
+  SimClock clock = SimClock::fromConfig(arm_config);
+  const auto start = ArmController::startConfiguration(arm, world.startCameraPose());
+  if (!start) throw std::runtime_error("plan: the start view is out of the arm's reach");
+  ArmController controller(arm, clock, *start);
+  controller.setMap(mapped.map->coarseOcTree());
+
+  std::unique_ptr<host::planner::ViewPlanner> planner;
+  if (o.planner == "fvp")
+    planner = std::make_unique<host::planner::FvpPlanner>(
+        o.planner_config.empty() ? host::planner::PlannerConfig{}
+                                 : host::planner::PlannerConfig::fromYamlFile(o.planner_config),
+        o.seed);
+  else
+    planner = std::make_unique<host::planner::RvpPlanner>(
+        o.planner_config.empty() ? host::planner::RvpConfig{}
+                                 : host::planner::RvpConfig::fromYamlFile(o.planner_config),
+        o.seed);
+
+  nlohmann::json motions = nlohmann::json::array();
+  const auto t_plan = std::chrono::steady_clock::now();
+  const host::planner::PlanStep step = planner->planAndMove(
+      *mapped.map, controller.cameraPose(),
+      [&](const Eigen::Isometry3d& T) { return workspace.reachable(T); },
+      [&](const Eigen::Isometry3d& T) {
+        const MotionPlan plan = controller.moveToPose(T);
+        motions.push_back({{"status", toString(plan.status)},
+                           {"planning_s", plan.planning_wall_s},
+                           {"duration_s", plan.ok() ? plan.trajectory.duration_s() : 0.0}});
+        return plan.ok();
+      });
+  const double plan_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_plan).count();
+
+  nlohmann::json candidates = nlohmann::json::array();
+  std::vector<Eigen::Vector3f> positions;
+  std::vector<std::array<std::uint8_t, 3>> colours;
+  double lo = INFINITY, hi = -INFINITY;
+  for (const auto& c : step.candidates)
+    if (std::isfinite(c.utility)) lo = std::min(lo, c.utility), hi = std::max(hi, c.utility);
+  for (const auto& c : step.candidates) {
+    candidates.push_back(
+        {{"kind", host::planner::toString(c.kind)},
+         {"position_m", vec3(c.position_m())},
+         {"target_m", vec3(c.target_m)},
+         {"ig", c.ig},
+         {"utility", std::isfinite(c.utility) ? nlohmann::json(c.utility) : nlohmann::json()},
+         {"reachable", c.reachable}});
+    positions.push_back(c.position_m().cast<float>());
+    colours.push_back(std::isfinite(c.utility)
+                          ? colour(hi > lo ? (c.utility - lo) / (hi - lo) : 1.0)
+                          : std::array<std::uint8_t, 3>{128, 128, 128});
+  }
+  nlohmann::json timings = {{"mapping_views", map_s}, {"plan_and_move", plan_s}};
+  for (const auto& [stage, s] : step.timings_s) timings[stage] = s;
+  nlohmann::json result = {
+      {"chosen", step.chosen ? nlohmann::json(*step.chosen) : nlohmann::json()},
+      {"candidates", candidates},
+      {"timings_s", timings},
+      {"config", nlohmann::json::parse(planner->configJson())},
+      {"planner", o.planner},
+      {"seed", o.seed},
+      {"views", o.views},
+      {"engine", engine},
+      {"backend", backend ? std::string(accel::toString(backend->kind())) : "none"},
+      {"move_attempts", step.move_attempts},
+      {"failed_moves", step.failed_moves},
+      {"rejected_clearance", step.rejected_clearance},
+      {"motions", motions}};
+  if (!o.out_dir.empty()) {
+    std::filesystem::create_directories(o.out_dir);
+    host::writePlyColoredPoints(o.out_dir / "candidates.ply", positions, colours,
+                                "fvp candidate camera positions, colour = utility (blue low, red "
+                                "high, grey unscored)");
+    host::writeFileAtomically(o.out_dir / "plan.json", "plan", result.dump(2) + "\n");
+  }
+  return result;
+}
+
+}  // namespace fvp::robot::sim
