@@ -5,11 +5,11 @@
 #include <filesystem>
 #include <fstream>
 
-#include "../map/synthetic_scan.h"
 #include "fvp/host/map/map_engine.h"
 #include "fvp/host/planner/fvp_planner.h"
 #include "fvp/host/planner/rvp_planner.h"
 #include "fvp/host/planner/viewpoint_sampler.h"
+#include "planner_test_maps.h"
 
 namespace fvp::host::planner {
 namespace {
@@ -17,19 +17,11 @@ namespace {
 namespace fs = std::filesystem;
 
 map::MapConfig smallConfig() {
-  map::MapConfig c;
-  c.observation_min_m = {-0.5, -0.5, 0.0};
-  c.observation_max_m = {0.5, 0.5, 0.6};
-  return c;
+  return testing::plannerTestConfig();
 }
-const ClusterRegion kRegion({0.0, 0.0, 0.3}, 0.04);
-
+const ClusterRegion& kRegion = testing::kPlannerTestRegion;
 std::unique_ptr<map::MapEngine> mappedEngine() {
-  auto e = map::createMapEngine("octomap", smallConfig(), kRegion, nullptr);
-  const auto world = map::testing::makeWorld(5, kRegion.center_m(), 4);
-  e->integrate(map::testing::renderScan(world, {0.0, -0.3, 0.35}, 96, 72, 0.5, 5).clouds());
-  e->integrate(map::testing::renderScan(world, {0.2, -0.25, 0.3}, 96, 72, 0.5, 6).clouds());
-  return e;
+  return testing::mappedTestEngine();
 }
 
 // A reachable shell around a base, standing in for the workspace tree in tests.

@@ -4,9 +4,9 @@
 
 #include <set>
 
-#include "../map/synthetic_scan.h"
 #include "fvp/host/map/map_engine.h"
 #include "fvp/host/planner/rvp_planner.h"
+#include "planner_test_maps.h"
 
 namespace fvp::host::planner {
 namespace {
@@ -14,19 +14,11 @@ namespace {
 using Vec3f = Eigen::Vector3f;
 
 map::MapConfig smallConfig() {
-  map::MapConfig c;
-  c.observation_min_m = {-0.6, -0.6, 0.0};
-  c.observation_max_m = {0.6, 0.6, 0.8};
-  return c;
+  return testing::plannerTestConfig();
 }
-const ClusterRegion kRegion({0.0, 0.0, 0.3}, 0.04);
-
+const ClusterRegion& kRegion = testing::kPlannerTestRegion;
 std::unique_ptr<map::MapEngine> mappedEngine() {
-  auto e = map::createMapEngine("octomap", smallConfig(), kRegion, nullptr);
-  const auto world = map::testing::makeWorld(5, kRegion.center_m(), 4);
-  e->integrate(map::testing::renderScan(world, {0.0, -0.3, 0.35}, 96, 72, 0.5, 5).clouds());
-  e->integrate(map::testing::renderScan(world, {0.2, -0.25, 0.3}, 96, 72, 0.5, 6).clouds());
-  return e;
+  return testing::mappedTestEngine();
 }
 
 TEST(RvpPlanner, RoiContourTargetsEqualTheirDefinition) {

@@ -33,6 +33,29 @@ void toFloat3(const Eigen::Vector3d& v, float* out) {
   out[2] = static_cast<float>(v.z());
 }
 
+/// Walks the grid voxels of the segment a -> b with the exact DDA, calling visit(linear
+/// index) for each until it returns false or the walk ends (end voxel or grid edge); counts
+/// the voxels in *steps.
+template <typename Visit>
+void walkSegment(const map::GridGeometry& grid, const Eigen::Vector3d& a_m,
+                 const Eigen::Vector3d& b_m, std::uint64_t* steps, Visit&& visit) {
+  const fvp_grid_params g = grid.params();
+  float o[3], e[3];
+  toFloat3(a_m, o);
+  toFloat3(b_m, e);
+  fvp_dda w;
+  if (fvp_dda_init(&w, &g, o, e) != 0) return;
+  for (;;) {
+    ++*steps;
+    if (!visit(w.key[0] + std::size_t(g.dim_x) * (w.key[1] + std::size_t(g.dim_y) * w.key[2])))
+      return;
+    const int axis = fvp_dda_next_axis(&w);
+    if (axis < 0) return;
+    fvp_dda_advance(&w, axis);
+    if (w.key[axis] < 0 || w.key[axis] >= (&g.dim_x)[axis]) return;
+  }
+}
+
 }  // namespace
 
 void InfoGainConfig::validate() const {
@@ -100,50 +123,23 @@ InfoGainEvaluator::RayCensus InfoGainEvaluator::census(const Eigen::Vector3d& fr
   }
   const auto walkCoarse = [&](double t0, double t1) {
     if (!(t1 > t0)) return;
-    const fvp_grid_params g = coarse_.params();
-    float o[3], e[3];
-    toFloat3(from_m + t0 * d, o);
-    toFloat3(from_m + t1 * d, e);
-    fvp_dda w;
-    if (fvp_dda_init(&w, &g, o, e) != 0) return;
-    for (;;) {
-      ++r.voxel_steps;
-      if (coarse_occupied_[w.key[0] +
-                           std::size_t(g.dim_x) * (w.key[1] + std::size_t(g.dim_y) * w.key[2])]) {
-        r.occluded = true;
-        return;
-      }
-      const int axis = fvp_dda_next_axis(&w);
-      if (axis < 0) return;
-      fvp_dda_advance(&w, axis);
-      if (w.key[axis] < 0 || w.key[axis] >= (&g.dim_x)[axis]) return;
-    }
+    walkSegment(coarse_, from_m + t0 * d, from_m + t1 * d, &r.voxel_steps, [&](std::size_t i) {
+      r.occluded = coarse_occupied_[i] != 0;
+      return !r.occluded;
+    });
   };
   const auto walkFine = [&](double t0, double t1) {
-    const fvp_grid_params g = fine_.params();
-    float o[3], e[3];
-    toFloat3(from_m + t0 * d, o);
-    toFloat3(from_m + t1 * d, e);
-    fvp_dda w;
-    if (fvp_dda_init(&w, &g, o, e) != 0) return;
-    for (;;) {
-      ++r.voxel_steps;
-      const std::uint16_t code =
-          fine_codes_[w.key[0] +
-                      std::size_t(g.dim_x) * (w.key[1] + std::size_t(g.dim_y) * w.key[2])];
-      if (code & kInRegion) {
-        if (code & kOccupied) {
-          r.occluded = true;
-          return;
-        }
-        ++r.region_voxels;
-        r.unknown_voxels += (code & kWeightMask) != 0;
+    walkSegment(fine_, from_m + t0 * d, from_m + t1 * d, &r.voxel_steps, [&](std::size_t i) {
+      const std::uint16_t code = fine_codes_[i];
+      if (!(code & kInRegion)) return true;
+      if (code & kOccupied) {
+        r.occluded = true;
+        return false;
       }
-      const int axis = fvp_dda_next_axis(&w);
-      if (axis < 0) return;
-      fvp_dda_advance(&w, axis);
-      if (w.key[axis] < 0 || w.key[axis] >= (&g.dim_x)[axis]) return;
-    }
+      ++r.region_voxels;
+      r.unknown_voxels += (code & kWeightMask) != 0;
+      return true;
+    });
   };
   if (t_in > 1.0) {
     walkCoarse(0.0, 1.0);
@@ -189,48 +185,23 @@ GainResult InfoGainEvaluator::evaluateRay(const Eigen::Vector3d& origin_m,
   float o[3], e[3];
 
   // Coarse map up to the region: the first occupied voxel blocks the view.
-  if (t_enter > 0.0) {
-    const fvp_grid_params g = coarse_.params();
-    fvp_dda d;
-    toFloat3(origin_m, o);
-    toFloat3(entry_m, e);
-    if (fvp_dda_init(&d, &g, o, e) == 0) {
-      for (;;) {
-        ++r.voxel_steps;
-        if (coarse_occupied_[d.key[0] +
-                             std::size_t(g.dim_x) * (d.key[1] + std::size_t(g.dim_y) * d.key[2])]) {
-          r.blocked = true;
-          return r;
-        }
-        const int axis = fvp_dda_next_axis(&d);
-        if (axis < 0) break;
-        fvp_dda_advance(&d, axis);
-        if (d.key[axis] < 0 || d.key[axis] >= (&g.dim_x)[axis]) break;
-      }
-    }
-  }
+  if (t_enter > 0.0)
+    walkSegment(coarse_, origin_m, entry_m, &r.voxel_steps, [&](std::size_t i) {
+      r.blocked = coarse_occupied_[i] != 0;
+      return !r.blocked;
+    });
+  if (r.blocked) return r;
 
   // Fine map from the region's surface to the end point.
-  const fvp_grid_params g = fine_.params();
-  fvp_dda d;
-  toFloat3(entry_m, o);
-  toFloat3(end_m, e);
-  if (fvp_dda_init(&d, &g, o, e) != 0) return r;
   std::uint64_t weight_sum = 0;
-  for (;;) {
-    ++r.voxel_steps;
-    const std::uint16_t code =
-        fine_codes_[d.key[0] + std::size_t(g.dim_x) * (d.key[1] + std::size_t(g.dim_y) * d.key[2])];
-    if (code & kInRegion) {
-      ++r.region_voxels;
-      if (code & kOccupied) break;
-      weight_sum += code & kWeightMask;
-    }
-    const int axis = fvp_dda_next_axis(&d);
-    if (axis < 0) break;
-    fvp_dda_advance(&d, axis);
-    if (d.key[axis] < 0 || d.key[axis] >= (&g.dim_x)[axis]) break;
-  }
+  walkSegment(fine_, entry_m, end_m, &r.voxel_steps, [&](std::size_t i) {
+    const std::uint16_t code = fine_codes_[i];
+    if (!(code & kInRegion)) return true;
+    ++r.region_voxels;
+    if (code & kOccupied) return false;
+    weight_sum += code & kWeightMask;
+    return true;
+  });
   if (r.region_voxels > 0) r.ig = double(weight_sum) / kWeightScale / r.region_voxels;
   return r;
 }

@@ -34,34 +34,32 @@ Candidate ViewpointSampler::make(CandidateKind kind, const Eigen::Vector3d& targ
 
 std::vector<Candidate> ViewpointSampler::sampleRoi(const std::vector<map::FrontierVoxel>& frontiers,
                                                    int count, const ReachabilityFn& reachable) {
-  std::vector<const map::FrontierVoxel*> targets;
-  for (const auto& f : frontiers)
-    if (f.roi_frontier) targets.push_back(&f);
-  std::vector<Candidate> out;
-  if (targets.empty()) return out;
-  std::uniform_int_distribution<std::size_t> pick(0, targets.size() - 1);
-  out.reserve(count);
-  for (int i = 0; i < count; ++i) {
-    const map::FrontierVoxel& t = *targets[pick(rng_)];
-    out.push_back(make(CandidateKind::kRoi, t.center_m, randomUnitVector(), reachable));
-  }
-  return out;
+  return sample(CandidateKind::kRoi, frontiers, count, reachable);
 }
 
 std::vector<Candidate> ViewpointSampler::sampleExploration(
     const std::vector<map::FrontierVoxel>& frontiers, int count, const ReachabilityFn& reachable) {
+  return sample(CandidateKind::kExploration, frontiers, count, reachable);
+}
+
+std::vector<Candidate> ViewpointSampler::sample(CandidateKind kind,
+                                                const std::vector<map::FrontierVoxel>& frontiers,
+                                                int count, const ReachabilityFn& reachable) {
+  const bool roi = kind == CandidateKind::kRoi;
   std::vector<const map::FrontierVoxel*> targets;
   for (const auto& f : frontiers)
-    if (f.exploration_frontier) targets.push_back(&f);
+    if (roi ? f.roi_frontier : f.exploration_frontier) targets.push_back(&f);
   std::vector<Candidate> out;
   if (targets.empty()) return out;
   std::uniform_int_distribution<std::size_t> pick(0, targets.size() - 1);
   out.reserve(count);
   for (int i = 0; i < count; ++i) {
     const map::FrontierVoxel& t = *targets[pick(rng_)];
-    const Eigen::Vector3d dir =
-        t.normal.squaredNorm() > 0.0 ? t.normal.normalized() : randomUnitVector();
-    out.push_back(make(CandidateKind::kExploration, t.center_m, dir, reachable));
+    // ROI-targeted: a random direction; exploration: along the frontier's normal.
+    const Eigen::Vector3d dir = !roi && t.normal.squaredNorm() > 0.0
+                                    ? Eigen::Vector3d(t.normal.normalized())
+                                    : randomUnitVector();
+    out.push_back(make(kind, t.center_m, dir, reachable));
   }
   return out;
 }

@@ -30,6 +30,9 @@ class ViewpointSampler {
                                            int count, const ReachabilityFn& reachable);
 
  private:
+  std::vector<Candidate> sample(CandidateKind kind,
+                                const std::vector<map::FrontierVoxel>& frontiers, int count,
+                                const ReachabilityFn& reachable);
   Candidate make(CandidateKind kind, const Eigen::Vector3d& target_m,
                  const Eigen::Vector3d& direction, const ReachabilityFn& reachable);
   Eigen::Vector3d randomUnitVector();
