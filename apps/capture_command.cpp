@@ -16,6 +16,7 @@
 #include "fvp/host/perception/capture.h"
 #include "fvp/host/perception/occlusion_statistic.h"
 #include "fvp/host/perception/perception_pipeline.h"
+#include "fvp/robot/sim/camera_views.h"
 #include "fvp/robot/sim/stereo_renderer.h"
 #include "fvp/robot/sim/world.h"
 
@@ -53,12 +54,54 @@ std::string vec(const Eigen::Vector3d& p) {
 
 }  // namespace
 
+// K views orbiting the cluster, each rendered, perceived and written as out/NNN.
+static void writeCaptureSet(std::uint64_t seed, const std::string& world_file, int views,
+                            double arc_deg, const std::filesystem::path& out) {
+  const robot::sim::WorldConfig world_config =
+      world_file.empty() ? robot::sim::WorldConfig{}
+                         : robot::sim::WorldConfig::fromYamlFile(world_file);
+  const auto world = robot::sim::World::generate(world_config, seed);
+  robot::sim::RenderConfig render;
+  render.noise_seed = seed;
+  robot::sim::StereoRenderer renderer(world, render);
+  host::PerceptionConfig config;
+  config.tag.tag_id = world.tag().tag_id;
+  config.tag.tag_size_m = world.tag().tag_size_m;
+  const host::PerceptionPipeline pipeline(config);
+  std::optional<host::ClusterRegion> region;
+  const auto poses = robot::sim::orbitViews(world, views, arc_deg);
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const host::StereoFrame frame = renderer.render(poses[i]);
+    const host::PerceptionResult result = pipeline.process(frame, region);
+    if (!region && result.region) region = result.region;
+    host::Capture capture;
+    capture.left_bgr = frame.left_bgr;
+    capture.right_bgr = frame.right_bgr;
+    capture.intrinsics = frame.intrinsics;
+    capture.T_world_camera = frame.T_world_camera;
+    capture.disparity_px = result.disparity.disparity_px;
+    capture.fruitlet_mask = result.fruitlet_mask;
+    capture.roi_points_m = result.clouds.roi_points_m;
+    capture.other_points_m = result.clouds.other_points_m;
+    capture.has_clouds = true;
+    capture.ground_truth_json = world.groundTruthJson();
+    char name[16];
+    std::snprintf(name, sizeof(name), "%03zu", i);
+    host::writeCapture(out / name, capture);
+    std::cout << "view " << name << ": tag " << (result.tag ? "seen" : "not seen") << ", "
+              << result.clouds.roi_points_m.size() << " ROI points -> " << (out / name).string()
+              << "\n";
+  }
+}
+
 void addCaptureCommand(CLI::App& app) {
   struct Options {
     std::uint64_t seed = 1;
     std::string world_file;
     std::string pose;
     std::string out;
+    int views = 1;
+    double arc_deg = 90.0;
   };
   auto opt = std::make_shared<Options>();
   auto* cmd = app.add_subcommand(
@@ -71,8 +114,21 @@ void addCaptureCommand(CLI::App& app) {
   cmd->add_option("--pose", opt->pose,
                   "left camera pose in the world, x,y,z,qx,qy,qz,qw (optical frame: x right, "
                   "y down, z forward; default: the world's start view)");
+  cmd->add_option("--views", opt->views,
+                  "write a set of this many views orbiting the cluster as --out/000, 001, ... "
+                  "(for fvp size)")
+      ->check(CLI::Range(1, 360))
+      ->capture_default_str();
+  cmd->add_option("--arc-deg", opt->arc_deg, "arc the --views span around the cluster")
+      ->check(CLI::Range(0.0, 360.0))
+      ->capture_default_str();
   cmd->add_option("--out", opt->out, "capture directory (created)")->required();
   cmd->callback([opt] {
+    if (opt->views > 1) {
+      if (!opt->pose.empty()) throw std::invalid_argument("--pose and --views exclude each other");
+      writeCaptureSet(opt->seed, opt->world_file, opt->views, opt->arc_deg, opt->out);
+      return;
+    }
     const robot::sim::WorldConfig world_config =
         opt->world_file.empty() ? robot::sim::WorldConfig{}
                                 : robot::sim::WorldConfig::fromYamlFile(opt->world_file);

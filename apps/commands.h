@@ -12,6 +12,7 @@ void addTraverseCommand(CLI::App& app);
 void addMapCommand(CLI::App& app);
 void addRunCommand(CLI::App& app);
 void addPlanCommand(CLI::App& app);
+void addSizeCommand(CLI::App& app);
 void addExperimentCommands(CLI::App& app);
 
 }  // namespace fvp::apps

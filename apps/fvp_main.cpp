@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   fvp::apps::addMapCommand(app);
   fvp::apps::addRunCommand(app);
   fvp::apps::addPlanCommand(app);
+  fvp::apps::addSizeCommand(app);
   fvp::apps::addExperimentCommands(app);
   try {
     app.parse(argc, argv);

@@ -41,8 +41,33 @@ ViewResult MappingSession::addView(const StereoFrame& frame, PerceptionResult* p
   } else {
     pending_.emplace_back(view.index, perceived.clouds);
   }
+  if (tsdf_) {
+    // The fruitlets' TSDF from this view's ROI depth, and what sizing needs of the view.
+    const cv::Mat depth =
+        tsdf::depthFromDisparity(perceived.disparity.disparity_px, frame.intrinsics);
+    views_.back().tsdf_s =
+        tsdf_->integrate(depth, perceived.fruitlet_mask, frame.intrinsics, frame.T_world_camera)
+            .seconds;
+    sizing_views_.push_back({perceived.fruitlet_mask, perceived.disparity.disparity_px,
+                             frame.intrinsics, frame.T_world_camera});
+  }
   if (perceived_out) *perceived_out = std::move(perceived);
   return views_.back();
+}
+
+void MappingSession::enableTsdf(const tsdf::TsdfConfig& config) {
+  tsdf_ = std::make_unique<tsdf::TsdfVolume>(config);
+}
+
+sizing::SizingResult MappingSession::sizeFruitlets(const sizing::SizingConfig& config) const {
+  if (!tsdf_) throw std::logic_error("MappingSession::sizeFruitlets: call enableTsdf() first");
+  const map::MapEngine* map = map_.get();
+  const auto in_roi_voxel = [map](const Eigen::Vector3f& p) {
+    if (!map) return false;
+    const map::VoxelState s = map->fineState(p.cast<double>());
+    return s.roi && s.occupancy == map::VoxelClass::kOccupied;
+  };
+  return sizing::sizeFruitlets(sizing_views_, tsdf_->extractSurfacePoints(), in_roi_voxel, config);
 }
 
 void MappingSession::integrate(std::size_t index, const LabeledClouds& clouds) {

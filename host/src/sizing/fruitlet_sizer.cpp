@@ -58,6 +58,23 @@ void SizingConfig::validate() const {
   if (disparity_window_half_px < 0) throw std::invalid_argument("sizing: window half >= 0");
 }
 
+std::vector<std::array<std::uint8_t, 3>> clusterColours(const std::vector<int>& labels) {
+  static constexpr std::array<std::array<std::uint8_t, 3>, 8> kPalette{{{228, 26, 28},
+                                                                        {55, 126, 184},
+                                                                        {77, 175, 74},
+                                                                        {152, 78, 163},
+                                                                        {255, 127, 0},
+                                                                        {166, 86, 40},
+                                                                        {247, 129, 191},
+                                                                        {255, 255, 51}}};
+  std::vector<std::array<std::uint8_t, 3>> out;
+  out.reserve(labels.size());
+  for (int label : labels)
+    out.push_back(label < 0 ? std::array<std::uint8_t, 3>{128, 128, 128}
+                            : kPalette[label % kPalette.size()]);
+  return out;
+}
+
 bool fitSphere(const std::vector<Eigen::Vector3f>& points, Eigen::Vector3d& center_m,
                double& radius_m) {
   if (points.size() < 4) return false;

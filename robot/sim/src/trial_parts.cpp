@@ -12,7 +12,7 @@
 #include "fvp/accel/backend.h"
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/host/core/gnuplot.h"
-#include "fvp/host/eval/fruitlet_matching.h"
+#include "fvp/host/eval/sizing_score.h"
 #include "fvp/host/map/map_config.h"
 #include "fvp/host/perception/ply_io.h"
 #include "fvp/host/planner/fvp_planner.h"
@@ -47,6 +47,7 @@ struct TrialParts::Impl {
         engine(engine),
         backend(backend),
         session(host::PerceptionConfig{}, engine, host::map::MapConfig{}, backend) {
+    session.enableTsdf();
     if (options.planner == "fvp") {
       const host::planner::PlannerConfig config =
           options.planner_config.empty()
@@ -67,8 +68,6 @@ struct TrialParts::Impl {
   accel::Backend* backend;
   host::MappingSession session;
   std::unique_ptr<host::planner::ViewPlanner> planner;
-  host::tsdf::TsdfVolume tsdf;
-  std::vector<host::sizing::SizingView> sizing_views;
   host::sizing::SizingConfig sizing_config;
   host::sizing::SizingResult sizing;  ///< of the last sizeAndScore
 };
@@ -81,17 +80,9 @@ TrialParts::~TrialParts() = default;
 
 ViewOutcome TrialParts::addView(const host::StereoFrame& frame) {
   ViewOutcome outcome;
-  host::PerceptionResult perceived;
-  outcome.result = impl_->session.addView(frame, &perceived);
+  outcome.result = impl_->session.addView(frame);
   outcome.mapping_s = outcome.result.scan.seconds;
-  // The fruitlets' TSDF from this view's ROI depth, and what sizing needs of the view.
-  const cv::Mat depth =
-      host::tsdf::depthFromDisparity(perceived.disparity.disparity_px, frame.intrinsics);
-  outcome.tsdf_s =
-      impl_->tsdf.integrate(depth, perceived.fruitlet_mask, frame.intrinsics, frame.T_world_camera)
-          .seconds;
-  impl_->sizing_views.push_back({perceived.fruitlet_mask, perceived.disparity.disparity_px,
-                                 frame.intrinsics, frame.T_world_camera});
+  outcome.tsdf_s = outcome.result.tsdf_s;
   return outcome;
 }
 
@@ -181,24 +172,10 @@ void TrialParts::writeOutputs(const nlohmann::json& result, const World& world,
   }
   if (!camera_path.empty()) plotCameraPath(world, camera_path, out_dir / "path.png");
   const auto& sz = impl_->sizing;
-  host::writePlyPoints(out_dir / "surface.ply", impl_->tsdf.extractSurfacePoints());
-  {
-    // Clusters in distinct colours, noise grey.
-    static constexpr std::array<std::array<std::uint8_t, 3>, 8> kPalette{{{228, 26, 28},
-                                                                          {55, 126, 184},
-                                                                          {77, 175, 74},
-                                                                          {152, 78, 163},
-                                                                          {255, 127, 0},
-                                                                          {166, 86, 40},
-                                                                          {247, 129, 191},
-                                                                          {255, 255, 51}}};
-    std::vector<std::array<std::uint8_t, 3>> colors;
-    for (int label : sz.labels)
-      colors.push_back(label < 0 ? std::array<std::uint8_t, 3>{128, 128, 128}
-                                 : kPalette[label % kPalette.size()]);
-    host::writePlyColoredPoints(out_dir / "clusters.ply", sz.points, colors,
-                                "fvp clusters, world frame, metres; grey = noise");
-  }
+  host::writePlyPoints(out_dir / "surface.ply", impl_->session.tsdf()->extractSurfacePoints());
+  host::writePlyColoredPoints(out_dir / "clusters.ply", sz.points,
+                              host::sizing::clusterColours(sz.labels),
+                              "fvp clusters, world frame, metres; grey = noise");
 
   std::ostringstream md;
   md << "# Trial: " << result["planner"].get<std::string>() << ", world seed " << result["seed"]
@@ -251,114 +228,17 @@ void TrialParts::writeOutputs(const nlohmann::json& result, const World& world,
 
 namespace fvp::robot::sim {
 
-namespace {
-
-nlohmann::json vec3(const Eigen::Vector3d& v) {
-  return {v.x(), v.y(), v.z()};
-}
-
-/// The fruitlets of result.json for one estimator: every ground-truth fruitlet with its
-/// match, plus detections and metrics.
-nlohmann::json scoreEstimator(const World& world, const host::sizing::SizingResult& sizing,
-                              host::sizing::SizingEstimator estimator) {
-  std::vector<Eigen::Vector3d> detections, truth;
-  std::vector<double> est_mm, gt_mm;
-  for (const auto& f : sizing.fruitlets) {
-    const bool paper = estimator == host::sizing::SizingEstimator::kPaper;
-    detections.push_back(paper ? f.centroid_m : f.sphere_center_m);
-    est_mm.push_back(paper ? f.size_paper_mm : f.size_ours_mm);
-  }
-  for (const auto& f : world.fruitlets()) {
-    truth.push_back(f.center_m);
-    gt_mm.push_back(f.gtSizeMm());
-  }
-  const std::vector<int> match = host::eval::matchFruitlets(detections, truth);
-  const host::eval::SizeMetrics m =
-      host::eval::sizeMetrics(gt_mm, est_mm, match, detections.size());
-  nlohmann::json fruitlets = nlohmann::json::array();
-  for (std::size_t g = 0; g < truth.size(); ++g) {
-    nlohmann::json f = {
-        {"gt_center_m", vec3(truth[g])}, {"gt_size_mm", gt_mm[g]}, {"matched", match[g] >= 0}};
-    if (match[g] >= 0) {
-      f["est_center_m"] = vec3(detections[match[g]]);
-      f["est_size_mm"] = est_mm[match[g]];
-      f["center_error_mm"] = 1000.0 * (detections[match[g]] - truth[g]).norm();
-      f["detection"] = match[g];
-    } else {
-      f["est_center_m"] = nullptr;
-      f["est_size_mm"] = nullptr;
-    }
-    fruitlets.push_back(f);
-  }
-  const auto opt = [](const std::optional<double>& v) {
-    return v ? nlohmann::json(*v) : nlohmann::json();
-  };
-  return {{"fruitlets", fruitlets},
-          {"detections", detections.size()},
-          {"metrics",
-           {{"match_percent", m.match_percent},
-            {"mae_mm", opt(m.mae_mm)},
-            {"mape_percent", opt(m.mape_percent)},
-            {"precision_percent", opt(m.precision_percent)}}}};
-}
-
-}  // namespace
-
 nlohmann::json TrialParts::sizeAndScore(const World& world, const std::filesystem::path&) {
-  const host::map::MapEngine* map = impl_->session.map();
-  const auto in_roi_voxel = [map](const Eigen::Vector3f& p) {
-    if (!map) return false;
-    const host::map::VoxelState s = map->fineState(p.cast<double>());
-    return s.roi && s.occupancy == host::map::VoxelClass::kOccupied;
-  };
-  impl_->sizing = host::sizing::sizeFruitlets(
-      impl_->sizing_views, impl_->tsdf.extractSurfacePoints(), in_roi_voxel, impl_->sizing_config);
-  const auto& sz = impl_->sizing;
-  nlohmann::json out = scoreEstimator(world, sz, impl_->sizing_config.estimator);
-  const auto other = impl_->sizing_config.estimator == host::sizing::SizingEstimator::kOurs
-                         ? host::sizing::SizingEstimator::kPaper
-                         : host::sizing::SizingEstimator::kOurs;
-  const nlohmann::json alternative = scoreEstimator(world, sz, other);
-  out["sizing_estimator"] = host::sizing::toString(impl_->sizing_config.estimator);
-  out[std::string("fruitlets_") + host::sizing::toString(other) + "_sizing"] =
-      alternative["fruitlets"];
-  out[std::string("metrics_") + host::sizing::toString(other) + "_sizing"] = alternative["metrics"];
-  nlohmann::json detections = nlohmann::json::array();
-  for (const auto& f : sz.fruitlets) {
-    nlohmann::json per_image = nlohmann::json::array();
-    for (const auto& s : f.per_image)
-      per_image.push_back({{"view", s.view},
-                           {"size_paper_mm", s.size_paper_mm},
-                           {"size_ours_mm", s.size_ours_mm},
-                           {"minor_axis_px", s.minor_axis_px},
-                           {"max_disparity_px", s.max_disparity_px},
-                           {"visible_fraction", s.visible_fraction},
-                           {"touches_border", s.touches_border},
-                           {"shared_segment", s.shared_segment},
-                           {"axis_ratio", s.axis_ratio}});
-    detections.push_back({{"center_m", vec3(f.center_m)},
-                          {"size_mm", f.size_mm},
-                          {"centroid_m", vec3(f.centroid_m)},
-                          {"sphere_center_m", vec3(f.sphere_center_m)},
-                          {"size_paper_mm", f.size_paper_mm},
-                          {"size_ours_mm", f.size_ours_mm},
-                          {"points", f.points},
-                          {"per_image", per_image}});
-  }
-  out["sized_fruitlets"] = detections;
-  out["sizing_stats"] = {{"surface_points", sz.surface_points},
-                         {"in_roi_points", sz.in_roi_points},
-                         {"inlier_points", sz.inlier_points},
-                         {"tsdf_blocks", impl_->tsdf.blockCount()},
-                         {"tsdf_bytes", impl_->tsdf.memoryBytes()},
-                         {"events",
-                          {{"small_clusters", sz.events.small_clusters},
-                           {"invalid_disparity_windows", sz.events.invalid_disparity_windows},
-                           {"saturated_windows", sz.events.saturated_windows},
-                           {"not_visible", sz.events.not_visible},
-                           {"single_image_fruitlets", sz.events.single_image_fruitlets},
-                           {"unsized_clusters", sz.events.unsized_clusters},
-                           {"failed_sphere_fits", sz.events.failed_sphere_fits}}}};
+  impl_->sizing = impl_->session.sizeFruitlets(impl_->sizing_config);
+  std::vector<host::eval::GroundTruthFruitlet> truth;
+  for (const auto& f : world.fruitlets()) truth.push_back({f.center_m, f.gtSizeMm()});
+  nlohmann::json out =
+      host::eval::scoreBothEstimators(impl_->sizing, truth, impl_->sizing_config.estimator);
+  // The details object must outlive the loop (items() of a temporary would dangle).
+  const nlohmann::json details = host::eval::sizingDetails(impl_->sizing);
+  for (const auto& [key, value] : details.items()) out[key] = value;
+  out["sizing_stats"]["tsdf_blocks"] = impl_->session.tsdf()->blockCount();
+  out["sizing_stats"]["tsdf_bytes"] = impl_->session.tsdf()->memoryBytes();
   return out;
 }
 

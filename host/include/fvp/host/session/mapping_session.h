@@ -17,6 +17,8 @@
 #include "fvp/host/map/map_engine.h"
 #include "fvp/host/perception/perception_pipeline.h"
 #include "fvp/host/perception/stereo_frame.h"
+#include "fvp/host/sizing/fruitlet_sizer.h"
+#include "fvp/host/tsdf/tsdf_volume.h"
 
 namespace fvp::accel {
 class Backend;
@@ -36,6 +38,7 @@ struct ViewResult {
   map::ScanStats scan;
   /// Earlier views this call integrated (the region became known with this view).
   std::size_t earlier_views_integrated = 0;
+  double tsdf_s = 0.0;  ///< TSDF integration of this view's ROI depth (0 without a TSDF)
 };
 
 class MappingSession {
@@ -61,6 +64,16 @@ class MappingSession {
   std::size_t pendingViews() const { return pending_.size(); }
   const PerceptionPipeline& perception() const { return perception_; }
 
+  /// From now on every view's ROI depth is fused into a TSDF and the view is kept for sizing
+  /// (its fruitlet mask, disparity, intrinsics and pose).
+  void enableTsdf(const tsdf::TsdfConfig& config = {});
+  /// Null unless enableTsdf() was called.
+  const tsdf::TsdfVolume* tsdf() const { return tsdf_.get(); }
+  const std::vector<sizing::SizingView>& sizingViews() const { return sizing_views_; }
+  /// The sizing chain on the session's TSDF surface and views, keeping surface points in
+  /// ROI-occupied fine voxels. Needs enableTsdf(); without a map no point is kept.
+  sizing::SizingResult sizeFruitlets(const sizing::SizingConfig& config) const;
+
   /// Hands the map over; the session is done with it.
   std::unique_ptr<map::MapEngine> releaseMap() && { return std::move(map_); }
 
@@ -76,6 +89,8 @@ class MappingSession {
   std::vector<ViewResult> views_;
   // Clouds of views seen before the region was known, with the index of their view.
   std::vector<std::pair<std::size_t, LabeledClouds>> pending_;
+  std::unique_ptr<tsdf::TsdfVolume> tsdf_;
+  std::vector<sizing::SizingView> sizing_views_;
 };
 
 }  // namespace fvp::host

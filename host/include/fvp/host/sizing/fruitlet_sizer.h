@@ -16,6 +16,8 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
 #include <functional>
 #include <opencv2/core.hpp>
 #include <string>
@@ -101,6 +103,9 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
                            const std::vector<Eigen::Vector3f>& surface_points_m,
                            const std::function<bool(const Eigen::Vector3f&)>& in_roi_voxel,
                            const SizingConfig& config);
+
+/// A distinct colour per DBSCAN label (grey for noise), for clusters.ply.
+std::vector<std::array<std::uint8_t, 3>> clusterColours(const std::vector<int>& labels);
 
 /// Least-squares sphere through points (algebraic fit); false when degenerate.
 bool fitSphere(const std::vector<Eigen::Vector3f>& points, Eigen::Vector3d& center_m,

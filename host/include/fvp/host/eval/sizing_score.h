@@ -1,0 +1,42 @@
+// A sizing result scored against ground truth, as result.json and fruitlets.json hold it:
+// every ground-truth fruitlet with its match, the detections, the metrics (DESIGN.md
+// section 9), for the chosen estimator and for the other one on the same measurements.
+#pragma once
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "fvp/host/sizing/fruitlet_sizer.h"
+
+namespace fvp::host::eval {
+
+struct GroundTruthFruitlet {
+  Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
+  double size_mm = 0.0;
+};
+
+/// The fruitlets of a ground_truth.json (the simulator's World::groundTruthJson): throws
+/// std::runtime_error naming `source` and the field when it is malformed.
+std::vector<GroundTruthFruitlet> groundTruthFromJson(const std::string& text,
+                                                     const std::string& source);
+
+/// {"fruitlets": [{"gt_center_m", "gt_size_mm", "matched", "est_center_m", "est_size_mm",
+/// "center_error_mm"}], "detections", "metrics": {"match_percent", "mae_mm", "mape_percent",
+/// "precision_percent"}} for one estimator's centres and sizes.
+nlohmann::json scoreSizing(const sizing::SizingResult& sizing,
+                           const std::vector<GroundTruthFruitlet>& truth,
+                           sizing::SizingEstimator estimator);
+
+/// The scored default estimator plus "fruitlets_<other>_sizing", "metrics_<other>_sizing",
+/// "sizing_estimator" (truth may be empty: then only detections).
+nlohmann::json scoreBothEstimators(const sizing::SizingResult& sizing,
+                                   const std::vector<GroundTruthFruitlet>& truth,
+                                   sizing::SizingEstimator estimator);
+
+/// Every detection with both estimators' sizes and every per-image measurement, and the
+/// chain's counts and expected events: "sized_fruitlets" and "sizing_stats".
+nlohmann::json sizingDetails(const sizing::SizingResult& sizing);
+
+}  // namespace fvp::host::eval

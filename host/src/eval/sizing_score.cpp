@@ -1,0 +1,141 @@
+#include "fvp/host/eval/sizing_score.h"
+
+#include <stdexcept>
+
+#include "fvp/host/eval/fruitlet_matching.h"
+
+namespace fvp::host::eval {
+namespace {
+
+nlohmann::json vec3(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
+
+}  // namespace
+
+std::vector<GroundTruthFruitlet> groundTruthFromJson(const std::string& text,
+                                                     const std::string& source) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(source + ": expected JSON: " + e.what());
+  }
+  if (!j.contains("fruitlets") || !j["fruitlets"].is_array())
+    throw std::runtime_error(source + ": field 'fruitlets': expected an array");
+  std::vector<GroundTruthFruitlet> out;
+  for (std::size_t i = 0; i < j["fruitlets"].size(); ++i) {
+    const auto& f = j["fruitlets"][i];
+    const std::string where = source + ": fruitlets[" + std::to_string(i) + "]";
+    if (!f.contains("center_m") || !f["center_m"].is_array() || f["center_m"].size() != 3)
+      throw std::runtime_error(where + ".center_m: expected [x, y, z] in metres");
+    if (!f.contains("gt_size_mm") || !f["gt_size_mm"].is_number() ||
+        !(f["gt_size_mm"].get<double>() > 0))
+      throw std::runtime_error(where + ".gt_size_mm: expected a positive size in mm");
+    GroundTruthFruitlet g;
+    for (int a = 0; a < 3; ++a) {
+      if (!f["center_m"][a].is_number())
+        throw std::runtime_error(where + ".center_m: expected [x, y, z] in metres");
+      g.center_m[a] = f["center_m"][a].get<double>();
+    }
+    g.size_mm = f["gt_size_mm"].get<double>();
+    out.push_back(g);
+  }
+  return out;
+}
+
+nlohmann::json scoreSizing(const sizing::SizingResult& sz,
+                           const std::vector<GroundTruthFruitlet>& truth,
+                           sizing::SizingEstimator estimator) {
+  const bool paper = estimator == sizing::SizingEstimator::kPaper;
+  std::vector<Eigen::Vector3d> detections, centres;
+  std::vector<double> est_mm, gt_mm;
+  for (const auto& f : sz.fruitlets) {
+    detections.push_back(paper ? f.centroid_m : f.sphere_center_m);
+    est_mm.push_back(paper ? f.size_paper_mm : f.size_ours_mm);
+  }
+  for (const auto& g : truth) {
+    centres.push_back(g.center_m);
+    gt_mm.push_back(g.size_mm);
+  }
+  const std::vector<int> match = matchFruitlets(detections, centres);
+  const SizeMetrics m = sizeMetrics(gt_mm, est_mm, match, detections.size());
+  nlohmann::json fruitlets = nlohmann::json::array();
+  for (std::size_t g = 0; g < truth.size(); ++g) {
+    nlohmann::json f = {
+        {"gt_center_m", vec3(centres[g])}, {"gt_size_mm", gt_mm[g]}, {"matched", match[g] >= 0}};
+    if (match[g] >= 0) {
+      f["est_center_m"] = vec3(detections[match[g]]);
+      f["est_size_mm"] = est_mm[match[g]];
+      f["center_error_mm"] = 1000.0 * (detections[match[g]] - centres[g]).norm();
+      f["detection"] = match[g];
+    } else {
+      f["est_center_m"] = nullptr;
+      f["est_size_mm"] = nullptr;
+    }
+    fruitlets.push_back(f);
+  }
+  const auto opt = [](const std::optional<double>& v) {
+    return v ? nlohmann::json(*v) : nlohmann::json();
+  };
+  return {{"fruitlets", fruitlets},
+          {"detections", detections.size()},
+          {"metrics",
+           {{"match_percent", m.match_percent},
+            {"mae_mm", opt(m.mae_mm)},
+            {"mape_percent", opt(m.mape_percent)},
+            {"precision_percent", opt(m.precision_percent)}}}};
+}
+
+nlohmann::json scoreBothEstimators(const sizing::SizingResult& sz,
+                                   const std::vector<GroundTruthFruitlet>& truth,
+                                   sizing::SizingEstimator estimator) {
+  nlohmann::json out = scoreSizing(sz, truth, estimator);
+  const auto other = estimator == sizing::SizingEstimator::kOurs ? sizing::SizingEstimator::kPaper
+                                                                 : sizing::SizingEstimator::kOurs;
+  const nlohmann::json alternative = scoreSizing(sz, truth, other);
+  out["sizing_estimator"] = sizing::toString(estimator);
+  out[std::string("fruitlets_") + sizing::toString(other) + "_sizing"] = alternative["fruitlets"];
+  out[std::string("metrics_") + sizing::toString(other) + "_sizing"] = alternative["metrics"];
+  return out;
+}
+
+nlohmann::json sizingDetails(const sizing::SizingResult& sz) {
+  nlohmann::json detections = nlohmann::json::array();
+  for (const auto& f : sz.fruitlets) {
+    nlohmann::json per_image = nlohmann::json::array();
+    for (const auto& s : f.per_image)
+      per_image.push_back({{"view", s.view},
+                           {"size_paper_mm", s.size_paper_mm},
+                           {"size_ours_mm", s.size_ours_mm},
+                           {"minor_axis_px", s.minor_axis_px},
+                           {"max_disparity_px", s.max_disparity_px},
+                           {"visible_fraction", s.visible_fraction},
+                           {"touches_border", s.touches_border},
+                           {"shared_segment", s.shared_segment},
+                           {"axis_ratio", s.axis_ratio}});
+    detections.push_back({{"center_m", vec3(f.center_m)},
+                          {"size_mm", f.size_mm},
+                          {"centroid_m", vec3(f.centroid_m)},
+                          {"sphere_center_m", vec3(f.sphere_center_m)},
+                          {"size_paper_mm", f.size_paper_mm},
+                          {"size_ours_mm", f.size_ours_mm},
+                          {"points", f.points},
+                          {"per_image", per_image}});
+  }
+  return {{"sized_fruitlets", detections},
+          {"sizing_stats",
+           {{"surface_points", sz.surface_points},
+            {"in_roi_points", sz.in_roi_points},
+            {"inlier_points", sz.inlier_points},
+            {"events",
+             {{"small_clusters", sz.events.small_clusters},
+              {"invalid_disparity_windows", sz.events.invalid_disparity_windows},
+              {"saturated_windows", sz.events.saturated_windows},
+              {"not_visible", sz.events.not_visible},
+              {"single_image_fruitlets", sz.events.single_image_fruitlets},
+              {"unsized_clusters", sz.events.unsized_clusters},
+              {"failed_sphere_fits", sz.events.failed_sphere_fits}}}}}};
+}
+
+}  // namespace fvp::host::eval
