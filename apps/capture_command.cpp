@@ -85,7 +85,7 @@ static void writeCaptureSet(std::uint64_t seed, const std::string& world_file, i
     capture.other_points_m = result.clouds.other_points_m;
     capture.has_clouds = true;
     capture.ground_truth_json = world.groundTruthJson();
-    char name[16];
+    char name[24];  // any size_t in %03zu fits
     std::snprintf(name, sizeof(name), "%03zu", i);
     host::writeCapture(out / name, capture);
     std::cout << "view " << name << ": tag " << (result.tag ? "seen" : "not seen") << ", "

@@ -6,8 +6,8 @@ namespace fvp::accel {
 std::span<const KernelDescriptor* const> allKernels() {
   static const KernelDescriptor* const kAll[] = {
       kernels::rayTraverse().descriptor, kernels::scanMark().descriptor,
-      kernels::scanUpdate().descriptor, kernels::roiDistance().descriptor,
-      kernels::frontier().descriptor};
+      kernels::scanUpdate().descriptor,  kernels::roiDistance().descriptor,
+      kernels::frontier().descriptor,    kernels::infoGain().descriptor};
   return kAll;
 }
 

@@ -25,25 +25,27 @@ void addTiming(StageTimings& timings, const std::string& stage, double s) {
   timings.emplace_back(stage, s);
 }
 
-InfoGainConfig gainConfig(const PlannerConfig& config, GainMode mode) {
+InfoGainConfig gainConfig(const PlannerConfig& config) {
+  config.validate();
   InfoGainConfig g;
   g.max_d_m = config.max_d_m;
-  g.mode = mode;
+  g.mode = config.gain_mode == "frustum" ? GainMode::kFrustum : GainMode::kSingleRay;
+  g.frustum_rays_x = config.frustum_rays_x;
+  g.frustum_rays_y = config.frustum_rays_y;
+  g.embree_cull = config.embree_cull;
   return g;
 }
 
 }  // namespace
 
-FvpPlanner::FvpPlanner(const PlannerConfig& config, std::uint64_t seed, GainMode mode)
+FvpPlanner::FvpPlanner(const PlannerConfig& config, std::uint64_t seed, accel::Backend* backend)
     : config_(config),
-      mode_(mode),
       sampler_(config, seed * 0x9E3779B97F4A7C15ull ^ static_cast<std::uint64_t>(config.seed)),
-      gain_(gainConfig(config, mode)),
-      u_t_(config.utility_threshold) {
-  config_.validate();
-}
+      gain_(gainConfig(config), backend),
+      u_t_(config.utility_threshold) {}
 
-void FvpPlanner::score(std::vector<Candidate>& candidates, const Eigen::Vector3d& camera_m) const {
+void FvpPlanner::score(std::vector<Candidate>& candidates, const Eigen::Vector3d& camera_m,
+                       EvaluateStats* stats) const {
   std::vector<ViewQuery> queries;
   std::vector<std::size_t> index;
   for (std::size_t i = 0; i < candidates.size(); ++i) {
@@ -53,7 +55,7 @@ void FvpPlanner::score(std::vector<Candidate>& candidates, const Eigen::Vector3d
     queries.push_back({candidates[i].T_world_camera, candidates[i].target_m});
     index.push_back(i);
   }
-  const std::vector<GainResult> gains = gain_.evaluate(queries);
+  const std::vector<GainResult> gains = gain_.evaluate(queries, stats);
   for (std::size_t k = 0; k < index.size(); ++k) {
     Candidate& c = candidates[index[k]];
     c.ig = gains[k].ig;
@@ -91,8 +93,13 @@ PlanStep FvpPlanner::planAndMove(map::MapEngine& map, const Eigen::Isometry3d& T
         }
     addTiming(step.timings_s, "sample", since(t));
     t = Clock::now();
-    score(candidates, T_world_camera_now.translation());
-    addTiming(step.timings_s, "info_gain", since(t));
+    EvaluateStats stats;
+    score(candidates, T_world_camera_now.translation(), &stats);
+    const double scoring_s = since(t);
+    if (config_.embree_cull) addTiming(step.timings_s, "cull", stats.cull_s);
+    addTiming(step.timings_s, "info_gain", scoring_s - stats.cull_s);
+    step.culled_rays += stats.culled;
+    step.gain_rays += stats.rays;
 
     // Algorithm 1, lines 6-14: the heap as a sort by utility (ties by index: deterministic).
     std::vector<std::size_t> order(candidates.size());
@@ -119,11 +126,7 @@ PlanStep FvpPlanner::planAndMove(map::MapEngine& map, const Eigen::Isometry3d& T
 
 std::string FvpPlanner::configJson() const {
   nlohmann::ordered_json j = nlohmann::ordered_json::parse(config_.toJson());
-  j["gain_mode"] = mode_ == GainMode::kSingleRay ? "single_ray" : "frustum";
-  if (mode_ == GainMode::kFrustum) {
-    j["frustum_rays_x"] = gain_.config().frustum_rays_x;
-    j["frustum_rays_y"] = gain_.config().frustum_rays_y;
-  }
+  j["gain_device"] = gain_.walkDevice();
   return j.dump();
 }
 

@@ -1,14 +1,14 @@
 #include "fvp/host/planner/info_gain_evaluator.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
 
+#include "fvp/accel/backend.h"
+#include "fvp/accel/kernels.h"
 #include "fvp/host/map/map_engine.h"
-
-extern "C" {
-#include "fvp_dda.h"
-}
+#include "fvp/host/map/occupied_voxel_scene.h"
 
 namespace fvp::host::planner {
 namespace {
@@ -66,8 +66,17 @@ void InfoGainConfig::validate() const {
     throw std::invalid_argument("info gain: fov_x_rad and fov_y_rad must be in (0, 3) rad");
 }
 
-InfoGainEvaluator::InfoGainEvaluator(const InfoGainConfig& config) : config_(config) {
+InfoGainEvaluator::InfoGainEvaluator(const InfoGainConfig& config, accel::Backend* backend)
+    : config_(config), backend_(backend) {
   config_.validate();
+}
+
+InfoGainEvaluator::~InfoGainEvaluator() = default;
+InfoGainEvaluator::InfoGainEvaluator(InfoGainEvaluator&&) noexcept = default;
+InfoGainEvaluator& InfoGainEvaluator::operator=(InfoGainEvaluator&&) noexcept = default;
+
+const char* InfoGainEvaluator::walkDevice() const {
+  return backend_ ? accel::toString(backend_->kind()).data() : "host";
 }
 
 double InfoGainEvaluator::refresh(map::MapEngine& map) {
@@ -78,13 +87,16 @@ double InfoGainEvaluator::refresh(map::MapEngine& map) {
   region_center_m_ = map.region().center_m();
   region_radius_m_ = map.region().radius_m();
 
-  coarse_occupied_.assign(static_cast<std::size_t>(coarse_.voxelCount()), 0);
+  coarse_words_.assign(accel::gainCoarseWords(coarse_.params()), 0u);
   const auto cstride = [&](const std::array<int, 3>& v) {
     return v[0] + std::size_t(coarse_.dims[0]) * (v[1] + std::size_t(coarse_.dims[1]) * v[2]);
   };
-  for (const auto& v : map.occupiedVoxels(map::MapLevel::kCoarse)) coarse_occupied_[cstride(v)] = 1;
+  for (const auto& v : map.occupiedVoxels(map::MapLevel::kCoarse)) {
+    const std::size_t i = cstride(v);
+    coarse_words_[i >> 2] |= 1u << ((i & 3) * 8);
+  }
 
-  fine_codes_.assign(static_cast<std::size_t>(fine_.voxelCount()), 0);
+  fine_words_.assign(accel::gainFineWords(fine_.params()), 0u);
   const fvp_region region = map::regionInGrid(fine_, map.region());
   for (int z = 0; z < fine_.dims[2]; ++z)
     for (int y = 0; y < fine_.dims[1]; ++y)
@@ -99,8 +111,14 @@ double InfoGainEvaluator::refresh(map::MapEngine& map) {
           const double w = roiProximityWeight(map.roiDistance_m(index), config_.max_d_m);
           code |= static_cast<std::uint16_t>(std::lround(w * kWeightScale));
         }
-        fine_codes_[x + std::size_t(fine_.dims[0]) * (y + std::size_t(fine_.dims[1]) * z)] = code;
+        const std::size_t i = x + std::size_t(fine_.dims[0]) * (y + std::size_t(fine_.dims[1]) * z);
+        fine_words_[i >> 1] |= std::uint32_t{code} << ((i & 1) * 16);
       }
+  coarse_scene_ = config_.embree_cull ? &map.occupiedScene(map::MapLevel::kCoarse) : nullptr;
+  if (backend_) {
+    fine_device_ = backend_->createBufferFrom(fine_words_);
+    coarse_device_ = backend_->createBufferFrom(coarse_words_);
+  }
   ready_ = true;
   snapshot_scans_ = map.scanCount();
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -124,13 +142,13 @@ InfoGainEvaluator::RayCensus InfoGainEvaluator::census(const Eigen::Vector3d& fr
   const auto walkCoarse = [&](double t0, double t1) {
     if (!(t1 > t0)) return;
     walkSegment(coarse_, from_m + t0 * d, from_m + t1 * d, &r.voxel_steps, [&](std::size_t i) {
-      r.occluded = coarse_occupied_[i] != 0;
+      r.occluded = coarseOccupied(i);
       return !r.occluded;
     });
   };
   const auto walkFine = [&](double t0, double t1) {
     walkSegment(fine_, from_m + t0 * d, from_m + t1 * d, &r.voxel_steps, [&](std::size_t i) {
-      const std::uint16_t code = fine_codes_[i];
+      const std::uint16_t code = fineCode(i);
       if (!(code & kInRegion)) return true;
       if (code & kOccupied) {
         r.occluded = true;
@@ -165,77 +183,176 @@ bool InfoGainEvaluator::occupiedWithin(const Eigen::Vector3d& p_m, double radius
           continue;
         const Eigen::Vector3d c((x + 0.5) * vs, (y + 0.5) * vs, (z + 0.5) * vs);
         if ((c - p_m).norm() > radius_m) continue;
-        if (coarse_occupied_[g[0] + std::size_t(coarse_.dims[0]) *
-                                        (g[1] + std::size_t(coarse_.dims[1]) * g[2])])
+        if (coarseOccupied(g[0] + std::size_t(coarse_.dims[0]) *
+                                      (g[1] + std::size_t(coarse_.dims[1]) * g[2])))
           return true;
       }
   return false;
 }
 
 std::size_t InfoGainEvaluator::snapshotBytes() const {
-  return fine_codes_.size() * sizeof(std::uint16_t) + coarse_occupied_.size();
+  return (fine_words_.size() + coarse_words_.size()) * sizeof(std::uint32_t);
 }
 
-GainResult InfoGainEvaluator::evaluateRay(const Eigen::Vector3d& origin_m,
-                                          const Eigen::Vector3d& end_m) const {
+namespace {
+
+// A ray split at the region sphere (kernels/fvp_info_gain.h); false when it never enters.
+bool makeSegment(const Eigen::Vector3d& origin_m, const Eigen::Vector3d& end_m,
+                 const Eigen::Vector3d& center_m, double radius_m, accel::GainSegment* s) {
+  const double t_enter = sphereEntry(origin_m, end_m, center_m, radius_m);
+  if (t_enter < 0.0) return false;  // never enters the region: nothing to gain
+  toFloat3(origin_m, s->origin_m);
+  toFloat3(origin_m + t_enter * (end_m - origin_m), s->entry_m);
+  toFloat3(end_m, s->end_m);
+  s->origin_m[3] = t_enter > 0.0 ? 1.0f : 0.0f;
+  s->entry_m[3] = s->end_m[3] = 0.0f;
+  return true;
+}
+
+GainResult toGain(const accel::GainResultRaw& raw) {
   GainResult r;
-  const double t_enter = sphereEntry(origin_m, end_m, region_center_m_, region_radius_m_);
-  if (t_enter < 0.0) return r;  // never enters the region: nothing to gain
-  const Eigen::Vector3d entry_m = origin_m + t_enter * (end_m - origin_m);
-  float o[3], e[3];
-
-  // Coarse map up to the region: the first occupied voxel blocks the view.
-  if (t_enter > 0.0)
-    walkSegment(coarse_, origin_m, entry_m, &r.voxel_steps, [&](std::size_t i) {
-      r.blocked = coarse_occupied_[i] != 0;
-      return !r.blocked;
-    });
-  if (r.blocked) return r;
-
-  // Fine map from the region's surface to the end point.
-  std::uint64_t weight_sum = 0;
-  walkSegment(fine_, entry_m, end_m, &r.voxel_steps, [&](std::size_t i) {
-    const std::uint16_t code = fine_codes_[i];
-    if (!(code & kInRegion)) return true;
-    ++r.region_voxels;
-    if (code & kOccupied) return false;
-    weight_sum += code & kWeightMask;
-    return true;
-  });
-  if (r.region_voxels > 0) r.ig = double(weight_sum) / kWeightScale / r.region_voxels;
+  r.region_voxels = raw.region_voxels;
+  r.voxel_steps = raw.voxel_steps;
+  r.blocked = raw.blocked != 0;
+  if (r.region_voxels > 0)
+    r.ig = double(raw.weight_sum) / InfoGainEvaluator::kWeightScale / r.region_voxels;
   return r;
 }
 
-std::vector<GainResult> InfoGainEvaluator::evaluate(std::span<const ViewQuery> queries) const {
+// Segments per kernel dispatch: bounds the staging memory (48 + 16 bytes per segment).
+constexpr std::size_t kSegmentsPerDispatch = std::size_t{1} << 20;
+
+}  // namespace
+
+GainResult InfoGainEvaluator::evaluateRay(const Eigen::Vector3d& origin_m,
+                                          const Eigen::Vector3d& end_m) const {
+  accel::GainSegment s;
+  if (!makeSegment(origin_m, end_m, region_center_m_, region_radius_m_, &s)) return {};
+  const accel::GainParams params{fine_.params(), coarse_.params(), 1u};
+  return toGain(fvp_gain_walk(&params, s.origin_m, s.entry_m, s.end_m, s.origin_m[3] != 0.0f,
+                              fine_words_.data(), coarse_words_.data()));
+}
+
+void InfoGainEvaluator::walk(std::span<const accel::GainSegment> segments,
+                             accel::GainResultRaw* results) const {
+  if (segments.empty()) return;
+  if (backend_) {
+    for (std::size_t first = 0; first < segments.size(); first += kSegmentsPerDispatch) {
+      const std::size_t n = std::min(kSegmentsPerDispatch, segments.size() - first);
+      const accel::GainParams params{fine_.params(), coarse_.params(), std::uint32_t(n)};
+      auto seg_buf = backend_->createBuffer(n * sizeof(accel::GainSegment));
+      backend_->upload(*seg_buf, segments.data() + first, n * sizeof(accel::GainSegment));
+      auto out_buf = backend_->createBuffer(n * sizeof(accel::GainResultRaw));
+      backend_->run(accel::kernels::infoGain(), params,
+                    {seg_buf.get(), fine_device_.get(), coarse_device_.get(), out_buf.get()});
+      backend_->download(*out_buf, results + first, n * sizeof(accel::GainResultRaw));
+    }
+    return;
+  }
+  const accel::GainParams params{fine_.params(), coarse_.params(), std::uint32_t(segments.size())};
+#pragma omp parallel for schedule(dynamic, 64)
+  for (std::ptrdiff_t i = 0; i < std::ptrdiff_t(segments.size()); ++i)
+    results[i] =
+        fvp_gain_walk(&params, segments[i].origin_m, segments[i].entry_m, segments[i].end_m,
+                      segments[i].origin_m[3] != 0.0f, fine_words_.data(), coarse_words_.data());
+}
+
+std::vector<GainResult> InfoGainEvaluator::evaluate(std::span<const ViewQuery> queries,
+                                                    EvaluateStats* stats) const {
   if (!ready_) throw std::logic_error("InfoGainEvaluator::evaluate before refresh()");
-  std::vector<GainResult> out(queries.size());
+  const bool frustum = config_.mode == GainMode::kFrustum;
+  const int nx = frustum ? config_.frustum_rays_x : 1, ny = frustum ? config_.frustum_rays_y : 1;
+  const std::size_t rays_per_query = std::size_t(nx) * ny;
   const double tx = std::tan(0.5 * config_.fov_x_rad), ty = std::tan(0.5 * config_.fov_y_rad);
-  const int nx = config_.frustum_rays_x, ny = config_.frustum_rays_y;
-#pragma omp parallel for schedule(dynamic, 16)
-  for (std::ptrdiff_t i = 0; i < std::ptrdiff_t(queries.size()); ++i) {
-    const ViewQuery& q = queries[i];
-    const Eigen::Vector3d c = q.T_world_camera.translation();
-    if (config_.mode == GainMode::kSingleRay) {
-      out[i] = evaluateRay(c, q.target_m);
+
+  // Every ray of every query; those that never enter the region get slot -1 (gain 0).
+  std::vector<accel::GainSegment> segments;
+  segments.reserve(queries.size() * rays_per_query);
+  std::vector<std::int64_t> slot(queries.size() * rays_per_query, -1);
+  for (std::size_t q = 0; q < queries.size(); ++q) {
+    const Eigen::Isometry3d& T = queries[q].T_world_camera;
+    const Eigen::Vector3d c = T.translation();
+    // Frustum: rays end on the plane through the target parallel to the image.
+    const double depth = frustum ? (T.inverse() * queries[q].target_m).z() : 1.0;
+    if (!(depth > 0.0)) continue;
+    for (int v = 0; v < ny; ++v)
+      for (int u = 0; u < nx; ++u) {
+        const Eigen::Vector3d end =
+            frustum ? Eigen::Vector3d(
+                          T * (depth * Eigen::Vector3d(((u + 0.5) / nx * 2.0 - 1.0) * tx,
+                                                       ((v + 0.5) / ny * 2.0 - 1.0) * ty, 1.0)))
+                    : queries[q].target_m;
+        accel::GainSegment s;
+        if (!makeSegment(c, end, region_center_m_, region_radius_m_, &s)) continue;
+        slot[q * rays_per_query + std::size_t(v) * nx + u] = std::int64_t(segments.size());
+        segments.push_back(s);
+      }
+  }
+
+  EvaluateStats st;
+  st.rays = segments.size();
+  std::vector<accel::GainResultRaw> walked(segments.size(), accel::GainResultRaw{0u, 0u, 0u, 0u});
+  if (coarse_scene_) {
+    // Embree first: the coarse part of each ray that starts outside the region.
+    const auto t0 = std::chrono::steady_clock::now();
+    std::vector<accel::Ray> coarse_parts;
+    std::vector<std::size_t> coarse_of;
+    for (std::size_t i = 0; i < segments.size(); ++i)
+      if (segments[i].origin_m[3] != 0.0f) {
+        const auto& s = segments[i];
+        coarse_parts.push_back(accel::makeRay({s.origin_m[0], s.origin_m[1], s.origin_m[2]},
+                                              {s.entry_m[0], s.entry_m[1], s.entry_m[2]}));
+        coarse_of.push_back(i);
+      }
+    const std::vector<std::uint8_t> blocked = coarse_scene_->occludedBatch(coarse_parts);
+    std::vector<std::uint8_t> culled(segments.size(), 0);
+    for (std::size_t k = 0; k < blocked.size(); ++k)
+      if (blocked[k]) {
+        culled[coarse_of[k]] = 1;
+        walked[coarse_of[k]].blocked = 1u;
+        ++st.culled;
+      }
+    std::vector<accel::GainSegment> kept;
+    std::vector<std::size_t> kept_of;
+    kept.reserve(segments.size() - st.culled);
+    for (std::size_t i = 0; i < segments.size(); ++i)
+      if (!culled[i]) {
+        kept.push_back(segments[i]);
+        kept_of.push_back(i);
+      }
+    st.cull_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const auto t1 = std::chrono::steady_clock::now();
+    std::vector<accel::GainResultRaw> kept_walked(kept.size());
+    walk(kept, kept_walked.data());
+    for (std::size_t k = 0; k < kept.size(); ++k) walked[kept_of[k]] = kept_walked[k];
+    st.walked = kept.size();
+    st.walk_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+  } else {
+    const auto t1 = std::chrono::steady_clock::now();
+    walk(segments, walked.data());
+    st.walked = segments.size();
+    st.walk_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+  }
+  if (stats) *stats = st;
+
+  std::vector<GainResult> out(queries.size());
+  for (std::size_t q = 0; q < queries.size(); ++q) {
+    if (!frustum) {
+      if (slot[q] >= 0) out[q] = toGain(walked[slot[q]]);
       continue;
     }
-    // Frustum: rays end on the plane through the target parallel to the image.
-    const double depth = (q.T_world_camera.inverse() * q.target_m).z();
     GainResult sum;
     double ig_sum = 0.0;
-    if (depth > 0.0) {
-      for (int v = 0; v < ny; ++v)
-        for (int u = 0; u < nx; ++u) {
-          const Eigen::Vector3d dir_camera(((u + 0.5) / nx * 2.0 - 1.0) * tx,
-                                           ((v + 0.5) / ny * 2.0 - 1.0) * ty, 1.0);
-          const GainResult ray = evaluateRay(c, q.T_world_camera * (depth * dir_camera));
-          ig_sum += ray.ig;
-          sum.region_voxels += ray.region_voxels;
-          sum.voxel_steps += ray.voxel_steps;
-        }
+    for (std::size_t k = 0; k < rays_per_query; ++k) {
+      const std::int64_t i = slot[q * rays_per_query + k];
+      if (i < 0) continue;
+      const GainResult ray = toGain(walked[i]);
+      ig_sum += ray.ig;
+      sum.region_voxels += ray.region_voxels;
+      sum.voxel_steps += ray.voxel_steps;
     }
-    sum.ig = ig_sum / (nx * ny);
-    out[i] = sum;
+    sum.ig = ig_sum / double(rays_per_query);
+    out[q] = sum;
   }
   return out;
 }

@@ -45,6 +45,14 @@ const std::vector<KeySpec>& keySpecs() {
       {"seed", [](auto& c, auto& n, auto& w) { c.seed = as<std::int64_t>(n, w, "an integer"); }},
       {"camera_clearance_m",
        [](auto& c, auto& n, auto& w) { c.camera_clearance_m = as<double>(n, w, "a number"); }},
+      {"gain_mode",
+       [](auto& c, auto& n, auto& w) { c.gain_mode = as<std::string>(n, w, "a string"); }},
+      {"frustum_rays_x",
+       [](auto& c, auto& n, auto& w) { c.frustum_rays_x = as<int>(n, w, "an integer"); }},
+      {"frustum_rays_y",
+       [](auto& c, auto& n, auto& w) { c.frustum_rays_y = as<int>(n, w, "an integer"); }},
+      {"embree_cull",
+       [](auto& c, auto& n, auto& w) { c.embree_cull = as<bool>(n, w, "true or false"); }},
   };
   return specs;
 }
@@ -88,6 +96,10 @@ void PlannerConfig::validate(const std::string& source) const {
           "a factor b in (0, 1)");
   require(camera_clearance_m >= 0.0 && camera_clearance_m < 1.0, source, "camera_clearance_m",
           "a distance in [0, 1) m");
+  require(gain_mode == "single_ray" || gain_mode == "frustum", source, "gain_mode",
+          "single_ray or frustum");
+  require(frustum_rays_x >= 1 && frustum_rays_x <= 256, source, "frustum_rays_x", "1 to 256 rays");
+  require(frustum_rays_y >= 1 && frustum_rays_y <= 256, source, "frustum_rays_y", "1 to 256 rays");
   require(max_sampling_rounds >= 1 && max_sampling_rounds <= 1000, source, "max_sampling_rounds",
           "1 to 1000 rounds");
 }
@@ -103,7 +115,11 @@ std::string PlannerConfig::toJson() const {
                                     {"threshold_decay", threshold_decay},
                                     {"max_sampling_rounds", max_sampling_rounds},
                                     {"seed", seed},
-                                    {"camera_clearance_m", camera_clearance_m}};
+                                    {"camera_clearance_m", camera_clearance_m},
+                                    {"gain_mode", gain_mode},
+                                    {"frustum_rays_x", frustum_rays_x},
+                                    {"frustum_rays_y", frustum_rays_y},
+                                    {"embree_cull", embree_cull}};
   return j.dump();
 }
 

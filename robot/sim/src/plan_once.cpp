@@ -72,7 +72,7 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
     planner = std::make_unique<host::planner::FvpPlanner>(
         o.planner_config.empty() ? host::planner::PlannerConfig{}
                                  : host::planner::PlannerConfig::fromYamlFile(o.planner_config),
-        o.seed);
+        o.seed, backend.get());
   else
     planner = std::make_unique<host::planner::RvpPlanner>(
         o.planner_config.empty() ? host::planner::RvpConfig{}
@@ -128,6 +128,8 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
       {"move_attempts", step.move_attempts},
       {"failed_moves", step.failed_moves},
       {"rejected_clearance", step.rejected_clearance},
+      {"gain_rays", step.gain_rays},
+      {"culled_rays", step.culled_rays},
       {"motions", motions}};
   if (!o.out_dir.empty()) {
     std::filesystem::create_directories(o.out_dir);

@@ -55,7 +55,7 @@ void validate(const TrialOptions& o) {
 /// Counted expected events of one trial (never errors).
 struct TrialEvents {
   std::size_t move_attempts = 0, failed_moves = 0, planning_iterations = 0, rejected_clearance = 0,
-              iterations_without_move = 0, views_without_tag = 0;
+              iterations_without_move = 0, views_without_tag = 0, culled_rays = 0;
   std::int64_t dropped_disparities = 0, saturated_disparities = 0;
   std::map<std::string, std::size_t> motion_status;
 };
@@ -174,6 +174,7 @@ nlohmann::json runTrial(const TrialOptions& options) {
     events.move_attempts += step.move_attempts;
     events.failed_moves += step.failed_moves;
     events.rejected_clearance += step.rejected_clearance;
+    events.culled_rays += step.culled_rays;
     nlohmann::json timings = nlohmann::json::object();
     for (const auto& [stage, s] : step.timings_s) timings[stage] = s;
     plan_log.push_back(
@@ -216,6 +217,7 @@ nlohmann::json runTrial(const TrialOptions& options) {
                             {"move_attempts", events.move_attempts},
                             {"failed_moves", events.failed_moves},
                             {"candidates_rejected_clearance", events.rejected_clearance},
+                            {"gain_rays_culled", events.culled_rays},
                             {"views_without_tag", events.views_without_tag},
                             {"dropped_disparities", events.dropped_disparities},
                             {"saturated_disparities", events.saturated_disparities},

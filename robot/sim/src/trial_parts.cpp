@@ -53,7 +53,7 @@ struct TrialParts::Impl {
           options.planner_config.empty()
               ? host::planner::PlannerConfig{}
               : host::planner::PlannerConfig::fromYamlFile(options.planner_config);
-      planner = std::make_unique<host::planner::FvpPlanner>(config, options.seed);
+      planner = std::make_unique<host::planner::FvpPlanner>(config, options.seed, backend);
     } else {
       const host::planner::RvpConfig config =
           options.planner_config.empty()

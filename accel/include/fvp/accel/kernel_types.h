@@ -11,6 +11,7 @@
 
 extern "C" {
 #include "fvp_dda.h"
+#include "fvp_info_gain.h"
 #include "fvp_map_kernels.h"
 }
 
@@ -30,6 +31,11 @@ using EdtParams = fvp_edt_params;
 using FrontierParams = fvp_frontier_params;
 using Frontier = fvp_frontier;
 
+// Information gain (kernels/fvp_info_gain.h).
+using GainParams = fvp_gain_params;
+using GainSegment = fvp_gain_segment;
+using GainResultRaw = fvp_gain_result;
+
 inline constexpr int kBrickEdge = FVP_BRICK_EDGE;
 inline constexpr int kBrickVoxels = FVP_BRICK_VOXELS;
 inline constexpr int kNoBrick = FVP_NO_BRICK;
@@ -41,6 +47,9 @@ static_assert(sizeof(UpdateParams) == 24, "must match FvpUpdateParams");
 static_assert(sizeof(EdtParams) == 76, "must match FvpEdtParams");
 static_assert(sizeof(FrontierParams) == 76, "must match FvpFrontierParams");
 static_assert(sizeof(Frontier) == 32, "must match FvpFrontier");
+static_assert(sizeof(GainParams) == 68, "must match FvpGainParams");
+static_assert(sizeof(GainSegment) == 48, "must match FvpGainSegment (three vec4)");
+static_assert(sizeof(GainResultRaw) == 16, "must match FvpGainResult");
 static_assert(sizeof(GridParams) == 32, "must match FvpGridParams in shaders/fvp_dda.glsl");
 static_assert(sizeof(Ray) == 32, "must match FvpRay (two vec4)");
 static_assert(sizeof(RayResult) == 16, "must match FvpRayResult");
@@ -72,6 +81,15 @@ inline void checkSlotCount(std::uint32_t slot_count, const char* what) {
 
 inline std::int64_t voxelCount(const GridParams& g) {
   return std::int64_t{g.dim_x} * g.dim_y * g.dim_z;
+}
+
+/// 32-bit words of the gain snapshot's fine codes (2 bytes per voxel) and coarse
+/// occupancy (1 byte per voxel) for grids of these geometries (kernels/fvp_info_gain.h).
+inline std::size_t gainFineWords(const GridParams& g) {
+  return static_cast<std::size_t>((voxelCount(g) + 1) / 2);
+}
+inline std::size_t gainCoarseWords(const GridParams& g) {
+  return static_cast<std::size_t>((voxelCount(g) + 3) / 4);
 }
 
 inline Ray makeRay(std::array<float, 3> origin_m, std::array<float, 3> end_m) {

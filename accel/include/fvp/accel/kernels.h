@@ -34,4 +34,10 @@ Kernel<EdtParams> roiDistance();
 /// any order), count (1 uint: the total found, which may exceed the capacity).
 Kernel<FrontierParams> frontier();
 
+/// Information gain of ray segments over the planner's map snapshot (fvp_info_gain): one
+/// item per segment. Bindings: segments (segment_count GainSegment), fine_codes
+/// (gainFineWords(fine) uint), coarse_occupied (gainCoarseWords(coarse) uint), results
+/// (segment_count GainResultRaw).
+Kernel<GainParams> infoGain();
+
 }  // namespace fvp::accel::kernels

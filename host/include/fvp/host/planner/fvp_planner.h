@@ -17,8 +17,9 @@ namespace fvp::host::planner {
 
 class FvpPlanner : public ViewPlanner {
  public:
-  /// seed: the trial's; mixed with config.seed so trials differ and repeat.
-  FvpPlanner(const PlannerConfig& config, std::uint64_t seed, GainMode mode = GainMode::kSingleRay);
+  /// seed: the trial's; mixed with config.seed so trials differ and repeat. backend: where
+  /// the information-gain walks run (null: on the host, without a backend).
+  FvpPlanner(const PlannerConfig& config, std::uint64_t seed, accel::Backend* backend = nullptr);
 
   std::string_view name() const override { return "fvp"; }
   PlanStep planAndMove(map::MapEngine& map, const Eigen::Isometry3d& T_world_camera_now,
@@ -31,7 +32,9 @@ class FvpPlanner : public ViewPlanner {
 
   /// Scores candidates in place (IG of the reachable ones in one batch; Eq. 3), using the
   /// snapshot of the last refresh. Unreachable candidates keep IG 0 and utility -infinity.
-  void score(std::vector<Candidate>& candidates, const Eigen::Vector3d& camera_m) const;
+  /// stats: what the gain evaluation did (rays, Embree culling, walk time), if wanted.
+  void score(std::vector<Candidate>& candidates, const Eigen::Vector3d& camera_m,
+             EvaluateStats* stats = nullptr) const;
   /// Rebuilds the distance field and the gain snapshot; returns its wall time.
   double refresh(map::MapEngine& map) {
     refreshed_ = true;
@@ -40,7 +43,6 @@ class FvpPlanner : public ViewPlanner {
 
  private:
   PlannerConfig config_;
-  GainMode mode_;
   ViewpointSampler sampler_;
   InfoGainEvaluator gain_;
   double u_t_;

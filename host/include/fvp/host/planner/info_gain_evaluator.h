@@ -13,18 +13,38 @@
 // rays_x x rays_y rays through pixel-grid directions over the field of view, each ending at
 // the target's depth, IG the mean of the per-ray IGs. Walks use the exact fixed-point DDA
 // of kernels/fvp_dda.h, so they visit the same voxels as every map kernel.
+//
+// The walks are the info_gain kernel (kernels/fvp_info_gain.h): the host splits every ray at
+// the region sphere in double precision, the kernel walks and returns integers, and the
+// host turns them into gains, so every backend gives bit-identical results. Without a
+// backend the same C walk runs here directly (OpenMP over rays).
+//
+// Embree culling (embree_cull): before the walks, each ray's coarse part (camera -> region
+// entry) is tested against the Embree scene of the coarse map's occupied voxels; rays it
+// finds blocked are not walked (gain 0, blocked). The kernel would stop at the same voxel
+// anyway, so culling saves the coarse walk of blocked rays and the transfer of their
+// segments; it costs one Embree occlusion query per ray. Embree tests the voxels' faces,
+// the DDA their lattice: they can disagree on rays that graze a voxel's edge.
 #pragma once
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
+#include "fvp/accel/kernel_types.h"
 #include "fvp/host/map/grid_geometry.h"
+
+namespace fvp::accel {
+class Backend;
+class DeviceBuffer;
+}  // namespace fvp::accel
 
 namespace fvp::host::map {
 class MapEngine;
-}
+class OccupiedVoxelScene;
+}  // namespace fvp::host::map
 
 namespace fvp::host::planner {
 
@@ -39,6 +59,7 @@ struct InfoGainConfig {
   GainMode mode = GainMode::kSingleRay;
   int frustum_rays_x = 16, frustum_rays_y = 12;
   double fov_x_rad = kDefaultFovXRad, fov_y_rad = kDefaultFovYRad;
+  bool embree_cull = false;  ///< test rays' coarse parts with Embree before the walks
   /// Throws std::invalid_argument naming the field.
   void validate() const;
 };
@@ -46,6 +67,15 @@ struct InfoGainConfig {
 struct ViewQuery {
   Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();
   Eigen::Vector3d target_m = Eigen::Vector3d::Zero();
+};
+
+/// What one evaluate() did (rays, Embree culling, walks), for reports and benchmarks.
+struct EvaluateStats {
+  std::size_t rays = 0;    ///< rays that enter the region (segments to walk or cull)
+  std::size_t culled = 0;  ///< of which Embree found blocked before the region
+  std::size_t walked = 0;  ///< rays the walk kernel ran
+  double cull_s = 0.0;     ///< wall time of the Embree queries
+  double walk_s = 0.0;     ///< wall time of the walks (with transfers)
 };
 
 struct GainResult {
@@ -57,15 +87,21 @@ struct GainResult {
 
 class InfoGainEvaluator {
  public:
-  explicit InfoGainEvaluator(const InfoGainConfig& config);
+  /// backend: where the walks run (any of cpu, opencl, vulkan); null walks here directly.
+  explicit InfoGainEvaluator(const InfoGainConfig& config, accel::Backend* backend = nullptr);
+  ~InfoGainEvaluator();
+  InfoGainEvaluator(InfoGainEvaluator&&) noexcept;
+  InfoGainEvaluator& operator=(InfoGainEvaluator&&) noexcept;
   const InfoGainConfig& config() const { return config_; }
 
   /// After each integration: the ROI distance field (map.updateRoiDistance(max_d_m)) and
   /// the snapshot. Returns the wall time it took, seconds.
   double refresh(map::MapEngine& map);
-  /// IG of every query (OpenMP over queries; the same result for any thread count).
-  /// Throws std::logic_error before the first refresh().
-  std::vector<GainResult> evaluate(std::span<const ViewQuery> queries) const;
+  /// IG of every query (the same result for any backend and thread count).
+  /// Throws std::logic_error before the first refresh(). With embree_cull, the map given
+  /// to refresh() must outlive the calls (its coarse Embree scene is queried).
+  std::vector<GainResult> evaluate(std::span<const ViewQuery> queries,
+                                   EvaluateStats* stats = nullptr) const;
   /// IG of one ray segment origin -> end (the per-ray step of both modes).
   GainResult evaluateRay(const Eigen::Vector3d& origin_m, const Eigen::Vector3d& end_m) const;
   std::size_t snapshotBytes() const;
@@ -85,21 +121,37 @@ class InfoGainEvaluator {
   std::size_t snapshotScans() const { return snapshot_scans_; }
   double fineVoxelSize_m() const { return fine_.voxel_size_m; }
 
-  // Snapshot codes of a fine voxel.
+  /// Where the walks of the last evaluate() ran, e.g. "vulkan" or "host".
+  const char* walkDevice() const;
+
+  // Snapshot codes of a fine voxel (kernels/fvp_info_gain.h).
   static constexpr std::uint16_t kInRegion = 0x8000;
   static constexpr std::uint16_t kOccupied = 0x4000;
   static constexpr std::uint16_t kWeightMask = 0x3FFF;
   static constexpr double kWeightScale = 8192.0;  ///< weight 1 = 8192
 
  private:
+  /// The info_gain kernel over segments (on the backend, or here without one).
+  void walk(std::span<const accel::GainSegment> segments, accel::GainResultRaw* results) const;
+  std::uint16_t fineCode(std::size_t i) const {
+    return static_cast<std::uint16_t>(fine_words_[i >> 1] >> ((i & 1) * 16));
+  }
+  bool coarseOccupied(std::size_t i) const {
+    return ((coarse_words_[i >> 2] >> ((i & 3) * 8)) & 0xFFu) != 0;
+  }
+
   InfoGainConfig config_;
+  accel::Backend* backend_ = nullptr;
   bool ready_ = false;
   std::size_t snapshot_scans_ = 0;
   map::GridGeometry fine_, coarse_;
   Eigen::Vector3d region_center_m_ = Eigen::Vector3d::Zero();
   double region_radius_m_ = 0.0;
-  std::vector<std::uint16_t> fine_codes_;
-  std::vector<std::uint8_t> coarse_occupied_;
+  // The snapshot in the kernel's layout: 2 bytes per fine voxel and 1 byte per coarse voxel,
+  // packed into 32-bit words; with a backend, also on its device.
+  std::vector<std::uint32_t> fine_words_, coarse_words_;
+  std::unique_ptr<accel::DeviceBuffer> fine_device_, coarse_device_;
+  const map::OccupiedVoxelScene* coarse_scene_ = nullptr;  ///< embree_cull only
 };
 
 /// Eq. 1: the weight of an unknown voxel at distance d_m from the nearest known ROI.

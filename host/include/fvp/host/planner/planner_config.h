@@ -32,6 +32,14 @@ inline constexpr std::int64_t kDefaultPlannerSeed = 1;
 // motion planner is asked: the camera body (3 cm) plus the collision padding (1 cm) would
 // stand in it. 0 disables the check.
 inline constexpr double kDefaultCameraClearanceM = 0.04;
+// Information gain: the paper's one ray per candidate, or our frustum of rays over the field
+// of view (16 x 12 by default).
+inline constexpr const char* kDefaultGainMode = "single_ray";
+inline constexpr int kDefaultFrustumRaysX = 16;
+inline constexpr int kDefaultFrustumRaysY = 12;
+// Embree culling of rays blocked in the coarse map before the gain walks. Off by default:
+// measured slower than letting the walk stop at the blocking voxel (docs/planner.md).
+inline constexpr bool kDefaultEmbreeCull = false;
 
 struct PlannerConfig {
   int roi_samples = kDefaultRoiSamples;
@@ -45,6 +53,10 @@ struct PlannerConfig {
   int max_sampling_rounds = kDefaultMaxSamplingRounds;
   std::int64_t seed = kDefaultPlannerSeed;  ///< mixed with the trial's seed
   double camera_clearance_m = kDefaultCameraClearanceM;
+  std::string gain_mode = kDefaultGainMode;  ///< "single_ray" (paper Eq. 2) or "frustum"
+  int frustum_rays_x = kDefaultFrustumRaysX;
+  int frustum_rays_y = kDefaultFrustumRaysY;
+  bool embree_cull = kDefaultEmbreeCull;
 
   /// Reads a YAML file; missing keys keep their defaults; unknown keys, wrong types and
   /// out-of-range values throw std::invalid_argument naming the file and the key.

@@ -57,6 +57,9 @@ struct PlanStep {
   /// Reachable candidates dropped before scoring because the camera body would stand in
   /// occupied space (counted, not sent to the motion planner).
   std::size_t rejected_clearance = 0;
+  /// Gain rays that Embree found blocked in the coarse map and the walks skipped
+  /// (FVP with embree_cull), of gain_rays rays that entered the Cluster Region.
+  std::size_t culled_rays = 0, gain_rays = 0;
   StageTimings timings_s;
   bool moved() const { return chosen.has_value(); }
 };
