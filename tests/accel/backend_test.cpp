@@ -2,7 +2,7 @@
 // FVP_REQUIRE_ALL_BACKENDS=1 an unavailable backend fails instead of skipping.
 #include <gtest/gtest.h>
 
-#include "backend_test_support.h"
+#include "backend_fixture.h"
 
 #include <cstdlib>
 #include <random>
@@ -19,19 +19,8 @@ namespace {
 // to the bit today; the tolerance allows a device that rounds float adds differently.
 constexpr float kFieldSumRelativeTolerance = 1e-5f;
 
-class BackendTest : public ::testing::TestWithParam<BackendKind> {
+class BackendTest : public fvp::testing::BackendFixture {
  protected:
-  void SetUp() override {
-    try {
-      backend_ = createBackend(GetParam());
-    } catch (const BackendUnavailable& e) {
-      if (fvp::testing::allBackendsRequired())
-        FAIL() << "required backend unavailable: " << e.what();
-      GTEST_SKIP() << e.what();
-    }
-    cpu_ = createBackend(BackendKind::kCpu);
-  }
-
   void expectSameAsCpu(const DenseGrid& grid, const std::vector<Ray>& rays,
                        const std::string& context) {
     const auto got = traverseOnBackend(*backend_, grid, rays);
@@ -46,9 +35,6 @@ class BackendTest : public ::testing::TestWithParam<BackendKind> {
           << context << ", ray " << i;
     }
   }
-
-  std::unique_ptr<Backend> backend_;
-  std::unique_ptr<Backend> cpu_;
 };
 
 TEST_P(BackendTest, ReportsItsKindAndDevice) {
@@ -160,14 +146,7 @@ TEST_P(BackendTest, MatchesCpuOnBoundaryCases) {
   expectSameAsCpu(grid, rays, "boundary cases");
 }
 
-std::string backendName(const ::testing::TestParamInfo<BackendKind>& info) {
-  return std::string(toString(info.param));
-}
-
-INSTANTIATE_TEST_SUITE_P(AllBackends, BackendTest,
-                         ::testing::Values(BackendKind::kCpu, BackendKind::kOpenCl,
-                                           BackendKind::kVulkan),
-                         backendName);
+FVP_INSTANTIATE_FOR_ALL_BACKENDS(BackendTest);
 
 TEST(BackendFactory, NamesAndErrors) {
   EXPECT_EQ(parseBackendKind("opencl"), BackendKind::kOpenCl);

@@ -3,7 +3,7 @@
 // frontier definitions on hand-made grids.
 #include <gtest/gtest.h>
 
-#include "backend_test_support.h"
+#include "backend_fixture.h"
 
 #include <unistd.h>
 
@@ -195,18 +195,8 @@ TEST(GridEngine, RequiresABackendAndAKnownEngineName) {
 // ---------------------------------------------------------------------------------------
 // Every backend against the cpu reference.
 
-class GridEngineBackends : public ::testing::TestWithParam<BackendKind> {
+class GridEngineBackends : public fvp::testing::BackendFixture {
  protected:
-  void SetUp() override {
-    try {
-      backend_ = accel::createBackend(GetParam());
-    } catch (const accel::BackendUnavailable& e) {
-      if (fvp::testing::allBackendsRequired()) FAIL() << e.what();
-      GTEST_SKIP() << e.what();
-    }
-    cpu_ = accel::createBackend(BackendKind::kCpu);
-  }
-
   static void expectSameVoxels(const OccupancyLayer& got, const OccupancyLayer& want) {
     ASSERT_EQ(got.bricks().allocatedBricks(), want.bricks().allocatedBricks());
     std::size_t compared = 0;
@@ -222,8 +212,6 @@ class GridEngineBackends : public ::testing::TestWithParam<BackendKind> {
     });
     EXPECT_GT(compared, 0u);
   }
-
-  std::unique_ptr<accel::Backend> backend_, cpu_;
 };
 
 TEST_P(GridEngineBackends, ScanIntegrationMatchesCpuExactly) {
@@ -356,10 +344,6 @@ TEST_P(GridEngineBackends, FrontiersFollowTheirDefinitions) {
   }
 }
 
-std::string backendName(const ::testing::TestParamInfo<BackendKind>& info) {
-  return std::string(accel::toString(info.param));
-}
-
 TEST_P(GridEngineBackends, ChangedBricksAreExactlyTheBricksWhoseVoxelsChanged) {
   // Readers (host mirror, Embree scenes, the coarse OcTree) refresh only the bricks a scan
   // reports changed: compare the report with a full before/after comparison.
@@ -404,10 +388,7 @@ TEST_P(GridEngineBackends, ChangedBricksAreExactlyTheBricksWhoseVoxelsChanged) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(AllBackends, GridEngineBackends,
-                         ::testing::Values(BackendKind::kCpu, BackendKind::kOpenCl,
-                                           BackendKind::kVulkan),
-                         backendName);
+FVP_INSTANTIATE_FOR_ALL_BACKENDS(GridEngineBackends);
 
 TEST(MapConfigYaml, TheDefaultsFileHoldsTheDefaults) {
   const MapConfig read = MapConfig::fromYamlFile(FVP_SOURCE_DIR "/host/config/map_default.yaml");

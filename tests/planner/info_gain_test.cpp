@@ -7,7 +7,7 @@
 #include <filesystem>
 
 #include "../map/synthetic_scan.h"
-#include "backend_test_support.h"
+#include "backend_fixture.h"
 #include "fvp/accel/backend.h"
 #include "fvp/host/map/map_engine.h"
 #include "fvp/host/planner/info_gain_evaluator.h"
@@ -262,24 +262,12 @@ TEST(InfoGain, EmbreeCullingRemovesOnlyBlockedRays) {
 // The info_gain kernel on every backend against the host walk (no backend): identical
 // integers, so identical gains, on fresh random maps and candidates.
 
-class InfoGainBackends : public ::testing::TestWithParam<accel::BackendKind> {
- protected:
-  void SetUp() override {
-    try {
-      backend_ = accel::createBackend(GetParam());
-    } catch (const accel::BackendUnavailable& e) {
-      if (fvp::testing::allBackendsRequired()) FAIL() << e.what();
-      GTEST_SKIP() << e.what();
-    }
-  }
-  std::unique_ptr<accel::Backend> backend_;
-};
+using InfoGainBackends = fvp::testing::BackendFixture;
 
 TEST_P(InfoGainBackends, KernelEqualsHostWalkOnRandomMapsAndCandidates) {
   const std::uint64_t seed = fvp::testing::freshSeed();
   SCOPED_TRACE(fvp::testing::replayHint(seed));
-  auto cpu = accel::createBackend(accel::BackendKind::kCpu);
-  auto e = map::createMapEngine("grid", smallConfig(), kRegion, cpu.get());
+  auto e = map::createMapEngine("grid", smallConfig(), kRegion, cpu_.get());
   const auto world = map::testing::makeWorld(seed, kRegion.center_m(), 5);
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0), unit(0.0, 1.0);
@@ -331,12 +319,7 @@ TEST_P(InfoGainBackends, KernelEqualsHostWalkOnRandomMapsAndCandidates) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(AllBackends, InfoGainBackends,
-                         ::testing::Values(accel::BackendKind::kCpu, accel::BackendKind::kOpenCl,
-                                           accel::BackendKind::kVulkan),
-                         [](const ::testing::TestParamInfo<accel::BackendKind>& info) {
-                           return std::string(accel::toString(info.param));
-                         });
+FVP_INSTANTIATE_FOR_ALL_BACKENDS(InfoGainBackends);
 
 }  // namespace
 }  // namespace fvp::host::planner

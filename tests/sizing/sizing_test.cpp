@@ -11,6 +11,7 @@
 #include "fvp/host/sizing/fruitlet_sizer.h"
 #include "fvp/host/sizing/point_filters.h"
 #include "fvp/host/tsdf/tsdf_volume.h"
+#include "sphere_views.h"
 
 namespace fvp::host {
 namespace {
@@ -127,28 +128,20 @@ TEST(SphereFit, RecoversCentreAndRadiusFromAHemisphere) {
   EXPECT_NEAR(r, 0.005, 1e-6);
 }
 
-// An ideal view of a sphere: exact depth and mask, from a pinhole camera at the origin.
-struct SphereView {
-  cv::Mat depth, mask, disparity;
-  StereoIntrinsics in;
+// An ideal view of a sphere from a pinhole camera at the origin: exact depth, mask and the
+// disparity a perfect stereo pair would give.
+struct SphereView : testing::SphereView {
+  cv::Mat disparity;
 };
 SphereView renderSphere(const Eigen::Vector3d& c, double r) {
   SphereView v;
-  v.depth = cv::Mat(v.in.height_px, v.in.width_px, CV_32F, cv::Scalar(0));
-  v.mask = cv::Mat(v.in.height_px, v.in.width_px, CV_8U, cv::Scalar(0));
-  v.disparity = cv::Mat(v.in.height_px, v.in.width_px, CV_32F, cv::Scalar(0));
-  for (int y = 0; y < v.in.height_px; ++y)
-    for (int x = 0; x < v.in.width_px; ++x) {
-      const Eigen::Vector3d d((x - v.in.cx_px) / v.in.fx_px, (y - v.in.cy_px) / v.in.fy_px, 1.0);
-      const Eigen::Vector3d u = d.normalized();
-      const double b = u.dot(c), disc = b * b - (c.squaredNorm() - r * r);
-      if (disc < 0) continue;
-      const double t = b - std::sqrt(disc);
-      const double z = t * u.z();
-      v.depth.at<float>(y, x) = float(z);
-      v.mask.at<std::uint8_t>(y, x) = 255;
-      v.disparity.at<float>(y, x) = float(v.in.fx_px * v.in.baseline_m / z);
-    }
+  static_cast<testing::SphereView&>(v) = testing::renderSpheres(
+      {Eigen::Vector4d(c.x(), c.y(), c.z(), r)}, Eigen::Isometry3d::Identity());
+  v.disparity = cv::Mat(v.depth.size(), CV_32F, cv::Scalar(0));
+  for (int y = 0; y < v.depth.rows; ++y)
+    for (int x = 0; x < v.depth.cols; ++x)
+      if (const float z = v.depth.at<float>(y, x); z > 0.0f)
+        v.disparity.at<float>(y, x) = float(v.in.fx_px * v.in.baseline_m / z);
   return v;
 }
 
@@ -156,7 +149,7 @@ TEST(Tsdf, SurfaceOfAnIdealSphereLiesOnIt) {
   const Eigen::Vector3d c(0.01, -0.005, 0.3);
   const double r = 0.006;
   const SphereView v = renderSphere(c, r);
-  tsdf::TsdfVolume volume;
+  tsdf::TsdfVolume volume({}, Eigen::AlignedBox3d(c.array() - 0.02, c.array() + 0.02));
   const auto stats = volume.integrate(v.depth, v.mask, v.in, Eigen::Isometry3d::Identity());
   EXPECT_GT(stats.roi_pixels, 1000u);
   EXPECT_GT(volume.blockCount(), 0u);

@@ -7,7 +7,7 @@ std::span<const KernelDescriptor* const> allKernels() {
   static const KernelDescriptor* const kAll[] = {
       kernels::rayTraverse().descriptor, kernels::scanMark().descriptor,
       kernels::scanUpdate().descriptor,  kernels::roiDistance().descriptor,
-      kernels::frontier().descriptor,    kernels::infoGain().descriptor};
+      kernels::frontier().descriptor,    kernels::infoGain().descriptor, kernels::tsdfIntegrate().descriptor};
   return kAll;
 }
 

@@ -77,7 +77,7 @@ nlohmann::json sizeCaptureSet(const std::filesystem::path& captures_dir,
   out["cluster_region_found"] = session.region().has_value();
   if (!options.out_dir.empty()) {
     std::filesystem::create_directories(options.out_dir);
-    writePlyPoints(options.out_dir / "surface.ply", session.tsdf()->extractSurfacePoints());
+    writePlyPoints(options.out_dir / "surface.ply", session.surfacePoints());
     writePlyColoredPoints(options.out_dir / "clusters.ply", sized.points,
                           sizing::clusterColours(sized.labels),
                           "fvp clusters, world frame, metres; grey = noise");

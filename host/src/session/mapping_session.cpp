@@ -41,33 +41,49 @@ ViewResult MappingSession::addView(const StereoFrame& frame, PerceptionResult* p
   } else {
     pending_.emplace_back(view.index, perceived.clouds);
   }
-  if (tsdf_) {
-    // The fruitlets' TSDF from this view's ROI depth, and what sizing needs of the view.
-    const cv::Mat depth =
-        tsdf::depthFromDisparity(perceived.disparity.disparity_px, frame.intrinsics);
-    views_.back().tsdf_s =
-        tsdf_->integrate(depth, perceived.fruitlet_mask, frame.intrinsics, frame.T_world_camera)
-            .seconds;
+  if (tsdf_config_) {
+    // What sizing needs of the view, and the fruitlets' TSDF from its ROI depth once the
+    // region bounds the TSDF (views seen before the tag are fused when it is found).
     sizing_views_.push_back({perceived.fruitlet_mask, perceived.disparity.disparity_px,
                              frame.intrinsics, frame.T_world_camera});
+    if (region_ && !tsdf_) {
+      const Eigen::Vector3d half = Eigen::Vector3d::Constant(region_->radius_m());
+      tsdf_ = std::make_unique<tsdf::TsdfVolume>(
+          *tsdf_config_,
+          Eigen::AlignedBox3d(region_->center_m() - half, region_->center_m() + half), backend_);
+      for (std::size_t i = 0; i + 1 < sizing_views_.size(); ++i) integrateTsdf(i);
+    }
+    if (tsdf_) views_.back().tsdf_s = integrateTsdf(sizing_views_.size() - 1);
   }
   if (perceived_out) *perceived_out = std::move(perceived);
   return views_.back();
 }
 
 void MappingSession::enableTsdf(const tsdf::TsdfConfig& config) {
-  tsdf_ = std::make_unique<tsdf::TsdfVolume>(config);
+  config.validate();
+  tsdf_config_ = config;
+}
+
+double MappingSession::integrateTsdf(std::size_t sizing_view) {
+  const sizing::SizingView& v = sizing_views_[sizing_view];
+  const cv::Mat depth = tsdf::depthFromDisparity(v.disparity_px, v.intrinsics);
+  return tsdf_->integrate(depth, v.fruitlet_mask, v.intrinsics, v.T_world_camera).seconds;
+}
+
+std::vector<Eigen::Vector3f> MappingSession::surfacePoints() const {
+  return tsdf_ ? tsdf_->extractSurfacePoints() : std::vector<Eigen::Vector3f>{};
 }
 
 sizing::SizingResult MappingSession::sizeFruitlets(const sizing::SizingConfig& config) const {
-  if (!tsdf_) throw std::logic_error("MappingSession::sizeFruitlets: call enableTsdf() first");
+  if (!tsdf_config_)
+    throw std::logic_error("MappingSession::sizeFruitlets: call enableTsdf() first");
   const map::MapEngine* map = map_.get();
   const auto in_roi_voxel = [map](const Eigen::Vector3f& p) {
     if (!map) return false;
     const map::VoxelState s = map->fineState(p.cast<double>());
     return s.roi && s.occupancy == map::VoxelClass::kOccupied;
   };
-  return sizing::sizeFruitlets(sizing_views_, tsdf_->extractSurfacePoints(), in_roi_voxel, config);
+  return sizing::sizeFruitlets(sizing_views_, surfacePoints(), in_roi_voxel, config);
 }
 
 void MappingSession::integrate(std::size_t index, const LabeledClouds& clouds) {

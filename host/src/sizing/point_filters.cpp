@@ -1,6 +1,7 @@
 #include "fvp/host/sizing/point_filters.h"
 
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <nanoflann.hpp>
 
@@ -97,6 +98,28 @@ std::vector<int> dbscan(const std::vector<Eigen::Vector3f>& points, double eps_m
     }
   }
   return label;
+}
+
+double meanNearestDistance_m(const std::vector<Eigen::Vector3f>& from,
+                             const std::vector<Eigen::Vector3f>& to) {
+  if (from.empty() || to.empty()) return std::numeric_limits<double>::infinity();
+  const Cloud cloud{to};
+  Tree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+  tree.buildIndex();
+  double sum = 0.0;
+#pragma omp parallel for schedule(static) reduction(+ : sum)
+  for (std::ptrdiff_t i = 0; i < std::ptrdiff_t(from.size()); ++i) {
+    std::size_t index;
+    float d2;
+    tree.knnSearch(from[i].data(), 1, &index, &d2);
+    sum += std::sqrt(double(d2));
+  }
+  return sum / from.size();
+}
+
+double chamferDistance_m(const std::vector<Eigen::Vector3f>& a,
+                         const std::vector<Eigen::Vector3f>& b) {
+  return 0.5 * (meanNearestDistance_m(a, b) + meanNearestDistance_m(b, a));
 }
 
 }  // namespace fvp::host::sizing

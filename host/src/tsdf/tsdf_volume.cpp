@@ -3,14 +3,31 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <set>
 #include <stdexcept>
+
+#include "fvp/accel/backend.h"
+#include "fvp/accel/kernels.h"
+#include "fvp/host/map/brick_layer.h"
+
+#include <opencv2/imgproc.hpp>
 
 namespace fvp::host::tsdf {
 namespace {
 
-int floorDiv(int a, int b) {
-  return a >= 0 ? a / b : -((-a + b - 1) / b);
+map::GridGeometry boundedGrid(double voxel_size_m, const Eigen::AlignedBox3d& bounds_m) {
+  if (bounds_m.isEmpty() || !bounds_m.min().allFinite() || !bounds_m.max().allFinite())
+    throw std::invalid_argument("TsdfVolume: the bounds must be a finite, non-empty box");
+  map::GridGeometry g;
+  g.voxel_size_m = voxel_size_m;
+  for (int a = 0; a < 3; ++a) {
+    const auto lo = static_cast<std::int64_t>(std::floor(bounds_m.min()[a] / voxel_size_m));
+    const auto hi = static_cast<std::int64_t>(std::ceil(bounds_m.max()[a] / voxel_size_m));
+    const std::int64_t n = std::max<std::int64_t>(kBlockSide, (hi - lo + 7) / 8 * 8);
+    if (n > 8192) throw std::invalid_argument("TsdfVolume: bounds wider than 8192 voxels");
+    g.first_voxel[a] = lo;
+    g.dims[a] = static_cast<int>(n);
+  }
+  return g;
 }
 
 }  // namespace
@@ -23,13 +40,29 @@ void TsdfConfig::validate() const {
   if (!(max_weight > 0.0f)) throw std::invalid_argument("tsdf config: max_weight: expected > 0");
 }
 
-TsdfVolume::TsdfVolume(const TsdfConfig& config) : config_(config) {
+TsdfVolume::TsdfVolume(const TsdfConfig& config, const Eigen::AlignedBox3d& bounds_m,
+                       accel::Backend* backend)
+    : config_(config), backend_(backend) {
   config_.validate();
+  geometry_ = boundedGrid(config_.voxel_size_m, bounds_m);
+  if (!backend_) {
+    own_backend_ = accel::createBackend(accel::BackendKind::kCpu);
+    backend_ = own_backend_.get();
+  }
+  layer_ = std::make_unique<map::BrickLayer>(*backend_, geometry_, std::nullopt,
+                                             map::BrickAllocation::kOnTouch);
+  distance_channel_ = layer_->addChannel("tsdf_distance", sizeof(float), 0u);
+  weight_channel_ = layer_->addChannel("tsdf_weight", sizeof(float), 0u);
 }
 
-const TsdfVolume::Block* TsdfVolume::findBlock(const std::array<int, 3>& coord) const {
-  const auto it = index_.find(coord);
-  return it == index_.end() ? nullptr : &blocks_[it->second];
+TsdfVolume::~TsdfVolume() = default;
+
+std::size_t TsdfVolume::blockCount() const {
+  return layer_->allocatedBricks();
+}
+
+std::size_t TsdfVolume::memoryBytes() const {
+  return layer_->deviceBytes();
 }
 
 cv::Mat depthFromDisparity(const cv::Mat& disparity_px, const StereoIntrinsics& in) {
@@ -49,143 +82,167 @@ TsdfIntegrateStats TsdfVolume::integrate(const cv::Mat& depth_m, const cv::Mat& 
                                          const Eigen::Isometry3d& T_world_camera) {
   if (depth_m.type() != CV_32F || roi_mask.type() != CV_8U || depth_m.size() != roi_mask.size())
     throw std::invalid_argument(
-        "TsdfVolume::integrate: expected CV_32F depth and CV_8U mask of "
-        "one size");
+        "TsdfVolume::integrate: expected CV_32F depth and CV_8U mask of one size");
   const auto start = std::chrono::steady_clock::now();
   TsdfIntegrateStats stats;
   const double vs = config_.voxel_size_m, trunc = config_.truncation_m;
-  const double block_m = vs * kBlockSide;
+  const Eigen::Vector3d grid_origin_m =
+      vs * Eigen::Vector3d(double(geometry_.first_voxel[0]), double(geometry_.first_voxel[1]),
+                           double(geometry_.first_voxel[2]));
+  const accel::BrickedGridParams& bp = layer_->params();
 
-  // 1. Blocks touched by the truncation band around every ROI point (along its ray).
-  std::set<std::array<int, 3>> touched;
+  // 1. The bricks of the truncation band around every ROI point (along its ray), and the
+  // pixel box that holds every ROI depth.
+  std::vector<std::uint8_t> in_band(layer_->gridBricks(), 0);
+  // The fruitlets cover a few % of the image: visit only the mask's bounding box.
+  const cv::Rect box = cv::boundingRect(roi_mask);
+  int u_min = depth_m.cols, u_max = -1, v_min = depth_m.rows, v_max = -1;
   const Eigen::Vector3d eye = T_world_camera.translation();
-  for (int v = 0; v < depth_m.rows; ++v) {
+  const double brick_m = vs * kBlockSide;
+  const int steps = static_cast<int>(std::ceil(2.0 * trunc / (0.5 * brick_m))) + 1;
+  for (int v = box.y; v < box.y + box.height; ++v) {
     const float* z = depth_m.ptr<float>(v);
     const std::uint8_t* m = roi_mask.ptr<std::uint8_t>(v);
-    for (int u = 0; u < depth_m.cols; ++u) {
+    for (int u = box.x; u < box.x + box.width; ++u) {
       if (!m[u] || !(z[u] > 0.0f) || !std::isfinite(z[u])) continue;
       ++stats.roi_pixels;
+      u_min = std::min(u_min, u);
+      u_max = std::max(u_max, u);
+      v_min = std::min(v_min, v);
+      v_max = std::max(v_max, v);
       const Eigen::Vector3d ray_camera((u - in.cx_px) / in.fx_px, (v - in.cy_px) / in.fy_px, 1.0);
       const Eigen::Vector3d p = T_world_camera * (z[u] * ray_camera);
       const Eigen::Vector3d dir = (p - eye).normalized();
-      const int steps = static_cast<int>(std::ceil(2.0 * trunc / (0.5 * block_m))) + 1;
       for (int s = 0; s <= steps; ++s) {
-        const Eigen::Vector3d q = p + (-trunc + 2.0 * trunc * s / steps) * dir;
-        touched.insert({static_cast<int>(std::floor(q.x() / block_m)),
-                        static_cast<int>(std::floor(q.y() / block_m)),
-                        static_cast<int>(std::floor(q.z() / block_m))});
+        const Eigen::Vector3d q =
+            (p + (-trunc + 2.0 * trunc * s / steps) * dir - grid_origin_m) / brick_m;
+        const double b[3] = {std::floor(q.x()), std::floor(q.y()), std::floor(q.z())};
+        if (b[0] < 0 || b[1] < 0 || b[2] < 0 || b[0] >= bp.bricks_x || b[1] >= bp.bricks_y ||
+            b[2] >= bp.bricks_z)
+          continue;
+        in_band[layer_->brickIndex(int(b[0]), int(b[1]), int(b[2]))] = 1;
       }
     }
   }
-  std::vector<std::size_t> work;
-  work.reserve(touched.size());
-  for (const auto& coord : touched) {
-    auto [it, inserted] = index_.try_emplace(coord, blocks_.size());
-    if (inserted) {
-      blocks_.push_back(
-          {coord, std::vector<float>(kBlockVoxels, 0.0f), std::vector<float>(kBlockVoxels, 0.0f)});
-      ++stats.blocks_allocated;
-    }
-    work.push_back(it->second);
+  std::vector<int> band;
+  for (std::size_t id = 0; id < in_band.size(); ++id)
+    if (in_band[id]) band.push_back(static_cast<int>(id));
+  if (band.empty()) {
+    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return stats;
   }
+  const std::size_t before = layer_->allocatedBricks();
+  layer_->allocate(band);
+  stats.blocks_allocated = layer_->allocatedBricks() - before;
+  std::vector<std::uint32_t> update;
+  update.reserve(band.size());
+  for (int id : band)
+    update.push_back(static_cast<std::uint32_t>(layer_->table()[id] & FVP_BRICK_INDEX_MASK));
+  stats.blocks_updated = update.size();
+  stats.voxels_updated = update.size() * kBlockVoxels;
 
-  // 2. Projective update of every voxel of those blocks (one thread per block).
-  const Eigen::Isometry3d T_camera_world = T_world_camera.inverse();
-  const float max_weight = config_.max_weight;
-  std::size_t updated = 0;
-#pragma omp parallel for schedule(dynamic, 4) reduction(+ : updated)
-  for (std::ptrdiff_t w = 0; w < std::ptrdiff_t(work.size()); ++w) {
-    Block& b = blocks_[work[w]];
-    for (int k = 0; k < kBlockVoxels; ++k) {
-      const int x = k % kBlockSide, y = (k / kBlockSide) % kBlockSide,
-                zc = k / (kBlockSide * kBlockSide);
-      const Eigen::Vector3d center((b.coord[0] * kBlockSide + x + 0.5) * vs,
-                                   (b.coord[1] * kBlockSide + y + 0.5) * vs,
-                                   (b.coord[2] * kBlockSide + zc + 0.5) * vs);
-      const Eigen::Vector3d pc = T_camera_world * center;
-      if (!(pc.z() > 0.0)) continue;
-      const int u = static_cast<int>(std::lround(in.fx_px * pc.x() / pc.z() + in.cx_px));
-      const int v = static_cast<int>(std::lround(in.fy_px * pc.y() / pc.z() + in.cy_px));
-      if (u < 0 || v < 0 || u >= depth_m.cols || v >= depth_m.rows) continue;
-      if (!roi_mask.at<std::uint8_t>(v, u)) continue;
-      const float depth = depth_m.at<float>(v, u);
-      if (!(depth > 0.0f) || !std::isfinite(depth)) continue;
-      // Projective distance along the viewing ray, in metres.
-      const double sdf = (depth - pc.z()) * pc.norm() / pc.z();
-      if (sdf < -trunc) continue;
-      // voxblox: weight 1/z^2, dropping linearly to 0 from one voxel behind the surface to
-      // the truncation distance.
-      double weight = 1.0 / (pc.z() * pc.z());
-      if (sdf < -vs) weight *= (trunc + sdf) / (trunc - vs);
-      if (!(weight > 0.0)) continue;
-      const float tsdf = static_cast<float>(std::min(sdf, trunc));
-      float& D = b.distance[k];
-      float& W = b.weight[k];
-      const float wf = static_cast<float>(weight);
-      D = (D * W + tsdf * wf) / (W + wf);
-      W = std::min(W + wf, max_weight);
-      ++updated;
-    }
+  // 2. The ROI depth, cropped to its pixel box, 0 where a pixel is not ROI or has no depth.
+  const int width = u_max - u_min + 1, height = v_max - v_min + 1;
+  std::vector<float> crop(std::size_t(width) * height, 0.0f);
+  for (int v = 0; v < height; ++v) {
+    const float* z = depth_m.ptr<float>(v + v_min) + u_min;
+    const std::uint8_t* m = roi_mask.ptr<std::uint8_t>(v + v_min) + u_min;
+    for (int u = 0; u < width; ++u)
+      if (m[u] && z[u] > 0.0f && std::isfinite(z[u])) crop[std::size_t(v) * width + u] = z[u];
   }
-  stats.voxels_updated = updated;
+  stats.depth_pixels_uploaded = crop.size();
+
+  // 3. The kernel over every voxel of the band's bricks.
+  accel::TsdfParams params{};
+  Eigen::Isometry3d T_world_grid = Eigen::Isometry3d::Identity();
+  T_world_grid.translation() = grid_origin_m;
+  const Eigen::Matrix<double, 3, 4> T_camera_grid =
+      (T_world_camera.inverse() * T_world_grid).matrix().topRows<3>();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) params.camera_from_grid[4 * r + c] = float(T_camera_grid(r, c));
+  params.voxel_size_m = float(vs);
+  params.truncation_m = float(trunc);
+  params.max_weight = config_.max_weight;
+  params.fx_px = float(in.fx_px);
+  params.fy_px = float(in.fy_px);
+  params.cx_px = float(in.cx_px - u_min);
+  params.cy_px = float(in.cy_px - v_min);
+  params.width_px = width;
+  params.height_px = height;
+  params.update_bricks = static_cast<std::uint32_t>(update.size());
+  params.allocated_bricks = static_cast<std::uint32_t>(layer_->allocatedBricks());
+  const auto update_buf = backend_->createBufferFrom(update);
+  const auto depth_buf = backend_->createBufferFrom(crop);
+  backend_->run(accel::kernels::tsdfIntegrate(), params,
+                {&layer_->coordsBuffer(), update_buf.get(), depth_buf.get(),
+                 &layer_->channel(distance_channel_), &layer_->channel(weight_channel_)});
+  layer_->markChanged(update);
+  host_stale_ = true;
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return stats;
 }
 
+void TsdfVolume::syncHost() const {
+  if (!host_stale_ && host_distance_.size() == layer_->slotCount()) return;
+  const std::size_t n = layer_->slotCount();
+  host_distance_.assign(n, 0.0f);
+  host_weight_.assign(n, 0.0f);
+  if (n) {
+    backend_->download(layer_->channel(distance_channel_), host_distance_.data(),
+                       n * sizeof(float));
+    backend_->download(layer_->channel(weight_channel_), host_weight_.data(), n * sizeof(float));
+  }
+  host_stale_ = false;
+}
+
+const std::vector<float>& TsdfVolume::distances() const {
+  syncHost();
+  return host_distance_;
+}
+
+const std::vector<float>& TsdfVolume::weights() const {
+  syncHost();
+  return host_weight_;
+}
+
 std::pair<float, float> TsdfVolume::voxel(const Eigen::Vector3d& p_m) const {
-  const double vs = config_.voxel_size_m;
-  const int g[3] = {static_cast<int>(std::floor(p_m.x() / vs)),
-                    static_cast<int>(std::floor(p_m.y() / vs)),
-                    static_cast<int>(std::floor(p_m.z() / vs))};
-  const Block* b = findBlock(
-      {floorDiv(g[0], kBlockSide), floorDiv(g[1], kBlockSide), floorDiv(g[2], kBlockSide)});
-  if (!b) return {0.0f, 0.0f};
-  const int k = (g[0] - b->coord[0] * kBlockSide) +
-                kBlockSide * ((g[1] - b->coord[1] * kBlockSide) +
-                              kBlockSide * (g[2] - b->coord[2] * kBlockSide));
-  return {b->distance[k], b->weight[k]};
+  std::array<int, 3> index;
+  if (!geometry_.gridIndex(p_m, index)) return {0.0f, 0.0f};
+  const std::int64_t slot = layer_->slotOf(index);
+  if (slot < 0) return {0.0f, 0.0f};
+  syncHost();
+  return {host_distance_[slot], host_weight_[slot]};
 }
 
 std::vector<Eigen::Vector3f> TsdfVolume::extractSurfacePoints() const {
-  const double vs = config_.voxel_size_m;
-  std::vector<std::vector<Eigen::Vector3f>> per_block(blocks_.size());
+  syncHost();
+  const std::size_t bricks = layer_->allocatedBricks();
+  std::vector<std::vector<Eigen::Vector3f>> per_brick(bricks);
 #pragma omp parallel for schedule(dynamic, 8)
-  for (std::ptrdiff_t i = 0; i < std::ptrdiff_t(blocks_.size()); ++i) {
-    const Block& b = blocks_[i];
+  for (std::ptrdiff_t b = 0; b < std::ptrdiff_t(bricks); ++b) {
     for (int k = 0; k < kBlockVoxels; ++k) {
-      if (!(b.weight[k] > 0.0f)) continue;
-      const int x = k % kBlockSide, y = (k / kBlockSide) % kBlockSide,
-                z = k / (kBlockSide * kBlockSide);
-      const int g[3] = {b.coord[0] * kBlockSide + x, b.coord[1] * kBlockSide + y,
-                        b.coord[2] * kBlockSide + z};
-      const Eigen::Vector3d c((g[0] + 0.5) * vs, (g[1] + 0.5) * vs, (g[2] + 0.5) * vs);
+      const std::size_t slot = std::size_t(b) * kBlockVoxels + k;
+      if (!(host_weight_[slot] > 0.0f)) continue;
+      const std::array<int, 3> g = layer_->voxelOfSlot(slot);
+      const Eigen::Vector3d c = geometry_.voxelCenter_m(g);
+      const float d0 = host_distance_[slot];
       for (int axis = 0; axis < 3; ++axis) {
-        Eigen::Vector3d n = c;
-        n[axis] += vs;
-        float dn, wn;
-        const int local[3] = {x, y, z};
-        if (local[axis] + 1 < kBlockSide) {
-          const int kn = k + (axis == 0 ? 1 : axis == 1 ? kBlockSide : kBlockSide * kBlockSide);
-          dn = b.distance[kn];
-          wn = b.weight[kn];
-        } else {
-          std::tie(dn, wn) = voxel(n);
-        }
-        const float d0 = b.distance[k];
-        if (!(wn > 0.0f) || (d0 > 0.0f) == (dn > 0.0f) || d0 == dn) continue;
+        std::array<int, 3> n = g;
+        ++n[axis];
+        const std::int64_t ns = layer_->slotOf(n);
+        if (ns < 0) continue;
+        const float dn = host_distance_[ns];
+        if (!(host_weight_[ns] > 0.0f) || (d0 > 0.0f) == (dn > 0.0f) || d0 == dn) continue;
         const double t = d0 / (d0 - dn);
-        per_block[i].push_back((c + t * (n - c)).cast<float>());
+        Eigen::Vector3d e = Eigen::Vector3d::Zero();
+        e[axis] = config_.voxel_size_m;
+        per_brick[b].push_back((c + t * e).cast<float>());
       }
     }
   }
   std::vector<Eigen::Vector3f> out;
-  for (const auto& v : per_block) out.insert(out.end(), v.begin(), v.end());
+  for (const auto& v : per_brick) out.insert(out.end(), v.begin(), v.end());
   return out;
-}
-
-std::size_t TsdfVolume::memoryBytes() const {
-  return blocks_.size() * (sizeof(Block) + 2 * kBlockVoxels * sizeof(float)) +
-         index_.size() * (sizeof(std::array<int, 3>) + sizeof(std::size_t) + 16);
 }
 
 }  // namespace fvp::host::tsdf

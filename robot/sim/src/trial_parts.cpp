@@ -172,7 +172,7 @@ void TrialParts::writeOutputs(const nlohmann::json& result, const World& world,
   }
   if (!camera_path.empty()) plotCameraPath(world, camera_path, out_dir / "path.png");
   const auto& sz = impl_->sizing;
-  host::writePlyPoints(out_dir / "surface.ply", impl_->session.tsdf()->extractSurfacePoints());
+  host::writePlyPoints(out_dir / "surface.ply", impl_->session.surfacePoints());
   host::writePlyColoredPoints(out_dir / "clusters.ply", sz.points,
                               host::sizing::clusterColours(sz.labels),
                               "fvp clusters, world frame, metres; grey = noise");
@@ -237,8 +237,12 @@ nlohmann::json TrialParts::sizeAndScore(const World& world, const std::filesyste
   // The details object must outlive the loop (items() of a temporary would dangle).
   const nlohmann::json details = host::eval::sizingDetails(impl_->sizing);
   for (const auto& [key, value] : details.items()) out[key] = value;
-  out["sizing_stats"]["tsdf_blocks"] = impl_->session.tsdf()->blockCount();
-  out["sizing_stats"]["tsdf_bytes"] = impl_->session.tsdf()->memoryBytes();
+  // No TSDF when no view ever saw the tag (nothing was sized then).
+  const host::tsdf::TsdfVolume* tsdf = impl_->session.tsdf();
+  out["sizing_stats"]["tsdf_blocks"] = tsdf ? tsdf->blockCount() : 0;
+  out["sizing_stats"]["tsdf_bytes"] = tsdf ? tsdf->memoryBytes() : 0;
+  out["sizing_stats"]["tsdf_bytes_per_block"] =
+      tsdf && tsdf->blockCount() ? double(tsdf->memoryBytes()) / tsdf->blockCount() : 0.0;
   return out;
 }
 

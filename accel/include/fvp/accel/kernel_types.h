@@ -13,6 +13,7 @@ extern "C" {
 #include "fvp_dda.h"
 #include "fvp_info_gain.h"
 #include "fvp_map_kernels.h"
+#include "fvp_tsdf.h"
 }
 
 namespace fvp::accel {
@@ -36,6 +37,9 @@ using GainParams = fvp_gain_params;
 using GainSegment = fvp_gain_segment;
 using GainResultRaw = fvp_gain_result;
 
+// Projective TSDF integration (kernels/fvp_tsdf.h).
+using TsdfParams = fvp_tsdf_params;
+
 inline constexpr int kBrickEdge = FVP_BRICK_EDGE;
 inline constexpr int kBrickVoxels = FVP_BRICK_VOXELS;
 inline constexpr int kNoBrick = FVP_NO_BRICK;
@@ -50,6 +54,7 @@ static_assert(sizeof(Frontier) == 32, "must match FvpFrontier");
 static_assert(sizeof(GainParams) == 68, "must match FvpGainParams");
 static_assert(sizeof(GainSegment) == 48, "must match FvpGainSegment (three vec4)");
 static_assert(sizeof(GainResultRaw) == 16, "must match FvpGainResult");
+static_assert(sizeof(TsdfParams) == 92, "must match FvpTsdfParams");
 static_assert(sizeof(GridParams) == 32, "must match FvpGridParams in shaders/fvp_dda.glsl");
 static_assert(sizeof(Ray) == 32, "must match FvpRay (two vec4)");
 static_assert(sizeof(RayResult) == 16, "must match FvpRayResult");

@@ -40,4 +40,10 @@ Kernel<FrontierParams> frontier();
 /// (segment_count GainResultRaw).
 Kernel<GainParams> infoGain();
 
+/// Projective TSDF integration of one view (fvp_tsdf): one item per voxel of the bricks to
+/// update. Bindings: brick_coords (3 int per allocated brick), update_bricks (update_bricks
+/// uint: allocation indices), depth_m (width_px * height_px float, 0 = no ROI depth),
+/// distance and weight (512 float per allocated brick, read and written).
+Kernel<TsdfParams> tsdfIntegrate();
+
 }  // namespace fvp::accel::kernels

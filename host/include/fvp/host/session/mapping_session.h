@@ -64,11 +64,15 @@ class MappingSession {
   std::size_t pendingViews() const { return pending_.size(); }
   const PerceptionPipeline& perception() const { return perception_; }
 
-  /// From now on every view's ROI depth is fused into a TSDF and the view is kept for sizing
-  /// (its fruitlet mask, disparity, intrinsics and pose).
+  /// From now on every view is kept for sizing (its fruitlet mask, disparity, intrinsics and
+  /// pose) and its ROI depth is fused into a TSDF over the Cluster Region's cube (on the
+  /// session's backend; a cpu backend of its own without one), from the view whose tag
+  /// places the region on, earlier views included.
   void enableTsdf(const tsdf::TsdfConfig& config = {});
-  /// Null unless enableTsdf() was called.
+  /// Null until enableTsdf() was called and the region is known.
   const tsdf::TsdfVolume* tsdf() const { return tsdf_.get(); }
+  /// The TSDF's surface points; empty while there is no TSDF.
+  std::vector<Eigen::Vector3f> surfacePoints() const;
   const std::vector<sizing::SizingView>& sizingViews() const { return sizing_views_; }
   /// The sizing chain on the session's TSDF surface and views, keeping surface points in
   /// ROI-occupied fine voxels. Needs enableTsdf(); without a map no point is kept.
@@ -79,6 +83,8 @@ class MappingSession {
 
  private:
   void integrate(std::size_t index, const LabeledClouds& clouds);
+  /// Fuses sizing_views_[i] into the TSDF; returns the seconds it took.
+  double integrateTsdf(std::size_t sizing_view);
 
   PerceptionPipeline perception_;
   std::string engine_;
@@ -89,6 +95,7 @@ class MappingSession {
   std::vector<ViewResult> views_;
   // Clouds of views seen before the region was known, with the index of their view.
   std::vector<std::pair<std::size_t, LabeledClouds>> pending_;
+  std::optional<tsdf::TsdfConfig> tsdf_config_;
   std::unique_ptr<tsdf::TsdfVolume> tsdf_;
   std::vector<sizing::SizingView> sizing_views_;
 };

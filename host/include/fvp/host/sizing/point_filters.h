@@ -24,4 +24,12 @@ inline constexpr int kDbscanNoise = -1;
 /// the points in order), kDbscanNoise for noise.
 std::vector<int> dbscan(const std::vector<Eigen::Vector3f>& points, double eps_m, int min_samples);
 
+/// Mean distance from each point of `from` to its nearest point of `to` (k-d tree over
+/// `to`); infinity when either is empty.
+double meanNearestDistance_m(const std::vector<Eigen::Vector3f>& from,
+                             const std::vector<Eigen::Vector3f>& to);
+/// Symmetric chamfer distance: the mean of meanNearestDistance_m both ways.
+double chamferDistance_m(const std::vector<Eigen::Vector3f>& a,
+                         const std::vector<Eigen::Vector3f>& b);
+
 }  // namespace fvp::host::sizing

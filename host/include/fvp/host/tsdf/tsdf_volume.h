@@ -1,21 +1,33 @@
-// The fruitlets' TSDF (paper, "Fruitlet Sizing"; DESIGN.md section 1 step 2): sparse blocks
-// of 8^3 voxels at 0.5 mm, allocated only inside the truncation band of ROI points, fed by
-// projective integration of each view's ROI depth with voxblox's weighting (1/z^2, and a
-// linear drop-off behind the surface). Each voxel is updated by exactly one thread in a
-// fixed order, so results do not depend on the thread count.
+// The fruitlets' TSDF (paper, "Fruitlet Sizing"; DESIGN.md section 1 step 2): a brick layer
+// (host/map/brick_layer.h) of 8^3-voxel bricks at 0.5 mm over a bounded box (the Cluster
+// Region's cube), bricks allocated only inside the truncation band of ROI points, with two
+// channels, distance and weight, fed by projective integration of each view's ROI depth
+// with voxblox's weighting (1/z^2, and a linear drop-off behind the surface).
 //
-// This is the CPU integrator; the surface it gives feeds the sizing chain.
+// Integration is the tsdf_integrate kernel (kernels/fvp_tsdf.h) on any backend: the host
+// finds the band's bricks and crops the ROI depth to the pixels that hold some, the kernel
+// updates every voxel of those bricks, each voxel by exactly one work item. Reads
+// (extractSurfacePoints, voxel) go through a host copy of the channels, downloaded once
+// after new views.
 #pragma once
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <opencv2/core.hpp>
-#include <unordered_map>
 #include <vector>
 
 #include "fvp/host/core/stereo_intrinsics.h"
+#include "fvp/host/map/grid_geometry.h"
+
+namespace fvp::accel {
+class Backend;
+}
+namespace fvp::host::map {
+class BrickLayer;
+}
 
 namespace fvp::host::tsdf {
 
@@ -34,16 +46,25 @@ struct TsdfConfig {
 };
 
 struct TsdfIntegrateStats {
-  std::size_t roi_pixels = 0;        ///< ROI pixels with a valid depth
-  std::size_t blocks_allocated = 0;  ///< new blocks this view
-  std::size_t voxels_updated = 0;
+  std::size_t roi_pixels = 0;             ///< ROI pixels with a valid depth
+  std::size_t blocks_allocated = 0;       ///< new blocks this view
+  std::size_t blocks_updated = 0;         ///< blocks in the band (every voxel visited)
+  std::size_t voxels_updated = 0;         ///< voxel slots the kernel visited (blocks_updated * 512)
+  std::size_t depth_pixels_uploaded = 0;  ///< the cropped ROI depth image
   double seconds = 0.0;
 };
 
 class TsdfVolume {
  public:
-  explicit TsdfVolume(const TsdfConfig& config = {});
+  /// The volume covers bounds_m (snapped outward to whole bricks); nothing outside is
+  /// integrated. backend: where the kernel runs; null: a cpu backend of its own.
+  TsdfVolume(const TsdfConfig& config, const Eigen::AlignedBox3d& bounds_m,
+             accel::Backend* backend = nullptr);
+  ~TsdfVolume();
+  TsdfVolume(const TsdfVolume&) = delete;
+  TsdfVolume& operator=(const TsdfVolume&) = delete;
   const TsdfConfig& config() const { return config_; }
+  const map::GridGeometry& geometry() const { return geometry_; }
 
   /// depth_m: CV_32F z-depth of the left camera, 0 (or non-finite) = invalid; roi_mask:
   /// CV_8U, nonzero = fruitlet, the same size. Only ROI pixels are integrated.
@@ -52,33 +73,30 @@ class TsdfVolume {
                                const Eigen::Isometry3d& T_world_camera);
 
   /// Zero crossings between face-neighbouring voxels that both have weight > 0, linearly
-  /// interpolated (world frame, metres).
+  /// interpolated (world frame, metres), in slot order.
   std::vector<Eigen::Vector3f> extractSurfacePoints() const;
 
-  std::size_t blockCount() const { return blocks_.size(); }
-  /// Bytes of voxel data (distance + weight per voxel) and the block table.
+  std::size_t blockCount() const;
+  /// Bytes of the brick layer on its device (table, coordinates, distance and weight).
   std::size_t memoryBytes() const;
 
-  /// Distance and weight of the voxel containing p (weight 0 where unallocated).
+  /// Distance and weight of the voxel containing p (weight 0 where unallocated or outside).
   std::pair<float, float> voxel(const Eigen::Vector3d& p_m) const;
+  /// Every allocated voxel's distance and weight, in slot order (what the kernel wrote).
+  const std::vector<float>& distances() const;
+  const std::vector<float>& weights() const;
 
  private:
-  struct Block {
-    std::array<int, 3> coord;
-    std::vector<float> distance, weight;
-  };
-  struct KeyHash {
-    std::size_t operator()(const std::array<int, 3>& k) const {
-      return (std::size_t(std::uint32_t(k[0])) * 73856093u) ^
-             (std::size_t(std::uint32_t(k[1])) * 19349663u) ^
-             (std::size_t(std::uint32_t(k[2])) * 83492791u);
-    }
-  };
-  const Block* findBlock(const std::array<int, 3>& coord) const;
+  void syncHost() const;
 
   TsdfConfig config_;
-  std::vector<Block> blocks_;
-  std::unordered_map<std::array<int, 3>, std::size_t, KeyHash> index_;
+  map::GridGeometry geometry_;
+  std::unique_ptr<accel::Backend> own_backend_;
+  accel::Backend* backend_;
+  std::unique_ptr<map::BrickLayer> layer_;
+  std::size_t distance_channel_ = 0, weight_channel_ = 0;
+  mutable bool host_stale_ = false;
+  mutable std::vector<float> host_distance_, host_weight_;
 };
 
 /// Left-camera z-depth from a disparity map (CV_32F, 0 = invalid): fx * baseline / d.
