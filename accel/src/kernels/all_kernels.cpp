@@ -5,9 +5,10 @@ namespace fvp::accel {
 
 std::span<const KernelDescriptor* const> allKernels() {
   static const KernelDescriptor* const kAll[] = {
-      kernels::rayTraverse().descriptor, kernels::scanMark().descriptor,
-      kernels::scanUpdate().descriptor,  kernels::roiDistance().descriptor,
-      kernels::frontier().descriptor,    kernels::infoGain().descriptor, kernels::tsdfIntegrate().descriptor};
+      kernels::rayTraverse().descriptor,  kernels::scanMark().descriptor,
+      kernels::scanUpdate().descriptor,   kernels::roiDistance().descriptor,
+      kernels::frontier().descriptor,     kernels::infoGain().descriptor,
+      kernels::tsdfIntegrate().descriptor};
   return kAll;
 }
 
