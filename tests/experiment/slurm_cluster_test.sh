@@ -6,8 +6,12 @@
 set -euo pipefail
 fvp=$(realpath "$1")
 src=$(realpath "$2")
-# What the test experiment runs: deterministic clock, two views per trial, both planners.
-experiment_args=(--planners fvp,rvp --trials 2 --first-seed 3 --clock fixed --max-views 2
+# What the test experiment runs: real trials of both planners on two worlds, deterministic
+# clock, the start view only. With moves, trials repeat exactly only while no motion-planning
+# query runs into its wall-clock limit (planning_time_s): under AddressSanitizer, two shards
+# on two cores did, and the merged MAE differed from the unsharded run's. Equality of the
+# sharded and merged results is what this test is for; docs/experiment.md has the caveat.
+experiment_args=(--planners fvp,rvp --trials 2 --first-seed 3 --clock fixed --max-views 1
                  --backend cpu)
 
 for tool in munged mungekey slurmctld slurmd sbatch squeue sinfo; do

@@ -382,7 +382,9 @@ TEST_P(GridEngineBackends, ChangedBricksAreExactlyTheBricksWhoseVoxelsChanged) {
     std::size_t slot = 0;
     layer->forEachVoxel([&](const std::array<int, 3>&, float o, float r) {
       EXPECT_TRUE(same(o, occ[slot]));
-      if (layer->hasRoi()) EXPECT_TRUE(same(r, roi[slot]));
+      if (layer->hasRoi()) {
+        EXPECT_TRUE(same(r, roi[slot]));
+      }
       ++slot;
     });
   }

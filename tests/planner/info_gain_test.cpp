@@ -314,7 +314,9 @@ TEST_P(InfoGainBackends, KernelEqualsHostWalkOnRandomMapsAndCandidates) {
       gaining += want[i].ig > 0.0;
     }
     // Both the coarse blocking and the fine gain were exercised.
-    if (mode == GainMode::kSingleRay) EXPECT_GT(blocked, 0u);
+    if (mode == GainMode::kSingleRay) {
+      EXPECT_GT(blocked, 0u);
+    }
     EXPECT_GT(gaining, queries.size() / 4);
   }
 }

@@ -102,7 +102,8 @@ TEST(Open3dPeer, TsdfSurfacesAgreeByChamferDistance) {
   }
   const auto a = ours.extractSurfacePoints();
   std::vector<Eigen::Vector3f> b;
-  for (const auto& p : theirs.ExtractPointCloud()->points_) b.push_back(p.cast<float>());
+  const auto cloud = theirs.ExtractPointCloud();  // the range below must not outlive it
+  for (const auto& p : cloud->points_) b.push_back(p.cast<float>());
   ASSERT_GT(a.size(), 1000u);
   ASSERT_GT(b.size(), 1000u);
   const double chamfer_m = sizing::chamferDistance_m(a, b);

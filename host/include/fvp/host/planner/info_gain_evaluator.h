@@ -121,7 +121,7 @@ class InfoGainEvaluator {
   std::size_t snapshotScans() const { return snapshot_scans_; }
   double fineVoxelSize_m() const { return fine_.voxel_size_m; }
 
-  /// Where the walks of the last evaluate() ran, e.g. "vulkan" or "host".
+  /// Where the walks run: the backend's name (e.g. "vulkan"), or "host" without one.
   const char* walkDevice() const;
 
   // Snapshot codes of a fine voxel (kernels/fvp_info_gain.h).
