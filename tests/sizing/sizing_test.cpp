@@ -209,5 +209,24 @@ TEST(Sizing, EmptyInputsAreCountedNotErrors) {
   EXPECT_EQ(unseen.events.not_visible, 1u);
 }
 
+TEST(Sizing, DisparityWindowsBeyondTheSensorRangeAreInvalidAndCounted) {
+  const Eigen::Vector3d c(0.0, 0.0, 0.3);
+  SphereView v = renderSphere(c, 0.005);
+  std::vector<Eigen::Vector3f> pts;
+  for (int i = 0; i < 400; ++i) {
+    const double a = 0.1 * i, z = -1.0 + 0.9 * (i % 100) / 100.0;
+    pts.push_back((c + 0.005 * Eigen::Vector3d(std::sqrt(1 - z * z) * std::cos(a),
+                                               std::sqrt(1 - z * z) * std::sin(a), z))
+                      .cast<float>());
+  }
+  // SGBM speckles: 1.4 px of disparity is 39 m away, far beyond max_depth_m.
+  v.disparity.setTo(1.4f, v.mask);
+  const sizing::SizingView view{v.mask, v.disparity, v.in, Eigen::Isometry3d::Identity()};
+  const auto r = sizing::sizeFruitlets({view}, pts, nullptr, sizing::SizingConfig{});
+  EXPECT_TRUE(r.fruitlets.empty());
+  EXPECT_EQ(r.events.invalid_disparity_windows, 1u);
+  EXPECT_EQ(r.events.unsized_clusters, 1u);
+}
+
 }  // namespace
 }  // namespace fvp::host

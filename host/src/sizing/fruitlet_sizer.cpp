@@ -56,6 +56,7 @@ void SizingConfig::validate() const {
   if (!(dbscan_eps_m > 0.0)) throw std::invalid_argument("sizing: dbscan_eps_m > 0");
   if (dbscan_min_samples < 1) throw std::invalid_argument("sizing: dbscan_min_samples >= 1");
   if (disparity_window_half_px < 0) throw std::invalid_argument("sizing: window half >= 0");
+  if (!(max_depth_m > 0.0)) throw std::invalid_argument("sizing: max_depth_m > 0");
 }
 
 std::vector<std::array<std::uint8_t, 3>> clusterColours(const std::vector<int>& labels) {
@@ -209,7 +210,7 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
       const double d_max =
           windowMaxDisparity(view.disparity_px, int(std::lround(c.x)), int(std::lround(c.y)),
                              config.disparity_window_half_px);
-      if (!(d_max > 0.0)) {
+      if (!(d_max > 0.0) || in.fx_px * in.baseline_m / d_max > config.max_depth_m) {
         ++result.events.invalid_disparity_windows;
         continue;
       }

@@ -49,6 +49,9 @@ struct SizingConfig {
   int min_cluster_points = 30;          ///< smaller clusters are dropped (counted)
   int disparity_window_half_px = 5;     ///< Eq. 4's square window: (2h+1)^2 pixels
   double saturated_disparity_px = 318;  ///< window maxima at or above: rejected
+  /// Window maxima implying a depth beyond this are invalid (SGBM speckles where the window
+  /// holds almost no disparity: 1.4 px, 38 m away, once made Eq. 4 read 1 m).
+  double max_depth_m = 1.0;
   double min_visible_fraction = 0.2;    ///< of in-image points on the segment, to use an image
   double well_seen_fraction = 0.6;      ///< ours: images used for the median
   /// Ours: minor / major axis at least this (a fruitlet's e <= 1.15 projects rounder; a
