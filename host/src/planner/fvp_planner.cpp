@@ -74,7 +74,12 @@ PlanStep FvpPlanner::planAndMove(map::MapEngine& map, const Eigen::Isometry3d& T
   }
   addTiming(step.timings_s, "snapshot", since(t));
   t = Clock::now();
-  const std::vector<map::FrontierVoxel> frontiers = map.frontiers();
+  if (frontiers_map_ != &map || frontiers_scans_ != map.scanCount()) {
+    frontiers_ = map.frontiers();
+    frontiers_map_ = &map;
+    frontiers_scans_ = map.scanCount();
+  }
+  const std::vector<map::FrontierVoxel>& frontiers = frontiers_;
   addTiming(step.timings_s, "frontiers", since(t));
 
   for (int round = 0; round < config_.max_sampling_rounds; ++round) {

@@ -172,7 +172,12 @@ PlanStep RvpPlanner::planAndMove(map::MapEngine& map, const Eigen::Isometry3d& T
     snapshot_.refresh(map);
   step.timings_s.emplace_back("snapshot", since(t));
   t = Clock::now();
-  const std::vector<Eigen::Vector3d> contour = roiContourTargets(map);
+  if (contour_map_ != &map || contour_scans_ != map.scanCount()) {
+    contour_ = roiContourTargets(map);
+    contour_map_ = &map;
+    contour_scans_ = map.scanCount();
+  }
+  const std::vector<Eigen::Vector3d>& contour = contour_;
   step.timings_s.emplace_back("targets", since(t));
 
   t = Clock::now();

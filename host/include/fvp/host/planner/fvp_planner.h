@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <string>
 
+#include "fvp/host/map/frontier_voxel.h"
 #include "fvp/host/planner/info_gain_evaluator.h"
 #include "fvp/host/planner/planner_config.h"
 #include "fvp/host/planner/view_planner.h"
@@ -47,6 +48,11 @@ class FvpPlanner : public ViewPlanner {
   InfoGainEvaluator gain_;
   double u_t_;
   bool refreshed_ = false;
+  // The frontiers hold until new scans arrive (planning again after failed moves reuses
+  // them): which map and scan count they were extracted from.
+  std::vector<map::FrontierVoxel> frontiers_;
+  const map::MapEngine* frontiers_map_ = nullptr;
+  std::size_t frontiers_scans_ = 0;
 };
 
 }  // namespace fvp::host::planner

@@ -65,6 +65,10 @@ class RvpPlanner : public ViewPlanner {
   RvpConfig config_;
   std::mt19937_64 rng_;
   InfoGainEvaluator snapshot_;
+  // The ROI-contour targets hold until new scans arrive: which map and scan count.
+  std::vector<Eigen::Vector3d> contour_;
+  const map::MapEngine* contour_map_ = nullptr;
+  std::size_t contour_scans_ = 0;
 };
 
 }  // namespace fvp::host::planner

@@ -52,8 +52,8 @@ struct SizingConfig {
   /// Window maxima implying a depth beyond this are invalid (SGBM speckles where the window
   /// holds almost no disparity: 1.4 px, 38 m away, once made Eq. 4 read 1 m).
   double max_depth_m = 1.0;
-  double min_visible_fraction = 0.2;    ///< of in-image points on the segment, to use an image
-  double well_seen_fraction = 0.6;      ///< ours: images used for the median
+  double min_visible_fraction = 0.2;  ///< of in-image points on the segment, to use an image
+  double well_seen_fraction = 0.6;    ///< ours: images used for the median
   /// Ours: minor / major axis at least this (a fruitlet's e <= 1.15 projects rounder; a
   /// segment cut by an occluder or two fruitlets merged in 2-D does not).
   double min_axis_ratio = 0.8;
