@@ -237,15 +237,21 @@ void InfoGainEvaluator::walk(std::span<const accel::GainSegment> segments,
                              accel::GainResultRaw* results) const {
   if (segments.empty()) return;
   if (backend_) {
+    // Segment and result buffers grow and are kept: planning calls evaluate() thousands of
+    // times per trial, and a device allocation each time costs more than the walks on a GPU.
+    const std::size_t batch = std::min(kSegmentsPerDispatch, segments.size());
+    if (!segment_device_ || segment_device_->sizeBytes() < batch * sizeof(accel::GainSegment)) {
+      segment_device_ = backend_->createBuffer(batch * sizeof(accel::GainSegment));
+      result_device_ = backend_->createBuffer(batch * sizeof(accel::GainResultRaw));
+    }
     for (std::size_t first = 0; first < segments.size(); first += kSegmentsPerDispatch) {
       const std::size_t n = std::min(kSegmentsPerDispatch, segments.size() - first);
       const accel::GainParams params{fine_.params(), coarse_.params(), std::uint32_t(n)};
-      auto seg_buf = backend_->createBuffer(n * sizeof(accel::GainSegment));
-      backend_->upload(*seg_buf, segments.data() + first, n * sizeof(accel::GainSegment));
-      auto out_buf = backend_->createBuffer(n * sizeof(accel::GainResultRaw));
-      backend_->run(accel::kernels::infoGain(), params,
-                    {seg_buf.get(), fine_device_.get(), coarse_device_.get(), out_buf.get()});
-      backend_->download(*out_buf, results + first, n * sizeof(accel::GainResultRaw));
+      backend_->upload(*segment_device_, segments.data() + first, n * sizeof(accel::GainSegment));
+      backend_->run(
+          accel::kernels::infoGain(), params,
+          {segment_device_.get(), fine_device_.get(), coarse_device_.get(), result_device_.get()});
+      backend_->download(*result_device_, results + first, n * sizeof(accel::GainResultRaw));
     }
     return;
   }

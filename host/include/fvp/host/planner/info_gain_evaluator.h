@@ -151,6 +151,7 @@ class InfoGainEvaluator {
   // packed into 32-bit words; with a backend, also on its device.
   std::vector<std::uint32_t> fine_words_, coarse_words_;
   std::unique_ptr<accel::DeviceBuffer> fine_device_, coarse_device_;
+  mutable std::unique_ptr<accel::DeviceBuffer> segment_device_, result_device_;
   const map::OccupiedVoxelScene* coarse_scene_ = nullptr;  ///< embree_cull only
 };
 
