@@ -22,7 +22,8 @@ map::GridGeometry boundedGrid(double voxel_size_m, const Eigen::AlignedBox3d& bo
   for (int a = 0; a < 3; ++a) {
     const auto lo = static_cast<std::int64_t>(std::floor(bounds_m.min()[a] / voxel_size_m));
     const auto hi = static_cast<std::int64_t>(std::ceil(bounds_m.max()[a] / voxel_size_m));
-    const std::int64_t n = std::max<std::int64_t>(kBlockSide, (hi - lo + 7) / 8 * 8);
+    const std::int64_t n =
+        std::max<std::int64_t>(kBlockSide, (hi - lo + kBlockSide - 1) / kBlockSide * kBlockSide);
     if (n > 8192) throw std::invalid_argument("TsdfVolume: bounds wider than 8192 voxels");
     g.first_voxel[a] = lo;
     g.dims[a] = static_cast<int>(n);

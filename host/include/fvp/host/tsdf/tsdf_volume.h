@@ -34,8 +34,9 @@ namespace fvp::host::tsdf {
 inline constexpr double kDefaultTsdfVoxelSizeM = 0.0005;
 inline constexpr double kDefaultTruncationM = 0.002;  ///< 4 voxels
 inline constexpr float kDefaultMaxWeight = 10000.0f;
-inline constexpr int kBlockSide = 8;
-inline constexpr int kBlockVoxels = kBlockSide * kBlockSide * kBlockSide;
+// The brick layer's bricks (the kernel indexes voxels by them).
+inline constexpr int kBlockSide = accel::kBrickEdge;
+inline constexpr int kBlockVoxels = accel::kBrickVoxels;
 
 struct TsdfConfig {
   double voxel_size_m = kDefaultTsdfVoxelSizeM;
