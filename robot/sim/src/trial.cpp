@@ -112,7 +112,10 @@ nlohmann::json runTrial(const TrialOptions& options) {
     clock.beginIteration();
     if (capture_next) {
       const Eigen::Isometry3d T_world_camera = controller.cameraPose();
-      const host::StereoFrame frame = renderer.render(T_world_camera);
+      // The trial perceives from the images alone: no ground-truth depth or ids to render.
+      RenderOptions render_options;
+      render_options.ground_truth = false;
+      const host::StereoFrame frame = renderer.render(T_world_camera, render_options);
       render_wall_s += renderer.lastRenderSeconds();
       clock.chargeCapture();
       const ViewOutcome view = parts.addView(frame);

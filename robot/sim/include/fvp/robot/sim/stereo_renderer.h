@@ -32,6 +32,9 @@ inline constexpr double kFlashFullScaleDistanceM = 0.18;
 struct RenderConfig {
   host::StereoIntrinsics intrinsics;
   int samples_per_pixel = 4;     ///< anti-aliasing (stratified sub-pixel samples)
+  /// Supersample only pixels with an edge inside (their four corners differ in object, shadow
+  /// or tag print); the rest average their corners. false: every pixel gets the samples.
+  bool adaptive_antialiasing = true;
   double flash_power = 1.0;      ///< radiance scale of the point light at the camera
   double noise_sigma = 2.0;      ///< Gaussian sensor noise, 8-bit grey levels
   std::uint64_t noise_seed = 0;  ///< mixed with the pose so each view's noise differs
