@@ -189,8 +189,8 @@ TEST(StereoRenderer, AdaptiveAntialiasingMatchesFullSupersampling) {
     const cv::Mat& ref = left ? reference.left_bgr : reference.right_bgr;
     const double full_error = meanAbs(left ? full.left_bgr : full.right_bgr, ref);
     const double adaptive_error = meanAbs(left ? adaptive.left_bgr : adaptive.right_bgr, ref);
-    std::cout << (left ? "left" : "right") << ": mean |error| vs 16 spp: full 4 spp "
-              << full_error << ", adaptive " << adaptive_error << " grey levels\n";
+    std::cout << (left ? "left" : "right") << ": mean |error| vs 16 spp: full 4 spp " << full_error
+              << ", adaptive " << adaptive_error << " grey levels\n";
     EXPECT_LT(adaptive_error, 1.5 * full_error + 0.05);
   }
   std::cout << "render time: full 4 spp " << full_s << " s, adaptive " << adaptive_s << " s\n";

@@ -427,8 +427,8 @@ host::StereoFrame StereoRenderer::render(const Eigen::Isometry3d& T_world_camera
       try {
         for (int col = 0; col < corner_cols; ++col) {
           for (int camera = 0; camera < 2; ++camera) {
-            const ShadedSample sample = im.radiance(
-                eyes[camera], rayDir(col - 0.5, row - 0.5), flash, options.with_leaves);
+            const ShadedSample sample =
+                im.radiance(eyes[camera], rayDir(col - 0.5, row - 0.5), flash, options.with_leaves);
             corners[camera][static_cast<std::size_t>(row) * corner_cols + col] = {
                 sample.rgb.cast<float>(), sample.region};
           }
@@ -466,8 +466,8 @@ host::StereoFrame StereoRenderer::render(const Eigen::Isometry3d& T_world_camera
             const CornerSample& c01 = c[1];
             const CornerSample& c10 = c[corner_cols];
             const CornerSample& c11 = c[corner_cols + 1];
-            uniform = c00.region == c01.region && c00.region == c10.region &&
-                      c00.region == c11.region;
+            uniform =
+                c00.region == c01.region && c00.region == c10.region && c00.region == c11.region;
             if (uniform) linear = (0.25f * (c00.rgb + c01.rgb + c10.rgb + c11.rgb)).cast<double>();
           }
           if (!uniform) {
@@ -480,9 +480,9 @@ host::StereoFrame StereoRenderer::render(const Eigen::Isometry3d& T_world_camera
                 du = ((s % strata_x) + jx) / strata_x - 0.5;
                 dv = ((s / strata_x) + jy) / strata_y - 0.5;
               }
-              linear += im.radiance(eyes[camera], rayDir(col + du, row + dv), flash,
-                                    options.with_leaves)
-                            .rgb;
+              linear +=
+                  im.radiance(eyes[camera], rayDir(col + du, row + dv), flash, options.with_leaves)
+                      .rgb;
             }
             linear /= spp;
           }

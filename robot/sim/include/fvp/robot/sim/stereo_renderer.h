@@ -31,7 +31,7 @@ inline constexpr double kFlashFullScaleDistanceM = 0.18;
 
 struct RenderConfig {
   host::StereoIntrinsics intrinsics;
-  int samples_per_pixel = 4;     ///< anti-aliasing (stratified sub-pixel samples)
+  int samples_per_pixel = 4;  ///< anti-aliasing (stratified sub-pixel samples)
   /// Supersample only pixels with an edge inside (their four corners differ in object, shadow
   /// or tag print); the rest average their corners. false: every pixel gets the samples.
   bool adaptive_antialiasing = true;
