@@ -16,7 +16,7 @@ void addSizeCommand(CLI::App& app) {
   auto opt = std::make_shared<Options>();
   auto* cmd = app.add_subcommand(
       "size",
-      "Size the fruitlets of a set of stored captures; write fruitlets.json, surface.ply "
+      "Size the fruitlets of a set of stored captures; write fruitlets.json, surface.ply, mesh.ply "
       "and clusters.ply to --out");
   cmd->add_option("--captures", opt->captures,
                   "a capture directory, or a directory of them (used in name order)")
@@ -58,7 +58,7 @@ void addSizeCommand(CLI::App& app) {
                                                   : "-")
                 << " %\n";
     }
-    std::cout << "wrote " << opt->out << "/{fruitlets.json, surface.ply, clusters.ply}\n";
+    std::cout << "wrote " << opt->out << "/{fruitlets.json, surface.ply, mesh.ply, clusters.ply}\n";
   });
 }
 

@@ -52,6 +52,34 @@ void writePlyColoredPoints(const std::filesystem::path& path,
   writeFileAtomically(path, "coloured point cloud (PLY)", bytes);
 }
 
+void writePlyMesh(const std::filesystem::path& path, const std::vector<Eigen::Vector3f>& vertices,
+                  const std::vector<std::array<std::uint32_t, 3>>& triangles,
+                  const std::string& comment) {
+  for (const auto& t : triangles)
+    for (const std::uint32_t v : t)
+      if (v >= vertices.size())
+        throw std::invalid_argument("writePlyMesh: a triangle names a vertex that is not there");
+  std::string bytes = "ply\nformat binary_little_endian 1.0\ncomment " + comment +
+                      "\nelement vertex " + std::to_string(vertices.size()) +
+                      "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
+                      std::to_string(triangles.size()) +
+                      "\nproperty list uchar uint vertex_indices\nend_header\n";
+  const std::size_t offset = bytes.size();
+  constexpr std::size_t kFaceBytes = 1 + 3 * sizeof(std::uint32_t);
+  bytes.resize(offset + vertices.size() * 3 * sizeof(float) + triangles.size() * kFaceBytes);
+  char* dst = bytes.data() + offset;
+  for (const auto& p : vertices) {
+    std::memcpy(dst, p.data(), 3 * sizeof(float));
+    dst += 3 * sizeof(float);
+  }
+  for (const auto& t : triangles) {
+    *dst = 3;
+    std::memcpy(dst + 1, t.data(), 3 * sizeof(std::uint32_t));
+    dst += kFaceBytes;
+  }
+  writeFileAtomically(path, "triangle mesh (PLY)", bytes);
+}
+
 std::vector<Eigen::Vector3f> readPlyPoints(const std::filesystem::path& path) {
   const std::string name = path.string();
   auto fail = [&](const std::string& field, const std::string& expected) -> void {

@@ -78,6 +78,9 @@ nlohmann::json sizeCaptureSet(const std::filesystem::path& captures_dir,
   if (!options.out_dir.empty()) {
     std::filesystem::create_directories(options.out_dir);
     writePlyPoints(options.out_dir / "surface.ply", session.surfacePoints());
+    const tsdf::TriangleMesh mesh = session.surfaceMesh();
+    writePlyMesh(options.out_dir / "mesh.ply", mesh.vertices_m, mesh.triangles,
+                 "fvp TSDF mesh (marching cubes), world frame, metres");
     writePlyColoredPoints(options.out_dir / "clusters.ply", sized.points,
                           sizing::clusterColours(sized.labels),
                           "fvp clusters, world frame, metres; grey = noise");

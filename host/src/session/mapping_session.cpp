@@ -74,6 +74,10 @@ std::vector<Eigen::Vector3f> MappingSession::surfacePoints() const {
   return tsdf_ ? tsdf_->extractSurfacePoints() : std::vector<Eigen::Vector3f>{};
 }
 
+tsdf::TriangleMesh MappingSession::surfaceMesh() const {
+  return tsdf_ ? tsdf_->extractMesh() : tsdf::TriangleMesh{};
+}
+
 sizing::SizingResult MappingSession::sizeFruitlets(const sizing::SizingConfig& config) const {
   if (!tsdf_config_)
     throw std::logic_error("MappingSession::sizeFruitlets: call enableTsdf() first");

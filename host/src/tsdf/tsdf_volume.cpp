@@ -246,4 +246,19 @@ std::vector<Eigen::Vector3f> TsdfVolume::extractSurfacePoints() const {
   return out;
 }
 
+TriangleMesh TsdfVolume::extractMesh() const {
+  syncHost();
+  std::vector<std::array<int, 3>> cubes;
+  for (std::size_t slot = 0; slot < host_weight_.size(); ++slot)
+    if (host_weight_[slot] > 0.0f) cubes.push_back(layer_->voxelOfSlot(slot));
+  const auto sample = [this](const std::array<int, 3>& index, float& distance) {
+    const std::int64_t slot = layer_->slotOf(index);
+    if (slot < 0 || !(host_weight_[slot] > 0.0f)) return false;
+    distance = host_distance_[slot];
+    return true;
+  };
+  return MarchingCubes::extract(cubes, sample, geometry_.voxelCenter_m({0, 0, 0}),
+                                config_.voxel_size_m);
+}
+
 }  // namespace fvp::host::tsdf

@@ -173,6 +173,9 @@ void TrialParts::writeOutputs(const nlohmann::json& result, const World& world,
   if (!camera_path.empty()) plotCameraPath(world, camera_path, out_dir / "path.png");
   const auto& sz = impl_->sizing;
   host::writePlyPoints(out_dir / "surface.ply", impl_->session.surfacePoints());
+  const host::tsdf::TriangleMesh mesh = impl_->session.surfaceMesh();
+  host::writePlyMesh(out_dir / "mesh.ply", mesh.vertices_m, mesh.triangles,
+                     "fvp TSDF mesh (marching cubes), world frame, metres");
   host::writePlyColoredPoints(out_dir / "clusters.ply", sz.points,
                               host::sizing::clusterColours(sz.labels),
                               "fvp clusters, world frame, metres; grey = noise");

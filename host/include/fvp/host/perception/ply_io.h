@@ -20,6 +20,11 @@ void writePlyColoredPoints(const std::filesystem::path& path,
                            const std::vector<std::array<std::uint8_t, 3>>& colors_rgb,
                            const std::string& comment);
 
+/// A triangle mesh (vertex element x y z, face element vertex_indices), binary, atomic.
+void writePlyMesh(const std::filesystem::path& path, const std::vector<Eigen::Vector3f>& vertices,
+                  const std::vector<std::array<std::uint32_t, 3>>& triangles,
+                  const std::string& comment);
+
 /// Throws std::runtime_error naming the file and what was expected. Accepts extra vertex
 /// properties (skipped) as long as x, y, z are floats.
 std::vector<Eigen::Vector3f> readPlyPoints(const std::filesystem::path& path);

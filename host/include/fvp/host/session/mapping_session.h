@@ -73,6 +73,8 @@ class MappingSession {
   const tsdf::TsdfVolume* tsdf() const { return tsdf_.get(); }
   /// The TSDF's surface points; empty while there is no TSDF.
   std::vector<Eigen::Vector3f> surfacePoints() const;
+  /// The TSDF's zero level set as a mesh (marching cubes); empty while there is no TSDF.
+  tsdf::TriangleMesh surfaceMesh() const;
   const std::vector<sizing::SizingView>& sizingViews() const { return sizing_views_; }
   /// The sizing chain on the session's TSDF surface and views, keeping surface points in
   /// ROI-occupied fine voxels. Needs enableTsdf(); without a map no point is kept.

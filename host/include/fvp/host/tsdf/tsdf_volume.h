@@ -21,6 +21,7 @@
 
 #include "fvp/host/core/stereo_intrinsics.h"
 #include "fvp/host/map/grid_geometry.h"
+#include "fvp/host/tsdf/marching_cubes.h"
 
 namespace fvp::accel {
 class Backend;
@@ -76,6 +77,9 @@ class TsdfVolume {
   /// Zero crossings between face-neighbouring voxels that both have weight > 0, linearly
   /// interpolated (world frame, metres), in slot order.
   std::vector<Eigen::Vector3f> extractSurfacePoints() const;
+  /// The zero level set as a triangle mesh (marching cubes over cubes whose eight voxels
+  /// all have weight > 0), world frame, metres: for looking at, not for sizing.
+  TriangleMesh extractMesh() const;
 
   std::size_t blockCount() const;
   /// Bytes of the brick layer on its device (table, coordinates, distance and weight).
