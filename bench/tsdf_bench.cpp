@@ -7,6 +7,10 @@
 // voxels. items_per_second counts the ROI depth pixels integrated; voxels_per_second the voxel
 // slots updated.
 //
+// BM_SurfaceExtract/<fvp|open3d>/<points|mesh>, BM_OutlierRemoval/<fvp|open3d>/cpu and
+// BM_Dbscan/<fvp|open3d>/cpu: the rest of the sizing front end against Open3D on the same
+// frame (see each below).
+//
 // BM_TsdfIntegrate/open3d/cpu: the peer, Open3D's ScalableTSDFVolume (0.5 mm voxels, 2 mm
 // truncation, 8^3-voxel units like our bricks, its default depth sampling stride of 4 for
 // finding units) on the same masked depth image, in the same program. Its surface must lie
@@ -19,11 +23,14 @@
 #include <open3d/geometry/Image.h>
 #include <open3d/geometry/PointCloud.h>
 #include <open3d/geometry/RGBDImage.h>
+#include <open3d/geometry/TriangleMesh.h>
 #include <open3d/pipelines/integration/ScalableTSDFVolume.h>
 #include <cmath>
+#include <map>
 
 #include "bench_common.h"
 #include "fvp/host/perception/perception_pipeline.h"
+#include "fvp/host/sizing/fruitlet_sizer.h"
 #include "fvp/host/sizing/point_filters.h"
 #include "fvp/host/tsdf/tsdf_volume.h"
 #include "fvp/robot/sim/stereo_renderer.h"
@@ -154,6 +161,148 @@ void BM_TsdfIntegrateOpen3d(benchmark::State& state) {
   state.counters["our_surface_points"] = double(a.size());
 }
 
+// Surface extraction from the integrated frame: our zero-crossing points and marching-cubes
+// mesh against Open3D's ExtractPointCloud and ExtractTriangleMesh of its own volume over the
+// same frame. Checked: each pair of surfaces within 0.25 mm (chamfer).
+struct IntegratedFrame {
+  std::unique_ptr<host::tsdf::TsdfVolume> ours;
+  std::unique_ptr<open3d::pipelines::integration::ScalableTSDFVolume> theirs;
+};
+
+const IntegratedFrame& integratedFrame() {
+  static const IntegratedFrame f = [] {
+    const TsdfFrame& frame = tsdfFrame();
+    IntegratedFrame out;
+    const host::tsdf::TsdfConfig config;
+    out.ours = std::make_unique<host::tsdf::TsdfVolume>(config, frame.bounds_m, nullptr);
+    out.ours->integrate(frame.depth_m, frame.mask, frame.intrinsics, frame.T_world_camera);
+    out.theirs = std::make_unique<open3d::pipelines::integration::ScalableTSDFVolume>(
+        config.voxel_size_m, config.truncation_m,
+        open3d::pipelines::integration::TSDFVolumeColorType::NoColor, 8);
+    const open3d::camera::PinholeCameraIntrinsic intrinsic(
+        frame.depth_m.cols, frame.depth_m.rows, frame.intrinsics.fx_px, frame.intrinsics.fy_px,
+        frame.intrinsics.cx_px, frame.intrinsics.cy_px);
+    out.theirs->Integrate(*open3dImage(frame), intrinsic, frame.T_world_camera.inverse().matrix());
+    return out;
+  }();
+  return f;
+}
+
+std::vector<Eigen::Vector3f> insideBounds(const std::vector<Eigen::Vector3d>& points) {
+  std::vector<Eigen::Vector3f> out;
+  for (const auto& p : points)
+    if (tsdfFrame().bounds_m.contains(p)) out.push_back(p.cast<float>());
+  return out;
+}
+
+void BM_SurfaceExtract(benchmark::State& state, bool open3d, bool mesh) {
+  const IntegratedFrame& f = integratedFrame();
+  std::vector<Eigen::Vector3f> points;
+  std::size_t triangles = 0;
+  for (auto _ : state) {
+    if (!open3d && !mesh) {
+      points = f.ours->extractSurfacePoints();
+    } else if (!open3d) {
+      const host::tsdf::TriangleMesh m = f.ours->extractMesh();
+      points = m.vertices_m;
+      triangles = m.triangles.size();
+    } else if (!mesh) {
+      points = insideBounds(f.theirs->ExtractPointCloud()->points_);
+    } else {
+      const auto m = f.theirs->ExtractTriangleMesh();
+      points = insideBounds(m->vertices_);
+      triangles = m->triangles_.size();
+    }
+  }
+  // Check against the other library's surface of the same kind.
+  std::vector<Eigen::Vector3f> other;
+  if (open3d)
+    other = mesh ? f.ours->extractMesh().vertices_m : f.ours->extractSurfacePoints();
+  else
+    other = insideBounds(mesh ? f.theirs->ExtractTriangleMesh()->vertices_
+                              : f.theirs->ExtractPointCloud()->points_);
+  if (points.empty() || other.empty()) {
+    state.SkipWithError("an empty surface");
+    return;
+  }
+  const double chamfer_mm = 1e3 * host::sizing::chamferDistance_m(points, other);
+  if (!(chamfer_mm < 0.25)) {
+    state.SkipWithError("the two libraries' surfaces are more than 0.25 mm apart");
+    return;
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(points.size()) * state.iterations());
+  state.counters["points"] = double(points.size());
+  state.counters["triangles"] = double(triangles);
+  state.counters["chamfer_mm"] = chamfer_mm;
+}
+
+// Outlier removal and DBSCAN with the sizing chain's defaults on the frame's surface points,
+// ours (nanoflann) against Open3D's. Checked: the same survivors; the same clusters up to
+// label permutation.
+const std::vector<Eigen::Vector3f>& surfacePoints() {
+  static const std::vector<Eigen::Vector3f> points = integratedFrame().ours->extractSurfacePoints();
+  return points;
+}
+
+open3d::geometry::PointCloud toOpen3d(const std::vector<Eigen::Vector3f>& points) {
+  open3d::geometry::PointCloud cloud;
+  for (const auto& p : points) cloud.points_.push_back(p.cast<double>());
+  return cloud;
+}
+
+void BM_OutlierRemoval(benchmark::State& state, bool open3d) {
+  const auto& points = surfacePoints();
+  const host::sizing::SizingConfig c;
+  const open3d::geometry::PointCloud cloud = toOpen3d(points);
+  std::vector<std::size_t> kept;
+  for (auto _ : state) {
+    if (open3d) {
+      const auto [inliers, index] =
+          cloud.RemoveStatisticalOutliers(c.outlier_neighbours, c.outlier_std_ratio);
+      kept.assign(index.begin(), index.end());
+    } else {
+      kept = host::sizing::statisticalOutlierInliers(points, c.outlier_neighbours,
+                                                     c.outlier_std_ratio);
+    }
+  }
+  const auto [unused, theirs] =
+      cloud.RemoveStatisticalOutliers(c.outlier_neighbours, c.outlier_std_ratio);
+  const auto ours =
+      host::sizing::statisticalOutlierInliers(points, c.outlier_neighbours, c.outlier_std_ratio);
+  if (ours != std::vector<std::size_t>(theirs.begin(), theirs.end())) {
+    state.SkipWithError("the survivors differ from Open3D's");
+    return;
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(points.size()) * state.iterations());
+  state.counters["points"] = double(points.size());
+  state.counters["removed"] = double(points.size() - kept.size());
+}
+
+void BM_Dbscan(benchmark::State& state, bool open3d) {
+  const auto& points = surfacePoints();
+  const host::sizing::SizingConfig c;
+  const open3d::geometry::PointCloud cloud = toOpen3d(points);
+  std::vector<int> labels;
+  for (auto _ : state) {
+    labels = open3d ? cloud.ClusterDBSCAN(c.dbscan_eps_m, c.dbscan_min_samples, false)
+                    : host::sizing::dbscan(points, c.dbscan_eps_m, c.dbscan_min_samples);
+  }
+  const auto ours = host::sizing::dbscan(points, c.dbscan_eps_m, c.dbscan_min_samples);
+  const auto theirs = cloud.ClusterDBSCAN(c.dbscan_eps_m, c.dbscan_min_samples, false);
+  std::map<int, int> forward, backward;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const int a = ours[i] == host::sizing::kDbscanNoise ? -1 : ours[i];
+    const int b = theirs[i] < 0 ? -1 : theirs[i];
+    if (forward.emplace(a, b).first->second != b || backward.emplace(b, a).first->second != a) {
+      state.SkipWithError("the clusters differ from Open3D's");
+      return;
+    }
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(points.size()) * state.iterations());
+  state.counters["points"] = double(points.size());
+  state.counters["clusters"] = double(forward.size() - forward.count(-1));
+}
+
 const bool kRegistered = [] {
   for (accel::BackendKind kind :
        {accel::BackendKind::kCpu, accel::BackendKind::kOpenCl, accel::BackendKind::kVulkan})
@@ -165,6 +314,22 @@ const bool kRegistered = [] {
   benchmark::RegisterBenchmark("BM_TsdfIntegrate/open3d/cpu", BM_TsdfIntegrateOpen3d)
       ->Unit(benchmark::kMillisecond)
       ->UseRealTime();
+  for (const bool open3d : {false, true}) {
+    const std::string who = open3d ? "open3d" : "fvp";
+    for (const bool mesh : {false, true})
+      benchmark::RegisterBenchmark(
+          ("BM_SurfaceExtract/" + who + (mesh ? "/mesh" : "/points")).c_str(), BM_SurfaceExtract,
+          open3d, mesh)
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
+    benchmark::RegisterBenchmark(("BM_OutlierRemoval/" + who + "/cpu").c_str(), BM_OutlierRemoval,
+                                 open3d)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+    benchmark::RegisterBenchmark(("BM_Dbscan/" + who + "/cpu").c_str(), BM_Dbscan, open3d)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+  }
   return true;
 }();
 

@@ -224,20 +224,26 @@ std::vector<Eigen::Vector3f> TsdfVolume::extractSurfacePoints() const {
     for (int k = 0; k < kBlockVoxels; ++k) {
       const std::size_t slot = std::size_t(b) * kBlockVoxels + k;
       if (!(host_weight_[slot] > 0.0f)) continue;
-      const std::array<int, 3> g = layer_->voxelOfSlot(slot);
-      const Eigen::Vector3d c = geometry_.voxelCenter_m(g);
       const float d0 = host_distance_[slot];
+      // In-brick neighbours are the next slots (x fastest); only the brick's far faces look
+      // their neighbour up in the table.
+      const std::array<int, 3> local = {k & 7, (k >> 3) & 7, k >> 6};
       for (int axis = 0; axis < 3; ++axis) {
-        std::array<int, 3> n = g;
-        ++n[axis];
-        const std::int64_t ns = layer_->slotOf(n);
-        if (ns < 0) continue;
+        std::int64_t ns;
+        if (local[axis] + 1 < kBlockSide) {
+          ns = std::int64_t(slot) + (std::int64_t{1} << (3 * axis));
+        } else {
+          std::array<int, 3> n = layer_->voxelOfSlot(slot);
+          ++n[axis];
+          ns = layer_->slotOf(n);
+          if (ns < 0) continue;
+        }
         const float dn = host_distance_[ns];
         if (!(host_weight_[ns] > 0.0f) || (d0 > 0.0f) == (dn > 0.0f) || d0 == dn) continue;
         const double t = d0 / (d0 - dn);
-        Eigen::Vector3d e = Eigen::Vector3d::Zero();
-        e[axis] = config_.voxel_size_m;
-        per_brick[b].push_back((c + t * e).cast<float>());
+        Eigen::Vector3d p = geometry_.voxelCenter_m(layer_->voxelOfSlot(slot));
+        p[axis] += t * config_.voxel_size_m;
+        per_brick[b].push_back(p.cast<float>());
       }
     }
   }
