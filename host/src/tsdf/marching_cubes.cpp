@@ -97,23 +97,25 @@ TriangleMesh MarchingCubes::extract(const std::vector<std::array<int, 3>>& cube_
     for (int axis = 0; axis < 3; ++axis)
       if (g[axis] < 0 || g[axis] + 1 >= kMaxIndex)
         throw std::invalid_argument("MarchingCubes::extract: cube index outside [0, 2^20 - 1)");
+    const auto cornerOf = [&g](int i) -> std::array<int, 3> {
+      return {g[0] + (i & 1), g[1] + ((i >> 1) & 1), g[2] + ((i >> 2) & 1)};
+    };
     std::array<float, kCorners> d;
     int config = 0;
     bool observed = true;
     for (int i = 0; i < kCorners && observed; ++i) {
-      const std::array<int, 3> corner = {g[0] + (i & 1), g[1] + ((i >> 1) & 1),
-                                         g[2] + ((i >> 2) & 1)};
-      observed = sample(corner, d[i]);
-      if (d[i] < 0.0f) config |= 1 << i;
+      observed = sample(cornerOf(i), d[i]);
+      if (observed && d[i] < 0.0f) config |= 1 << i;
     }
     if (!observed || config == 0 || config == 255) continue;
 
     const auto cornerPosition = [&](int i) {
-      return Eigen::Vector3d(g[0] + (i & 1), g[1] + ((i >> 1) & 1), g[2] + ((i >> 2) & 1));
+      const std::array<int, 3> c = cornerOf(i);
+      return Eigen::Vector3d(c[0], c[1], c[2]);
     };
     const auto vertexOn = [&](int edge) {
       const auto [a, b] = edgeCorners(edge);
-      const std::array<int, 3> low = {g[0] + (a & 1), g[1] + ((a >> 1) & 1), g[2] + ((a >> 2) & 1)};
+      const std::array<int, 3> low = cornerOf(a);
       const std::uint64_t key =
           (((std::uint64_t(low[0]) << 40) | (std::uint64_t(low[1]) << 20) | std::uint64_t(low[2]))
            << 2) |
