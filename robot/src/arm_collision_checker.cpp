@@ -2,7 +2,12 @@
 
 #include <octomap/OcTree.h>
 
+#include <cmath>
+#include <utility>
+#include <vector>
+
 #include <fcl/geometry/octree/octree.h>
+#include <fcl/geometry/shape/box.h>
 #include <fcl/geometry/shape/capsule.h>
 #include <fcl/narrowphase/collision.h>
 #include <fcl/narrowphase/collision_request.h>
@@ -19,8 +24,95 @@ struct ArmCollisionChecker::Fcl {
 ArmCollisionChecker::ArmCollisionChecker(const ArmModel& arm) : arm_(arm) {}
 ArmCollisionChecker::~ArmCollisionChecker() = default;
 
+namespace {
+
+// FCL's capsule for a link, padded, and its pose (FCL capsules lie along their local z axis).
+std::pair<fcl::Capsuled, fcl::Transform3d> fclCapsule(const Capsule& link, double pad_m) {
+  const Eigen::Vector3d axis = link.b_m - link.a_m;
+  const double length = axis.norm();
+  fcl::Capsuled capsule(link.radius_m + pad_m, length);
+  capsule.computeLocalAABB();
+  fcl::Transform3d tf = fcl::Transform3d::Identity();
+  tf.translation() = 0.5 * (link.a_m + link.b_m);
+  if (length > 1e-12) {
+    tf.linear() = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), axis / length)
+                      .toRotationMatrix();
+  }
+  return {capsule, tf};
+}
+
+Eigen::AlignedBox3d paddedBounds(const Capsule& link, double pad_m) {
+  const double r = link.radius_m + pad_m;
+  Eigen::AlignedBox3d box(link.a_m.cwiseMin(link.b_m), link.a_m.cwiseMax(link.b_m));
+  box.min().array() -= r;
+  box.max().array() += r;
+  return box;
+}
+
+bool capsuleTouchesBox(const fcl::Capsuled& capsule, const fcl::Transform3d& tf,
+                       const Eigen::Vector3d& centre_m, double size_m) {
+  const fcl::Boxd box(size_m, size_m, size_m);
+  fcl::Transform3d box_tf = fcl::Transform3d::Identity();
+  box_tf.translation() = centre_m;
+  fcl::CollisionRequestd request;
+  fcl::CollisionResultd result;
+  fcl::collide(&box, box_tf, &capsule, tf, request, result);
+  return result.isCollision();
+}
+
+}  // namespace
+
 void ArmCollisionChecker::setMap(const octomap::OcTree& coarse_map) {
+  setMapOwned(std::make_shared<octomap::OcTree>(coarse_map));
+}
+
+std::size_t ArmCollisionChecker::setMapFreeAt(const octomap::OcTree& coarse_map,
+                                              const JointVector& q_now) {
   auto copy = std::make_shared<octomap::OcTree>(coarse_map);
+  const double pad = arm_.config().collision_padding_m;
+  std::vector<std::pair<fcl::Capsuled, fcl::Transform3d>> capsules;
+  std::vector<Eigen::AlignedBox3d> capsule_bounds;
+  for (const Capsule& link : arm_.linkCapsules(q_now)) {
+    capsules.push_back(fclCapsule(link, pad));
+    capsule_bounds.push_back(paddedBounds(link, pad));
+  }
+  const auto touched = [&](const Eigen::Vector3d& centre_m, double size_m) {
+    const Eigen::Vector3d half = Eigen::Vector3d::Constant(0.5 * size_m);
+    const Eigen::AlignedBox3d box(centre_m - half, centre_m + half);
+    for (std::size_t i = 0; i < capsules.size(); ++i) {
+      if (box.intersects(capsule_bounds[i]) &&
+          capsuleTouchesBox(capsules[i].first, capsules[i].second, centre_m, size_m))
+        return true;
+    }
+    return false;
+  };
+  // Collect first (the tree must not change under its iterator). A pruned leaf larger than
+  // one voxel is split: only the voxels of it that the arm overlaps are freed.
+  std::vector<octomap::OcTreeKey> to_free;
+  const double resolution = copy->getResolution();
+  for (auto it = copy->begin_leafs(), end = copy->end_leafs(); it != end; ++it) {
+    if (!copy->isNodeOccupied(*it)) continue;
+    const Eigen::Vector3d centre(it.getX(), it.getY(), it.getZ());
+    if (!touched(centre, it.getSize())) continue;
+    const int cells = static_cast<int>(std::lround(it.getSize() / resolution));
+    const Eigen::Vector3d first =
+        centre - Eigen::Vector3d::Constant(0.5 * (cells - 1) * resolution);
+    for (int i = 0; i < cells; ++i)
+      for (int j = 0; j < cells; ++j)
+        for (int k = 0; k < cells; ++k) {
+          const Eigen::Vector3d v = first + resolution * Eigen::Vector3d(i, j, k);
+          if (cells == 1 || touched(v, resolution))
+            to_free.push_back(copy->coordToKey(v.x(), v.y(), v.z()));
+        }
+  }
+  for (const octomap::OcTreeKey& key : to_free)
+    copy->setNodeValue(key, copy->getClampingThresMinLog(), /*lazy_eval=*/true);
+  if (!to_free.empty()) copy->updateInnerOccupancy();
+  setMapOwned(std::move(copy));
+  return to_free.size();
+}
+
+void ArmCollisionChecker::setMapOwned(std::shared_ptr<octomap::OcTree> copy) {
   auto fcl = std::make_unique<Fcl>();
   fcl->occupied_bounds.setEmpty();
   for (auto it = copy->begin_leafs(), end = copy->end_leafs(); it != end; ++it) {
@@ -49,21 +141,8 @@ bool ArmCollisionChecker::mapCollision(const LinkCapsules& links) const {
   if (!fcl_ || fcl_->occupied_bounds.isEmpty()) return false;
   const double pad = arm_.config().collision_padding_m;
   for (const Capsule& link : links) {
-    const double r = link.radius_m + pad;
-    Eigen::AlignedBox3d box(link.a_m.cwiseMin(link.b_m), link.a_m.cwiseMax(link.b_m));
-    box.min().array() -= r;
-    box.max().array() += r;
-    if (!box.intersects(fcl_->occupied_bounds)) continue;
-    const Eigen::Vector3d axis = link.b_m - link.a_m;
-    const double length = axis.norm();
-    fcl::Capsuled capsule(r, length);
-    capsule.computeLocalAABB();
-    fcl::Transform3d tf = fcl::Transform3d::Identity();
-    tf.translation() = 0.5 * (link.a_m + link.b_m);
-    if (length > 1e-12) {
-      tf.linear() = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), axis / length)
-                        .toRotationMatrix();
-    }
+    if (!paddedBounds(link, pad).intersects(fcl_->occupied_bounds)) continue;
+    const auto [capsule, tf] = fclCapsule(link, pad);
     fcl::CollisionRequestd request;  // one contact is enough
     fcl::CollisionResultd result;
     fcl::collide(fcl_->tree.get(), fcl::Transform3d::Identity(), &capsule, tf, request, result);

@@ -110,6 +110,90 @@ TEST(ArmCollisionChecker, AgreesWithBruteForceOnRandomMaps) {
   EXPECT_GT(free, 100);
 }
 
+// The finest-level voxels of `tree`'s occupied leaves whose box the padded capsules overlap
+// (brute force); `ties` counts those within FCL's 0.1 mm tolerance either way.
+std::vector<octomap::OcTreeKey> voxelsOverlapping(const octomap::OcTree& tree,
+                                                  const LinkCapsules& links, double pad,
+                                                  int& ties) {
+  std::vector<octomap::OcTreeKey> keys;
+  const double res = tree.getResolution();
+  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
+    if (!tree.isNodeOccupied(*it)) continue;
+    const int cells = static_cast<int>(std::lround(it.getSize() / res));
+    const Eigen::Vector3d first = Eigen::Vector3d(it.getX(), it.getY(), it.getZ()) -
+                                  Eigen::Vector3d::Constant(0.5 * (cells - 1) * res);
+    for (int i = 0; i < cells; ++i)
+      for (int j = 0; j < cells; ++j)
+        for (int k = 0; k < cells; ++k) {
+          const Eigen::Vector3d c = first + res * Eigen::Vector3d(i, j, k);
+          const Eigen::AlignedBox3d box(c - Eigen::Vector3d::Constant(0.5 * res),
+                                        c + Eigen::Vector3d::Constant(0.5 * res));
+          double clearance = std::numeric_limits<double>::infinity();
+          for (const Capsule& link : links)
+            clearance = std::min(
+                clearance, segmentBoxDistance(link.a_m, link.b_m, box) - (link.radius_m + pad));
+          if (std::abs(clearance) < 1e-4) ++ties;
+          if (clearance < 0.0) keys.push_back(tree.coordToKey(c.x(), c.y(), c.z()));
+        }
+  }
+  return keys;
+}
+
+// The arm is physically at q_now: the voxels its padded links overlap there are freed, and
+// exactly those. Random maps get a solid block around the camera so that there always is
+// overlap, some of it in pruned leaves larger than one voxel.
+TEST(ArmCollisionChecker, SetMapFreeAtFreesExactlyTheVoxelsTheArmOverlaps) {
+  const ArmModel arm{ArmConfig{}};
+  const double pad = arm.config().collision_padding_m;
+  std::mt19937_64 rng(11);
+  std::size_t freed_total = 0;
+  int collisions = 0, free = 0;
+  for (int m = 0; m < 6; ++m) {
+    const double res = m % 2 == 0 ? 0.02 : 0.05;
+    octomap::OcTree tree = randomMap(rng, res);
+    JointVector q_now;
+    do {
+      q_now = randomConfiguration(arm, rng);
+    } while (arm.selfOrStaticCollision(arm.linkCapsules(q_now)));
+    const Eigen::Vector3d camera = arm.T_world_camera(q_now).translation();
+    for (int i = -4; i < 4; ++i)
+      for (int j = -4; j < 4; ++j)
+        for (int k = -4; k < 4; ++k)
+          tree.updateNode(camera.x() + i * res, camera.y() + j * res, camera.z() + k * res, true);
+    tree.updateInnerOccupancy();
+    tree.prune();
+
+    int ties = 0;
+    const std::vector<octomap::OcTreeKey> expected_keys =
+        voxelsOverlapping(tree, arm.linkCapsules(q_now), pad, ties);
+    if (ties > 0) continue;  // a voxel within FCL's tolerance of the arm: either answer is right
+    ArmCollisionChecker checker(arm);
+    const std::size_t freed = checker.setMapFreeAt(tree, q_now);
+    EXPECT_EQ(freed, expected_keys.size()) << "map " << m;
+    EXPECT_GT(freed, 0u);
+    EXPECT_TRUE(checker.isValid(q_now)) << "map " << m;
+    freed_total += freed;
+
+    // Everywhere else the checker answers as brute force does on the map less those voxels.
+    octomap::OcTree expected = tree;
+    for (const octomap::OcTreeKey& key : expected_keys)
+      expected.setNodeValue(key, expected.getClampingThresMinLog(), true);
+    expected.updateInnerOccupancy();
+    for (int i = 0; i < 100; ++i) {
+      const LinkCapsules links = arm.linkCapsules(randomConfiguration(arm, rng));
+      const double clearance = bruteForceClearance(expected, links, pad);
+      if (std::abs(clearance) < 1e-4) continue;
+      EXPECT_EQ(checker.mapCollision(links), clearance < 0.0) << "map " << m << " query " << i;
+      (clearance < 0.0 ? collisions : free) += 1;
+    }
+  }
+  std::cout << "freed " << freed_total << " voxels; " << collisions << " colliding, " << free
+            << " free queries after\n";
+  EXPECT_GT(freed_total, 0u);
+  EXPECT_GT(collisions, 50);
+  EXPECT_GT(free, 50);
+}
+
 TEST(ArmCollisionChecker, NoMapMeansOnlySelfAndStatic) {
   const ArmModel arm{ArmConfig{}};
   ArmCollisionChecker checker(arm);

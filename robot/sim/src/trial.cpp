@@ -55,7 +55,8 @@ void validate(const TrialOptions& o) {
 /// Counted expected events of one trial (never errors).
 struct TrialEvents {
   std::size_t move_attempts = 0, failed_moves = 0, planning_iterations = 0, rejected_clearance = 0,
-              iterations_without_move = 0, views_without_tag = 0, culled_rays = 0;
+              iterations_without_move = 0, views_without_tag = 0, culled_rays = 0,
+              collision_voxels_freed_at_arm = 0;
   std::int64_t dropped_disparities = 0, saturated_disparities = 0;
   std::map<std::string, std::size_t> motion_status;
 };
@@ -157,7 +158,7 @@ nlohmann::json runTrial(const TrialOptions& options) {
     // after a failed move keeps it); building it is map upkeep, charged as mapping.
     if (collision_map_scans != map->scanCount()) {
       const auto t_collision = Clock::now();
-      controller.setMap(map->coarseOcTree());
+      events.collision_voxels_freed_at_arm += controller.setMap(map->coarseOcTree());
       collision_map_scans = map->scanCount();
       const double collision_s = secondsSince(t_collision);
       mapping_wall_s += collision_s;
@@ -234,6 +235,7 @@ nlohmann::json runTrial(const TrialOptions& options) {
                             {"views_without_tag", events.views_without_tag},
                             {"dropped_disparities", events.dropped_disparities},
                             {"saturated_disparities", events.saturated_disparities},
+                            {"collision_voxels_freed_at_arm", events.collision_voxels_freed_at_arm},
                             {"motion_status", events.motion_status}};
   result["events"] = counted;
   result["wall_breakdown_s"] = {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 
@@ -27,6 +28,13 @@ class ArmCollisionChecker {
   /// Copies the coarse map (MapEngine::coarseOcTree()); voxels with occupancy above the
   /// tree's threshold are obstacles, unknown space is not.
   void setMap(const octomap::OcTree& coarse_map);
+  /// setMap, with the occupied voxels that the arm's padded links overlap at configuration
+  /// `q_now` taken as free: the arm is physically there, so what the map holds there is
+  /// stereo noise or a surface the padding grazes, not an obstacle (MoveIt filters the
+  /// robot's own body out of its octomap for the same reason). Without this, one such voxel
+  /// makes every plan from `q_now` fail as start_invalid. Returns how many finest-level
+  /// voxels were freed.
+  std::size_t setMapFreeAt(const octomap::OcTree& coarse_map, const JointVector& q_now);
   void clearMap();
   bool hasMap() const;
 
@@ -39,6 +47,7 @@ class ArmCollisionChecker {
 
  private:
   struct Fcl;
+  void setMapOwned(std::shared_ptr<octomap::OcTree> map);
   const ArmModel& arm_;
   std::unique_ptr<Fcl> fcl_;
   mutable std::atomic<std::uint64_t> checks_{0};

@@ -22,8 +22,11 @@ class ArmController {
   static std::optional<JointVector> startConfiguration(const ArmModel& arm,
                                                        const Eigen::Isometry3d& T_world_camera);
 
-  /// The coarse map planning avoids from now on (copied).
-  void setMap(const octomap::OcTree& coarse_map) { checker_.setMap(coarse_map); }
+  /// The coarse map planning avoids from now on (copied), less the voxels the arm itself
+  /// occupies now (ArmCollisionChecker::setMapFreeAt); returns how many those were.
+  std::size_t setMap(const octomap::OcTree& coarse_map) {
+    return checker_.setMapFreeAt(coarse_map, joints_);
+  }
   /// Plans to the camera pose, charges the planning time, and on success charges and
   /// "executes" the motion. Never throws for planning failures.
   MotionPlan moveToPose(const Eigen::Isometry3d& T_world_camera);
