@@ -118,6 +118,8 @@ nlohmann::json sizingDetails(const sizing::SizingResult& sz) {
                           {"size_mm", f.size_mm},
                           {"centroid_m", vec3(f.centroid_m)},
                           {"sphere_center_m", vec3(f.sphere_center_m)},
+                          {"sphere_radius_m", f.sphere_radius_m},
+                          {"size_source", sizing::toString(f.size_source)},
                           {"size_paper_mm", f.size_paper_mm},
                           {"size_ours_mm", f.size_ours_mm},
                           {"points", f.points},
@@ -135,7 +137,8 @@ nlohmann::json sizingDetails(const sizing::SizingResult& sz) {
               {"not_visible", sz.events.not_visible},
               {"single_image_fruitlets", sz.events.single_image_fruitlets},
               {"unsized_clusters", sz.events.unsized_clusters},
-              {"failed_sphere_fits", sz.events.failed_sphere_fits}}}}}};
+              {"failed_sphere_fits", sz.events.failed_sphere_fits},
+              {"clusters_split_off", sz.events.clusters_split_off}}}}}};
 }
 
 }  // namespace fvp::host::eval

@@ -51,6 +51,18 @@ const char* toString(SizingEstimator estimator) {
   return estimator == SizingEstimator::kOurs ? "ours" : "paper";
 }
 
+const char* toString(SizeSource source) {
+  switch (source) {
+    case SizeSource::kWellSeenImages:
+      return "well_seen_images";
+    case SizeSource::kSphereFit:
+      return "sphere_fit";
+    case SizeSource::kAllImages:
+      return "all_images";
+  }
+  return "unknown";
+}
+
 void SizingConfig::validate() const {
   if (outlier_neighbours < 1) throw std::invalid_argument("sizing: outlier_neighbours >= 1");
   if (!(dbscan_eps_m > 0.0)) throw std::invalid_argument("sizing: dbscan_eps_m > 0");
@@ -76,30 +88,6 @@ std::vector<std::array<std::uint8_t, 3>> clusterColours(const std::vector<int>& 
   return out;
 }
 
-bool fitSphere(const std::vector<Eigen::Vector3f>& points, Eigen::Vector3d& center_m,
-               double& radius_m) {
-  if (points.size() < 4) return false;
-  // |p|^2 = 2 c.p + (r^2 - |c|^2): linear in (c, k); centred for conditioning.
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const auto& p : points) mean += p.cast<double>();
-  mean /= double(points.size());
-  Eigen::MatrixXd A(points.size(), 4);
-  Eigen::VectorXd b(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const Eigen::Vector3d q = points[i].cast<double>() - mean;
-    A.row(i) << 2.0 * q.x(), 2.0 * q.y(), 2.0 * q.z(), 1.0;
-    b[i] = q.squaredNorm();
-  }
-  const Eigen::Vector4d x = A.colPivHouseholderQr().solve(b);
-  if (!x.allFinite()) return false;
-  const Eigen::Vector3d c = x.head<3>();
-  const double r2 = x[3] + c.squaredNorm();
-  if (!(r2 > 0.0)) return false;
-  center_m = c + mean;
-  radius_m = std::sqrt(r2);
-  return true;
-}
-
 SizingResult sizeFruitlets(const std::vector<SizingView>& views,
                            const std::vector<Eigen::Vector3f>& surface_points_m,
                            const std::function<bool(const Eigen::Vector3f&)>& in_roi_voxel,
@@ -116,6 +104,11 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
     result.points.push_back(roi[i]);
   result.inlier_points = result.points.size();
   result.labels = dbscan(result.points, config.dbscan_eps_m, config.dbscan_min_samples);
+  if (config.split_merged_clusters) {
+    ClusterSplitConfig split;
+    split.min_cluster_points = config.min_cluster_points;
+    result.events.clusters_split_off = splitMergedClusters(result.points, result.labels, split);
+  }
 
   std::map<int, std::vector<Eigen::Vector3f>> clusters;
   for (std::size_t i = 0; i < result.points.size(); ++i)
@@ -249,17 +242,30 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
           !s.shared_segment && s.axis_ratio >= config.min_axis_ratio)
         good.push_back(s.size_ours_mm);
     }
-    f.size_ours_mm = median(good.empty() ? all : good);
-
     double radius = 0.0;
     f.sphere_center_m = f.centroid_m;
     Eigen::Vector3d sphere;
     // Accept a sphere only of a fruitlet's size near the points (3-8 mm radius and margin).
-    if (fitSphere(pts, sphere, radius) && radius > 0.0015 && radius < 0.012 &&
-        (sphere - f.centroid_m).norm() < 0.010)
+    if (fitSphere(pts, sphere, radius) && radius > kDefaultMinFruitletRadius_m &&
+        radius < kDefaultMaxFruitletRadius_m && (sphere - f.centroid_m).norm() < 0.010) {
       f.sphere_center_m = sphere;
-    else
+      f.sphere_radius_m = radius;
+    } else {
       ++result.events.failed_sphere_fits;
+    }
+
+    if (!good.empty()) {
+      f.size_ours_mm = median(good);
+      f.size_source = SizeSource::kWellSeenImages;
+    } else if (f.sphere_radius_m > 0.0) {
+      // Every segment is shared, cut or at the border: its hull measures more (or less) than
+      // this fruitlet; its 3-D surface does not.
+      f.size_ours_mm = 2000.0 * f.sphere_radius_m;
+      f.size_source = SizeSource::kSphereFit;
+    } else {
+      f.size_ours_mm = median(all);
+      f.size_source = SizeSource::kAllImages;
+    }
 
     if (config.estimator == SizingEstimator::kPaper) {
       f.center_m = f.centroid_m;

@@ -12,7 +12,9 @@
 //   images where the segment is well seen (mostly unoccluded, off the image border, not
 //   shared with another cluster, round as a fruitlet projects) instead
 //   of the maximum, which turns per-image noise into an upward bias, and places the centre by
-//   a sphere fit to the surface points instead of the one-sided centroid.
+//   a sphere fit to the surface points instead of the one-sided centroid. Where no image
+//   sees the fruitlet alone (its segment merges with a neighbour's in every view), the
+//   sphere fit's diameter is its size.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -24,6 +26,7 @@
 #include <vector>
 
 #include "fvp/host/core/stereo_intrinsics.h"
+#include "fvp/host/sizing/sphere_ransac.h"
 
 namespace fvp::host::sizing {
 
@@ -46,7 +49,10 @@ struct SizingConfig {
   /// authors' 1 cm merges neighbours in a cluster, which lie within a few mm).
   double dbscan_eps_m = 0.002;
   int dbscan_min_samples = 10;
-  int min_cluster_points = 30;          ///< smaller clusters are dropped (counted)
+  int min_cluster_points = 30;  ///< smaller clusters are dropped (counted)
+  /// Split DBSCAN clusters that hold more than one fruitlet (sphere_ransac.h): touching
+  /// fruitlets, bridged by stereo points at the depth edges between them, merge otherwise.
+  bool split_merged_clusters = true;
   int disparity_window_half_px = 5;     ///< Eq. 4's square window: (2h+1)^2 pixels
   double saturated_disparity_px = 318;  ///< window maxima at or above: rejected
   /// Window maxima implying a depth beyond this are invalid (SGBM speckles where the window
@@ -72,11 +78,21 @@ struct ImageSize {
   double axis_ratio = 0.0;      ///< minor / major axis of the fitted ellipse
 };
 
+/// Where our estimator's size came from.
+enum class SizeSource {
+  kWellSeenImages,  ///< the median over the well-seen images
+  kSphereFit,       ///< no image saw the fruitlet alone: the sphere fit's diameter
+  kAllImages,       ///< neither: the median over every image that gave a size
+};
+const char* toString(SizeSource source);
+
 struct FruitletEstimate {
   Eigen::Vector3d center_m = Eigen::Vector3d::Zero();  ///< the chosen estimator's
   double size_mm = 0.0;                                ///< the chosen estimator's
   Eigen::Vector3d centroid_m = Eigen::Vector3d::Zero(), sphere_center_m = Eigen::Vector3d::Zero();
+  double sphere_radius_m = 0.0;  ///< 0 when the sphere fit failed
   double size_paper_mm = 0.0, size_ours_mm = 0.0;
+  SizeSource size_source = SizeSource::kWellSeenImages;
   std::size_t points = 0;
   std::vector<ImageSize> per_image;
 };
@@ -90,6 +106,7 @@ struct SizingEvents {
   std::size_t single_image_fruitlets = 0;
   std::size_t unsized_clusters = 0;    ///< no image gave a size (dropped)
   std::size_t failed_sphere_fits = 0;  ///< centre fell back to the centroid
+  std::size_t clusters_split_off = 0;  ///< parts of DBSCAN clusters split off (one per fruitlet)
 };
 
 struct SizingResult {
@@ -109,9 +126,5 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
 
 /// A distinct colour per DBSCAN label (grey for noise), for clusters.ply.
 std::vector<std::array<std::uint8_t, 3>> clusterColours(const std::vector<int>& labels);
-
-/// Least-squares sphere through points (algebraic fit); false when degenerate.
-bool fitSphere(const std::vector<Eigen::Vector3f>& points, Eigen::Vector3d& center_m,
-               double& radius_m);
 
 }  // namespace fvp::host::sizing
