@@ -102,6 +102,9 @@ class TsdfVolume {
   std::size_t distance_channel_ = 0, weight_channel_ = 0;
   mutable bool host_stale_ = false;
   mutable std::vector<float> host_distance_, host_weight_;
+  /// One flag per grid brick, all 0 between calls of integrate (only the band's are set and
+  /// cleared): the grid spans the Cluster Region's cube, ~10^5 bricks, the band ~10^2.
+  std::vector<std::uint8_t> band_flags_;
 };
 
 /// Left-camera z-depth from a disparity map (CV_32F, 0 = invalid): fx * baseline / d.
