@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <iostream>
+#include <vector>
 
 #include "fvp/accel/backend.h"
 #include "fvp/host/eval/fruitlet_matching.h"
@@ -20,6 +22,9 @@ namespace fvp::host {
 namespace {
 
 constexpr double kMaxMaeMm = 0.4;
+// Detections that match nothing (3-6 a world of ~4: stereo ghosts between fruitlets, and
+// parts a wrong split would make) pull precision down; 86 % measured.
+constexpr double kMinPrecisionPercent = 80.0;
 
 struct Pooled {
   std::size_t ground_truth = 0, matched = 0, detections = 0;
@@ -86,6 +91,7 @@ TEST(UnoccludedWorlds, OursMatchesEveryFruitletWithinAPooledMaeOf04Mm) {
   paper.print("paper's");
   EXPECT_EQ(ours.matched, ours.ground_truth);
   EXPECT_LE(ours.mae(), kMaxMaeMm);
+  EXPECT_GE(100.0 * ours.matched / ours.detections, kMinPrecisionPercent);
 }
 
 }  // namespace

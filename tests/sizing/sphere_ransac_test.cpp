@@ -2,6 +2,8 @@
 // sees them: the near side of each fruitlet, with depth noise and stray points.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdint>
 #include <map>
 #include <random>
 #include <set>
@@ -187,10 +189,6 @@ TEST(ClusterSplit, SplitsThreeInARowAndLeavesSingleFruitletsWhole) {
     if (truth[i] >= 3 || before[i] == kDbscanNoise) {
       EXPECT_EQ(labels[i], before[i]) << i;
     }
-  // Deterministic.
-  std::vector<int> again = before;
-  splitMergedClusters(pts, again);
-  EXPECT_EQ(again, labels);
 }
 
 // A fruitlet more elongated than the world generator makes (e = 1.4): its ends lie farther
@@ -205,8 +203,14 @@ TEST(ClusterSplit, KeepsAVeryElongatedFruitletWhole) {
   ASSERT_EQ(clustersOf(labels).size(), 1u);
   const SphereFit best = fitSphereRansac(pts);
   ASSERT_TRUE(best.found);
-  ASSERT_GT(double(pts.size() - best.inliers.size()), 0.2 * double(pts.size()))
-      << "the test's premise: the ends are not the best sphere's";
+  const ClusterSplitConfig config;
+  std::size_t beyond = 0;
+  for (const auto& p : pts)
+    beyond += std::abs((p.cast<double>() - best.center_m).norm() - best.radius_m) >
+              config.max_assignment_distance_m;
+  ASSERT_GT(double(beyond), config.min_outlier_fraction * double(pts.size()))
+      << "the test's premise: its ends lie beyond the assignment distance, so only the "
+         "overlap rule keeps it whole";
   EXPECT_EQ(splitMergedClusters(pts, labels), 0u);
   EXPECT_EQ(clustersOf(labels).size(), 1u);
 }

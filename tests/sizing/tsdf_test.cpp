@@ -9,6 +9,7 @@
 #include "backend_fixture.h"
 #include "fvp/accel/backend.h"
 #include "fvp/host/core/look_at.h"
+#include "fvp/host/map/grid_geometry.h"
 #include "fvp/host/tsdf/tsdf_volume.h"
 #include "sphere_views.h"
 
@@ -75,6 +76,93 @@ TEST(Tsdf, ViewsOutsideTheBoundsAllocateNothing) {
   EXPECT_EQ(volume.blockCount(), 0u);
   EXPECT_TRUE(volume.extractSurfacePoints().empty());
   EXPECT_THROW(TsdfVolume({}, Eigen::AlignedBox3d()), std::invalid_argument);
+}
+
+// What one view does to one voxel, from the whole depth image, in double: the oracle for
+// the kernel's per-voxel update (kernels/fvp_tsdf.h) of a fresh volume.
+struct ExpectedVoxel {
+  bool updated = false;
+  double distance_m = 0.0, weight = 0.0;
+};
+ExpectedVoxel expectedFirstUpdate(const Eigen::Vector3d& centre_world_m, const cv::Mat& depth,
+                                  const cv::Mat& mask, const StereoIntrinsics& in,
+                                  const Eigen::Isometry3d& T_world_camera, const TsdfConfig& c) {
+  const Eigen::Vector3d p = T_world_camera.inverse() * centre_world_m;
+  ExpectedVoxel e;
+  if (!(p.z() > 0.0)) return e;
+  const double u = std::floor(in.fx_px * p.x() / p.z() + in.cx_px + 0.5);
+  const double v = std::floor(in.fy_px * p.y() / p.z() + in.cy_px + 0.5);
+  if (u < 0 || v < 0 || u >= depth.cols || v >= depth.rows) return e;
+  if (!mask.at<std::uint8_t>(int(v), int(u))) return e;
+  const double z = depth.at<float>(int(v), int(u));
+  if (!(z > 0.0)) return e;
+  const double sdf = (z - p.z()) * p.norm() / p.z();
+  if (sdf < -c.truncation_m) return e;
+  double w = 1.0 / (p.z() * p.z());
+  if (sdf < -c.voxel_size_m) w *= (c.truncation_m + sdf) / (c.truncation_m - c.voxel_size_m);
+  if (!(w > 0.0)) return e;
+  e.updated = true;
+  e.distance_m = std::min(sdf, c.truncation_m);
+  e.weight = std::min(w, double(c.max_weight));
+  return e;
+}
+
+// Weights near the far end of the ramp are (truncation + sdf) / ..., with sdf in floats: a
+// 1e-8 m difference there is 1e-4 of weight (1 / z^2 = 11 at 0.3 m).
+constexpr double kRampWeightTolerance = 1e-3;
+
+// The depth uploaded is a crop of the image around the band's bricks. Every voxel of a
+// brick the view updates must come out as if the whole image had been uploaded, also where
+// it looks past the cluster onto fruit outside the volume (free space: +truncation).
+TEST(Tsdf, CroppedUploadEqualsTheWholeImage) {
+  const Eigen::Vector3d centre(0.0, 0.0, 0.3);
+  // Two fruitlets in the volume and a large one 6 cm behind it, outside, filling the view
+  // around them: its pixels are ROI too, as a fruitlet mask's would be.
+  const std::vector<Eigen::Vector4d> spheres = {
+      {centre.x() - 0.006, centre.y(), centre.z(), 0.005},
+      {centre.x() + 0.007, centre.y() + 0.002, centre.z() + 0.002, 0.004},
+      {centre.x(), centre.y(), centre.z() + 0.08, 0.05}};
+  const testing::SphereView v = testing::renderSpheres(spheres, Eigen::Isometry3d::Identity());
+  const Eigen::AlignedBox3d bounds(centre.array() - 0.015, centre.array() + 0.015);
+  const TsdfConfig config;
+  TsdfVolume volume(config, bounds);
+  const auto stats = volume.integrate(v.depth, v.mask, v.in, v.T_world_camera);
+  ASSERT_GT(stats.blocks_updated, 10u);
+  // The upload is smaller than the mask's box (the background sphere spans most of it).
+  EXPECT_LT(stats.depth_pixels_uploaded, std::size_t(v.in.width_px) * v.in.height_px / 4);
+
+  const map::GridGeometry& g = volume.geometry();
+  std::size_t compared = 0, free_space = 0, mismatched = 0;
+  for (int bz = 0; bz < g.dims[2] / 8; ++bz)
+    for (int by = 0; by < g.dims[1] / 8; ++by)
+      for (int bx = 0; bx < g.dims[0] / 8; ++bx) {
+        // A brick the view touched: some voxel of it has weight.
+        std::vector<std::pair<Eigen::Vector3d, std::pair<float, float>>> voxels;
+        bool touched = false;
+        for (int k = 0; k < 512; ++k) {
+          const std::array<int, 3> index{8 * bx + (k & 7), 8 * by + ((k >> 3) & 7),
+                                         8 * bz + (k >> 6)};
+          const Eigen::Vector3d c = g.voxelCenter_m(index);
+          voxels.emplace_back(c, volume.voxel(c));
+          touched |= voxels.back().second.second > 0.0f;
+        }
+        if (!touched) continue;
+        for (const auto& [c, dw] : voxels) {
+          const ExpectedVoxel e =
+              expectedFirstUpdate(c, v.depth, v.mask, v.in, v.T_world_camera, config);
+          ++compared;
+          free_space += e.updated && e.distance_m >= config.truncation_m ? 1 : 0;
+          const bool ok = e.updated ? std::abs(dw.first - e.distance_m) < 1e-5 &&
+                                          std::abs(dw.second - e.weight) < kRampWeightTolerance
+                                    : dw.second == 0.0f;
+          mismatched += ok ? 0 : 1;
+        }
+      }
+  EXPECT_GT(compared, 5000u);
+  EXPECT_GT(free_space, 500u) << "the test's premise: voxels that see the fruit behind";
+  // Float against double at pixel boundaries: a voxel centre a hair from one may round to
+  // the neighbouring pixel; allow 1 in 2 000.
+  EXPECT_LE(mismatched, compared / 2000) << mismatched << " of " << compared;
 }
 
 FVP_INSTANTIATE_FOR_ALL_BACKENDS(TsdfBackends);

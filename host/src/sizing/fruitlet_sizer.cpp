@@ -69,6 +69,8 @@ void SizingConfig::validate() const {
   if (dbscan_min_samples < 1) throw std::invalid_argument("sizing: dbscan_min_samples >= 1");
   if (disparity_window_half_px < 0) throw std::invalid_argument("sizing: window half >= 0");
   if (!(max_depth_m > 0.0)) throw std::invalid_argument("sizing: max_depth_m > 0");
+  if (split_merged_clusters && min_cluster_points < 4)
+    throw std::invalid_argument("sizing: min_cluster_points >= 4 (a sphere needs 4 points)");
 }
 
 std::vector<std::array<std::uint8_t, 3>> clusterColours(const std::vector<int>& labels) {
@@ -254,12 +256,16 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
       ++result.events.failed_sphere_fits;
     }
 
+    const bool every_segment_shared =
+        std::all_of(f.per_image.begin(), f.per_image.end(),
+                    [](const ImageSize& s) { return s.shared_segment; });
     if (!good.empty()) {
       f.size_ours_mm = median(good);
       f.size_source = SizeSource::kWellSeenImages;
-    } else if (f.sphere_radius_m > 0.0) {
-      // Every segment is shared, cut or at the border: its hull measures more (or less) than
-      // this fruitlet; its 3-D surface does not.
+    } else if (every_segment_shared && f.sphere_radius_m > 0.0) {
+      // In every image the fruitlet's segment is merged with another's: each hull measures
+      // both; its 3-D surface measures it alone. (Cut or border segments measure less of it,
+      // and their median stays the estimate.)
       f.size_ours_mm = 2000.0 * f.sphere_radius_m;
       f.size_source = SizeSource::kSphereFit;
     } else {

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 
 #include "fvp/accel/backend.h"
@@ -100,22 +101,19 @@ TsdfIntegrateStats TsdfVolume::integrate(const cv::Mat& depth_m, const cv::Mat& 
                            double(geometry_.first_voxel[2]));
   const accel::BrickedGridParams& bp = layer_->params();
 
-  // 1. The bricks of the truncation band around every ROI point (along its ray), and the
-  // pixel box that holds every ROI depth.
+  // 1. The bricks of the truncation band around every ROI point (along its ray). The
+  // fruitlets cover a few % of the image: skip the mask's empty runs eight pixels at a time
+  // (faster than cv::boundingRect's own pass over the mask).
   band_flags_.resize(layer_->gridBricks(), 0);
   std::vector<int> band;
-  // The fruitlets cover a few % of the image: skip the mask's empty runs eight pixels at a
-  // time (faster than cv::boundingRect's own pass over the mask).
-  const cv::Rect box(0, 0, roi_mask.cols, roi_mask.rows);
-  int u_min = depth_m.cols, u_max = -1, v_min = depth_m.rows, v_max = -1;
   const Eigen::Vector3d eye = T_world_camera.translation();
   const double brick_m = vs * kBlockSide;
   const int steps = static_cast<int>(std::ceil(2.0 * trunc / (0.5 * brick_m))) + 1;
-  for (int v = box.y; v < box.y + box.height; ++v) {
+  for (int v = 0; v < roi_mask.rows; ++v) {
     const float* z = depth_m.ptr<float>(v);
     const std::uint8_t* m = roi_mask.ptr<std::uint8_t>(v);
-    for (int u = box.x; u < box.x + box.width; ++u) {
-      if (u + 8 <= box.x + box.width && noneOfEight(m + u)) {
+    for (int u = 0; u < roi_mask.cols; ++u) {
+      if (u + 8 <= roi_mask.cols && noneOfEight(m + u)) {
         u += 7;
         continue;
       }
@@ -124,7 +122,6 @@ TsdfIntegrateStats TsdfVolume::integrate(const cv::Mat& depth_m, const cv::Mat& 
       const Eigen::Vector3d ray_camera((u - in.cx_px) / in.fx_px, (v - in.cy_px) / in.fy_px, 1.0);
       const Eigen::Vector3d p = T_world_camera * (z[u] * ray_camera);
       const Eigen::Vector3d dir = (p - eye).normalized();
-      bool reaches_grid = false;
       for (int s = 0; s <= steps; ++s) {
         const Eigen::Vector3d q =
             (p + (-trunc + 2.0 * trunc * s / steps) * dir - grid_origin_m) / brick_m;
@@ -132,20 +129,11 @@ TsdfIntegrateStats TsdfVolume::integrate(const cv::Mat& depth_m, const cv::Mat& 
         if (b[0] < 0 || b[1] < 0 || b[2] < 0 || b[0] >= bp.bricks_x || b[1] >= bp.bricks_y ||
             b[2] >= bp.bricks_z)
           continue;
-        reaches_grid = true;
         const int id = layer_->brickIndex(int(b[0]), int(b[1]), int(b[2]));
         if (!band_flags_[id]) {
           band_flags_[id] = 1;
           band.push_back(id);
         }
-      }
-      // The depth uploaded is the box of the pixels whose band reaches the grid: fruit
-      // outside the Cluster Region widens the mask's box, not the volume's.
-      if (reaches_grid) {
-        u_min = std::min(u_min, u);
-        u_max = std::max(u_max, u);
-        v_min = std::min(v_min, v);
-        v_max = std::max(v_max, v);
       }
     }
   }
@@ -165,7 +153,39 @@ TsdfIntegrateStats TsdfVolume::integrate(const cv::Mat& depth_m, const cv::Mat& 
   stats.blocks_updated = update.size();
   stats.voxels_updated = update.size() * kBlockVoxels;
 
-  // 2. The ROI depth, cropped to its pixel box, 0 where a pixel is not ROI or has no depth.
+  // 2. The ROI depth over the pixels a voxel of the band's bricks can project to, 0 where a
+  // pixel is not ROI or has no depth: the box of the bricks' projected corners (a brick is
+  // convex and in front of the camera, so its voxel centres project inside), rounded as the
+  // kernel rounds, clamped to the image. The result equals integrating the whole image; fruit
+  // outside the Cluster Region no longer widens the upload.
+  int u_min = 0, u_max = depth_m.cols - 1, v_min = 0, v_max = depth_m.rows - 1;
+  {
+    const Eigen::Isometry3d T_camera_world = T_world_camera.inverse();
+    double lo_u = std::numeric_limits<double>::infinity(), hi_u = -lo_u, lo_v = lo_u, hi_v = -lo_u;
+    bool in_front = true;
+    for (int id : band) {
+      const int bx = id % bp.bricks_x, by = (id / bp.bricks_x) % bp.bricks_y,
+                bz = id / (bp.bricks_x * bp.bricks_y);
+      for (int corner = 0; corner < 8; ++corner) {
+        const Eigen::Vector3d c =
+            T_camera_world *
+            (grid_origin_m + brick_m * Eigen::Vector3d(bx + (corner & 1), by + ((corner >> 1) & 1),
+                                                       bz + (corner >> 2)));
+        if (!(c.z() > 0.0)) in_front = false;
+        const double u = in.fx_px * c.x() / c.z() + in.cx_px,
+                     v = in.fy_px * c.y() / c.z() + in.cy_px;
+        lo_u = std::min(lo_u, u), hi_u = std::max(hi_u, u);
+        lo_v = std::min(lo_v, v), hi_v = std::max(hi_v, v);
+      }
+    }
+    if (in_front) {  // else: keep the whole image
+      const auto pixel = [](double x, int size) {
+        return int(std::clamp(std::floor(x + 0.5), 0.0, double(size - 1)));
+      };
+      u_min = pixel(lo_u - 1.0, depth_m.cols), u_max = pixel(hi_u + 1.0, depth_m.cols);
+      v_min = pixel(lo_v - 1.0, depth_m.rows), v_max = pixel(hi_v + 1.0, depth_m.rows);
+    }
+  }
   const int width = u_max - u_min + 1, height = v_max - v_min + 1;
   std::vector<float> crop(std::size_t(width) * height, 0.0f);
   for (int v = 0; v < height; ++v) {

@@ -155,7 +155,9 @@ nlohmann::json runTrial(const TrialOptions& options) {
     }
 
     // The arm's collision map follows the coarse map after new scans only (planning again
-    // after a failed move keeps it); building it is map upkeep, charged as mapping.
+    // after a failed move keeps it); building it is map upkeep, charged as mapping. The
+    // voxels the arm occupies where it stands are freed in it (counted per rebuild, so a
+    // voxel seen again after the next scan counts again).
     if (collision_map_scans != map->scanCount()) {
       const auto t_collision = Clock::now();
       events.collision_voxels_freed_at_arm += controller.setMap(map->coarseOcTree());

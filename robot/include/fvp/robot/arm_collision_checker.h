@@ -30,10 +30,12 @@ class ArmCollisionChecker {
   void setMap(const octomap::OcTree& coarse_map);
   /// setMap, with the occupied voxels that the arm's padded links overlap at configuration
   /// `q_now` taken as free: the arm is physically there, so what the map holds there is
-  /// stereo noise or a surface the padding grazes, not an obstacle (MoveIt filters the
-  /// robot's own body out of its octomap for the same reason). Without this, one such voxel
-  /// makes every plan from `q_now` fail as start_invalid. Returns how many finest-level
-  /// voxels were freed.
+  /// stereo noise or a surface the padding grazes, not an obstacle. MoveIt's octomap
+  /// updaters filter the points around the robot's links out likewise (its tutorials'
+  /// configurations pad the links by 10 cm; ours is the 1 cm collision padding). Without this, one
+  /// such voxel makes every plan from `q_now` fail as start_invalid. The cost: a real obstacle
+  /// within the padding of where the arm stands is not avoided by the next motion. Returns how many
+  /// finest-level voxels were freed.
   std::size_t setMapFreeAt(const octomap::OcTree& coarse_map, const JointVector& q_now);
   void clearMap();
   bool hasMap() const;

@@ -12,9 +12,8 @@
 //   images where the segment is well seen (mostly unoccluded, off the image border, not
 //   shared with another cluster, round as a fruitlet projects) instead
 //   of the maximum, which turns per-image noise into an upward bias, and places the centre by
-//   a sphere fit to the surface points instead of the one-sided centroid. Where no image
-//   sees the fruitlet alone (its segment merges with a neighbour's in every view), the
-//   sphere fit's diameter is its size.
+//   a sphere fit to the surface points instead of the one-sided centroid. Where its segment
+//   merges with a neighbour's in every view, the sphere fit's diameter is its size.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -81,7 +80,7 @@ struct ImageSize {
 /// Where our estimator's size came from.
 enum class SizeSource {
   kWellSeenImages,  ///< the median over the well-seen images
-  kSphereFit,       ///< no image saw the fruitlet alone: the sphere fit's diameter
+  kSphereFit,       ///< every segment merged with another's: the sphere fit's diameter
   kAllImages,       ///< neither: the median over every image that gave a size
 };
 const char* toString(SizeSource source);

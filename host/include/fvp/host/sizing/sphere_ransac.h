@@ -55,9 +55,12 @@ SphereFit fitSphereRansac(const std::vector<Eigen::Vector3f>& points,
 
 struct ClusterSplitConfig {
   SphereRansacConfig ransac;
-  /// Clusters smaller than twice this are not split; no part is smaller than this.
+  /// Clusters smaller than twice this are not split; a sphere after the first needs this
+  /// many inliers (among the points the spheres before it leave) to be a part of its own.
+  /// (After the points are reassigned to the nearest sphere a part may come out smaller; the
+  /// sizing chain then drops it as a small cluster, counted.)
   int min_cluster_points = 30;
-  /// Nor smaller than this fraction of its cluster (stray spheres through clutter are small).
+  /// And this fraction of its cluster (stray spheres through clutter are small).
   double min_part_fraction = 0.05;
   /// A cluster whose first sphere leaves less than this fraction of it is one fruitlet.
   double min_outlier_fraction = 0.1;
