@@ -397,6 +397,7 @@ TEST(MapConfigYaml, TheDefaultsFileHoldsTheDefaults) {
   const MapConfig defaults;
   EXPECT_EQ(read.coarse_voxel_size_m, defaults.coarse_voxel_size_m);
   EXPECT_EQ(read.fine_voxel_size_m, defaults.fine_voxel_size_m);
+  EXPECT_EQ(read.fine_map_extent, defaults.fine_map_extent);
   EXPECT_EQ(read.observation_min_m, defaults.observation_min_m);
   EXPECT_EQ(read.observation_max_m, defaults.observation_max_m);
   EXPECT_EQ(read.sensor_max_range_m, defaults.sensor_max_range_m);
@@ -428,6 +429,7 @@ TEST(MapConfigYaml, ErrorsNameTheFileAndTheKey) {
   expectError("prob_hit: high\n", "prob_hit", "expected a number");
   expectError("observation_min_m: [0, 0, 3]\n", "observation_max_m", "must exceed");
   expectError("sensor_max_range_m: 5.0\n", "sensor_max_range_m", "fewer than 4096 voxels per ray");
+  expectError("fine_map_extent: everywhere\n", "fine_map_extent", "cluster_region or observation_box");
   std::filesystem::remove_all(dir);
 }
 

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "fvp/accel/backend.h"
 #include "fvp/host/map/octomap_io.h"
 #include "fvp/host/map/octomap_map_engine.h"
 #include "fvp/host/map/roi_octree.h"
@@ -363,15 +364,19 @@ TEST(RoiColor, EncodingKeepsTheRoiClassAndTheValueWithinHalfAStep) {
 // ---- files ---------------------------------------------------------------------------
 
 // An engine after a few synthetic views of fruitlets in the region.
-std::unique_ptr<OctomapMapEngine> mappedEngine(int views = 3) {
+std::unique_ptr<OctomapMapEngine> mappedEngine(
+    int views = 3, FineMapExtent extent = FineMapExtent::kClusterRegion, int width_px = 160,
+    int height_px = 120) {
   MapConfig c = smallConfig();
+  c.fine_map_extent = extent;
   const ClusterRegion region({0.0, 0.0, 0.3}, 0.04);
   auto e = std::make_unique<OctomapMapEngine>(c, region);
   const testing::SyntheticWorld world = testing::makeWorld(11, region.center_m());
   const Eigen::Vector3d origins[] = {
       {0.2, 0.05, 0.1}, {-0.15, 0.2, 0.15}, {0.0, -0.2, 0.05}, {0.1, 0.1, 0.45}};
   for (int v = 0; v < views; ++v) {
-    const auto scan = testing::renderScan(world, origins[v % 4], 160, 120, 0.5, 100 + v);
+    const auto scan =
+        testing::renderScan(world, origins[v % 4], width_px, height_px, 0.5, 100 + v);
     e->integrate(scan.clouds());
   }
   return e;
@@ -755,6 +760,76 @@ TEST(OctomapEnginePlannerReads, FrontiersOfSyntheticViewsEqualBruteForce) {
   EXPECT_GT(roi, 50u);
   EXPECT_GT(exploration, 500u);
   expectSameFrontiers(frontiers, bruteForceFrontiers(*e));
+}
+
+// RVP's map in the paper: one 1 mm ROI octree over the whole observation space. The fine
+// tree then holds the rays' voxels everywhere in the box, while every read the planners
+// make (Cluster Region only) gives what the region-only tree gives.
+TEST(OctomapEngine, ObservationBoxExtentUpdatesTheWholeBoxAndReadsTheSameRegion) {
+  // A quarter of the usual rays: 1 mm over the whole box is what makes this map slow.
+  const auto region_only = mappedEngine(3, FineMapExtent::kClusterRegion, 80, 60);
+  const auto whole_box = mappedEngine(3, FineMapExtent::kObservationBox, 80, 60);
+
+  // Every leaf of the whole-box tree lies in the observation box, and far more of them
+  // lie outside the region than inside.
+  const GridGeometry& coarse = whole_box->coarseGrid();
+  std::size_t outside_region = 0, leaves = 0;
+  Eigen::Vector3d known_outside = Eigen::Vector3d::Constant(std::nan(""));
+  for (auto it = whole_box->fineTree().begin_leafs(); it != whole_box->fineTree().end_leafs();
+       ++it) {
+    const auto c = it.getCoordinate();
+    const Eigen::Vector3d p(c.x(), c.y(), c.z());
+    std::array<int, 3> index;
+    ASSERT_TRUE(coarse.gridIndex(p, index)) << p.transpose();
+    if (!inRegion(*whole_box, p)) {
+      ++outside_region;
+      known_outside = p;
+    }
+    ++leaves;
+  }
+  EXPECT_GT(outside_region, leaves / 2);
+  EXPECT_GT(whole_box->fineTree().size(), 10 * region_only->fineTree().size());
+
+  // Reads: the same states in the region. The whole-box rays start at the sensor, the
+  // region's at the clipped point, so near-tie crossings may differ (the >= 99.9 % of
+  // octomap_map_engine.h).
+  const GridGeometry& g = whole_box->fineGrid();
+  std::size_t known = 0, differ = 0;
+  for (int z = 0; z < g.dims[2]; ++z)
+    for (int y = 0; y < g.dims[1]; ++y)
+      for (int x = 0; x < g.dims[0]; ++x) {
+        const VoxelState a = region_only->fineStateAt({x, y, z});
+        const VoxelState b = whole_box->fineStateAt({x, y, z});
+        known += a.occupancy != VoxelClass::kUnknown;
+        differ += !(a == b);
+      }
+  EXPECT_GT(known, 10000u);
+  EXPECT_LE(differ, known / 1000) << differ << " of " << known;
+  // Outside the region, the whole-box tree knows voxels that fineState still calls unknown.
+  ASSERT_TRUE(known_outside.allFinite());
+  EXPECT_EQ(whole_box->fineState(known_outside), VoxelState{});
+
+  // Planner reads over the region's cube: occupied voxels and frontiers agree likewise.
+  const auto occupied_a = region_only->occupiedVoxels(MapLevel::kFine);
+  const auto occupied_b = whole_box->occupiedVoxels(MapLevel::kFine);
+  EXPECT_GT(occupied_a.size(), 100u);
+  EXPECT_NEAR(double(occupied_b.size()), double(occupied_a.size()), 0.001 * occupied_a.size());
+  const auto frontiers_a = region_only->frontiers();
+  const auto frontiers_b = whole_box->frontiers();
+  EXPECT_NEAR(double(frontiers_b.size()), double(frontiers_a.size()), 0.01 * frontiers_a.size());
+  expectSameFrontiers(frontiers_b, bruteForceFrontiers(*whole_box));
+}
+
+TEST(OctomapEngine, GridEngineRejectsTheObservationBoxExtent) {
+  MapConfig c = smallConfig();
+  c.fine_map_extent = FineMapExtent::kObservationBox;
+  try {
+    auto cpu = accel::createBackend(accel::BackendKind::kCpu);
+    createMapEngine("grid", c, kRegion, cpu.get());
+    FAIL() << "the grid engine accepted fine_map_extent observation_box";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("observation_box"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <octomap/OcTree.h>
 
 #include <cmath>
+#include <stdexcept>
 
 #include "fvp/host/map/octomap_io.h"
 #include "fvp/host/map/roi_octree.h"
@@ -18,6 +19,10 @@ BrickAllocation allocationFor(const GridGeometry& g) {
 // Validates before any member is built from the config.
 const MapConfig& validated(const MapConfig& config) {
   config.validate();
+  if (config.fine_map_extent != FineMapExtent::kClusterRegion)
+    throw std::invalid_argument(
+        "grid engine: fine_map_extent observation_box is not supported (its fine map is the "
+        "Cluster Region's dense cube); use the octomap engine");
   return config;
 }
 

@@ -23,6 +23,17 @@ void requireRange(double value, double lo, double hi, const std::string& field, 
 
 }  // namespace
 
+std::string toString(FineMapExtent extent) {
+  return extent == FineMapExtent::kObservationBox ? "observation_box" : "cluster_region";
+}
+
+FineMapExtent parseFineMapExtent(const std::string& text, const std::string& field) {
+  if (text == "cluster_region") return FineMapExtent::kClusterRegion;
+  if (text == "observation_box") return FineMapExtent::kObservationBox;
+  throw std::invalid_argument(field + ": expected cluster_region or observation_box, got '" + text +
+                              "'");
+}
+
 void OccupancyModel::validate(const std::string& source) const {
   requireRange(prob_hit, 0.5, 1.0, source + ".prob_hit");
   requireRange(prob_miss, 0.0, 0.5, source + ".prob_miss");
@@ -82,6 +93,11 @@ MapConfig MapConfig::fromYamlFile(const std::filesystem::path& path) {
       {"fine_voxel_size_m", [&](auto& n, auto& k) { config.fine_voxel_size_m = number(n, k); }},
       {"observation_min_m", [&](auto& n, auto& k) { config.observation_min_m = vector3(n, k); }},
       {"observation_max_m", [&](auto& n, auto& k) { config.observation_max_m = vector3(n, k); }},
+      {"fine_map_extent",
+       [&](auto& n, auto& k) {
+         config.fine_map_extent = parseFineMapExtent(
+             n.IsScalar() ? n.template as<std::string>() : "", source + ": " + k);
+       }},
       {"sensor_max_range_m", [&](auto& n, auto& k) { config.sensor_max_range_m = number(n, k); }},
       {"prob_hit", [&](auto& n, auto& k) { config.model.prob_hit = number(n, k); }},
       {"prob_miss", [&](auto& n, auto& k) { config.model.prob_miss = number(n, k); }},

@@ -112,8 +112,21 @@ OctomapMapEngine::OctomapMapEngine(const MapConfig& config, const ClusterRegion&
   setSensorModel(*fine_, config.model);
   key_offset_ = coarse_->coordToKey(0.0);  // tree_max_val: the key of lattice index 0
 
+  // The observation box (the coarse grid's, snapped to coarse voxels) on the fine lattice.
+  for (int a = 0; a < 3; ++a) {
+    const double ratio = config.coarse_voxel_size_m / config.fine_voxel_size_m;
+    fine_box_lo_[a] = std::llround(coarse_grid_.first_voxel[a] * ratio);
+    fine_box_hi_[a] = std::llround((coarse_grid_.first_voxel[a] + coarse_grid_.dims[a]) * ratio);
+  }
+  GridGeometry fine_box = fine_grid_;
+  for (int a = 0; a < 3; ++a) {
+    fine_box.first_voxel[a] = static_cast<int>(fine_box_lo_[a]);
+    fine_box.dims[a] = static_cast<int>(fine_box_hi_[a] - fine_box_lo_[a]);
+  }
+  const bool whole_box = config.fine_map_extent == FineMapExtent::kObservationBox;
+
   // Keys are 16 bit: the whole grid must lie within OctoMap's +-32768 voxels.
-  for (const GridGeometry* g : {&coarse_grid_, &fine_grid_}) {
+  for (const GridGeometry* g : {&coarse_grid_, whole_box ? &fine_box : &fine_grid_}) {
     for (int a = 0; a < 3; ++a) {
       const std::int64_t lo = g->first_voxel[a] + key_offset_;
       const std::int64_t hi = lo + g->dims[a] - 1;
@@ -182,6 +195,16 @@ void OctomapMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
     std::array<int, 3> i;
     return inGrid(coarse_grid, key_offset, key, i);
   };
+  const bool whole_box = config().fine_map_extent == FineMapExtent::kObservationBox;
+  const std::array<std::int64_t, 3> box_lo = fine_box_lo_, box_hi = fine_box_hi_;
+  auto inFineMap = [&](const octomap::OcTreeKey& key) {
+    if (!whole_box) return inFineRegion(key);
+    for (int a = 0; a < 3; ++a) {
+      const std::int64_t i = std::int64_t{key[a]} - key_offset;
+      if (i < box_lo[a] || i >= box_hi[a]) return false;
+    }
+    return true;
+  };
   // computeRayKeys on the part of the ray inside `clip`, keeping the keys `keep` accepts.
   auto addFreeKeys = [](const auto& tree, const octomap::point3d& o, const octomap::point3d& e,
                         const Interval& clip, octomap::KeyRay& key_ray, const auto& keep,
@@ -217,15 +240,16 @@ void OctomapMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
       const Eigen::Vector3d dd = Eigen::Vector3d(end.x(), end.y(), end.z()) - of;
       addFreeKeys(coarse, origin, end, clipToBox(of, dd, coarse_lo, coarse_hi, {}), key_ray,
                   inCoarseGrid, local.coarse_free);
-      const Interval fine_clip = clipToSphere(of, dd, region_center, region_clip_radius,
-                                              clipToBox(of, dd, fine_lo, fine_hi, {}));
-      addFreeKeys(fine, origin, end, fine_clip, key_ray, inFineRegion, local.fine_free);
+      const Interval fine_clip = whole_box ? clipToBox(of, dd, coarse_lo, coarse_hi, {})
+                                           : clipToSphere(of, dd, region_center, region_clip_radius,
+                                                          clipToBox(of, dd, fine_lo, fine_hi, {}));
+      addFreeKeys(fine, origin, end, fine_clip, key_ray, inFineMap, local.fine_free);
       if (point.flags & FVP_POINT_HIT) {
         octomap::OcTreeKey key;
         if (coarse.coordToKeyChecked(end, key) && inCoarseGrid(key)) {
           local.coarse_hit.insert(key);
         }
-        if (fine.coordToKeyChecked(end, key) && inFineRegion(key)) {
+        if (fine.coordToKeyChecked(end, key) && inFineMap(key)) {
           (point.flags & FVP_POINT_ROI ? local.fine_roi_hit : local.fine_other_hit).insert(key);
         }
       }
@@ -300,26 +324,53 @@ void OctomapMapEngine::exportFine(const std::filesystem::path& ot_path) const {
 
 namespace {
 
+// Calls f(index) for every voxel of `grid` that the leaf (lattice corner `corner`, n voxels
+// per edge) covers, the loops clipped to the grid: a pruned leaf may be far larger.
+template <typename F>
+void forLeafVoxelsInGrid(const GridGeometry& grid, const std::array<std::int64_t, 3>& corner,
+                         std::int64_t n, F&& f) {
+  std::array<std::int64_t, 3> lo, hi;
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = std::max<std::int64_t>(corner[a] - grid.first_voxel[a], 0);
+    hi[a] = std::min<std::int64_t>(corner[a] - grid.first_voxel[a] + n, grid.dims[a]);
+  }
+  for (std::int64_t z = lo[2]; z < hi[2]; ++z)
+    for (std::int64_t y = lo[1]; y < hi[1]; ++y)
+      for (std::int64_t x = lo[0]; x < hi[0]; ++x)
+        f(std::array<int, 3>{static_cast<int>(x), static_cast<int>(y), static_cast<int>(z)});
+}
+
+// The leaves of `tree` that overlap `grid`'s box, by OctoMap's bounding-box iterator: with
+// fine_map_extent observation_box the fine tree holds far more than the grid's cube.
+template <typename Tree, typename F>
+void forLeavesOverlappingGrid(const Tree& tree, const GridGeometry& grid, int key_offset, F&& f) {
+  octomap::OcTreeKey min_key, max_key;
+  for (int a = 0; a < 3; ++a) {
+    min_key[a] = static_cast<octomap::key_type>(grid.first_voxel[a] + key_offset);
+    max_key[a] =
+        static_cast<octomap::key_type>(grid.first_voxel[a] + grid.dims[a] - 1 + key_offset);
+  }
+  const unsigned depth = tree.getTreeDepth();
+  for (auto it = tree.begin_leafs_bbx(min_key, max_key); it != tree.end_leafs_bbx(); ++it) {
+    const octomap::OcTreeKey key = it.getIndexKey();
+    const std::array<std::int64_t, 3> corner{std::int64_t{key[0]} - key_offset,
+                                             std::int64_t{key[1]} - key_offset,
+                                             std::int64_t{key[2]} - key_offset};
+    f(*it, corner, std::int64_t{1} << (depth - it.getDepth()));
+  }
+}
+
 // Grid indices of the occupied leaves of `tree` (pruned leaves expanded to their voxels).
 template <typename Tree>
 std::vector<std::array<int, 3>> occupiedLeaves(const Tree& tree, const GridGeometry& grid,
-                                               float occupied_logodds) {
+                                               int key_offset, float occupied_logodds) {
   std::vector<std::array<int, 3>> voxels;
-  const double res = tree.getResolution();
-  for (auto it = tree.begin_leafs(); it != tree.end_leafs(); ++it) {
-    if (classifyLogOdds(it->getLogOdds(), occupied_logodds) != VoxelClass::kOccupied) continue;
-    const auto n = static_cast<std::int64_t>(std::llround(it.getSize() / res));
-    std::array<std::int64_t, 3> lo;
-    for (int a = 0; a < 3; ++a)
-      lo[a] =
-          std::llround((it.getCoordinate()(a) - 0.5 * it.getSize()) / res) - grid.first_voxel[a];
-    for (std::int64_t z = lo[2]; z < lo[2] + n; ++z)
-      for (std::int64_t y = lo[1]; y < lo[1] + n; ++y)
-        for (std::int64_t x = lo[0]; x < lo[0] + n; ++x)
-          if (x >= 0 && y >= 0 && z >= 0 && x < grid.dims[0] && y < grid.dims[1] &&
-              z < grid.dims[2])
-            voxels.push_back({static_cast<int>(x), static_cast<int>(y), static_cast<int>(z)});
-  }
+  forLeavesOverlappingGrid(
+      tree, grid, key_offset, [&](const auto& node, const auto& corner, std::int64_t n) {
+        if (classifyLogOdds(node.getLogOdds(), occupied_logodds) != VoxelClass::kOccupied) return;
+        forLeafVoxelsInGrid(grid, corner, n,
+                            [&](const std::array<int, 3>& i) { voxels.push_back(i); });
+      });
   return voxels;
 }
 
@@ -327,8 +378,15 @@ std::vector<std::array<int, 3>> occupiedLeaves(const Tree& tree, const GridGeome
 
 std::vector<std::array<int, 3>> OctomapMapEngine::occupiedVoxels(MapLevel level) const {
   const float occupied = config().model.occupiedLogOdds();
-  return level == MapLevel::kCoarse ? occupiedLeaves(*coarse_, coarse_grid_, occupied)
-                                    : occupiedLeaves(*fine_, fine_grid_, occupied);
+  if (level == MapLevel::kCoarse)
+    return occupiedLeaves(*coarse_, coarse_grid_, key_offset_, occupied);
+  std::vector<std::array<int, 3>> voxels =
+      occupiedLeaves(*fine_, fine_grid_, key_offset_, occupied);
+  // The tree of an observation_box extent holds the cube's corners outside the region too.
+  std::erase_if(voxels, [&](const std::array<int, 3>& i) {
+    return !fvp_region_contains(&fine_region_, i[0], i[1], i[2]);
+  });
+  return voxels;
 }
 
 namespace {
@@ -344,24 +402,13 @@ struct KnownVoxel {
 std::vector<KnownVoxel> knownFineVoxels(const RoiOcTree& tree, const GridGeometry& grid,
                                         const fvp_region& region, int key_offset) {
   std::vector<KnownVoxel> voxels;
-  const unsigned depth = tree.getTreeDepth();
-  for (auto it = tree.begin_leafs(); it != tree.end_leafs(); ++it) {
-    const int n = 1 << (depth - it.getDepth());
-    const octomap::OcTreeKey corner = it.getIndexKey();
-    std::array<std::int64_t, 3> lo;
-    for (int a = 0; a < 3; ++a) lo[a] = std::int64_t{corner[a]} - key_offset - grid.first_voxel[a];
-    for (std::int64_t z = lo[2]; z < lo[2] + n; ++z)
-      for (std::int64_t y = lo[1]; y < lo[1] + n; ++y)
-        for (std::int64_t x = lo[0]; x < lo[0] + n; ++x) {
-          if (x < 0 || y < 0 || z < 0 || x >= grid.dims[0] || y >= grid.dims[1] ||
-              z >= grid.dims[2])
-            continue;
-          const std::array<int, 3> index{static_cast<int>(x), static_cast<int>(y),
-                                         static_cast<int>(z)};
-          if (!fvp_region_contains(&region, index[0], index[1], index[2])) continue;
-          voxels.push_back({index, &*it});
-        }
-  }
+  forLeavesOverlappingGrid(tree, grid, key_offset,
+                           [&](const RoiOcTreeNode& node, const auto& corner, std::int64_t n) {
+                             forLeafVoxelsInGrid(grid, corner, n, [&](const std::array<int, 3>& i) {
+                               if (fvp_region_contains(&region, i[0], i[1], i[2]))
+                                 voxels.push_back({i, &node});
+                             });
+                           });
   return voxels;
 }
 

@@ -47,6 +47,7 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
   if (engine == "grid" || o.backend != "auto") backend = accel::createBackend(o.backend);
   SimulatedMappingOptions mapping;
   mapping.engine = engine;
+  mapping.map = plannerMapConfig(o.planner, engine);
   mapping.render.noise_seed = o.seed;
   const auto t_map = std::chrono::steady_clock::now();
   SimulatedMapping mapped =
@@ -124,6 +125,7 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
       {"seed", o.seed},
       {"views", o.views},
       {"engine", engine},
+      {"fine_map_extent", host::map::toString(mapping.map.fine_map_extent)},
       {"backend", backend ? std::string(accel::toString(backend->kind())) : "none"},
       {"move_attempts", step.move_attempts},
       {"failed_moves", step.failed_moves},

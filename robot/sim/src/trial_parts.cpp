@@ -32,6 +32,13 @@ std::string defaultEngine(const std::string& planner) {
   return planner == "rvp" ? "octomap" : "grid";
 }
 
+host::map::MapConfig plannerMapConfig(const std::string& planner, const std::string& engine) {
+  host::map::MapConfig config;
+  if (planner == "rvp" && engine == "octomap")
+    config.fine_map_extent = host::map::FineMapExtent::kObservationBox;
+  return config;
+}
+
 std::string defaultCacheDir() {
   if (const char* dir = std::getenv("FVP_CACHE_DIR"); dir && *dir) return dir;
   if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
@@ -46,7 +53,8 @@ struct TrialParts::Impl {
       : options(options),
         engine(engine),
         backend(backend),
-        session(host::PerceptionConfig{}, engine, host::map::MapConfig{}, backend) {
+        session(host::PerceptionConfig{}, engine, plannerMapConfig(options.planner, engine),
+                backend) {
     session.enableTsdf();
     if (options.planner == "fvp") {
       const host::planner::PlannerConfig config =
@@ -95,7 +103,11 @@ host::planner::ViewPlanner& TrialParts::planner() {
 }
 
 nlohmann::json TrialParts::configJson() const {
-  return {{"engine", impl_->engine}, {"clock", impl_->options.clock}};
+  return {{"engine", impl_->engine},
+          {"clock", impl_->options.clock},
+          {"fine_map_extent",
+           host::map::toString(
+               plannerMapConfig(impl_->options.planner, impl_->engine).fine_map_extent)}};
 }
 
 void TrialParts::keepViewImage(int index, const host::StereoFrame& frame) const {

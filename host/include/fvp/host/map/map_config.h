@@ -13,14 +13,26 @@ inline constexpr double kDefaultCoarseVoxelSizeM = 0.01;
 inline constexpr double kDefaultFineVoxelSizeM = 0.001;
 inline constexpr double kDefaultSensorMaxRangeM = 1.0;
 
+/// Where the fine map's rays update voxels. The planners read the fine map only inside the
+/// Cluster Region either way; kObservationBox is RVP's setting in the paper (one 1 mm ROI
+/// octree over the whole observation space) and costs what that map costs to update.
+enum class FineMapExtent { kClusterRegion, kObservationBox };
+
+/// "cluster_region" / "observation_box"; parse throws std::invalid_argument naming `field`.
+std::string toString(FineMapExtent extent);
+FineMapExtent parseFineMapExtent(const std::string& text, const std::string& field);
+
 struct MapConfig {
   /// Coarse map: whole observation space. The box is snapped outward to whole voxels of
   /// the OctoMap key lattice (voxel k covers [k, k+1) * voxel size).
   double coarse_voxel_size_m = kDefaultCoarseVoxelSizeM;
   Eigen::Vector3d observation_min_m{-1.0, -1.0, 0.0};
   Eigen::Vector3d observation_max_m{1.0, 1.0, 2.0};
-  /// Fine map: occupancy + ROI, only inside the Cluster Region sphere.
+  /// Fine map: occupancy + ROI, inside the Cluster Region sphere (see fine_map_extent).
   double fine_voxel_size_m = kDefaultFineVoxelSizeM;
+  /// kObservationBox: the fine map is updated over the whole observation box (octomap
+  /// engine only; the grid engine's fine map is the Cluster Region's cube).
+  FineMapExtent fine_map_extent = FineMapExtent::kClusterRegion;
   /// Points farther than this from the sensor: the ray is cut at this range and its end
   /// is not a hit (OctoMap's maxrange).
   double sensor_max_range_m = kDefaultSensorMaxRangeM;

@@ -21,6 +21,11 @@
 //   as OctoMap's maxrange does (free up to the cut, the cut voxel itself not updated, no
 //   hit) and counted. The cut is computed in double and rounded to float, where OctoMap's
 //   computeUpdate computes it in float: the end may differ in the last bits.
+// - fine_map_extent observation_box (RVP's setting in the paper, one 1 mm ROI octree over
+//   the whole observation space): the fine tree's rays are clipped to the observation box
+//   instead, and every voxel of that box is updated. Reads (fineState, frontiers, the ROI
+//   distance, occupiedVoxels, the scene) still cover the Cluster Region's cube only; the
+//   rest is what that map costs to keep, and it is exported with the tree.
 // - ROI (fine map): +hit where any ROI point ends, +miss where only other points end,
 //   unchanged in free voxels; clamped like occupancy.
 //
@@ -91,6 +96,8 @@ class OctomapMapEngine : public MapEngine {
   GridGeometry coarse_grid_;
   GridGeometry fine_grid_;
   fvp_region fine_region_{};
+  // Fine lattice indices of the observation box, [lo, hi) per axis (observation_box extent).
+  std::array<std::int64_t, 3> fine_box_lo_{}, fine_box_hi_{};
   int key_offset_ = 0;  ///< OctoMap key of lattice index 0 (tree_max_val)
   std::unique_ptr<octomap::OcTree> coarse_;
   std::unique_ptr<RoiOcTree> fine_;
