@@ -405,6 +405,18 @@ TEST(MapConfigYaml, TheDefaultsFileHoldsTheDefaults) {
   EXPECT_EQ(read.model.occupied_prob, defaults.model.occupied_prob);
 }
 
+TEST(MapConfigYaml, FineMapExtentParsesBothValues) {
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("fvp_map_extent_" + std::to_string(::getpid()) + ".yaml");
+  for (const FineMapExtent extent :
+       {FineMapExtent::kObservationBox, FineMapExtent::kClusterRegion}) {
+    std::ofstream(path) << "fine_map_extent: " << toString(extent) << "\n";
+    EXPECT_EQ(MapConfig::fromYamlFile(path).fine_map_extent, extent) << toString(extent);
+  }
+  std::filesystem::remove(path);
+  EXPECT_EQ(toString(FineMapExtent::kObservationBox), "observation_box");
+}
+
 TEST(MapConfigYaml, ErrorsNameTheFileAndTheKey) {
   const auto dir =
       std::filesystem::temp_directory_path() / ("fvp_map_config_" + std::to_string(::getpid()));
@@ -429,7 +441,8 @@ TEST(MapConfigYaml, ErrorsNameTheFileAndTheKey) {
   expectError("prob_hit: high\n", "prob_hit", "expected a number");
   expectError("observation_min_m: [0, 0, 3]\n", "observation_max_m", "must exceed");
   expectError("sensor_max_range_m: 5.0\n", "sensor_max_range_m", "fewer than 4096 voxels per ray");
-  expectError("fine_map_extent: everywhere\n", "fine_map_extent", "cluster_region or observation_box");
+  expectError("fine_map_extent: everywhere\n", "fine_map_extent",
+              "cluster_region or observation_box");
   std::filesystem::remove_all(dir);
 }
 

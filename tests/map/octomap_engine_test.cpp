@@ -13,6 +13,7 @@
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -364,9 +365,9 @@ TEST(RoiColor, EncodingKeepsTheRoiClassAndTheValueWithinHalfAStep) {
 // ---- files ---------------------------------------------------------------------------
 
 // An engine after a few synthetic views of fruitlets in the region.
-std::unique_ptr<OctomapMapEngine> mappedEngine(
-    int views = 3, FineMapExtent extent = FineMapExtent::kClusterRegion, int width_px = 160,
-    int height_px = 120) {
+std::unique_ptr<OctomapMapEngine> mappedEngine(int views = 3,
+                                               FineMapExtent extent = FineMapExtent::kClusterRegion,
+                                               int width_px = 160, int height_px = 120) {
   MapConfig c = smallConfig();
   c.fine_map_extent = extent;
   const ClusterRegion region({0.0, 0.0, 0.3}, 0.04);
@@ -375,8 +376,7 @@ std::unique_ptr<OctomapMapEngine> mappedEngine(
   const Eigen::Vector3d origins[] = {
       {0.2, 0.05, 0.1}, {-0.15, 0.2, 0.15}, {0.0, -0.2, 0.05}, {0.1, 0.1, 0.45}};
   for (int v = 0; v < views; ++v) {
-    const auto scan =
-        testing::renderScan(world, origins[v % 4], width_px, height_px, 0.5, 100 + v);
+    const auto scan = testing::renderScan(world, origins[v % 4], width_px, height_px, 0.5, 100 + v);
     e->integrate(scan.clouds());
   }
   return e;
@@ -774,7 +774,8 @@ TEST(OctomapEngine, ObservationBoxExtentUpdatesTheWholeBoxAndReadsTheSameRegion)
   // lie outside the region than inside.
   const GridGeometry& coarse = whole_box->coarseGrid();
   std::size_t outside_region = 0, leaves = 0;
-  Eigen::Vector3d known_outside = Eigen::Vector3d::Constant(std::nan(""));
+  // A leaf in the fine grid's cube but outside the sphere: known to the tree, not to reads.
+  Eigen::Vector3d cube_not_sphere = Eigen::Vector3d::Constant(std::nan(""));
   for (auto it = whole_box->fineTree().begin_leafs(); it != whole_box->fineTree().end_leafs();
        ++it) {
     const auto c = it.getCoordinate();
@@ -783,7 +784,9 @@ TEST(OctomapEngine, ObservationBoxExtentUpdatesTheWholeBoxAndReadsTheSameRegion)
     ASSERT_TRUE(coarse.gridIndex(p, index)) << p.transpose();
     if (!inRegion(*whole_box, p)) {
       ++outside_region;
-      known_outside = p;
+      if (it.getDepth() == whole_box->fineTree().getTreeDepth() &&
+          whole_box->fineGrid().gridIndex(p, index))
+        cube_not_sphere = p;
     }
     ++leaves;
   }
@@ -806,14 +809,37 @@ TEST(OctomapEngine, ObservationBoxExtentUpdatesTheWholeBoxAndReadsTheSameRegion)
   EXPECT_GT(known, 10000u);
   EXPECT_LE(differ, known / 1000) << differ << " of " << known;
   // Outside the region, the whole-box tree knows voxels that fineState still calls unknown.
-  ASSERT_TRUE(known_outside.allFinite());
-  EXPECT_EQ(whole_box->fineState(known_outside), VoxelState{});
+  ASSERT_TRUE(cube_not_sphere.allFinite());
+  ASSERT_NE(
+      whole_box->fineTree().search(cube_not_sphere.x(), cube_not_sphere.y(), cube_not_sphere.z()),
+      nullptr);
+  EXPECT_EQ(whole_box->fineState(cube_not_sphere), VoxelState{});
 
   // Planner reads over the region's cube: occupied voxels and frontiers agree likewise.
-  const auto occupied_a = region_only->occupiedVoxels(MapLevel::kFine);
-  const auto occupied_b = whole_box->occupiedVoxels(MapLevel::kFine);
-  EXPECT_GT(occupied_a.size(), 100u);
-  EXPECT_NEAR(double(occupied_b.size()), double(occupied_a.size()), 0.001 * occupied_a.size());
+  // Occupied voxels: exactly the region's occupied states, nothing from the cube's corners.
+  for (const auto* e : {region_only.get(), whole_box.get()}) {
+    std::set<std::array<int, 3>> want;
+    for (int z = 0; z < g.dims[2]; ++z)
+      for (int y = 0; y < g.dims[1]; ++y)
+        for (int x = 0; x < g.dims[0]; ++x)
+          if (e->fineStateAt({x, y, z}).occupancy == VoxelClass::kOccupied) want.insert({x, y, z});
+    const auto got = e->occupiedVoxels(MapLevel::kFine);
+    EXPECT_GT(got.size(), 100u);
+    const std::set<std::array<int, 3>> got_set(got.begin(), got.end());
+    EXPECT_EQ(got_set, want);
+  }
+  // ROI comes from end points only, which clipping does not move: the same distance field.
+  region_only->updateRoiDistance(0.02);
+  whole_box->updateRoiDistance(0.02);
+  std::size_t near_roi = 0;
+  for (int z = 0; z < g.dims[2]; ++z)
+    for (int y = 0; y < g.dims[1]; ++y)
+      for (int x = 0; x < g.dims[0]; ++x) {
+        const double d = region_only->roiDistance_m({x, y, z});
+        ASSERT_EQ(whole_box->roiDistance_m({x, y, z}), d) << x << " " << y << " " << z;
+        near_roi += d < 0.02;
+      }
+  EXPECT_GT(near_roi, 1000u);
   const auto frontiers_a = region_only->frontiers();
   const auto frontiers_b = whole_box->frontiers();
   EXPECT_NEAR(double(frontiers_b.size()), double(frontiers_a.size()), 0.01 * frontiers_a.size());

@@ -44,6 +44,13 @@ Interval clipToBox(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eig
   return in;
 }
 
+// The smallest interval holding both (the keep predicate drops what lies between).
+Interval hull(const Interval& a, const Interval& b) {
+  if (a.empty()) return b;
+  if (b.empty()) return a;
+  return {std::min(a.t0, b.t0), std::max(a.t1, b.t1)};
+}
+
 // Segment o + t d against a sphere.
 Interval clipToSphere(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::Vector3d& c,
                       double r, Interval in) {
@@ -112,31 +119,41 @@ OctomapMapEngine::OctomapMapEngine(const MapConfig& config, const ClusterRegion&
   setSensorModel(*fine_, config.model);
   key_offset_ = coarse_->coordToKey(0.0);  // tree_max_val: the key of lattice index 0
 
-  // The observation box (the coarse grid's, snapped to coarse voxels) on the fine lattice.
+  // The observation box as the coarse grid holds it (snapped outward to whole 8-voxel
+  // bricks), on the fine lattice: where an observation_box extent updates the fine tree.
+  const double ratio = config.coarse_voxel_size_m / config.fine_voxel_size_m;
   for (int a = 0; a < 3; ++a) {
-    const double ratio = config.coarse_voxel_size_m / config.fine_voxel_size_m;
     fine_box_lo_[a] = std::llround(coarse_grid_.first_voxel[a] * ratio);
     fine_box_hi_[a] = std::llround((coarse_grid_.first_voxel[a] + coarse_grid_.dims[a]) * ratio);
   }
-  GridGeometry fine_box = fine_grid_;
-  for (int a = 0; a < 3; ++a) {
-    fine_box.first_voxel[a] = static_cast<int>(fine_box_lo_[a]);
-    fine_box.dims[a] = static_cast<int>(fine_box_hi_[a] - fine_box_lo_[a]);
-  }
-  const bool whole_box = config.fine_map_extent == FineMapExtent::kObservationBox;
 
-  // Keys are 16 bit: the whole grid must lie within OctoMap's +-32768 voxels.
-  for (const GridGeometry* g : {&coarse_grid_, whole_box ? &fine_box : &fine_grid_}) {
+  // Keys are 16 bit: every lattice index the engine turns into a key must lie within
+  // OctoMap's +-32768 voxels.
+  auto checkKeyRange = [&](const char* name, const std::array<std::int64_t, 3>& lo_index,
+                           const std::array<std::int64_t, 3>& end_index) {
     for (int a = 0; a < 3; ++a) {
-      const std::int64_t lo = g->first_voxel[a] + key_offset_;
-      const std::int64_t hi = lo + g->dims[a] - 1;
-      if (lo < 0 || hi > std::numeric_limits<octomap::key_type>::max()) {
-        throw std::invalid_argument(
-            std::string("octomap engine: the ") + (g == &coarse_grid_ ? "coarse" : "fine") +
-            " grid lies outside OctoMap's key range (+-32768 voxels around the origin)");
+      if (lo_index[a] + key_offset_ < 0 ||
+          end_index[a] - 1 + key_offset_ > std::numeric_limits<octomap::key_type>::max()) {
+        throw std::invalid_argument(std::string("octomap engine: the ") + name +
+                                    " lies outside OctoMap's key range (+-32768 voxels around "
+                                    "the origin)");
       }
     }
-  }
+  };
+  const auto range = [](const GridGeometry& g, std::array<std::int64_t, 3>& lo,
+                        std::array<std::int64_t, 3>& end) {
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = g.first_voxel[a];
+      end[a] = std::int64_t{g.first_voxel[a]} + g.dims[a];
+    }
+  };
+  std::array<std::int64_t, 3> lo, end;
+  range(coarse_grid_, lo, end);
+  checkKeyRange("coarse grid", lo, end);
+  range(fine_grid_, lo, end);
+  checkKeyRange("fine grid", lo, end);
+  if (config.fine_map_extent == FineMapExtent::kObservationBox)
+    checkKeyRange("observation box at the fine voxel size", fine_box_lo_, fine_box_hi_);
 }
 
 OctomapMapEngine::~OctomapMapEngine() = default;
@@ -197,8 +214,11 @@ void OctomapMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
   };
   const bool whole_box = config().fine_map_extent == FineMapExtent::kObservationBox;
   const std::array<std::int64_t, 3> box_lo = fine_box_lo_, box_hi = fine_box_hi_;
+  // The region is always updated (it may reach beyond the box); with an observation_box
+  // extent, every voxel of the box too.
   auto inFineMap = [&](const octomap::OcTreeKey& key) {
-    if (!whole_box) return inFineRegion(key);
+    if (inFineRegion(key)) return true;
+    if (!whole_box) return false;
     for (int a = 0; a < 3; ++a) {
       const std::int64_t i = std::int64_t{key[a]} - key_offset;
       if (i < box_lo[a] || i >= box_hi[a]) return false;
@@ -240,9 +260,10 @@ void OctomapMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
       const Eigen::Vector3d dd = Eigen::Vector3d(end.x(), end.y(), end.z()) - of;
       addFreeKeys(coarse, origin, end, clipToBox(of, dd, coarse_lo, coarse_hi, {}), key_ray,
                   inCoarseGrid, local.coarse_free);
-      const Interval fine_clip = whole_box ? clipToBox(of, dd, coarse_lo, coarse_hi, {})
-                                           : clipToSphere(of, dd, region_center, region_clip_radius,
-                                                          clipToBox(of, dd, fine_lo, fine_hi, {}));
+      const Interval region_clip = clipToSphere(of, dd, region_center, region_clip_radius,
+                                                clipToBox(of, dd, fine_lo, fine_hi, {}));
+      const Interval fine_clip =
+          whole_box ? hull(region_clip, clipToBox(of, dd, coarse_lo, coarse_hi, {})) : region_clip;
       addFreeKeys(fine, origin, end, fine_clip, key_ray, inFineMap, local.fine_free);
       if (point.flags & FVP_POINT_HIT) {
         octomap::OcTreeKey key;

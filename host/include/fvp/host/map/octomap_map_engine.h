@@ -23,9 +23,10 @@
 //   computeUpdate computes it in float: the end may differ in the last bits.
 // - fine_map_extent observation_box (RVP's setting in the paper, one 1 mm ROI octree over
 //   the whole observation space): the fine tree's rays are clipped to the observation box
-//   instead, and every voxel of that box is updated. Reads (fineState, frontiers, the ROI
-//   distance, occupiedVoxels, the scene) still cover the Cluster Region's cube only; the
-//   rest is what that map costs to keep, and it is exported with the tree.
+//   as the coarse grid holds it (snapped outward to whole bricks) and to the region, and
+//   every voxel of either is updated. Reads (fineState, frontiers, the ROI distance,
+//   occupiedVoxels, the scene) still cover the Cluster Region sphere only; the rest is what
+//   that map costs to keep, and it is exported with the tree.
 // - ROI (fine map): +hit where any ROI point ends, +miss where only other points end,
 //   unchanged in free voxels; clamped like occupancy.
 //
