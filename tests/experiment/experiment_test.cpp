@@ -28,7 +28,9 @@ nlohmann::json fakeTrial(const TrialOptions& o) {
   if (fvp) f1["est_size_mm"] = gt1 - 1.0;
   nlohmann::json r = {{"planner", o.planner},
                       {"seed", o.seed},
-                      {"engine", fvp ? "grid" : "octomap"},
+                      {"engine", !o.engine.empty() ? o.engine
+                                 : fvp             ? "grid"
+                                                   : "octomap"},
                       {"views", fvp ? 30 : 20},
                       {"wall_time_s", 100.0},
                       {"detections", fvp ? 2 : 2},
@@ -127,6 +129,26 @@ TEST(Experiment, ShardsMergedEqualOneRun) {
   EXPECT_EQ(slurp(merged / "trials.jsonl"), slurp(whole / "trials.jsonl"));
   // The same shard twice is a conflict.
   EXPECT_THROW(mergeExperiments({a, a}, freshDir("dup")), std::runtime_error);
+}
+
+// The "FVP on the octomap engine" ablation runs on its own and merges with the main run
+// into its own row: same planner and seeds, a different engine, not a conflict.
+TEST(Experiment, AnEngineAblationMergesWithTheMainRunAsItsOwnRow) {
+  const fs::path main_run = freshDir("main"), ablation = freshDir("ablation"),
+                 merged = freshDir("merged_ablation");
+  ExperimentOptions m = options(main_run, 3), a = options(ablation, 3);
+  m.planners = a.planners = {"fvp"};
+  a.trial.engine = "octomap";
+  runExperiment(m, fakeTrial, nullptr);
+  runExperiment(a, fakeTrial, nullptr);
+  mergeExperiments({main_run, ablation}, merged);
+  const auto summary = nlohmann::json::parse(slurp(merged / "summary.json"));
+  EXPECT_EQ(summary["fvp"]["trials"].get<int>(), 3);
+  EXPECT_EQ(summary["fvp-octomap"]["trials"].get<int>(), 3);
+  EXPECT_NE(slurp(merged / "table1.md").find("FVP on the octomap engine"), std::string::npos);
+  EXPECT_EQ(readTrials(merged / "trials.jsonl", nullptr).size(), 6u);
+  EXPECT_THROW(mergeExperiments({ablation, ablation}, freshDir("dup_ablation")),
+               std::runtime_error);
 }
 
 TEST(Experiment, CorruptLinesAreErrorsButATornLastLineIsReported) {

@@ -23,6 +23,16 @@ std::string trialKey(const std::string& planner, std::uint64_t seed) {
   return planner + "-" + std::to_string(seed);
 }
 
+/// The summary row of a finished trial: its planner, plus the engine when that is not the
+/// planner's default (the "FVP on the octomap engine" ablation is its own row).
+std::string rowKey(const nlohmann::json& trial) {
+  std::string key = trial["planner"].get<std::string>();
+  const std::string engine = trial.value("engine", "");
+  if ((key == "fvp" && engine == "octomap") || (key == "rvp" && engine == "grid"))
+    key += "-" + engine;
+  return key;
+}
+
 /// Appends one line with a single write and fsync: a reader sees whole lines, or a last
 /// line cut short by a crash, which readTrials reports and ignores.
 void appendLine(const std::filesystem::path& path, const std::string& line) {
@@ -117,11 +127,7 @@ std::vector<nlohmann::json> readTrials(const std::filesystem::path& jsonl,
 nlohmann::json summarize(const std::vector<nlohmann::json>& trials) {
   std::map<std::string, std::vector<const nlohmann::json*>> by_key;
   for (const auto& t : trials) {
-    std::string key = t["planner"].get<std::string>();
-    const std::string engine = t.value("engine", "");
-    if ((key == "fvp" && engine == "octomap") || (key == "rvp" && engine == "grid"))
-      key += "-" + engine;  // engine ablations get their own rows
-    by_key[key].push_back(&t);
+    by_key[rowKey(t)].push_back(&t);
   }
   nlohmann::ordered_json summary;
   for (const auto& [key, list] : by_key) {
@@ -138,8 +144,8 @@ void writeReports(const std::filesystem::path& dir, const std::vector<nlohmann::
   // A canonical order: sums (and so every figure) do not depend on how trials were run.
   std::vector<nlohmann::json> trials = unsorted;
   std::sort(trials.begin(), trials.end(), [](const nlohmann::json& a, const nlohmann::json& b) {
-    return std::make_pair(a["seed"].get<std::uint64_t>(), a["planner"].get<std::string>()) <
-           std::make_pair(b["seed"].get<std::uint64_t>(), b["planner"].get<std::string>());
+    return std::make_pair(a["seed"].get<std::uint64_t>(), rowKey(a)) <
+           std::make_pair(b["seed"].get<std::uint64_t>(), rowKey(b));
   });
   const nlohmann::json summary = summarize(trials);
   host::writeFileAtomically(dir / "summary.json", "experiment summary", summary.dump(2) + "\n");
@@ -284,7 +290,8 @@ void mergeExperiments(const std::vector<std::filesystem::path>& shard_dirs,
     if (!std::filesystem::exists(jsonl))
       throw std::runtime_error(jsonl.string() + ": not found (not an experiment directory?)");
     for (auto& t : readTrials(jsonl, nullptr)) {
-      const std::string key = trialKey(t["planner"], t["seed"].get<std::uint64_t>());
+      // A row's trial once: the main run and an engine ablation of one planner may merge.
+      const std::string key = trialKey(rowKey(t), t["seed"].get<std::uint64_t>());
       if (!seen.insert(key).second)
         throw std::runtime_error(jsonl.string() + ": trial " + key + " is in two shards");
       all.push_back(std::move(t));
@@ -292,8 +299,8 @@ void mergeExperiments(const std::vector<std::filesystem::path>& shard_dirs,
   }
   // A canonical order, so that merged output does not depend on the shard split.
   std::sort(all.begin(), all.end(), [](const nlohmann::json& a, const nlohmann::json& b) {
-    return std::make_pair(a["seed"].get<std::uint64_t>(), a["planner"].get<std::string>()) <
-           std::make_pair(b["seed"].get<std::uint64_t>(), b["planner"].get<std::string>());
+    return std::make_pair(a["seed"].get<std::uint64_t>(), rowKey(a)) <
+           std::make_pair(b["seed"].get<std::uint64_t>(), rowKey(b));
   });
   std::filesystem::create_directories(out_dir);
   std::ostringstream whole;
