@@ -15,6 +15,7 @@
 
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/host/core/gnuplot.h"
+#include "trial_parts.h"
 
 namespace fvp::robot::sim {
 namespace {
@@ -28,9 +29,14 @@ std::string trialKey(const std::string& planner, std::uint64_t seed) {
 std::string rowKey(const nlohmann::json& trial) {
   std::string key = trial["planner"].get<std::string>();
   const std::string engine = trial.value("engine", "");
-  if ((key == "fvp" && engine == "octomap") || (key == "rvp" && engine == "grid"))
-    key += "-" + engine;
+  if (!engine.empty() && engine != defaultEngine(key)) key += "-" + engine;
   return key;
+}
+
+/// Canonical trial order: by world seed, then by row.
+bool bySeedThenRow(const nlohmann::json& a, const nlohmann::json& b) {
+  return std::make_pair(a["seed"].get<std::uint64_t>(), rowKey(a)) <
+         std::make_pair(b["seed"].get<std::uint64_t>(), rowKey(b));
 }
 
 /// Appends one line with a single write and fsync: a reader sees whole lines, or a last
@@ -143,10 +149,7 @@ nlohmann::json summarize(const std::vector<nlohmann::json>& trials) {
 void writeReports(const std::filesystem::path& dir, const std::vector<nlohmann::json>& unsorted) {
   // A canonical order: sums (and so every figure) do not depend on how trials were run.
   std::vector<nlohmann::json> trials = unsorted;
-  std::sort(trials.begin(), trials.end(), [](const nlohmann::json& a, const nlohmann::json& b) {
-    return std::make_pair(a["seed"].get<std::uint64_t>(), rowKey(a)) <
-           std::make_pair(b["seed"].get<std::uint64_t>(), rowKey(b));
-  });
+  std::sort(trials.begin(), trials.end(), bySeedThenRow);
   const nlohmann::json summary = summarize(trials);
   host::writeFileAtomically(dir / "summary.json", "experiment summary", summary.dump(2) + "\n");
 
@@ -178,7 +181,7 @@ void writeReports(const std::filesystem::path& dir, const std::vector<nlohmann::
   std::map<std::string, std::vector<double>> sizes;
   for (const auto& t : trials) {
     const std::string planner = t["planner"].get<std::string>();
-    if (t.value("engine", "") == (planner == "fvp" ? "octomap" : "grid")) continue;
+    if (rowKey(t) != planner) continue;  // engine ablations are not in the figure
     for (const auto& f : t["fruitlets"]) {
       if (planner == "fvp") sizes["GT"].push_back(f["gt_size_mm"].get<double>());
       if (f.value("matched", false))
@@ -298,10 +301,7 @@ void mergeExperiments(const std::vector<std::filesystem::path>& shard_dirs,
     }
   }
   // A canonical order, so that merged output does not depend on the shard split.
-  std::sort(all.begin(), all.end(), [](const nlohmann::json& a, const nlohmann::json& b) {
-    return std::make_pair(a["seed"].get<std::uint64_t>(), rowKey(a)) <
-           std::make_pair(b["seed"].get<std::uint64_t>(), rowKey(b));
-  });
+  std::sort(all.begin(), all.end(), bySeedThenRow);
   std::filesystem::create_directories(out_dir);
   std::ostringstream whole;
   for (const auto& t : all) whole << t.dump() << "\n";

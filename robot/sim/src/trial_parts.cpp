@@ -53,8 +53,8 @@ struct TrialParts::Impl {
       : options(options),
         engine(engine),
         backend(backend),
-        session(host::PerceptionConfig{}, engine, plannerMapConfig(options.planner, engine),
-                backend) {
+        map_config(plannerMapConfig(options.planner, engine)),
+        session(host::PerceptionConfig{}, engine, map_config, backend) {
     session.enableTsdf();
     if (options.planner == "fvp") {
       const host::planner::PlannerConfig config =
@@ -74,6 +74,7 @@ struct TrialParts::Impl {
   TrialOptions options;
   std::string engine;
   accel::Backend* backend;
+  host::map::MapConfig map_config;  ///< the maps' config, as the session got it
   host::MappingSession session;
   std::unique_ptr<host::planner::ViewPlanner> planner;
   host::sizing::SizingConfig sizing_config;
@@ -105,9 +106,7 @@ host::planner::ViewPlanner& TrialParts::planner() {
 nlohmann::json TrialParts::configJson() const {
   return {{"engine", impl_->engine},
           {"clock", impl_->options.clock},
-          {"fine_map_extent",
-           host::map::toString(
-               plannerMapConfig(impl_->options.planner, impl_->engine).fine_map_extent)}};
+          {"fine_map_extent", host::map::toString(impl_->map_config.fine_map_extent)}};
 }
 
 void TrialParts::keepViewImage(int index, const host::StereoFrame& frame) const {
