@@ -238,7 +238,9 @@ void BM_ScanIntegrateFineBoxOctomapEngine(benchmark::State& state) {
   state.counters["voxel_updates"] = got;
   state.counters["leaves"] = static_cast<double>(leaves);
   state.counters["map_MB"] = bytes / 1e6;
-  state.SetLabel("octomap engine, fine_map_extent observation_box (RVP's map), OpenMP key sets");
+  state.SetLabel(
+      "octomap engine, fine_map_extent observation_box (RVP's map), flat key sets, Morton-ordered "
+      "lazy updates");
 }
 
 // One planning iteration's map work after a view (DESIGN.md section 5): integrate the view,
