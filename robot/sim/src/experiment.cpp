@@ -254,6 +254,7 @@ void runExperiment(const ExperimentOptions& o, const TrialRunner& run_trial,
 
   const auto start = std::chrono::steady_clock::now();
   std::size_t ran = 0, todo = 0;
+  double finished_s = 0.0;  // elapsed when the last trial finished
   for (const auto& [p, s] : mine) todo += !finished.count(trialKey(p, s));
   for (const auto& [planner, seed] : mine) {
     if (finished.count(trialKey(planner, seed))) continue;
@@ -269,7 +270,12 @@ void runExperiment(const ExperimentOptions& o, const TrialRunner& run_trial,
       line << "trial " << index + 1 << "/" << todo << " (" << planner << ", seed " << seed
            << "): view " << p.views << ", sim " << std::fixed << std::setprecision(0)
            << p.sim_time_s << "/" << p.budget_s << " s";
-      if (index > 0) line << ", ETA " << elapsed / index * (todo - index) / 60.0 << " min";
+      // Mean finished trial times the trials left, less what the trial in flight has run.
+      if (index > 0) {
+        const double eta_s =
+            finished_s / double(index) * double(todo - index) - (elapsed - finished_s);
+        line << ", ETA " << std::max(0.0, eta_s) / 60.0 << " min";
+      }
       if (progress) progress(line.str());
     };
     nlohmann::json result = run_trial(t);
@@ -278,6 +284,7 @@ void runExperiment(const ExperimentOptions& o, const TrialRunner& run_trial,
     result.erase("clock");
     appendLine(jsonl, result.dump());
     ++ran;
+    finished_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     done.push_back(std::move(result));
   }
   writeReports(o.out_dir, done);
