@@ -13,6 +13,7 @@
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <random>
 #include <set>
 #include <sstream>
 #include <string>
@@ -327,6 +328,58 @@ TEST(RoiOcTree, PruningKeepsTheRoiOfEachVoxel) {
     EXPECT_EQ(n->getRoiLogOdds(), i == 3 ? hit + miss : hit) << i;
   }
   EXPECT_EQ(tree.getNumLeafNodes(), 8u);
+}
+
+// The octomap engine applies a scan's updates lazily, in its own order, then restores inner
+// nodes and pruning once (updateInnerOccupancy + prune): the tree must be the one eager
+// per-key updates give. Scans over a 16^3 block with every kind of update; whole-block free
+// scans clamp it so it prunes, and later scans must expand it again.
+TEST(RoiOcTree, LazyScanThenInnerAndPruneEqualsEagerUpdates) {
+  RoiOcTree eager(0.001), lazy(0.001);
+  const octomap::OcTreeKey base = eager.coordToKey(0.0, 0.0, 0.0);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::size_t fewest_leaves = std::numeric_limits<std::size_t>::max();
+  for (int scan = 0; scan < 24; ++scan) {
+    const bool whole_block_free = scan < 6 || scan % 6 == 0;  // clamps after 5 misses
+    std::vector<std::pair<octomap::OcTreeKey, int>> updates;  // 0 free, 1 hit, 2 ROI hit
+    for (int i = 0; i < 16 * 16 * 16; ++i) {
+      if (!whole_block_free && u(rng) < 0.4) continue;
+      const octomap::OcTreeKey key(static_cast<octomap::key_type>(base[0] + i % 16),
+                                   static_cast<octomap::key_type>(base[1] + i / 16 % 16),
+                                   static_cast<octomap::key_type>(base[2] + i / 256));
+      const double r = u(rng);
+      updates.emplace_back(key, whole_block_free || r < 0.7 ? 0 : r < 0.85 ? 1 : 2);
+    }
+    const auto apply = [](RoiOcTree& tree, const std::pair<octomap::OcTreeKey, int>& up,
+                          bool lazy_eval) {
+      tree.updateNodeAndRoi(up.first, up.second != 0,
+                            up.second == 2   ? RoiOcTree::RoiUpdate::kHit
+                            : up.second == 1 ? RoiOcTree::RoiUpdate::kMiss
+                                             : RoiOcTree::RoiUpdate::kNone,
+                            lazy_eval);
+    };
+    for (const auto& up : updates) apply(eager, up, false);
+    std::shuffle(updates.begin(), updates.end(), rng);
+    for (const auto& up : updates) apply(lazy, up, true);
+    lazy.updateInnerOccupancy();
+    lazy.prune();
+
+    ASSERT_EQ(lazy.getNumLeafNodes(), eager.getNumLeafNodes()) << "scan " << scan;
+    ASSERT_EQ(lazy.size(), eager.size()) << "scan " << scan;
+    auto e = eager.begin_tree(), l = lazy.begin_tree();
+    for (; e != eager.end_tree() && l != lazy.end_tree(); ++e, ++l) {
+      ASSERT_EQ(e.getKey(), l.getKey()) << "scan " << scan;
+      ASSERT_EQ(e.getDepth(), l.getDepth()) << "scan " << scan;
+      ASSERT_EQ(e->getLogOdds(), l->getLogOdds()) << "scan " << scan;
+      ASSERT_EQ(e->getRoiLogOdds(), l->getRoiLogOdds()) << "scan " << scan;
+    }
+    EXPECT_TRUE(e == eager.end_tree() && l == lazy.end_tree()) << "scan " << scan;
+    fewest_leaves = std::min(fewest_leaves, eager.getNumLeafNodes());
+  }
+  // The block clamped free and pruned (the case the test is for), then split again.
+  EXPECT_EQ(fewest_leaves, 1u);
+  EXPECT_GT(eager.getNumLeafNodes(), 64u);
 }
 
 TEST(RoiOcTree, NativeOtRoundTripThroughOctomapsTypeRegistry) {

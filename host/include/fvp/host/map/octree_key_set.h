@@ -49,9 +49,10 @@ class OcTreeKeySet {
     // without touching the table, which is far larger than the cache for a whole frame.
     Packed& recent = recent_[(h >> 20) & (kRecentSlots - 1)];
     if (recent == packed) return false;
-    recent = packed;
     if ((size_ + 1) * 2 > slots_.size()) grow();
-    return insertIntoTable(packed, h);
+    const bool inserted = insertIntoTable(packed, h);
+    recent = packed;  // only once it is in the table (grow may throw)
+    return inserted;
   }
 
   bool contains(const octomap::OcTreeKey& key) const { return containsPacked(pack(key)); }
@@ -82,12 +83,13 @@ class OcTreeKeySet {
   static constexpr std::size_t kRecentSlots = 8192;
 
   void grow() {
-    std::vector<Packed> old;
-    old.swap(slots_);
-    slots_.assign(old.empty() ? kInitialSlots : old.size() * 2, kEmpty);
+    // The new table is built before the old one is let go, so a failed allocation leaves
+    // the set as it was.
+    std::vector<Packed> previous(slots_.empty() ? kInitialSlots : slots_.size() * 2, kEmpty);
+    previous.swap(slots_);  // slots_ is now the empty, larger table
     mask_ = slots_.size() - 1;
     size_ = 0;
-    for (const Packed packed : old) {
+    for (const Packed packed : previous) {
       if (packed != kEmpty) insertIntoTable(packed, hash(packed));
     }
   }
