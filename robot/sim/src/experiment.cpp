@@ -253,6 +253,9 @@ void runExperiment(const ExperimentOptions& o, const TrialRunner& run_trial,
     if (int(i % o.shard_count) == o.shard_index) mine.push_back(all[i]);
 
   const auto start = std::chrono::steady_clock::now();
+  const auto elapsed_s = [start] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
   std::size_t ran = 0, todo = 0;
   double finished_s = 0.0;  // elapsed when the last trial finished
   for (const auto& [p, s] : mine) todo += !finished.count(trialKey(p, s));
@@ -264,8 +267,7 @@ void runExperiment(const ExperimentOptions& o, const TrialRunner& run_trial,
     t.out_dir = o.out_dir / "trials" / trialKey(planner, seed);
     const std::size_t index = ran;
     t.on_progress = [&, index, planner, seed](const TrialProgress& p) {
-      const double elapsed =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double elapsed = elapsed_s();
       std::ostringstream line;
       line << "trial " << index + 1 << "/" << todo << " (" << planner << ", seed " << seed
            << "): view " << p.views << ", sim " << std::fixed << std::setprecision(0)
@@ -284,7 +286,7 @@ void runExperiment(const ExperimentOptions& o, const TrialRunner& run_trial,
     result.erase("clock");
     appendLine(jsonl, result.dump());
     ++ran;
-    finished_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    finished_s = elapsed_s();
     done.push_back(std::move(result));
   }
   writeReports(o.out_dir, done);
