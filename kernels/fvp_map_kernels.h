@@ -76,6 +76,10 @@ typedef struct fvp_edt_params {
   int radius_vox; /* the cap: distances beyond it read as the cap */
   unsigned int slot_count;
   int axis; /* the pass: 0 seeds from the ROI channel, 1 and 2 read the previous pass */
+  /* Bricks the pass computes (work item i: voxel i % 512 of brick work_bricks[i / 512]):
+   * those within the radius of an ROI brick. Every other slot is far from all ROI, so the
+   * host fills its pass values with FVP_EDT_FAR and its distance with the cap. */
+  unsigned int work_brick_count;
 } fvp_edt_params;
 
 typedef struct fvp_frontier_params {
@@ -183,28 +187,41 @@ FVP_FN void fvp_scan_update_item(const fvp_update_params* p, unsigned int item,
 /* ROI distance field, one separable pass for one voxel (exact squared Euclidean distance
  * within the cap radius; Felzenszwalb-style min-plus over a window). axis 0 seeds from
  * the ROI log-odds (known ROI: roi > 0); axes 1 and 2 read the previous pass. */
+/* One term of a pass's minimum: the squared distance through the voxel k steps along the
+ * pass's axis, FVP_EDT_FAR where there is none. */
+FVP_FN unsigned int fvp_edt_term(const fvp_edt_params* p, int x, int y, int z, int k,
+                                 FVP_GLOBAL const int* table, FVP_GLOBAL const float* roi,
+                                 FVP_GLOBAL const unsigned int* sq_in) {
+  int axis = p->axis;
+  int nx = x + (axis == 0 ? k : 0), ny = y + (axis == 1 ? k : 0), nz = z + (axis == 2 ? k : 0);
+  int slot;
+  unsigned int v;
+  if (nx < 0 || ny < 0 || nz < 0 || nx >= p->map.grid.dim_x || ny >= p->map.grid.dim_y ||
+      nz >= p->map.grid.dim_z)
+    return FVP_EDT_FAR;
+  slot = fvp_slot(&p->map, table, nx, ny, nz);
+  if (slot < 0) return FVP_EDT_FAR;
+  if (axis == 0) {
+    if (!(roi[slot] > 0.0f)) return FVP_EDT_FAR; /* NaN (unknown) fails too */
+    v = 0u;
+  } else {
+    v = sq_in[slot];
+    if (v == FVP_EDT_FAR) return FVP_EDT_FAR;
+  }
+  return v + (unsigned int)(k * k);
+}
+
+/* Minimum over k in [-radius, radius] of the terms, nearest k first: every term at |k| = d
+ * is at least d^2, so the scan stops once d^2 reaches the best found (the same minimum). */
 FVP_FN unsigned int fvp_edt_pass_voxel(const fvp_edt_params* p, int x, int y, int z,
                                        FVP_GLOBAL const int* table, FVP_GLOBAL const float* roi,
                                        FVP_GLOBAL const unsigned int* sq_in) {
-  unsigned int best = FVP_EDT_FAR;
-  int axis = p->axis, k;
-  for (k = -p->radius_vox; k <= p->radius_vox; ++k) {
-    int nx = x + (axis == 0 ? k : 0), ny = y + (axis == 1 ? k : 0), nz = z + (axis == 2 ? k : 0);
-    int slot;
-    unsigned int v;
-    if (nx < 0 || ny < 0 || nz < 0 || nx >= p->map.grid.dim_x || ny >= p->map.grid.dim_y ||
-        nz >= p->map.grid.dim_z)
-      continue;
-    slot = fvp_slot(&p->map, table, nx, ny, nz);
-    if (slot < 0) continue;
-    if (axis == 0) {
-      if (!(roi[slot] > 0.0f)) continue; /* NaN (unknown) fails too */
-      v = 0u;
-    } else {
-      v = sq_in[slot];
-      if (v == FVP_EDT_FAR) continue;
-    }
-    v += (unsigned int)(k * k);
+  unsigned int best = fvp_edt_term(p, x, y, z, 0, table, roi, sq_in), v;
+  int d;
+  for (d = 1; d <= p->radius_vox && (unsigned int)(d * d) < best; ++d) {
+    v = fvp_edt_term(p, x, y, z, -d, table, roi, sq_in);
+    if (v < best) best = v;
+    v = fvp_edt_term(p, x, y, z, d, table, roi, sq_in);
     if (v < best) best = v;
   }
   return best;
@@ -290,6 +307,11 @@ FVP_FN void fvp_frontier_append(const fvp_frontier_params* p, int x, int y, int 
 
 /* One ROI distance pass (p->axis) for one slot: axes 0 and 1 write the squared distance
  * to sq_out, axis 2 the capped distance in voxels to distance_vox. */
+/* Slot of work item i of a pass over a list of bricks (allocation indices). */
+FVP_FN unsigned int fvp_work_slot(FVP_GLOBAL const unsigned int* work_bricks, unsigned int i) {
+  return work_bricks[i / FVP_BRICK_VOXELS] * FVP_BRICK_VOXELS + i % FVP_BRICK_VOXELS;
+}
+
 FVP_FN void fvp_roi_distance_slot(const fvp_edt_params* p, unsigned int slot,
                                   FVP_GLOBAL const int* brick_coords, FVP_GLOBAL const int* table,
                                   FVP_GLOBAL const float* roi, FVP_GLOBAL const unsigned int* sq_in,

@@ -39,6 +39,7 @@ struct FvpEdtParams {
   int radius_vox;
   uint slot_count;
   int axis;
+  uint work_brick_count;
 };
 
 struct FvpFrontierParams {
@@ -146,28 +147,31 @@ void fvp_scan_update_item(FvpUpdateParams p, uint item) {
     defined(FVP_HAS_BRICK_COORDS) && defined(FVP_HAS_SQ_OUT) && defined(FVP_HAS_DISTANCE_VOX) && \
     !defined(FVP_EDT_GLSL)
 #define FVP_EDT_GLSL
+uint fvp_edt_term(FvpEdtParams p, int x, int y, int z, int k) {
+  ivec3 n = ivec3(x, y, z);
+  n[p.axis] += k;
+  if (n.x < 0 || n.y < 0 || n.z < 0 || n.x >= p.map.grid.dim_x || n.y >= p.map.grid.dim_y ||
+      n.z >= p.map.grid.dim_z)
+    return FVP_EDT_FAR;
+  int slot = fvp_slot(p.map, n.x, n.y, n.z);
+  if (slot < 0) return FVP_EDT_FAR;
+  uint v;
+  if (p.axis == 0) {
+    float r = roi[slot];
+    if (fvp_is_nan(r) || !(r > 0.0)) return FVP_EDT_FAR;
+    v = 0u;
+  } else {
+    v = sq_in[slot];
+    if (v == FVP_EDT_FAR) return FVP_EDT_FAR;
+  }
+  return v + uint(k * k);
+}
+
 uint fvp_edt_pass_voxel(FvpEdtParams p, int x, int y, int z) {
-  uint best = FVP_EDT_FAR;
-  int axis = p.axis;
-  for (int k = -p.radius_vox; k <= p.radius_vox; ++k) {
-    ivec3 n = ivec3(x, y, z);
-    n[axis] += k;
-    if (n.x < 0 || n.y < 0 || n.z < 0 || n.x >= p.map.grid.dim_x || n.y >= p.map.grid.dim_y ||
-        n.z >= p.map.grid.dim_z)
-      continue;
-    int slot = fvp_slot(p.map, n.x, n.y, n.z);
-    if (slot < 0) continue;
-    uint v;
-    if (axis == 0) {
-      float r = roi[slot];
-      if (fvp_is_nan(r) || !(r > 0.0)) continue;
-      v = 0u;
-    } else {
-      v = sq_in[slot];
-      if (v == FVP_EDT_FAR) continue;
-    }
-    v += uint(k * k);
-    best = min(best, v);
+  uint best = fvp_edt_term(p, x, y, z, 0);
+  for (int d = 1; d <= p.radius_vox && uint(d * d) < best; ++d) {
+    best = min(best, fvp_edt_term(p, x, y, z, -d));
+    best = min(best, fvp_edt_term(p, x, y, z, d));
   }
   return best;
 }

@@ -14,6 +14,7 @@ layout(std430, set = 0, binding = 2) readonly buffer Roi { float roi[]; };
 layout(std430, set = 0, binding = 3) readonly buffer SqIn { uint sq_in[]; };
 layout(std430, set = 0, binding = 4) writeonly buffer SqOut { uint sq_out[]; };
 layout(std430, set = 0, binding = 5) writeonly buffer Distance { float distance_vox[]; };
+layout(std430, set = 0, binding = 6) readonly buffer WorkBricks { uint work_bricks[]; };
 #define FVP_HAS_BRICK_COORDS
 #define FVP_HAS_BRICK_TABLE
 #define FVP_HAS_ROI
@@ -24,6 +25,9 @@ layout(std430, set = 0, binding = 5) writeonly buffer Distance { float distance_
 #include "fvp_map_kernels.glsl"
 
 void main() {
-  uint slot = FVP_ITEM_INDEX;
-  if (slot < FVP_ITEM_COUNT) fvp_roi_distance_slot(fvp_params.p, slot);
+  uint i = FVP_ITEM_INDEX;
+  if (i >= FVP_ITEM_COUNT) return;
+  uint slot = work_bricks[i / uint(FVP_BRICK_VOXELS)] * uint(FVP_BRICK_VOXELS) +
+              i % uint(FVP_BRICK_VOXELS);
+  fvp_roi_distance_slot(fvp_params.p, slot);
 }

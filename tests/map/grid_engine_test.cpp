@@ -255,33 +255,35 @@ TEST_P(GridEngineBackends, OnTouchBrickAllocationMatchesCpu) {
   expectSameVoxels(got, want);
 }
 
-TEST_P(GridEngineBackends, RoiDistanceFieldEqualsBruteForce) {
-  const std::uint64_t seed = fvp::testing::freshSeed();
-  SCOPED_TRACE(fvp::testing::replayHint(seed));
-  std::mt19937_64 rng(seed);
-  GridGeometry g;
-  g.voxel_size_m = 0.001;
-  g.first_voxel = {0, 0, 0};
-  g.dims = {24, 16, 32};
-  const auto n = static_cast<std::size_t>(g.voxelCount());
-  std::vector<float> occupancy(n, -0.4f), roi(n, std::nanf(""));
-  std::vector<std::array<int, 3>> roi_voxels;
-  std::uniform_int_distribution<int> pick(0, static_cast<int>(n) - 1);
-  for (int k = 0; k < 12; ++k) {
-    const int i = pick(rng);
-    roi[i] = 0.85f;
-    roi_voxels.push_back({i % g.dims[0], (i / g.dims[0]) % g.dims[1], i / (g.dims[0] * g.dims[1])});
+// Random ROI voxels (and known non-ROI ones, which must not count) in the box [lo, hi) of
+// the grid; returns the dense ROI channel and the ROI voxels.
+std::vector<float> randomRoi(const GridGeometry& g, std::array<int, 3> lo, std::array<int, 3> hi,
+                             int count, std::mt19937_64& rng,
+                             std::vector<std::array<int, 3>>* roi_voxels) {
+  std::vector<float> roi(static_cast<std::size_t>(g.voxelCount()), std::nanf(""));
+  const auto pick = [&] {
+    std::array<int, 3> v;
+    for (int a = 0; a < 3; ++a) v[a] = std::uniform_int_distribution<int>(lo[a], hi[a] - 1)(rng);
+    return v;
+  };
+  const auto at = [&](const std::array<int, 3>& v) {
+    return v[0] + std::size_t(g.dims[0]) * (v[1] + std::size_t(g.dims[1]) * v[2]);
+  };
+  for (int k = 0; k < count; ++k) {
+    const auto v = pick();
+    roi[at(v)] = 0.85f;
+    roi_voxels->push_back(v);
   }
-  // Known, not ROI: must not count. Never over an ROI voxel, which the brute force counts.
-  for (int k = 0; k < 30; ++k) {
-    const int i = pick(rng);
-    if (!(roi[i] > 0.0f)) roi[i] = -0.4f;
+  // Never over an ROI voxel, which the brute force counts.
+  for (int k = 0; k < 3 * count; ++k) {
+    const auto v = pick();
+    if (!(roi[at(v)] > 0.0f)) roi[at(v)] = -0.4f;
   }
-  OccupancyLayer grid(*backend_, g, true, std::nullopt, BrickAllocation::kUpFront);
-  grid.assignDense(occupancy, roi);
-  const int radius = 9;
-  RoiDistanceField field(grid);
-  field.compute(radius);
+  return roi;
+}
+
+void expectDistancesEqualBruteForce(const RoiDistanceField& field, const GridGeometry& g,
+                                    const std::vector<std::array<int, 3>>& roi_voxels, int radius) {
   const std::vector<float> d = field.dense();
   for (int z = 0; z < g.dims[2]; ++z)
     for (int y = 0; y < g.dims[1]; ++y)
@@ -293,6 +295,52 @@ TEST_P(GridEngineBackends, RoiDistanceFieldEqualsBruteForce) {
         ASSERT_NEAR(d[x + g.dims[0] * (y + g.dims[1] * z)], best, 1e-5)
             << "voxel " << x << "," << y << "," << z;
       }
+}
+
+TEST_P(GridEngineBackends, RoiDistanceFieldEqualsBruteForce) {
+  const std::uint64_t seed = fvp::testing::freshSeed();
+  SCOPED_TRACE(fvp::testing::replayHint(seed));
+  std::mt19937_64 rng(seed);
+  GridGeometry g;
+  g.voxel_size_m = 0.001;
+  g.first_voxel = {0, 0, 0};
+  g.dims = {24, 16, 32};
+  std::vector<std::array<int, 3>> roi_voxels;
+  const std::vector<float> roi = randomRoi(g, {0, 0, 0}, g.dims, 12, rng, &roi_voxels);
+  OccupancyLayer grid(*backend_, g, true, std::nullopt, BrickAllocation::kUpFront);
+  grid.assignDense(std::vector<float>(roi.size(), -0.4f), roi);
+  const int radius = 9;
+  RoiDistanceField field(grid);
+  field.compute(radius);
+  expectDistancesEqualBruteForce(field, g, roi_voxels, radius);
+}
+
+// The passes run only over bricks within the radius of ROI bricks; the rest must read the
+// cap, also where ROI was before and is no more.
+TEST_P(GridEngineBackends, RoiDistanceFieldFarFromRoiIsTheCapAfterRoiMoves) {
+  const std::uint64_t seed = fvp::testing::freshSeed();
+  SCOPED_TRACE(fvp::testing::replayHint(seed));
+  std::mt19937_64 rng(seed);
+  GridGeometry g;
+  g.voxel_size_m = 0.001;
+  g.first_voxel = {0, 0, 0};
+  g.dims = {56, 48, 40};  // 7 x 6 x 5 bricks
+  const int radius = 6;   // a halo of one brick
+  OccupancyLayer grid(*backend_, g, true, std::nullopt, BrickAllocation::kUpFront);
+  RoiDistanceField field(grid);
+  const std::vector<float> occupancy(static_cast<std::size_t>(g.voxelCount()), -0.4f);
+  // ROI in one corner, then only in the opposite one.
+  std::vector<std::array<int, 3>> first, second;
+  grid.assignDense(occupancy, randomRoi(g, {0, 0, 0}, {12, 10, 9}, 5, rng, &first));
+  field.compute(radius);
+  expectDistancesEqualBruteForce(field, g, first, radius);
+  grid.assignDense(occupancy, randomRoi(g, {44, 36, 30}, g.dims, 5, rng, &second));
+  field.compute(radius);
+  expectDistancesEqualBruteForce(field, g, second, radius);
+  // No ROI at all: the cap everywhere.
+  grid.assignDense(occupancy, std::vector<float>(occupancy.size(), -0.4f));
+  field.compute(radius);
+  expectDistancesEqualBruteForce(field, g, {}, radius);
 }
 
 TEST_P(GridEngineBackends, FrontiersFollowTheirDefinitions) {

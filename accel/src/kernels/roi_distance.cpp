@@ -24,6 +24,8 @@ void validate(const void* p) {
   checkSlotCount(params.slot_count, "roi_distance");
   if (params.axis < 0 || params.axis > 2)
     throw std::invalid_argument("roi_distance: axis must be 0, 1 or 2");
+  if (std::uint64_t{params.work_brick_count} * kBrickVoxels > params.slot_count)
+    throw std::invalid_argument("roi_distance: work_brick_count exceeds the allocated bricks");
   if (params.radius_vox < 1 || params.radius_vox > 1000)
     throw std::invalid_argument("roi_distance: radius_vox must be in [1, 1000]");
 }
@@ -36,10 +38,11 @@ void cpuLoop(const void* p, void* const* buffers, std::uint32_t count) {
   const auto* sq_in = static_cast<const unsigned int*>(buffers[3]);
   auto* sq_out = static_cast<unsigned int*>(buffers[4]);
   auto* distance = static_cast<float*>(buffers[5]);
+  const auto* work_bricks = static_cast<const std::uint32_t*>(buffers[6]);
 #pragma omp parallel for schedule(static)
-  for (std::int64_t s = 0; s < count; ++s)
-    fvp_roi_distance_slot(&params, static_cast<unsigned>(s), coords, table, roi, sq_in, sq_out,
-                          distance);
+  for (std::int64_t i = 0; i < count; ++i)
+    fvp_roi_distance_slot(&params, fvp_work_slot(work_bricks, static_cast<unsigned>(i)), coords,
+                          table, roi, sq_in, sq_out, distance);
 }
 
 constexpr KernelBinding kBindings[] = {
@@ -55,16 +58,19 @@ constexpr KernelBinding kBindings[] = {
      [](const void* p) { return edt(p).axis < 2 ? slots(p) : 0; }},
     {"distance_vox", sizeof(float), Access::kWrite,
      [](const void* p) { return edt(p).axis == 2 ? slots(p) : 0; }},
+    {"work_bricks", sizeof(std::uint32_t), Access::kRead,
+     [](const void* p) { return std::size_t{edt(p).work_brick_count}; }},
 };
 
-const KernelDescriptor kDescriptor{"roi_distance",
-                                   sizeof(EdtParams),
-                                   kBindings,
-                                   [](const void* p) { return edt(p).slot_count; },
-                                   validate,
-                                   cpuLoop,
-                                   FVP_OPENCL_CODE(roi_distance, "fvp_roi_distance"),
-                                   FVP_SPIRV_CODE(roi_distance)};
+const KernelDescriptor kDescriptor{
+    "roi_distance",
+    sizeof(EdtParams),
+    kBindings,
+    [](const void* p) { return edt(p).work_brick_count * kBrickVoxels; },
+    validate,
+    cpuLoop,
+    FVP_OPENCL_CODE(roi_distance, "fvp_roi_distance"),
+    FVP_SPIRV_CODE(roi_distance)};
 
 }  // namespace
 

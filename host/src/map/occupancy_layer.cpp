@@ -24,11 +24,20 @@ accel::DeviceBuffer& OccupancyLayer::roi() {
 }
 
 void OccupancyLayer::refreshMirror() const {
+  // Every voxel read calls this: the common case, a current mirror, takes no lock. (The
+  // layer does not change during const reads, so the two counts cannot move under us.)
+  if (mirror_synced_change_.load(std::memory_order_acquire) == bricks_.changeCount() &&
+      mirror_synced_slots_.load(std::memory_order_acquire) == bricks_.slotCount())
+    return;
   // Const reads may come from several threads; the first one refreshes the mirror.
   std::lock_guard<std::mutex> lock(mirror_mutex_);
   const std::size_t slots = bricks_.slotCount();
   const bool grew = mirror_occupancy_.size() != slots;
-  if (!grew && mirror_change_count_ == bricks_.changeCount()) return;
+  if (!grew && mirror_change_count_ == bricks_.changeCount()) {
+    mirror_synced_slots_.store(slots, std::memory_order_release);
+    mirror_synced_change_.store(mirror_change_count_, std::memory_order_release);
+    return;
+  }
   // New bricks hold the channels' fill (unknown) until an operation marks them changed.
   mirror_occupancy_.resize(slots, kUnknown);
   if (with_roi_) mirror_roi_.resize(slots, kUnknown);
@@ -52,6 +61,8 @@ void OccupancyLayer::refreshMirror() const {
     b = end;
   }
   mirror_change_count_ = bricks_.changeCount();
+  mirror_synced_slots_.store(slots, std::memory_order_release);
+  mirror_synced_change_.store(mirror_change_count_, std::memory_order_release);
 }
 
 float OccupancyLayer::occupancyAt(const std::array<int, 3>& index) const {

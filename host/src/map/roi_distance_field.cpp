@@ -21,14 +21,13 @@ bool RoiDistanceField::current() const {
          computed_layout_ == layer_.bricks().layoutVersion();
 }
 
-void RoiDistanceField::allocateRoiHalo(int radius_vox) {
-  // The passes need every voxel within radius_vox (Chebyshev) of an ROI voxel to have a
-  // slot: the x pass result at (qx, py, pz) is what carries p's distance to q.
-  BrickLayer& bricks = layer_.bricks();
+std::vector<char> RoiDistanceField::roiHalo(int radius_vox) const {
+  // A voxel's distance is below the cap only if an ROI voxel lies within radius_vox of it
+  // on every axis, so in a brick at most ceil(radius_vox / 8) bricks from an ROI brick.
+  const BrickLayer& bricks = layer_.bricks();
   const accel::BrickedGridParams& m = bricks.params();
   const int halo = (radius_vox + accel::kBrickEdge - 1) / accel::kBrickEdge;
-  std::vector<int> ids;
-  std::vector<char> wanted(bricks.gridBricks(), 0);
+  std::vector<char> near(bricks.gridBricks(), 0);
   for (std::size_t b = 0; b < bricks.allocatedBricks(); ++b) {
     bool has_roi = false;
     layer_.forEachVoxelOfBrick(
@@ -37,45 +36,65 @@ void RoiDistanceField::allocateRoiHalo(int radius_vox) {
     const int* c = &bricks.brickCoords()[3 * b];
     for (int z = std::max(0, c[2] - halo); z <= std::min(m.bricks_z - 1, c[2] + halo); ++z)
       for (int y = std::max(0, c[1] - halo); y <= std::min(m.bricks_y - 1, c[1] + halo); ++y)
-        for (int x = std::max(0, c[0] - halo); x <= std::min(m.bricks_x - 1, c[0] + halo); ++x) {
-          const int id = bricks.brickIndex(x, y, z);
-          if (bricks.table()[id] == accel::kNoBrick) wanted[id] = 1;
-        }
+        for (int x = std::max(0, c[0] - halo); x <= std::min(m.bricks_x - 1, c[0] + halo); ++x)
+          near[bricks.brickIndex(x, y, z)] = 1;
   }
-  for (std::size_t id = 0; id < wanted.size(); ++id)
-    if (wanted[id]) ids.push_back(static_cast<int>(id));
-  bricks.allocate(ids);
+  return near;
 }
 
 void RoiDistanceField::compute(int radius_vox) {
   BrickLayer& bricks = layer_.bricks();
   // The channel costs 4 bytes per slot: added when first needed.
   if (!distance_) distance_ = bricks.addChannel("roi_distance_vox", sizeof(float), 0u);
-  if (bricks.allocation() == BrickAllocation::kOnTouch) allocateRoiHalo(radius_vox);
+  std::vector<char> near = roiHalo(radius_vox);
+  if (bricks.allocation() == BrickAllocation::kOnTouch) {
+    // The passes carry distances through every near voxel (the x pass result at
+    // (qx, py, pz) is what carries p's distance to q): each needs a slot.
+    std::vector<int> ids;
+    for (std::size_t id = 0; id < near.size(); ++id)
+      if (near[id] && bricks.table()[id] == accel::kNoBrick) ids.push_back(static_cast<int>(id));
+    bricks.allocate(ids);
+  }
+  // The passes run over the near bricks only: elsewhere every pass value is "far" and the
+  // distance the cap, filled here. Most of a Cluster Region is far from every fruitlet.
+  std::vector<std::uint32_t> work;
+  for (std::size_t id = 0; id < near.size(); ++id)
+    if (near[id]) work.push_back(static_cast<std::uint32_t>(bricks.table()[id]));
   accel::Backend& backend = bricks.backend();
   const std::size_t slots = bricks.slotCount();
-  accel::EdtParams edt{};
-  edt.map = bricks.params();
-  edt.radius_vox = radius_vox;
-  edt.slot_count = static_cast<std::uint32_t>(slots);
-  auto sq_a = backend.createBuffer(std::max<std::size_t>(slots, 1) * sizeof(std::uint32_t));
-  auto sq_b = backend.createBuffer(std::max<std::size_t>(slots, 1) * sizeof(std::uint32_t));
-  // x pass: roi -> sq_a; y pass: sq_a -> sq_b; z pass: sq_b -> distance.
-  const auto kernel = accel::kernels::roiDistance();
-  auto* coords = &bricks.coordsBuffer();
-  auto* table = &bricks.tableBuffer();
-  edt.axis = 0;
-  backend.run(kernel, edt, {coords, table, &layer_.roi(), nullptr, sq_a.get(), nullptr});
-  edt.axis = 1;
-  backend.run(kernel, edt, {coords, table, nullptr, sq_a.get(), sq_b.get(), nullptr});
-  edt.axis = 2;
-  backend.run(kernel, edt, {coords, table, nullptr, sq_b.get(), nullptr, &distanceVox()});
+  backend.upload(distanceVox(), std::vector<float>(slots, float(radius_vox)).data(),
+                 slots * sizeof(float));
+  if (!work.empty()) {
+    accel::EdtParams edt{};
+    edt.map = bricks.params();
+    edt.radius_vox = radius_vox;
+    edt.slot_count = static_cast<std::uint32_t>(slots);
+    edt.work_brick_count = static_cast<std::uint32_t>(work.size());
+    const std::vector<std::uint32_t> far(slots, FVP_EDT_FAR);
+    auto sq_a = backend.createBufferFrom(far);
+    auto sq_b = backend.createBufferFrom(far);
+    auto work_bricks = backend.createBufferFrom(work);
+    // x pass: roi -> sq_a; y pass: sq_a -> sq_b; z pass: sq_b -> distance.
+    const auto kernel = accel::kernels::roiDistance();
+    auto* coords = &bricks.coordsBuffer();
+    auto* table = &bricks.tableBuffer();
+    edt.axis = 0;
+    backend.run(kernel, edt,
+                {coords, table, &layer_.roi(), nullptr, sq_a.get(), nullptr, work_bricks.get()});
+    edt.axis = 1;
+    backend.run(kernel, edt,
+                {coords, table, nullptr, sq_a.get(), sq_b.get(), nullptr, work_bricks.get()});
+    edt.axis = 2;
+    backend.run(kernel, edt,
+                {coords, table, nullptr, sq_b.get(), nullptr, &distanceVox(), work_bricks.get()});
+  }
   radius_vox_ = radius_vox;
   computed_slots_ = slots;
   computed_ = true;
   computed_change_ = bricks.changeCount();
   computed_layout_ = bricks.layoutVersion();
   std::lock_guard<std::mutex> lock(mirror_mutex_);
+  mirror_ready_.store(false, std::memory_order_release);
   mirror_.clear();  // downloaded on the first read
 }
 
@@ -86,11 +105,15 @@ float RoiDistanceField::distanceVoxAt(const std::array<int, 3>& index) const {
   // Bricks allocated after compute() were not in it: the cap, as for unallocated ones.
   if (slot < 0 || static_cast<std::size_t>(slot) >= computed_slots_)
     return static_cast<float>(radius_vox_);
-  std::lock_guard<std::mutex> lock(mirror_mutex_);
-  if (mirror_.empty()) {
-    mirror_.resize(computed_slots_);
-    bricks.backend().download(bricks.channel(*distance_), mirror_.data(),
-                              mirror_.size() * sizeof(float));
+  // The snapshot reads every voxel: once the mirror is down, no lock.
+  if (!mirror_ready_.load(std::memory_order_acquire)) {
+    std::lock_guard<std::mutex> lock(mirror_mutex_);
+    if (mirror_.empty()) {
+      mirror_.resize(computed_slots_);
+      bricks.backend().download(bricks.channel(*distance_), mirror_.data(),
+                                mirror_.size() * sizeof(float));
+    }
+    mirror_ready_.store(true, std::memory_order_release);
   }
   return mirror_[static_cast<std::size_t>(slot)];
 }

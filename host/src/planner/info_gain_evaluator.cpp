@@ -96,24 +96,30 @@ double InfoGainEvaluator::refresh(map::MapEngine& map) {
     coarse_words_[i >> 2] |= 1u << ((i & 3) * 8);
   }
 
-  fine_words_.assign(accel::gainFineWords(fine_.params()), 0u);
+  // Codes per voxel first (z slices in parallel: the engines' const reads are thread-safe),
+  // then packed two to a word.
   const fvp_region region = map::regionInGrid(fine_, map.region());
+  const map::MapEngine& reader = map;
+  std::vector<std::uint16_t> codes(static_cast<std::size_t>(fine_.voxelCount()), 0);
+#pragma omp parallel for schedule(dynamic, 1)
   for (int z = 0; z < fine_.dims[2]; ++z)
     for (int y = 0; y < fine_.dims[1]; ++y)
       for (int x = 0; x < fine_.dims[0]; ++x) {
         if (!fvp_region_contains(&region, x, y, z)) continue;
         const std::array<int, 3> index{x, y, z};
-        const map::VoxelState s = map.fineState(fine_.voxelCenter_m(index));
+        const map::VoxelState s = reader.fineState(fine_.voxelCenter_m(index));
         std::uint16_t code = kInRegion;
         if (s.occupancy == map::VoxelClass::kOccupied) {
           code |= kOccupied;
         } else if (s.occupancy == map::VoxelClass::kUnknown) {
-          const double w = roiProximityWeight(map.roiDistance_m(index), config_.max_d_m);
+          const double w = roiProximityWeight(reader.roiDistance_m(index), config_.max_d_m);
           code |= static_cast<std::uint16_t>(std::lround(w * kWeightScale));
         }
-        const std::size_t i = x + std::size_t(fine_.dims[0]) * (y + std::size_t(fine_.dims[1]) * z);
-        fine_words_[i >> 1] |= std::uint32_t{code} << ((i & 1) * 16);
+        codes[x + std::size_t(fine_.dims[0]) * (y + std::size_t(fine_.dims[1]) * z)] = code;
       }
+  fine_words_.assign(accel::gainFineWords(fine_.params()), 0u);
+  for (std::size_t i = 0; i < codes.size(); ++i)
+    fine_words_[i >> 1] |= std::uint32_t{codes[i]} << ((i & 1) * 16);
   coarse_scene_ = config_.embree_cull ? &map.occupiedScene(map::MapLevel::kCoarse) : nullptr;
   if (backend_) {
     fine_device_ = backend_->createBufferFrom(fine_words_);

@@ -48,7 +48,7 @@ static_assert(sizeof(ScanPoint) == 16, "must match FvpScanPoint");
 static_assert(sizeof(BrickedGridParams) == 64, "must match FvpBrickedGrid");
 static_assert(sizeof(ScanParams) == 88, "must match FvpScanParams");
 static_assert(sizeof(UpdateParams) == 24, "must match FvpUpdateParams");
-static_assert(sizeof(EdtParams) == 76, "must match FvpEdtParams");
+static_assert(sizeof(EdtParams) == 80, "must match FvpEdtParams");
 static_assert(sizeof(FrontierParams) == 76, "must match FvpFrontierParams");
 static_assert(sizeof(Frontier) == 32, "must match FvpFrontier");
 static_assert(sizeof(GainParams) == 68, "must match FvpGainParams");

@@ -25,8 +25,9 @@ Kernel<ScanParams> scanMark();
 Kernel<UpdateParams> scanUpdate();
 
 /// One pass (params.axis) of the ROI distance field (fvp_roi_distance_slot): one item per
-/// slot. Bindings: brick_coords (3 int per brick), brick_table, roi (axis 0), sq_in (axes 1
-/// and 2), sq_out (axes 0 and 1) as slot_count uint, distance_vox (axis 2, slot_count float).
+/// voxel of the work bricks. Bindings: brick_coords (3 int per brick), brick_table, roi
+/// (axis 0), sq_in (axes 1 and 2), sq_out (axes 0 and 1) as slot_count uint, distance_vox
+/// (axis 2, slot_count float), work_bricks (work_brick_count uint allocation indices).
 Kernel<EdtParams> roiDistance();
 
 /// Frontier extraction (fvp_frontier_append): one item per slot. Bindings: brick_coords,

@@ -54,6 +54,10 @@ class MapEngine {
   /// cut and counted by prepareScanPoints (scan_points.h), the same for both engines.
   ScanStats integrate(const LabeledClouds& clouds);
 
+  // Const reads (coarseClass, fineState, roiDistance_m, ...) may run on several threads at
+  // once (the planner's snapshot reads every fine voxel in parallel); nothing may change the
+  // map meanwhile.
+
   /// State of the coarse voxel containing p (unknown outside the observation box).
   virtual VoxelClass coarseClass(const Eigen::Vector3d& p_m) const = 0;
   /// State of the fine voxel containing p (unknown outside the Cluster Region).

@@ -1,11 +1,13 @@
 // Paper Eq. 1's d_i over an occupancy layer with ROI (kernel roi_distance): the Euclidean
 // distance in voxels from every allocated voxel to the nearest known ROI voxel (ROI
-// log-odds > 0), capped at a radius. Three separable passes; the result is a channel of the
-// layer, per brick slot on the device, for the information-gain kernels. Host reads download
+// log-odds > 0), capped at a radius. Three separable passes over the bricks near ROI (the
+// rest is the cap); the result is a channel of the layer, per brick slot on the device,
+// for the information-gain kernels. Host reads download
 // it once per computation, per slot (never expanded densely).
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <mutex>
 #include <optional>
 #include <vector>
@@ -37,7 +39,8 @@ class RoiDistanceField {
   std::vector<float> dense() const;
 
  private:
-  void allocateRoiHalo(int radius_vox);
+  /// Per brick of the grid: whether it lies within the radius of a brick holding ROI.
+  std::vector<char> roiHalo(int radius_vox) const;
 
   OccupancyLayer& layer_;
   std::optional<BrickLayer::ChannelId> distance_;
@@ -47,6 +50,7 @@ class RoiDistanceField {
   bool computed_ = false;
   mutable std::mutex mirror_mutex_;
   mutable std::vector<float> mirror_;
+  mutable std::atomic<bool> mirror_ready_{false};
 };
 
 }  // namespace fvp::host::map
