@@ -16,9 +16,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-map::MapConfig smallConfig() {
-  return testing::plannerTestConfig();
-}
 const ClusterRegion& kRegion = testing::kPlannerTestRegion;
 std::unique_ptr<map::MapEngine> mappedEngine() {
   return testing::mappedTestEngine();
@@ -58,9 +55,10 @@ TEST(ViewpointSampler, TargetsDistancesOrientationsAndReachability) {
       EXPECT_NEAR(c.T_world_camera.linear().determinant(), 1.0, 1e-9);
       EXPECT_EQ(c.reachable, inShell(c.T_world_camera));
       reachable += c.reachable;
-      if (c.kind == CandidateKind::kExploration && it->normal.squaredNorm() > 0.0)
+      if (c.kind == CandidateKind::kExploration && it->normal.squaredNorm() > 0.0) {
         EXPECT_LT(((c.position_m() - c.target_m).normalized() - it->normal.normalized()).norm(),
                   1e-9);
+      }
     }
   }
   EXPECT_GT(reachable, 0u);

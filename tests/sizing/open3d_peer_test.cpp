@@ -26,7 +26,7 @@ std::vector<Eigen::Vector3f> blobsWithNoise(std::uint64_t seed) {
   std::normal_distribution<float> n(0.0f, 0.0012f);
   std::uniform_real_distribution<float> u(-0.04f, 0.04f);
   std::vector<Eigen::Vector3f> pts;
-  for (const Eigen::Vector3f c :
+  for (const Eigen::Vector3f& c :
        {Eigen::Vector3f(0, 0, 0), Eigen::Vector3f(0.02f, 0, 0), Eigen::Vector3f(0, 0.025f, 0.01f)})
     for (int i = 0; i < 600; ++i) pts.push_back(c + Eigen::Vector3f(n(rng), n(rng), n(rng)));
   for (int i = 0; i < 150; ++i) pts.emplace_back(u(rng), u(rng), u(rng));

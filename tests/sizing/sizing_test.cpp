@@ -73,8 +73,11 @@ TEST(PointFilters, DbscanEqualsBruteForce) {
   for (std::size_t i = 0; i < n; ++i) {
     if (core[i]) {
       ASSERT_NE(got[i], sizing::kDbscanNoise) << i << " " << testing::replayHint(seed);
-      for (std::size_t j : nb[i])  // cores within eps share a cluster
-        if (core[j]) ASSERT_EQ(got[i], got[j]) << testing::replayHint(seed);
+      for (std::size_t j : nb[i]) {  // cores within eps share a cluster
+        if (core[j]) {
+          ASSERT_EQ(got[i], got[j]) << testing::replayHint(seed);
+        }
+      }
     } else {
       bool near_core = false;
       for (std::size_t j : nb[i]) near_core |= bool(core[j]);
