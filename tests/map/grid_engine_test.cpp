@@ -255,6 +255,14 @@ TEST_P(GridEngineBackends, OnTouchBrickAllocationMatchesCpu) {
   expectSameVoxels(got, want);
 }
 
+GridGeometry millimetreGrid(std::array<int, 3> dims) {
+  GridGeometry g;
+  g.voxel_size_m = 0.001;
+  g.first_voxel = {0, 0, 0};
+  g.dims = dims;
+  return g;
+}
+
 // Random ROI voxels (and known non-ROI ones, which must not count) in the box [lo, hi) of
 // the grid; returns the dense ROI channel and the ROI voxels.
 std::vector<float> randomRoi(const GridGeometry& g, std::array<int, 3> lo, std::array<int, 3> hi,
@@ -301,10 +309,7 @@ TEST_P(GridEngineBackends, RoiDistanceFieldEqualsBruteForce) {
   const std::uint64_t seed = fvp::testing::freshSeed();
   SCOPED_TRACE(fvp::testing::replayHint(seed));
   std::mt19937_64 rng(seed);
-  GridGeometry g;
-  g.voxel_size_m = 0.001;
-  g.first_voxel = {0, 0, 0};
-  g.dims = {24, 16, 32};
+  const GridGeometry g = millimetreGrid({24, 16, 32});
   std::vector<std::array<int, 3>> roi_voxels;
   const std::vector<float> roi = randomRoi(g, {0, 0, 0}, g.dims, 12, rng, &roi_voxels);
   OccupancyLayer grid(*backend_, g, true, std::nullopt, BrickAllocation::kUpFront);
@@ -321,11 +326,8 @@ TEST_P(GridEngineBackends, RoiDistanceFieldFarFromRoiIsTheCapAfterRoiMoves) {
   const std::uint64_t seed = fvp::testing::freshSeed();
   SCOPED_TRACE(fvp::testing::replayHint(seed));
   std::mt19937_64 rng(seed);
-  GridGeometry g;
-  g.voxel_size_m = 0.001;
-  g.first_voxel = {0, 0, 0};
-  g.dims = {56, 48, 40};  // 7 x 6 x 5 bricks
-  const int radius = 6;   // a halo of one brick
+  const GridGeometry g = millimetreGrid({56, 48, 40});  // 7 x 6 x 5 bricks
+  const int radius = 6;                                 // a halo of one brick
   OccupancyLayer grid(*backend_, g, true, std::nullopt, BrickAllocation::kUpFront);
   RoiDistanceField field(grid);
   const std::vector<float> occupancy(static_cast<std::size_t>(g.voxelCount()), -0.4f);
