@@ -327,7 +327,7 @@ TEST_P(GridEngineBackends, RoiDistanceFieldFarFromRoiIsTheCapAfterRoiMoves) {
   SCOPED_TRACE(fvp::testing::replayHint(seed));
   std::mt19937_64 rng(seed);
   const GridGeometry g = millimetreGrid({56, 48, 40});  // 7 x 6 x 5 bricks
-  const int radius = 6;                                 // a halo of one brick
+  const int radius = 11;  // two bricks around ROI bricks, less their far corners
   OccupancyLayer grid(*backend_, g, true, std::nullopt, BrickAllocation::kUpFront);
   RoiDistanceField field(grid);
   const std::vector<float> occupancy(static_cast<std::size_t>(g.voxelCount()), -0.4f);

@@ -1,6 +1,7 @@
 #include "fvp/host/map/roi_distance_field.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <stdexcept>
 
 #include "fvp/accel/kernels.h"
@@ -22,11 +23,17 @@ bool RoiDistanceField::current() const {
 }
 
 std::vector<char> RoiDistanceField::roiHalo(int radius_vox) const {
-  // A voxel's distance is below the cap only if an ROI voxel lies within radius_vox of it
-  // on every axis, so in a brick at most ceil(radius_vox / 8) bricks from an ROI brick.
+  // A voxel's distance is below the cap only if an ROI voxel lies within radius_vox of it,
+  // and so is every pass value that a distance below the cap is built from (the voxels of
+  // the x, y, z path lie in the box spanned by the voxel and its ROI voxel). So only
+  // bricks closer than radius_vox to an ROI brick (nearest voxels, Euclidean) need the
+  // passes; the others read "far", whose effect is a distance of the cap or more.
   const BrickLayer& bricks = layer_.bricks();
   const accel::BrickedGridParams& m = bricks.params();
   const int halo = (radius_vox + accel::kBrickEdge - 1) / accel::kBrickEdge;
+  const auto gap = [](int bricks_apart) {  // voxels between the nearest voxels of two bricks
+    return std::max(0, accel::kBrickEdge * std::abs(bricks_apart) - (accel::kBrickEdge - 1));
+  };
   std::vector<char> near(bricks.gridBricks(), 0);
   for (std::size_t b = 0; b < bricks.allocatedBricks(); ++b) {
     bool has_roi = false;
@@ -36,8 +43,11 @@ std::vector<char> RoiDistanceField::roiHalo(int radius_vox) const {
     const int* c = &bricks.brickCoords()[3 * b];
     for (int z = std::max(0, c[2] - halo); z <= std::min(m.bricks_z - 1, c[2] + halo); ++z)
       for (int y = std::max(0, c[1] - halo); y <= std::min(m.bricks_y - 1, c[1] + halo); ++y)
-        for (int x = std::max(0, c[0] - halo); x <= std::min(m.bricks_x - 1, c[0] + halo); ++x)
-          near[bricks.brickIndex(x, y, z)] = 1;
+        for (int x = std::max(0, c[0] - halo); x <= std::min(m.bricks_x - 1, c[0] + halo); ++x) {
+          const int gx = gap(x - c[0]), gy = gap(y - c[1]), gz = gap(z - c[2]);
+          if (gx * gx + gy * gy + gz * gz < radius_vox * radius_vox)
+            near[bricks.brickIndex(x, y, z)] = 1;
+        }
   }
   return near;
 }
