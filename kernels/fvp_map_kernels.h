@@ -77,8 +77,8 @@ typedef struct fvp_edt_params {
   unsigned int slot_count;
   int axis; /* the pass: 0 seeds from the ROI channel, 1 and 2 read the previous pass */
   /* Bricks the pass computes (work item i: voxel i % 512 of brick work_bricks[i / 512]):
-   * those within the radius of an ROI brick. Every other slot is far from all ROI, so the
-   * host fills its pass values with FVP_EDT_FAR and its distance with the cap. */
+   * those closer than the radius to a brick holding ROI. The host fills every other slot's
+   * pass values with FVP_EDT_FAR and its distance with the cap. */
   unsigned int work_brick_count;
 } fvp_edt_params;
 
@@ -184,9 +184,6 @@ FVP_FN void fvp_scan_update_item(const fvp_update_params* p, unsigned int item,
   FVP_FLAG(&changed_bricks[first / FVP_BRICK_VOXELS]);
 }
 
-/* ROI distance field, one separable pass for one voxel (exact squared Euclidean distance
- * within the cap radius; Felzenszwalb-style min-plus over a window). axis 0 seeds from
- * the ROI log-odds (known ROI: roi > 0); axes 1 and 2 read the previous pass. */
 /* One term of a pass's minimum: the squared distance through the voxel k steps along the
  * pass's axis, FVP_EDT_FAR where there is none. */
 FVP_FN unsigned int fvp_edt_term(const fvp_edt_params* p, int x, int y, int z, int k,
@@ -211,8 +208,12 @@ FVP_FN unsigned int fvp_edt_term(const fvp_edt_params* p, int x, int y, int z, i
   return v + (unsigned int)(k * k);
 }
 
-/* Minimum over k in [-radius, radius] of the terms, nearest k first: every term at |k| = d
- * is at least d^2, so the scan stops once d^2 reaches the best found (the same minimum). */
+/* ROI distance field, one separable pass for one voxel (exact squared Euclidean distance
+ * within the cap radius; Felzenszwalb-style min-plus over a window). axis 0 seeds from
+ * the ROI log-odds (known ROI: roi > 0); axes 1 and 2 read the previous pass. */
+/* The minimum over k in [-radius, radius] of the terms, nearest k first: every term at
+ * |k| = d is at least d^2, so the scan stops once d^2 reaches the best found (the same
+ * minimum). */
 FVP_FN unsigned int fvp_edt_pass_voxel(const fvp_edt_params* p, int x, int y, int z,
                                        FVP_GLOBAL const int* table, FVP_GLOBAL const float* roi,
                                        FVP_GLOBAL const unsigned int* sq_in) {
@@ -305,13 +306,13 @@ FVP_FN void fvp_frontier_append(const fvp_frontier_params* p, int x, int y, int 
   frontiers[index] = f;
 }
 
-/* One ROI distance pass (p->axis) for one slot: axes 0 and 1 write the squared distance
- * to sq_out, axis 2 the capped distance in voxels to distance_vox. */
 /* Slot of work item i of a pass over a list of bricks (allocation indices). */
 FVP_FN unsigned int fvp_work_slot(FVP_GLOBAL const unsigned int* work_bricks, unsigned int i) {
   return work_bricks[i / FVP_BRICK_VOXELS] * FVP_BRICK_VOXELS + i % FVP_BRICK_VOXELS;
 }
 
+/* One ROI distance pass (p->axis) for one slot: axes 0 and 1 write the squared distance
+ * to sq_out, axis 2 the capped distance in voxels to distance_vox. */
 FVP_FN void fvp_roi_distance_slot(const fvp_edt_params* p, unsigned int slot,
                                   FVP_GLOBAL const int* brick_coords, FVP_GLOBAL const int* table,
                                   FVP_GLOBAL const float* roi, FVP_GLOBAL const unsigned int* sq_in,

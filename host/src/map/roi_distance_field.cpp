@@ -23,11 +23,10 @@ bool RoiDistanceField::current() const {
 }
 
 std::vector<char> RoiDistanceField::roiHalo(int radius_vox) const {
-  // A voxel's distance is below the cap only if an ROI voxel lies within radius_vox of it,
-  // and so is every pass value that a distance below the cap is built from (the voxels of
-  // the x, y, z path lie in the box spanned by the voxel and its ROI voxel). So only
-  // bricks closer than radius_vox to an ROI brick (nearest voxels, Euclidean) need the
-  // passes; the others read "far", whose effect is a distance of the cap or more.
+  // A distance below the cap comes from an ROI voxel within radius_vox, through pass values
+  // at voxels of the box spanned by the two, all within radius_vox of that ROI voxel. So
+  // only bricks closer than radius_vox to an ROI brick (nearest voxels, Euclidean) need the
+  // passes; the others read "far", which can only yield the cap.
   const BrickLayer& bricks = layer_.bricks();
   const accel::BrickedGridParams& m = bricks.params();
   const int halo = (radius_vox + accel::kBrickEdge - 1) / accel::kBrickEdge;
