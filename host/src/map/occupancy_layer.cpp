@@ -26,18 +26,16 @@ accel::DeviceBuffer& OccupancyLayer::roi() {
 void OccupancyLayer::refreshMirror() const {
   // Every voxel read calls this: the common case, a current mirror, takes no lock. (The
   // layer does not change during const reads, so the two counts cannot move under us.)
-  if (mirror_synced_change_.load(std::memory_order_acquire) == bricks_.changeCount() &&
-      mirror_synced_slots_.load(std::memory_order_acquire) == bricks_.slotCount())
-    return;
+  const auto current = [&] {
+    return mirror_change_count_.load(std::memory_order_acquire) == bricks_.changeCount() &&
+           mirror_slots_.load(std::memory_order_acquire) == bricks_.slotCount();
+  };
+  if (current()) return;
   // Const reads may come from several threads; the first one refreshes the mirror.
   std::lock_guard<std::mutex> lock(mirror_mutex_);
+  if (current()) return;
   const std::size_t slots = bricks_.slotCount();
-  const bool grew = mirror_occupancy_.size() != slots;
-  if (!grew && mirror_change_count_ == bricks_.changeCount()) {
-    mirror_synced_slots_.store(slots, std::memory_order_release);
-    mirror_synced_change_.store(mirror_change_count_, std::memory_order_release);
-    return;
-  }
+  const std::uint64_t since = mirror_change_count_.load(std::memory_order_relaxed);
   // New bricks hold the channels' fill (unknown) until an operation marks them changed.
   mirror_occupancy_.resize(slots, kUnknown);
   if (with_roi_) mirror_roi_.resize(slots, kUnknown);
@@ -46,12 +44,12 @@ void OccupancyLayer::refreshMirror() const {
   // Download runs of consecutive changed bricks, one transfer per run.
   std::size_t b = 0;
   while (b < stamps.size()) {
-    if (stamps[b] <= mirror_change_count_) {
+    if (stamps[b] <= since) {
       ++b;
       continue;
     }
     std::size_t end = b + 1;
-    while (end < stamps.size() && stamps[end] > mirror_change_count_) ++end;
+    while (end < stamps.size() && stamps[end] > since) ++end;
     const std::size_t first = b * accel::kBrickVoxels, count = (end - b) * accel::kBrickVoxels;
     backend.download(bricks_.channel(occupancy_), mirror_occupancy_.data() + first,
                      count * sizeof(float), first * sizeof(float));
@@ -60,9 +58,8 @@ void OccupancyLayer::refreshMirror() const {
                        first * sizeof(float));
     b = end;
   }
-  mirror_change_count_ = bricks_.changeCount();
-  mirror_synced_slots_.store(slots, std::memory_order_release);
-  mirror_synced_change_.store(mirror_change_count_, std::memory_order_release);
+  mirror_slots_.store(slots, std::memory_order_release);
+  mirror_change_count_.store(bricks_.changeCount(), std::memory_order_release);
 }
 
 float OccupancyLayer::occupancyAt(const std::array<int, 3>& index) const {

@@ -52,11 +52,9 @@ class OccupancyLayer {
   std::optional<BrickLayer::ChannelId> roi_;
   mutable std::mutex mirror_mutex_;
   mutable std::vector<float> mirror_occupancy_, mirror_roi_;
-  mutable std::uint64_t mirror_change_count_ = 0;
-  // What the mirror holds, for the lock-free check; kNever until the first refresh.
-  static constexpr std::uint64_t kNever = ~std::uint64_t{0};
-  mutable std::atomic<std::uint64_t> mirror_synced_change_{kNever};
-  mutable std::atomic<std::size_t> mirror_synced_slots_{0};
+  // What the mirror holds (atomic: refreshMirror checks them without the lock).
+  mutable std::atomic<std::uint64_t> mirror_change_count_{0};
+  mutable std::atomic<std::size_t> mirror_slots_{0};
 };
 
 template <typename F>

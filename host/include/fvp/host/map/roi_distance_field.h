@@ -2,8 +2,8 @@
 // distance in voxels from every allocated voxel to the nearest known ROI voxel (ROI
 // log-odds > 0), capped at a radius. Three separable passes over the bricks near ROI (the
 // rest is the cap); the result is a channel of the layer, per brick slot on the device,
-// for the information-gain kernels. Host reads download
-// it once per computation, per slot (never expanded densely).
+// for the information-gain kernels. Host reads download it once per computation, per slot
+// (never expanded densely).
 #pragma once
 
 #include <array>
