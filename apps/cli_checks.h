@@ -1,0 +1,50 @@
+// Option checks shared by the subcommands. CLI11 converts integers with strtoull/strtoll in
+// base 0, so on its own it reads "-1" as 2^64-1 for an unsigned option and "010" as 8; it
+// also lets "inf" and "nan" through its range checks. These validators run on the option's
+// text before any conversion.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <string>
+
+namespace fvp::apps {
+
+/// A decimal integer in [0, 2^64 - 1]: digits only (no sign, no 0x, no leading zeros).
+inline CLI::Validator decimalUnsigned() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        if (text.empty()) return "expected a non-negative decimal integer, got nothing";
+        for (char c : text)
+          if (c < '0' || c > '9')
+            return "expected a non-negative decimal integer, got '" + text + "'";
+        if (text.size() > 1 && text[0] == '0')
+          return "expected a decimal integer without leading zeros, got '" + text + "'";
+        errno = 0;
+        (void)std::strtoull(text.c_str(), nullptr, 10);
+        if (errno == ERANGE) return "'" + text + "' does not fit in 64 bits";
+        return {};
+      },
+      "UINT", "decimalUnsigned");
+}
+
+/// A finite decimal number (no inf, nan or hexadecimal floats).
+inline CLI::Validator finiteNumber() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        char* end = nullptr;
+        errno = 0;
+        const double v = std::strtod(text.c_str(), &end);
+        if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v) ||
+            errno == ERANGE || text.find_first_of("xXpP") != std::string::npos)
+          return "expected a finite decimal number, got '" + text + "'";
+        return {};
+      },
+      "NUMBER", "finiteNumber");
+}
+
+}  // namespace fvp::apps
