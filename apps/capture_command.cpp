@@ -12,7 +12,10 @@
 #include <string>
 #include <vector>
 
+#include "cli_checks.h"
 #include "commands.h"
+#include "fvp/host/core/input_checks.h"
+#include "fvp/host/core/output_directory.h"
 #include "fvp/host/perception/capture.h"
 #include "fvp/host/perception/occlusion_statistic.h"
 #include "fvp/host/perception/perception_pipeline.h"
@@ -31,9 +34,9 @@ Eigen::Isometry3d parsePose(const std::string& text) {
     try {
       std::size_t used = 0;
       v.push_back(std::stod(item, &used));
-      if (used != item.size()) throw std::invalid_argument(item);
+      if (used != item.size() || !std::isfinite(v.back())) throw std::invalid_argument(item);
     } catch (const std::exception&) {
-      throw std::invalid_argument("--pose: '" + item + "' is not a number");
+      throw std::invalid_argument("--pose: '" + item + "' is not a finite number");
     }
   }
   if (v.size() != 7)
@@ -43,6 +46,7 @@ Eigen::Isometry3d parsePose(const std::string& text) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = q.normalized().toRotationMatrix();
   T.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
+  host::checkPose(T, "--pose", "x,y,z");
   return T;
 }
 
@@ -57,6 +61,14 @@ std::string vec(const Eigen::Vector3d& p) {
 // K views orbiting the cluster, each rendered, perceived and written as out/NNN.
 static void writeCaptureSet(std::uint64_t seed, const std::string& world_file, int views,
                             double arc_deg, const std::filesystem::path& out) {
+  // A set written over an older one would leave its extra views behind, and fvp size would
+  // mix the two worlds.
+  for (const auto& entry : std::filesystem::directory_iterator(out))
+    if (std::filesystem::exists(entry.path() / "camera.yaml") ||
+        entry.path().filename() == "camera.yaml")
+      throw std::runtime_error("--out '" + out.string() + "' already holds captures (" +
+                               entry.path().filename().string() +
+                               "): write the set to a new or empty directory");
   const robot::sim::WorldConfig world_config =
       world_file.empty() ? robot::sim::WorldConfig{}
                          : robot::sim::WorldConfig::fromYamlFile(world_file);
@@ -108,7 +120,7 @@ void addCaptureCommand(CLI::App& app) {
       "capture",
       "Render one view of a simulated world (default: the start view), run the "
       "perception chain and write it in the capture format (docs/capture-format.md)");
-  cmd->add_option("--seed", opt->seed, "world seed")->required();
+  cmd->add_option("--seed", opt->seed, "world seed")->check(decimalUnsigned())->required();
   cmd->add_option("--world", opt->world_file, "world config YAML (default: built-in defaults)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--pose", opt->pose,
@@ -117,13 +129,16 @@ void addCaptureCommand(CLI::App& app) {
   cmd->add_option("--views", opt->views,
                   "write a set of this many views orbiting the cluster as --out/000, 001, ... "
                   "(for fvp size)")
+      ->check(decimalUnsigned())
       ->check(CLI::Range(1, 360))
       ->capture_default_str();
   cmd->add_option("--arc-deg", opt->arc_deg, "arc the --views span around the cluster")
+      ->check(finiteNumber())
       ->check(CLI::Range(0.0, 360.0))
       ->capture_default_str();
   cmd->add_option("--out", opt->out, "capture directory (created)")->required();
   cmd->callback([opt] {
+    host::prepareOutputDirectory(opt->out, "--out");
     if (opt->views > 1) {
       if (!opt->pose.empty()) throw std::invalid_argument("--pose and --views exclude each other");
       writeCaptureSet(opt->seed, opt->world_file, opt->views, opt->arc_deg, opt->out);

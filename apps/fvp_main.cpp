@@ -1,6 +1,7 @@
 // fvp: command-line entry point. Options are parsed here; the work is in the libraries.
 #include <exception>
 #include <iostream>
+#include <string>
 
 #include "commands.h"
 
@@ -15,10 +16,25 @@ int main(int argc, char** argv) {
   fvp::apps::addPlanCommand(app);
   fvp::apps::addSizeCommand(app);
   fvp::apps::addExperimentCommands(app);
+  // CLI11 reports a mistyped subcommand as "A subcommand is required"; name it instead.
+  if (argc > 1 && argv[1][0] != '-') {
+    std::string known;
+    bool found = false;
+    for (const CLI::App* sub : app.get_subcommands({})) {
+      found |= sub->get_name() == argv[1];
+      known += (known.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!found) {
+      std::cerr << "fvp: error: unknown subcommand '" << argv[1] << "' (known: " << known
+                << "; see fvp --help)\n";
+      return 2;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // Usage errors exit 2 (CLI11's own codes are 100+); --help exits 0.
+    return app.exit(e) == 0 ? 0 : 2;
   } catch (const std::exception& e) {
     std::cerr << "fvp: error: " << e.what() << "\n";
     return 1;

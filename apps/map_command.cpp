@@ -6,9 +6,11 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "cli_checks.h"
 #include "commands.h"
 #include "fvp/accel/backend.h"
 #include "fvp/host/core/atomic_file.h"
+#include "fvp/host/core/output_directory.h"
 #include "fvp/robot/sim/camera_views.h"
 #include "fvp/robot/sim/simulated_mapping.h"
 
@@ -30,16 +32,20 @@ void addMapCommand(CLI::App& app) {
       "map",
       "Map a simulated world from views orbiting the cluster; write coarse.bt, fine.ot "
       "and map.json to --out");
-  cmd->add_option("--seed", opt->seed, "world seed")->capture_default_str();
+  cmd->add_option("--seed", opt->seed, "world seed")
+      ->check(decimalUnsigned())
+      ->capture_default_str();
   cmd->add_option("--world", opt->world_file, "world config YAML (default: built-in defaults)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--map-config", opt->map_config_file,
                   "map config YAML (keys and defaults: host/config/map_default.yaml)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--views", opt->views, "number of views")
+      ->check(decimalUnsigned())
       ->check(CLI::Range(1, 360))
       ->capture_default_str();
   cmd->add_option("--arc-deg", opt->arc_deg, "arc the views span around the cluster")
+      ->check(finiteNumber())
       ->check(CLI::Range(0.0, 360.0))
       ->capture_default_str();
   cmd->add_option("--engine", opt->engine, "map engine: grid | octomap")
@@ -51,6 +57,8 @@ void addMapCommand(CLI::App& app) {
   cmd->add_option("--out", opt->out, "output directory")->required();
   cmd->callback([opt] {
     using robot::sim::WorldConfig;
+    host::prepareOutputDirectory(opt->out, "--out");
+    host::removeStaleOutputs(opt->out, {"coarse.bt", "fine.ot", "map.json"});
     const WorldConfig config =
         opt->world_file.empty() ? WorldConfig{} : WorldConfig::fromYamlFile(opt->world_file);
     const auto world = robot::sim::World::generate(config, opt->seed);

@@ -3,6 +3,7 @@
 #include <iostream>
 #include <memory>
 
+#include "cli_checks.h"
 #include "commands.h"
 #include "fvp/robot/sim/plan_once.h"
 
@@ -19,8 +20,11 @@ void addPlanCommand(CLI::App& app) {
   cmd->add_option("--planner", opt->planner, "fvp | rvp")
       ->check(CLI::IsMember({"fvp", "rvp"}))
       ->capture_default_str();
-  cmd->add_option("--seed", opt->seed, "world seed")->capture_default_str();
+  cmd->add_option("--seed", opt->seed, "world seed")
+      ->check(decimalUnsigned())
+      ->capture_default_str();
   cmd->add_option("--views", opt->views, "views orbiting the cluster that build the map")
+      ->check(decimalUnsigned())
       ->check(CLI::Range(1, 360))
       ->capture_default_str();
   cmd->add_option("--backend", opt->backend, "cpu | opencl | vulkan | auto")->capture_default_str();
@@ -35,6 +39,8 @@ void addPlanCommand(CLI::App& app) {
     o.planner_config = *config;
     o.out_dir = *out;
     const nlohmann::json plan = robot::sim::planOnce(o);
+    for (const auto& w : plan["warnings"])
+      std::cerr << "fvp: warning: " << w.get<std::string>() << "\n";
     std::size_t reachable = 0;
     for (const auto& c : plan["candidates"]) reachable += c["reachable"].get<bool>();
     std::cout << "planner " << o.planner << ", engine " << plan["engine"].get<std::string>()

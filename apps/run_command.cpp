@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include "cli_checks.h"
 #include "commands.h"
 #include "fvp/robot/sim/trial.h"
 
@@ -24,12 +25,15 @@ void addRunCommand(CLI::App& app) {
   cmd->add_option("--planner", opt->trial.planner, "viewpoint planner: fvp | rvp")
       ->check(CLI::IsMember({"fvp", "rvp"}))
       ->capture_default_str();
-  cmd->add_option("--seed", opt->trial.seed, "world seed")->capture_default_str();
+  cmd->add_option("--seed", opt->trial.seed, "world seed")
+      ->check(decimalUnsigned())
+      ->capture_default_str();
   cmd->add_option("--world", opt->world, "world config YAML (default: built-in defaults)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--config", opt->config, "planner config YAML (default: the planner's)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--budget-s", opt->trial.budget_s, "simulated time budget, seconds")
+      ->check(finiteNumber())
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd->add_option("--backend", opt->trial.backend, "compute backend: cpu | opencl | vulkan | auto")
@@ -38,6 +42,7 @@ void addRunCommand(CLI::App& app) {
                   "map engine: grid | octomap (default: grid for fvp, octomap for rvp)")
       ->check(CLI::IsMember({"grid", "octomap"}));
   cmd->add_option("--max-views", opt->max_views, "stop after this many views (0: no limit)")
+      ->check(decimalUnsigned())
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--clock", opt->trial.clock,
                   "simulated clock: wall (charge measured compute time) | fixed (a constant)")
@@ -55,6 +60,9 @@ void addRunCommand(CLI::App& app) {
       std::cerr << (tty ? "\r" : "") << "view " << p.views << "  sim " << std::fixed
                 << std::setprecision(1) << p.sim_time_s << " / " << p.budget_s << " s  wall "
                 << p.wall_time_s << " s" << (tty ? "   " : "\n") << std::flush;
+    };
+    trial.on_warning = [tty](const std::string& text) {
+      std::cerr << (tty ? "\n" : "") << "fvp: warning: " << text << "\n";
     };
     const nlohmann::json result = robot::sim::runTrial(trial);
     if (tty) std::cerr << "\n";

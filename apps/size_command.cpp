@@ -37,6 +37,7 @@ void addSizeCommand(CLI::App& app) {
                                          : host::sizing::SizingEstimator::kOurs;
     o.engine = opt->engine;
     o.out_dir = opt->out;
+    o.on_warning = [](const std::string& text) { std::cerr << "fvp: warning: " << text << "\n"; };
     const nlohmann::json r = host::sizeCaptureSet(opt->captures, o, backend.get());
     std::cout << r["captures"].size() << " captures, Cluster Region "
               << (r["cluster_region_found"].get<bool>() ? "found" : "NOT found (no tag seen)")

@@ -2,6 +2,7 @@
 #include <iostream>
 #include <string>
 
+#include "cli_checks.h"
 #include "commands.h"
 #include "fvp/accel/ray_workload.h"
 
@@ -24,19 +25,25 @@ void addTraverseCommand(CLI::App& app) {
                          "check it against the cpu reference and report voxel steps per second");
   cmd->add_option("--backend", opt->backend, "cpu | opencl | vulkan | auto")->capture_default_str();
   cmd->add_option("--side-voxels", opt->side_voxels, "grid side in voxels")
+      ->check(decimalUnsigned())
       ->check(CLI::Range(8, 1024))
       ->capture_default_str();
   cmd->add_option("--voxel-size-m", opt->voxel_size_m, "voxel edge in metres")
+      ->check(finiteNumber())
       ->check(CLI::Range(1e-4, 1.0))
       ->capture_default_str();
   cmd->add_option("--rays", opt->rays, "number of rays")
+      ->check(decimalUnsigned())
       ->check(CLI::Range(1, 50000000))
       ->capture_default_str();
   cmd->add_option("--outside-fraction", opt->outside_fraction,
                   "fraction of rays starting outside the grid")
+      ->check(finiteNumber())
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
-  cmd->add_option("--seed", opt->seed, "workload seed")->capture_default_str();
+  cmd->add_option("--seed", opt->seed, "workload seed")
+      ->check(decimalUnsigned())
+      ->capture_default_str();
   cmd->add_flag("!--no-check", opt->check, "skip the comparison with the cpu reference");
   cmd->callback([opt] {
     using Clock = std::chrono::steady_clock;

@@ -123,26 +123,24 @@ ArmConfig ArmConfig::fromYamlFile(const std::filesystem::path& path) {
     return config;
   }
   for (const auto& entry : root) {
-    const std::string key = entry.first.as<std::string>();
+    const std::string key = host::keyText(entry.first, source);
     const KeySpec* spec = &host::findKeySpec(keySpecs(), key, source);
     const YAML::Node& value = entry.second;
+    const std::string where = source + ": key '" + key + "'";
     std::visit(
         [&](auto field) {
           using T = std::decay_t<decltype(config.*field)>;
-          const char* expected = std::is_same_v<T, Eigen::Vector3d> ? "a list of 3 numbers"
-                                 : std::is_same_v<T, std::string>   ? "a string"
-                                 : std::is_floating_point_v<T>      ? "a number"
-                                                                    : "an integer";
-          try {
-            if constexpr (std::is_same_v<T, Eigen::Vector3d>) {
-              if (!value.IsSequence() || value.size() != 3) throw YAML::Exception({}, "shape");
-              for (int i = 0; i < 3; ++i) (config.*field)[i] = value[i].as<double>();
-            } else {
-              if (!value.IsScalar()) throw YAML::Exception({}, "not a scalar");
-              config.*field = value.as<T>();
-            }
-          } catch (const YAML::Exception&) {
-            throw std::invalid_argument(source + ": key '" + key + "' must be " + expected);
+          if constexpr (std::is_same_v<T, Eigen::Vector3d>) {
+            if (!value.IsSequence() || value.size() != 3)
+              throw std::invalid_argument(where + ": expected a list of 3 numbers");
+            for (int i = 0; i < 3; ++i)
+              (config.*field)[i] = host::readScalar<double>(value[i], where, "a list of 3 numbers");
+          } else {
+            const char* expected = std::is_same_v<T, std::string> ? "a string"
+                                   : std::is_floating_point_v<T>  ? "a number"
+                                   : std::is_same_v<T, bool>      ? "true or false"
+                                                                  : "an integer";
+            config.*field = host::readScalar<T>(value, where, expected);
           }
         },
         spec->member);

@@ -51,13 +51,13 @@ TEST(ArmConfig, ErrorsNameFileAndKey) {
   e = errorOf("no_such_key: 1\n");
   EXPECT_NE(e.find("unknown key 'no_such_key'"), std::string::npos) << e;
   e = errorOf("slider_origin_m: [1, 2]\n");
-  EXPECT_NE(e.find("'slider_origin_m' must be a list of 3 numbers"), std::string::npos) << e;
+  EXPECT_NE(e.find("key 'slider_origin_m': expected a list of 3 numbers"), std::string::npos) << e;
   e = errorOf("planner: Dijkstra\n");
   EXPECT_NE(e.find("'planner'"), std::string::npos) << e;
   e = errorOf("clock: sundial\n");
   EXPECT_NE(e.find("'clock'"), std::string::npos) << e;
   e = errorOf("ik_slider_samples: many\n");
-  EXPECT_NE(e.find("'ik_slider_samples' must be an integer"), std::string::npos) << e;
+  EXPECT_NE(e.find("key 'ik_slider_samples': expected an integer"), std::string::npos) << e;
 }
 
 }  // namespace

@@ -67,11 +67,11 @@ TEST(WorldConfig, OutOfRangeNamesKeyAndExpectedRange) {
 
 TEST(WorldConfig, WrongTypeNamesKey) {
   std::string error = readError("fvp_sim_type.yaml", "leaf_count: many\n");
-  EXPECT_NE(error.find("'leaf_count' must be an integer"), std::string::npos) << error;
+  EXPECT_NE(error.find("key 'leaf_count': expected an integer"), std::string::npos) << error;
   error = readError("fvp_sim_type2.yaml", "leaf_count: 2.5\n");
-  EXPECT_NE(error.find("'leaf_count' must be an integer"), std::string::npos) << error;
+  EXPECT_NE(error.find("key 'leaf_count': expected an integer"), std::string::npos) << error;
   error = readError("fvp_sim_type3.yaml", "tag_size_m: [1, 2]\n");
-  EXPECT_NE(error.find("'tag_size_m' must be a number"), std::string::npos) << error;
+  EXPECT_NE(error.find("key 'tag_size_m': expected a number"), std::string::npos) << error;
 }
 
 TEST(WorldConfig, UnreadableFileNamesIt) {

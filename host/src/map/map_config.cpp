@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "fvp/host/core/yaml_config.h"
 #include "fvp/host/map/map_config.h"
 #include "fvp/host/map/occupancy_model.h"
 
@@ -15,9 +16,9 @@ namespace {
 void requireRange(double value, double lo, double hi, const std::string& field, bool open = true) {
   const bool ok = open ? (value > lo && value < hi) : (value >= lo && value <= hi);
   if (!ok) {
-    throw std::invalid_argument(field + " = " + std::to_string(value) + ": expected a value in " +
-                                (open ? "(" : "[") + std::to_string(lo) + ", " +
-                                std::to_string(hi) + (open ? ")" : "]"));
+    throw std::invalid_argument(field + " = " + formatNumber(value) + ": expected a value in " +
+                                (open ? "(" : "[") + formatNumber(lo) + ", " + formatNumber(hi) +
+                                (open ? ")" : "]"));
   }
 }
 
@@ -66,22 +67,12 @@ void MapConfig::validate(const std::string& source) const {
 }
 
 MapConfig MapConfig::fromYamlFile(const std::filesystem::path& path) {
-  const std::string source = path.string();
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(source);
-  } catch (const YAML::Exception& e) {
-    throw std::invalid_argument(source + ": not a readable YAML file: " + e.what());
-  }
+  const std::string source = "map config '" + path.string() + "'";
+  const YAML::Node root = readYamlMapping(path, source);
   MapConfig config;
   if (root.IsNull()) return config;
-  if (!root.IsMap()) throw std::invalid_argument(source + ": expected a map of keys");
   auto number = [&](const YAML::Node& node, const std::string& key) {
-    try {
-      return node.as<double>();
-    } catch (const YAML::Exception&) {
-      throw std::invalid_argument(source + ": " + key + ": expected a number");
-    }
+    return readScalar<double>(node, source + ": key '" + key + "'", "a number");
   };
   auto vector3 = [&](const YAML::Node& node, const std::string& key) {
     if (!node.IsSequence() || node.size() != 3)
@@ -106,7 +97,7 @@ MapConfig MapConfig::fromYamlFile(const std::filesystem::path& path) {
       {"occupied_prob", [&](auto& n, auto& k) { config.model.occupied_prob = number(n, k); }},
   };
   for (const auto& entry : root) {
-    const std::string key = entry.first.as<std::string>();
+    const std::string key = keyText(entry.first, source);
     const auto it = keys.find(key);
     if (it == keys.end()) {
       std::string known;

@@ -15,6 +15,8 @@ extern "C" {
 
 #include "task_runner.h"
 
+#include "fvp/host/core/input_checks.h"
+
 namespace fvp::host {
 
 void AprilTagDetectorConfig::validate() const {
@@ -58,6 +60,11 @@ AprilTagDetector::~AprilTagDetector() = default;
 std::vector<TagDetection> AprilTagDetector::detectAll(
     const cv::Mat& image, const StereoIntrinsics& K,
     const Eigen::Isometry3d& T_world_camera) const {
+  // libapriltag asserts or crashes on images too small for its decimated quad search and on
+  // a degenerate camera model (estimate_tag_pose); neither can hold a tag.
+  checkIntrinsics(K, "AprilTagDetector: camera model");
+  if (image.cols != K.width_px || image.rows != K.height_px)
+    throw std::invalid_argument("AprilTagDetector: the image does not match the camera model");
   cv::Mat gray;
   if (image.type() == CV_8UC3) {
     cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);

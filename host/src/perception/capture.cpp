@@ -11,6 +11,7 @@
 #include <string>
 
 #include "fvp/host/core/atomic_file.h"
+#include "fvp/host/core/input_checks.h"
 #include "fvp/host/perception/ply_io.h"
 
 namespace fvp::host {
@@ -160,6 +161,11 @@ void readCameraYaml(const fs::path& file, Capture& c) {
   if ((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-5 ||
       R.determinant() < 0.0)
     fail(file, tkey, "a proper rotation (orthonormal, det +1) in the top-left 3x3");
+  // Every number plausible before any library sees it (a focal length in metres crashed
+  // libapriltag; a 2x2 image crashed its quad search).
+  checkIntrinsics(K, file.string());
+  if (M.topRightCorner<3, 1>().norm() > kMaxPoseTranslationM)
+    fail(file, tkey, "a camera position within 1 km of the world origin");
   // Remove rounding so downstream code can rely on an exact rotation.
   Eigen::JacobiSVD<Eigen::Matrix3d> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);
   c.T_world_camera.setIdentity();

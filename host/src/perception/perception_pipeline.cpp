@@ -4,6 +4,7 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "fvp/host/core/input_checks.h"
 #include "fvp/host/perception/cluster_region_image.h"
 
 namespace fvp::host {
@@ -52,6 +53,8 @@ PerceptionPipeline::PerceptionPipeline(PerceptionConfig config)
 PerceptionResult PerceptionPipeline::process(
     const StereoFrame& frame, const std::optional<ClusterRegion>& known_region) const {
   const StereoIntrinsics& K = frame.intrinsics;
+  checkIntrinsics(K, "stereo frame: camera model");
+  checkPose(frame.T_world_camera, "stereo frame", "T_world_camera");
   if (frame.left_bgr.empty() || frame.left_bgr.cols != K.width_px ||
       frame.left_bgr.rows != K.height_px)
     throw std::invalid_argument("PerceptionPipeline: left image does not match the intrinsics");

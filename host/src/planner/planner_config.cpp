@@ -16,11 +16,7 @@ struct KeySpec {
 
 template <typename T>
 T as(const YAML::Node& node, const std::string& where, const char* expected) {
-  try {
-    return node.as<T>();
-  } catch (const YAML::Exception&) {
-    throw std::invalid_argument(where + ": expected " + expected);
-  }
+  return readScalar<T>(node, where, expected);
 }
 
 const std::vector<KeySpec>& keySpecs() {
@@ -69,7 +65,7 @@ PlannerConfig PlannerConfig::fromYamlFile(const std::filesystem::path& path) {
   PlannerConfig config;
   if (root.IsNull()) return config;
   for (const auto& item : root) {
-    const std::string key = item.first.as<std::string>();
+    const std::string key = keyText(item.first, source);
     findKeySpec(keySpecs(), key, source).read(config, item.second, source + ": key '" + key + "'");
   }
   config.validate(source);

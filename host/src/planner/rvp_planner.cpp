@@ -23,28 +23,30 @@ double since(Clock::time_point t) {
 
 struct KeySpec {
   const char* name;
-  std::function<void(RvpConfig&, const YAML::Node&)> read;
+  std::function<void(RvpConfig&, const YAML::Node&, const std::string&)> read;
 };
+
+/// A spec that reads key into member as an integer or a finite number.
+template <typename T>
+KeySpec field(const char* name, T RvpConfig::*member) {
+  return {name, [member](RvpConfig& c, const YAML::Node& n, const std::string& where) {
+            c.*member = readScalar<T>(n, where, std::is_integral_v<T> ? "an integer" : "a number");
+          }};
+}
 
 const std::vector<KeySpec>& keySpecs() {
   static const std::vector<KeySpec> specs = {
-      {"roi_samples", [](RvpConfig& c, const YAML::Node& n) { c.roi_samples = n.as<int>(); }},
-      {"exploration_samples",
-       [](RvpConfig& c, const YAML::Node& n) { c.exploration_samples = n.as<int>(); }},
-      {"sensor_min_m", [](RvpConfig& c, const YAML::Node& n) { c.sensor_min_m = n.as<double>(); }},
-      {"sensor_max_m", [](RvpConfig& c, const YAML::Node& n) { c.sensor_max_m = n.as<double>(); }},
-      {"alpha_per_m", [](RvpConfig& c, const YAML::Node& n) { c.alpha_per_m = n.as<double>(); }},
-      {"roi_utility_threshold",
-       [](RvpConfig& c, const YAML::Node& n) { c.roi_utility_threshold = n.as<double>(); }},
-      {"exploration_rays_x",
-       [](RvpConfig& c, const YAML::Node& n) { c.exploration_rays_x = n.as<int>(); }},
-      {"exploration_rays_y",
-       [](RvpConfig& c, const YAML::Node& n) { c.exploration_rays_y = n.as<int>(); }},
-      {"exploration_fov_x_deg",
-       [](RvpConfig& c, const YAML::Node& n) { c.exploration_fov_x_deg = n.as<double>(); }},
-      {"exploration_box_half_m",
-       [](RvpConfig& c, const YAML::Node& n) { c.exploration_box_half_m = n.as<double>(); }},
-      {"seed", [](RvpConfig& c, const YAML::Node& n) { c.seed = n.as<std::int64_t>(); }},
+      field("roi_samples", &RvpConfig::roi_samples),
+      field("exploration_samples", &RvpConfig::exploration_samples),
+      field("sensor_min_m", &RvpConfig::sensor_min_m),
+      field("sensor_max_m", &RvpConfig::sensor_max_m),
+      field("alpha_per_m", &RvpConfig::alpha_per_m),
+      field("roi_utility_threshold", &RvpConfig::roi_utility_threshold),
+      field("exploration_rays_x", &RvpConfig::exploration_rays_x),
+      field("exploration_rays_y", &RvpConfig::exploration_rays_y),
+      field("exploration_fov_x_deg", &RvpConfig::exploration_fov_x_deg),
+      field("exploration_box_half_m", &RvpConfig::exploration_box_half_m),
+      field("seed", &RvpConfig::seed),
   };
   return specs;
 }
@@ -61,13 +63,8 @@ RvpConfig RvpConfig::fromYamlFile(const std::filesystem::path& path) {
   RvpConfig c;
   if (root.IsNull()) return c;
   for (const auto& item : root) {
-    const std::string key = item.first.as<std::string>();
-    const KeySpec& spec = findKeySpec(keySpecs(), key, source);
-    try {
-      spec.read(c, item.second);
-    } catch (const YAML::Exception&) {
-      throw std::invalid_argument(source + ": key '" + key + "': expected a number");
-    }
+    const std::string key = keyText(item.first, source);
+    findKeySpec(keySpecs(), key, source).read(c, item.second, source + ": key '" + key + "'");
   }
   c.validate(source);
   return c;
@@ -78,7 +75,10 @@ void RvpConfig::validate(const std::string& source) const {
           source, "roi_samples", "non-negative sample counts, not both 0");
   require(sensor_min_m > 0.0 && sensor_max_m >= sensor_min_m && sensor_max_m < 5.0, source,
           "sensor_max_m", "0 < sensor_min_m <= sensor_max_m < 5 m");
-  require(alpha_per_m >= 0.0, source, "alpha_per_m", "a non-negative weight");
+  require(alpha_per_m >= 0.0 && alpha_per_m < 100.0, source, "alpha_per_m",
+          "a cost weight in [0, 100) per metre");
+  require(std::isfinite(roi_utility_threshold), source, "roi_utility_threshold",
+          "a finite utility");
   require(exploration_rays_x >= 1 && exploration_rays_y >= 1, source, "exploration_rays_x",
           "at least one ray per axis");
   require(exploration_fov_x_deg > 0.0 && exploration_fov_x_deg < 170.0, source,

@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include <opencv2/core.hpp>
+
 #include "fvp/host/core/atomic_file.h"
+#include "fvp/host/core/output_directory.h"
 #include "fvp/host/eval/sizing_score.h"
 #include "fvp/host/perception/capture.h"
 #include "fvp/host/perception/ply_io.h"
@@ -11,25 +14,70 @@
 
 namespace fvp::host {
 
-std::vector<std::filesystem::path> listCaptures(const std::filesystem::path& dir) {
-  if (!std::filesystem::is_directory(dir))
+namespace {
+
+/// Files of the capture format (docs/capture-format.md) besides camera.yaml.
+bool holdsCaptureFiles(const std::filesystem::path& dir) {
+  for (const char* name : {"left.png", "right.png", "disparity.png", "mask.png", "roi.ply",
+                           "other.ply", "ground_truth.json"})
+    if (std::filesystem::exists(dir / name)) return true;
+  return false;
+}
+
+}  // namespace
+
+std::vector<std::filesystem::path> listCaptures(const std::filesystem::path& dir,
+                                                std::vector<std::string>* skipped) {
+  namespace fs = std::filesystem;
+  if (!fs::is_directory(dir))
     throw std::runtime_error(dir.string() + ": not a directory of captures");
-  if (std::filesystem::exists(dir / "camera.yaml")) return {dir};
-  std::vector<std::filesystem::path> out;
-  for (const auto& entry : std::filesystem::directory_iterator(dir))
-    if (entry.is_directory() && std::filesystem::exists(entry.path() / "camera.yaml"))
-      out.push_back(entry.path());
-  std::sort(out.begin(), out.end());
-  if (out.empty())
+  std::vector<fs::path> captures, subdirs;
+  for (const auto& entry : fs::directory_iterator(dir))
+    if (entry.is_directory()) subdirs.push_back(entry.path());
+  std::sort(subdirs.begin(), subdirs.end());
+  for (const fs::path& sub : subdirs) {
+    if (fs::exists(sub / "camera.yaml"))
+      captures.push_back(sub);
+    else if (holdsCaptureFiles(sub))
+      throw std::runtime_error(sub.string() +
+                               ": holds capture files but no camera.yaml (an incomplete "
+                               "capture); complete it or move it out of the set");
+    else if (skipped)
+      skipped->push_back(sub.string() + ": not a capture (no camera.yaml), skipped");
+  }
+  if (fs::exists(dir / "camera.yaml")) {
+    if (!captures.empty())
+      throw std::runtime_error(dir.string() +
+                               ": holds camera.yaml and capture subdirectories too (" +
+                               captures.front().filename().string() +
+                               ", ...): point --captures at one capture or at the set, and "
+                               "remove the stray camera.yaml");
+    if (skipped) skipped->clear();  // one capture: its subdirectories are none of ours
+    return {dir};
+  }
+  if (captures.empty())
     throw std::runtime_error(dir.string() +
                              ": no capture (a directory with camera.yaml) in it; see "
                              "docs/capture-format.md");
-  return out;
+  return captures;
 }
 
 nlohmann::json sizeCaptureSet(const std::filesystem::path& captures_dir,
                               const CaptureSizingOptions& options, accel::Backend* backend) {
-  const std::vector<std::filesystem::path> dirs = listCaptures(captures_dir);
+  std::vector<std::string> warnings;
+  const auto warn = [&](const std::string& text) {
+    warnings.push_back(text);
+    if (options.on_warning) options.on_warning(text);
+  };
+  std::vector<std::string> skipped;
+  const std::vector<std::filesystem::path> dirs = listCaptures(captures_dir, &skipped);
+  for (const std::string& s : skipped) warn(s);
+  static const std::vector<std::string> kOutputs = {"fruitlets.json", "surface.ply", "mesh.ply",
+                                                    "clusters.ply"};
+  if (!options.out_dir.empty()) {
+    prepareOutputDirectory(options.out_dir, "sizing output directory");
+    removeStaleOutputs(options.out_dir, kOutputs);
+  }
   MappingSession session(PerceptionConfig{}, options.engine, map::MapConfig{}, backend);
   session.enableTsdf();
   std::string ground_truth, ground_truth_source;
@@ -41,13 +89,21 @@ nlohmann::json sizeCaptureSet(const std::filesystem::path& captures_dir,
     frame.right_bgr = capture.right_bgr;
     frame.intrinsics = capture.intrinsics;
     frame.T_world_camera = capture.T_world_camera;
-    const ViewResult v = session.addView(frame);
+    PerceptionResult perceived;
+    const ViewResult v = session.addView(frame, &perceived);
+    const int fruitlet_px =
+        perceived.fruitlet_mask.empty() ? 0 : cv::countNonZero(perceived.fruitlet_mask);
+    if (fruitlet_px == 0)
+      warn(dir.string() +
+           ": no fruitlet pixels segmented (HSV thresholds for the simulator's fruitlet "
+           "colours; a grey or real image needs its own mask)");
     if (ground_truth.empty() && !capture.ground_truth_json.empty()) {
       ground_truth = capture.ground_truth_json;
       ground_truth_source = (dir / "ground_truth.json").string();
     }
     views.push_back({{"capture", dir.filename().string()},
                      {"tag_detected", v.tag_detected},
+                     {"fruitlet_pixels", fruitlet_px},
                      {"roi_points", v.roi_points},
                      {"dropped_disparities", v.perception.droppedDisparities()}});
   }
@@ -56,6 +112,8 @@ nlohmann::json sizeCaptureSet(const std::filesystem::path& captures_dir,
     c.estimator = options.estimator;
     return c;
   }();
+  if (!session.region())
+    warn("no capture showed the AprilTag: no Cluster Region, nothing mapped or sized");
   const sizing::SizingResult sized = session.sizeFruitlets(config);
   std::vector<eval::GroundTruthFruitlet> truth;
   if (!ground_truth.empty()) truth = eval::groundTruthFromJson(ground_truth, ground_truth_source);
@@ -75,8 +133,12 @@ nlohmann::json sizeCaptureSet(const std::filesystem::path& captures_dir,
   for (const auto& [key, value] : details.items()) out[key] = value;
   out["captures"] = views;
   out["cluster_region_found"] = session.region().has_value();
+  if (session.region() && out["sized_fruitlets"].empty())
+    warn("no fruitlet was sized (no surface cluster passed the sizing chain)");
+  out["warnings"] = warnings;
   if (!options.out_dir.empty()) {
-    std::filesystem::create_directories(options.out_dir);
+    // The result first: a failure writing the clouds cannot lose it.
+    writeFileAtomically(options.out_dir / "fruitlets.json", "fruitlets", out.dump(2) + "\n");
     writePlyPoints(options.out_dir / "surface.ply", session.surfacePoints());
     const tsdf::TriangleMesh mesh = session.surfaceMesh();
     writePlyMesh(options.out_dir / "mesh.ply", mesh.vertices_m, mesh.triangles,
@@ -84,7 +146,6 @@ nlohmann::json sizeCaptureSet(const std::filesystem::path& captures_dir,
     writePlyColoredPoints(options.out_dir / "clusters.ply", sized.points,
                           sizing::clusterColours(sized.labels),
                           "fvp clusters, world frame, metres; grey = noise");
-    writeFileAtomically(options.out_dir / "fruitlets.json", "fruitlets", out.dump(2) + "\n");
   }
   return out;
 }

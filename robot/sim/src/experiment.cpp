@@ -192,7 +192,7 @@ void writeReports(const std::filesystem::path& dir, const std::vector<nlohmann::
     for (const auto& t : trials)
       for (const auto& f : t["fruitlets"]) sizes["GT"].push_back(f["gt_size_mm"].get<double>());
   std::ostringstream gp;
-  gp << "set terminal pngcairo size 900,600 font 'DejaVu Sans,12'\nset output '{png}'\n"
+  gp << "set terminal pngcairo size 900,600 font 'DejaVu Sans,12'\n"
      << "set title 'Fruitlet sizes: ground truth and matched estimates (x: mean, line: median)'\n"
      << "set ylabel 'size (mm)'\nset style fill solid 0.35 border -1\nset style boxplot "
         "nooutliers\nset style data boxplot\nset boxwidth 0.5\nset grid ytics\n"

@@ -8,6 +8,7 @@
 
 #include "fvp/accel/backend.h"
 #include "fvp/host/core/atomic_file.h"
+#include "fvp/host/core/output_directory.h"
 #include "fvp/host/perception/ply_io.h"
 #include "fvp/host/planner/fvp_planner.h"
 #include "fvp/host/planner/rvp_planner.h"
@@ -38,6 +39,10 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
   if (o.planner != "fvp" && o.planner != "rvp")
     throw std::invalid_argument("plan: --planner: expected fvp or rvp, got '" + o.planner + "'");
   if (o.views < 1) throw std::invalid_argument("plan: --views: expected at least 1");
+  if (!o.out_dir.empty()) {
+    host::prepareOutputDirectory(o.out_dir, "plan output directory");
+    host::removeStaleOutputs(o.out_dir, {"plan.json", "candidates.ply"});
+  }
   const std::string engine = o.engine.empty() ? defaultEngine(o.planner) : o.engine;
   const WorldConfig world_config =
       o.world_config.empty() ? WorldConfig{} : WorldConfig::fromYamlFile(o.world_config);
@@ -45,6 +50,18 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
 
   std::unique_ptr<accel::Backend> backend;
   if (engine == "grid" || o.backend != "auto") backend = accel::createBackend(o.backend);
+  // The planner (and its config file) before the views are mapped: a bad config fails fast.
+  std::unique_ptr<host::planner::ViewPlanner> planner;
+  if (o.planner == "fvp")
+    planner = std::make_unique<host::planner::FvpPlanner>(
+        o.planner_config.empty() ? host::planner::PlannerConfig{}
+                                 : host::planner::PlannerConfig::fromYamlFile(o.planner_config),
+        o.seed, backend.get());
+  else
+    planner = std::make_unique<host::planner::RvpPlanner>(
+        o.planner_config.empty() ? host::planner::RvpConfig{}
+                                 : host::planner::RvpConfig::fromYamlFile(o.planner_config),
+        o.seed);
   SimulatedMappingOptions mapping;
   mapping.engine = engine;
   mapping.map = plannerMapConfig(o.planner, engine);
@@ -62,23 +79,15 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
   const ArmModel arm(arm_config);
   std::ostringstream log;
   const WorkspaceTree workspace = WorkspaceTree::loadOrBuild(arm, log);
+  nlohmann::json warnings = nlohmann::json::array();
+  std::istringstream log_lines(log.str());
+  for (std::string line; std::getline(log_lines, line);)
+    if (line.rfind("warning: ", 0) == 0) warnings.push_back(line.substr(9));
   SimClock clock = SimClock::fromConfig(arm_config);
   const auto start = ArmController::startConfiguration(arm, world.startCameraPose());
   if (!start) throw std::runtime_error("plan: the start view is out of the arm's reach");
   ArmController controller(arm, clock, *start);
   controller.setMap(mapped.map->coarseOcTree());
-
-  std::unique_ptr<host::planner::ViewPlanner> planner;
-  if (o.planner == "fvp")
-    planner = std::make_unique<host::planner::FvpPlanner>(
-        o.planner_config.empty() ? host::planner::PlannerConfig{}
-                                 : host::planner::PlannerConfig::fromYamlFile(o.planner_config),
-        o.seed, backend.get());
-  else
-    planner = std::make_unique<host::planner::RvpPlanner>(
-        o.planner_config.empty() ? host::planner::RvpConfig{}
-                                 : host::planner::RvpConfig::fromYamlFile(o.planner_config),
-        o.seed);
 
   nlohmann::json motions = nlohmann::json::array();
   const auto t_plan = std::chrono::steady_clock::now();
@@ -132,7 +141,8 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
       {"rejected_clearance", step.rejected_clearance},
       {"gain_rays", step.gain_rays},
       {"culled_rays", step.culled_rays},
-      {"motions", motions}};
+      {"motions", motions},
+      {"warnings", warnings}};
   if (!o.out_dir.empty()) {
     std::filesystem::create_directories(o.out_dir);
     host::writePlyColoredPoints(o.out_dir / "candidates.ply", positions, colours,

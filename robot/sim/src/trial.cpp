@@ -14,6 +14,7 @@
 
 #include "fvp/accel/backend.h"
 #include "fvp/host/core/atomic_file.h"
+#include "fvp/host/core/output_directory.h"
 #include "fvp/host/planner/view_planner.h"
 #include "fvp/host/session/mapping_session.h"
 #include "fvp/robot/arm_controller.h"
@@ -65,9 +66,25 @@ struct TrialEvents {
 
 nlohmann::json runTrial(const TrialOptions& options) {
   validate(options);
+  if (!options.out_dir.empty()) {
+    host::prepareOutputDirectory(options.out_dir, "trial output directory");
+    host::removeStaleOutputs(options.out_dir, TrialParts::outputFiles(), {"views"});
+  }
+  std::vector<std::string> warnings;
+  const auto warn = [&](const std::string& text) {
+    warnings.push_back(text);
+    if (options.on_warning) options.on_warning(text);
+  };
   const auto wall_start = Clock::now();
   const std::string engine =
       options.engine.empty() ? defaultEngine(options.planner) : options.engine;
+
+  // Maps (and TSDF) fed view by view, the planner, and the sizing at the end. First: a
+  // missing backend or a bad planner config fails before the world and the arm are built.
+  std::unique_ptr<accel::Backend> backend;
+  if (engine == "grid" || options.backend != "auto")
+    backend = accel::createBackend(options.backend);
+  TrialParts parts(options, engine, backend.get());
 
   // The world and the simulated camera.
   const WorldConfig world_config = options.world_config.empty()
@@ -85,18 +102,15 @@ nlohmann::json runTrial(const TrialOptions& options) {
   const ArmModel arm(arm_config);
   std::ostringstream arm_log;
   const WorkspaceTree workspace = WorkspaceTree::loadOrBuild(arm, arm_log);
+  std::istringstream arm_log_lines(arm_log.str());
+  for (std::string line; std::getline(arm_log_lines, line);)
+    if (line.rfind("warning: ", 0) == 0) warn(line.substr(9));
   SimClock clock = SimClock::fromConfig(arm_config);
   const auto start = ArmController::startConfiguration(arm, world.startCameraPose());
   if (!start)
     throw std::runtime_error("world seed " + std::to_string(options.seed) +
                              ": the start view is out of the arm's reach");
   ArmController controller(arm, clock, *start);
-
-  // Maps (and TSDF) fed view by view, the planner, and the sizing at the end.
-  std::unique_ptr<accel::Backend> backend;
-  if (engine == "grid" || options.backend != "auto")
-    backend = accel::createBackend(options.backend);
-  TrialParts parts(options, engine, backend.get());
 
   TrialEvents events;
   nlohmann::json view_log = nlohmann::json::array();
@@ -252,7 +266,9 @@ nlohmann::json runTrial(const TrialOptions& options) {
   for (const auto& p : camera_path) path.push_back(vec3(p));
   result["camera_path_m"] = path;
 
-  if (!options.out_dir.empty()) parts.writeOutputs(result, world, camera_path, options.out_dir);
+  result["warnings"] = warnings;
+  if (!options.out_dir.empty())
+    parts.writeOutputs(result, world, camera_path, options.out_dir, warn);
   return result;
 }
 

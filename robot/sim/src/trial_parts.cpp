@@ -145,7 +145,7 @@ std::string fmtOrDash(const nlohmann::json& v, int precision) {
 void plotCameraPath(const World& world, const std::vector<Eigen::Vector3d>& path,
                     const std::filesystem::path& png) {
   std::ostringstream s;
-  s << "set terminal pngcairo size 1200,560 font 'DejaVu Sans,11'\nset output '{png}'\n"
+  s << "set terminal pngcairo size 1200,560 font 'DejaVu Sans,11'\n"
     << "set multiplot layout 1,2 title 'Camera positions (numbered in capture order) and "
        "fruitlets'\nset size ratio -1\nset grid\nset key bottom right\n";
   const auto block = [&](int a, int b) {
@@ -173,15 +173,39 @@ void plotCameraPath(const World& world, const std::vector<Eigen::Vector3d>& path
 
 }  // namespace
 
-void TrialParts::writeOutputs(const nlohmann::json& result, const World& world,
+const std::vector<std::string>& TrialParts::outputFiles() {
+  static const std::vector<std::string> files = {"result.json",  "report.md",   "coarse.bt",
+                                                 "fine.ot",      "surface.ply", "mesh.ply",
+                                                 "clusters.ply", "path.png"};
+  return files;
+}
+
+void TrialParts::writeOutputs(nlohmann::json& result, const World& world,
                               const std::vector<Eigen::Vector3d>& camera_path,
-                              const std::filesystem::path& out_dir) const {
+                              const std::filesystem::path& out_dir,
+                              const std::function<void(const std::string&)>& warn) const {
   std::filesystem::create_directories(out_dir);
+  // The result first: nothing after it (a full disk, a missing gnuplot) can lose it.
+  const auto write_result = [&] {
+    host::writeFileAtomically(out_dir / "result.json", "trial result", result.dump(2) + "\n");
+  };
+  write_result();
   if (const host::map::MapEngine* map = impl_->session.map()) {
     map->exportCoarse(out_dir / "coarse.bt");
     map->exportFine(out_dir / "fine.ot");
   }
-  if (!camera_path.empty()) plotCameraPath(world, camera_path, out_dir / "path.png");
+  bool path_drawn = false;
+  if (!camera_path.empty()) {
+    try {
+      plotCameraPath(world, camera_path, out_dir / "path.png");
+      path_drawn = true;
+    } catch (const std::exception& e) {
+      const std::string text = std::string("path.png not drawn: ") + e.what();
+      result["warnings"].push_back(text);
+      if (warn) warn(text);
+      write_result();
+    }
+  }
   const auto& sz = impl_->sizing;
   host::writePlyPoints(out_dir / "surface.ply", impl_->session.surfacePoints());
   const host::tsdf::TriangleMesh mesh = impl_->session.surfaceMesh();
@@ -226,7 +250,11 @@ void TrialParts::writeOutputs(const nlohmann::json& result, const World& world,
   for (const auto& [part, s] : result["wall_breakdown_s"].items())
     md << "| " << part << " | " << fmt(s, 2) << " |\n";
   md << "\n## Counted events\n\n```json\n" << result["events"].dump(2) << "\n```\n";
-  if (!camera_path.empty()) md << "\n## Camera path\n\n![camera path](path.png)\n";
+  if (path_drawn) md << "\n## Camera path\n\n![camera path](path.png)\n";
+  if (!result["warnings"].empty()) {
+    md << "\n## Warnings\n\n";
+    for (const auto& w : result["warnings"]) md << "- " << w.get<std::string>() << "\n";
+  }
   md << "\n## Captured views\n\n";
   for (std::size_t v = 0; v < camera_path.size(); ++v) {
     std::ostringstream name;
@@ -235,7 +263,6 @@ void TrialParts::writeOutputs(const nlohmann::json& result, const World& world,
   }
   md << "\n";
   host::writeFileAtomically(out_dir / "report.md", "trial report", md.str());
-  host::writeFileAtomically(out_dir / "result.json", "trial result", result.dump(2) + "\n");
 }
 
 }  // namespace fvp::robot::sim

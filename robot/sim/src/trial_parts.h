@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -59,10 +60,15 @@ class TrialParts {
   /// Sizes the fruitlets from the views so far and scores them against the world's ground
   /// truth: {"fruitlets", "detections", "metrics", ...} of result.json.
   nlohmann::json sizeAndScore(const World& world, const std::filesystem::path& out_dir);
-  /// Maps, surface, clusters, report.md and result.json (atomically) into out_dir.
-  void writeOutputs(const nlohmann::json& result, const World& world,
+  /// result.json first, then the maps, surface, clusters, the camera-path figure and
+  /// report.md, each atomically, into out_dir. A figure that cannot be drawn is passed to
+  /// warn and added to result["warnings"] (result.json is written again then).
+  void writeOutputs(nlohmann::json& result, const World& world,
                     const std::vector<Eigen::Vector3d>& camera_path,
-                    const std::filesystem::path& out_dir) const;
+                    const std::filesystem::path& out_dir,
+                    const std::function<void(const std::string&)>& warn) const;
+  /// The files writeOutputs writes (relative to out_dir), besides views/NNN.png.
+  static const std::vector<std::string>& outputFiles();
 
  private:
   struct Impl;

@@ -123,24 +123,15 @@ WorldConfig WorldConfig::fromYamlFile(const std::filesystem::path& path) {
     return config;
   }
   for (const auto& entry : root) {
-    const std::string key = entry.first.as<std::string>();
+    const std::string key = host::keyText(entry.first, source);
     const KeySpec* spec = &host::findKeySpec(keySpecs(), key, source);
-    const YAML::Node& value = entry.second;
-    const bool is_int = std::holds_alternative<int WorldConfig::*>(spec->member);
-    const std::string expected = is_int ? "an integer" : "a number";
-    if (!value.IsScalar()) {
-      throw std::invalid_argument(source + ": key '" + key + "' must be " + expected);
-    }
-    try {
-      if (is_int) {
-        config.*std::get<int WorldConfig::*>(spec->member) = value.as<int>();
-      } else {
-        config.*std::get<double WorldConfig::*>(spec->member) = value.as<double>();
-      }
-    } catch (const YAML::Exception&) {
-      throw std::invalid_argument(source + ": key '" + key + "' must be " + expected + ", got '" +
-                                  value.Scalar() + "'");
-    }
+    const std::string where = source + ": key '" + key + "'";
+    if (std::holds_alternative<int WorldConfig::*>(spec->member))
+      config.*std::get<int WorldConfig::*>(spec->member) =
+          host::readScalar<int>(entry.second, where, "an integer");
+    else
+      config.*std::get<double WorldConfig::*>(spec->member) =
+          host::readScalar<double>(entry.second, where, "a number");
   }
   config.validate(source);
   return config;

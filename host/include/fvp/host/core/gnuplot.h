@@ -8,10 +8,10 @@
 
 namespace fvp::host {
 
-/// Runs gnuplot on `script` (which must set its own terminal and output; `{png}` in the
-/// script is replaced by the temporary output path) and renames the result to png_path, so
-/// a figure is never half-written. Throws std::runtime_error naming the figure when gnuplot
-/// is missing or fails (its messages included).
+/// Runs gnuplot (no shell) on `script`, which sets a PNG terminal and no output, so the PNG
+/// comes back on gnuplot's standard output; writes it to png_path atomically (a figure is
+/// never half-written). Throws std::runtime_error naming the figure when gnuplot is missing
+/// or fails (its messages included). Callers treat a figure as an optional extra.
 void plotWithGnuplot(const std::string& script, const std::filesystem::path& png_path,
                      const std::string& what);
 

@@ -5,10 +5,12 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <filesystem>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace fvp::host {
@@ -16,6 +18,11 @@ namespace fvp::host {
 /// The file's top-level node: null for an empty file, else a mapping. Throws
 /// std::invalid_argument when the file cannot be read as YAML or is not a mapping.
 inline YAML::Node readYamlMapping(const std::filesystem::path& path, const std::string& source) {
+  // yaml-cpp reads a directory as an empty document, which would mean "all defaults".
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw std::invalid_argument(source + ": not a readable file" +
+                                (std::filesystem::is_directory(path, ec) ? " (a directory)" : ""));
   YAML::Node root;
   try {
     root = YAML::LoadFile(path.string());
@@ -25,6 +32,31 @@ inline YAML::Node readYamlMapping(const std::filesystem::path& path, const std::
   if (!root.IsNull() && !root.IsMap())
     throw std::invalid_argument(source + ": expected a mapping of key: value");
   return root;
+}
+
+/// A mapping key as text; a key that is a list or a mapping is an error naming the source.
+inline std::string keyText(const YAML::Node& key, const std::string& source) {
+  if (!key.IsScalar()) throw std::invalid_argument(source + ": expected plain text keys");
+  return key.Scalar();
+}
+
+/// node as T: a scalar that converts to T and, for floating point, is finite (yaml-cpp
+/// reads .nan and .inf). Throws std::invalid_argument "WHERE: expected EXPECTED, got 'X'".
+template <typename T>
+T readScalar(const YAML::Node& node, const std::string& where, const std::string& expected) {
+  if (!node.IsScalar()) throw std::invalid_argument(where + ": expected " + expected);
+  T value{};
+  try {
+    value = node.as<T>();
+  } catch (const YAML::Exception&) {
+    throw std::invalid_argument(where + ": expected " + expected + ", got '" + node.Scalar() + "'");
+  }
+  if constexpr (std::is_floating_point_v<T>) {
+    if (!std::isfinite(value))
+      throw std::invalid_argument(where + ": expected " + expected + " (finite), got '" +
+                                  node.Scalar() + "'");
+  }
+  return value;
 }
 
 /// The spec whose `name` is key; throws std::invalid_argument listing the known keys.

@@ -5,8 +5,10 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "fvp/host/sizing/fruitlet_sizer.h"
 
@@ -19,16 +21,26 @@ namespace fvp::host {
 struct CaptureSizingOptions {
   sizing::SizingEstimator estimator = sizing::SizingEstimator::kOurs;
   std::string engine = "grid";    ///< map engine (grid needs backend)
-  std::filesystem::path out_dir;  ///< fruitlets.json, surface.ply, clusters.ply
+  std::filesystem::path out_dir;  ///< fruitlets.json, surface.ply, mesh.ply, clusters.ply
+  /// Called with each warning as it happens; every warning is also in the result's
+  /// "warnings" list.
+  std::function<void(const std::string&)> on_warning;
 };
 
 /// The capture directories of a set: dir itself when it holds camera.yaml, else its
-/// subdirectories that do, sorted by name. Throws std::runtime_error naming dir when none.
-std::vector<std::filesystem::path> listCaptures(const std::filesystem::path& dir);
+/// subdirectories that do, sorted by name. Throws std::runtime_error naming the directory
+/// when there is none, when dir holds camera.yaml and capture subdirectories too (which one
+/// was meant?), and when a subdirectory holds capture files but no camera.yaml (an
+/// incomplete capture: writeCapture writes camera.yaml last). Other subdirectories are
+/// skipped and reported through `skipped`.
+std::vector<std::filesystem::path> listCaptures(const std::filesystem::path& dir,
+                                                std::vector<std::string>* skipped = nullptr);
 
 /// Sizes the set and writes fruitlets.json (centres, sizes, per-image sizes, estimator,
-/// counted events; with ground truth: the match, MAE and MAPE of both estimators),
-/// surface.ply and clusters.ply into options.out_dir. Returns fruitlets.json's object.
+/// counted events, warnings; with ground truth: the match, MAE and MAPE of both
+/// estimators), then surface.ply, mesh.ply and clusters.ply into options.out_dir, which is
+/// checked (and cleared of those files) before the first capture is read. Returns
+/// fruitlets.json's object.
 nlohmann::json sizeCaptureSet(const std::filesystem::path& captures_dir,
                               const CaptureSizingOptions& options, accel::Backend* backend);
 

@@ -36,10 +36,16 @@ struct TrialOptions {
   /// nothing is written (the result is only returned).
   std::filesystem::path out_dir;
   std::function<void(const TrialProgress&)> on_progress;  ///< called after every view
+  /// Called with each warning as it happens (a rebuilt workspace cache, a figure not
+  /// drawn, a view without fruitlet pixels); every warning is also in result["warnings"].
+  std::function<void(const std::string&)> on_warning;
 };
 
 /// Runs one trial and returns its result.json object (the contract of DESIGN.md section 9),
-/// also written atomically to out_dir/result.json when out_dir is set. Throws
+/// also written atomically to out_dir/result.json when out_dir is set. out_dir is checked
+/// before the trial starts and the files an earlier trial left there are removed; result.json
+/// is written before the extras (maps, clouds, figures), and a figure that cannot be drawn is
+/// a warning, not an error. Throws
 /// std::invalid_argument / std::runtime_error for bad options or files (misconfiguration);
 /// expected events (failed motions, IK failures, dropped disparities, empty clusters) are
 /// counted in the result, never thrown.

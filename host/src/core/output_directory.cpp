@@ -1,0 +1,54 @@
+#include "fvp/host/core/output_directory.h"
+
+#include <algorithm>
+#include <cctype>
+#include <stdexcept>
+#include <system_error>
+
+#include "fvp/host/core/atomic_file.h"
+
+namespace fvp::host {
+namespace fs = std::filesystem;
+
+void prepareOutputDirectory(const fs::path& dir, const std::string& what) {
+  const std::string where = what + " '" + dir.string() + "'";
+  std::error_code ec;
+  const fs::file_status status = fs::status(dir, ec);
+  if (fs::exists(status) && !fs::is_directory(status))
+    throw std::runtime_error(where + ": exists and is not a directory");
+  fs::create_directories(dir, ec);
+  if (ec) throw std::runtime_error(where + ": cannot create the directory: " + ec.message());
+  try {
+    writeFileAtomically(dir / ".fvp-write-check", "output directory check", "");
+  } catch (const std::exception&) {
+    throw std::runtime_error(where + ": cannot write files in it");
+  }
+  fs::remove(dir / ".fvp-write-check", ec);
+}
+
+void removeStaleOutputs(const fs::path& dir, const std::vector<std::string>& outputs,
+                        const std::vector<std::string>& numbered_dirs) {
+  const auto remove = [](const fs::path& path) {
+    std::error_code ec;
+    if (fs::is_directory(path)) return;  // never a directory the user made
+    fs::remove(path, ec);
+    if (ec)
+      throw std::runtime_error(path.string() +
+                               ": cannot remove the file an earlier run left: " + ec.message());
+  };
+  for (const std::string& name : outputs) remove(dir / name);
+  for (const std::string& sub : numbered_dirs) {
+    std::error_code ec;
+    if (!fs::is_directory(dir / sub, ec)) continue;
+    std::vector<fs::path> stale;
+    for (const auto& entry : fs::directory_iterator(dir / sub, ec)) {
+      const std::string stem = entry.path().stem().string();
+      if (entry.path().extension() == ".png" && !stem.empty() &&
+          std::all_of(stem.begin(), stem.end(), [](unsigned char c) { return std::isdigit(c); }))
+        stale.push_back(entry.path());
+    }
+    for (const fs::path& path : stale) remove(path);
+  }
+}
+
+}  // namespace fvp::host

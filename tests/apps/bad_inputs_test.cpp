@@ -1,0 +1,340 @@
+// The `fvp` program on broken captures, configs and option values, run as a user runs it:
+// each case must end with exit code 1 (a bad file or value) or 2 (a usage error), never a
+// signal, with a message naming the file and field or the option, and leave no half-written
+// (*.tmp-*) or result file behind. A second group checks the documented warnings.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
+
+#include "fvp/host/core/subprocess.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const char* const kFvp = FVP_BINARY;
+
+void writeText(const fs::path& path, const std::string& text) {
+  fs::create_directories(path.parent_path());
+  std::ofstream(path) << text;
+}
+
+/// camera.yaml of a 320x240 camera looking along +z from the origin, with `extra` lines
+/// replacing the defaults of the same key.
+std::string cameraYaml(const std::vector<std::pair<std::string, std::string>>& overrides = {}) {
+  std::vector<std::pair<std::string, std::string>> fields = {
+      {"format_version", "1"}, {"width", "320"}, {"height", "240"}, {"fx", "300"},
+      {"fy", "300"},           {"cx", "159.5"},  {"cy", "119.5"},   {"baseline_m", "0.05"}};
+  for (auto& [key, value] : fields)
+    for (const auto& [k, v] : overrides)
+      if (k == key) value = v;
+  std::string text;
+  for (const auto& [key, value] : fields) text += key + ": " + value + "\n";
+  text += "T_world_camera: [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]\n";
+  return text;
+}
+
+/// A capture of uniform grey images (no fruitlet, no tag) at dir.
+void writeGreyCapture(const fs::path& dir, int width = 320, int height = 240,
+                      const std::string& yaml = cameraYaml()) {
+  fs::create_directories(dir);
+  const cv::Mat grey(height, width, CV_8UC3, cv::Scalar(128, 128, 128));
+  cv::imwrite((dir / "left.png").string(), grey);
+  cv::imwrite((dir / "right.png").string(), grey);
+  writeText(dir / "camera.yaml", yaml);
+}
+
+struct BadInput {
+  std::string name;
+  /// Makes the case's files under dir and returns the command line (without the program).
+  std::function<std::vector<std::string>(const fs::path& dir)> setup;
+  int exit_code;                      ///< 1: bad file or value; 2: usage error
+  std::vector<std::string> messages;  ///< each must appear in stderr
+  std::vector<std::string> absent;    ///< paths under dir that must not exist afterwards
+};
+
+std::ostream& operator<<(std::ostream& os, const BadInput& c) {
+  return os << c.name;
+}
+
+std::vector<std::string> temporaries(const fs::path& dir) {
+  std::vector<std::string> found;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    if (e.path().filename().string().find(".tmp-") != std::string::npos)
+      found.push_back(e.path().string());
+  return found;
+}
+
+std::string p(const fs::path& path) {
+  return path.string();
+}
+
+const std::vector<BadInput>& cases() {
+  static const std::vector<BadInput> table = {
+      {"SizeFocalLengthInMetres",
+       [](const fs::path& d) {
+         writeGreyCapture(d / "cap", 320, 240, cameraYaml({{"fx", "0.004"}, {"fy", "0.004"}}));
+         return std::vector<std::string>{"size", "--captures", p(d / "cap"), "--backend",
+                                         "cpu",  "--out",      p(d / "out")};
+       },
+       1,
+       {"camera.yaml: field 'fx': expected a focal length in pixels"},
+       {"out/fruitlets.json"}},
+      {"SizeTwoPixelImages",
+       [](const fs::path& d) {
+         writeGreyCapture(d / "cap", 2, 2, cameraYaml({{"width", "2"}, {"height", "2"}}));
+         return std::vector<std::string>{"size", "--captures", p(d / "cap"), "--out", p(d / "out")};
+       },
+       1,
+       {"camera.yaml: field 'width': expected an image side of 32 to 16384 pixels, got 2"},
+       {"out/fruitlets.json"}},
+      {"SizeNonFiniteIntrinsic",
+       [](const fs::path& d) {
+         writeGreyCapture(d / "cap", 320, 240, cameraYaml({{"cx", ".nan"}}));
+         return std::vector<std::string>{"size", "--captures", p(d / "cap"), "--out", p(d / "out")};
+       },
+       1,
+       {"camera.yaml: field 'cx'"},
+       {"out/fruitlets.json"}},
+      {"SizeViewWithoutCameraYaml",
+       [](const fs::path& d) {
+         writeGreyCapture(d / "set" / "000");
+         writeGreyCapture(d / "set" / "001");
+         fs::remove(d / "set" / "001" / "camera.yaml");
+         return std::vector<std::string>{"size", "--captures", p(d / "set"), "--out", p(d / "out")};
+       },
+       1,
+       {"001: holds capture files but no camera.yaml"},
+       {"out/fruitlets.json"}},
+      {"SizeStrayCameraYamlAtTheSetsRoot",
+       [](const fs::path& d) {
+         writeGreyCapture(d / "set" / "000");
+         writeText(d / "set" / "camera.yaml", cameraYaml());
+         return std::vector<std::string>{"size", "--captures", p(d / "set"), "--out", p(d / "out")};
+       },
+       1,
+       {"holds camera.yaml and capture subdirectories too"},
+       {"out/fruitlets.json"}},
+      {"SizeOutIsAFile",
+       [](const fs::path& d) {
+         writeGreyCapture(d / "cap");
+         writeText(d / "out", "not a directory");
+         return std::vector<std::string>{"size", "--captures", p(d / "cap"), "--out", p(d / "out")};
+       },
+       1,
+       {"out': exists and is not a directory"},
+       {}},
+      {"RunOutIsAFile",
+       [](const fs::path& d) {
+         writeText(d / "out", "x");
+         return std::vector<std::string>{"run", "--seed", "1",         "--backend",
+                                         "cpu", "--out",  p(d / "out")};
+       },
+       1,
+       {"exists and is not a directory"},
+       {}},
+      {"MapOutIsAFile",
+       [](const fs::path& d) {
+         writeText(d / "out", "x");
+         return std::vector<std::string>{"map", "--seed", "1", "--out", p(d / "out")};
+       },
+       1,
+       {"--out '", "exists and is not a directory"},
+       {}},
+      {"PlanOutIsAFile",
+       [](const fs::path& d) {
+         writeText(d / "out", "x");
+         return std::vector<std::string>{"plan", "--seed", "1",         "--backend",
+                                         "cpu",  "--out",  p(d / "out")};
+       },
+       1,
+       {"exists and is not a directory"},
+       {}},
+      {"CaptureOutIsAFile",
+       [](const fs::path& d) {
+         writeText(d / "out", "x");
+         return std::vector<std::string>{"capture", "--seed", "1", "--out", p(d / "out")};
+       },
+       1,
+       {"exists and is not a directory"},
+       {}},
+      {"CapturePoseNaN",
+       [](const fs::path& d) {
+         return std::vector<std::string>{"capture",         "--seed", "1",         "--pose",
+                                         "nan,0,1,0,0,0,1", "--out",  p(d / "out")};
+       },
+       1,
+       {"--pose: 'nan' is not a finite number"},
+       {"out/camera.yaml"}},
+      {"CapturePoseFarAway",
+       [](const fs::path& d) {
+         return std::vector<std::string>{"capture",         "--seed", "1",         "--pose",
+                                         "1e9,0,1,0,0,0,1", "--out",  p(d / "out")};
+       },
+       1,
+       {"--pose: field 'x,y,z': expected a position within 1000 m"},
+       {"out/camera.yaml"}},
+      {"CaptureSetOverAnOlderSet",
+       [](const fs::path& d) {
+         writeGreyCapture(d / "out" / "000");
+         return std::vector<std::string>{"capture", "--seed", "1",         "--views",
+                                         "2",       "--out",  p(d / "out")};
+       },
+       1,
+       {"already holds captures (000)"},
+       {"out/001"}},
+      {"SeedNegative",
+       [](const fs::path& d) {
+         return std::vector<std::string>{"run", "--seed", "-1", "--out", p(d / "out")};
+       },
+       2,
+       {"--seed", "non-negative decimal integer, got '-1'"},
+       {"out"}},
+      {"SeedOctal",
+       [](const fs::path& d) {
+         return std::vector<std::string>{"plan", "--seed", "010", "--out", p(d / "out")};
+       },
+       2,
+       {"--seed", "without leading zeros"},
+       {"out"}},
+      {"BudgetInfinite",
+       [](const fs::path& d) {
+         return std::vector<std::string>{"run", "--budget-s", "inf", "--out", p(d / "out")};
+       },
+       2,
+       {"--budget-s", "finite"},
+       {"out"}},
+      {"MaxViewsNegative",
+       [](const fs::path& d) {
+         return std::vector<std::string>{"run", "--max-views", "-1", "--out", p(d / "out")};
+       },
+       2,
+       {"--max-views"},
+       {"out"}},
+      {"UnknownSubcommand",
+       [](const fs::path&) {
+         return std::vector<std::string>{"frobnicate", "--out", "x"};
+       },
+       2,
+       {"unknown subcommand 'frobnicate'"},
+       {}},
+      {"RvpConfigNaN",
+       [](const fs::path& d) {
+         writeText(d / "rvp.yaml", "roi_utility_threshold: .nan\n");
+         return std::vector<std::string>{"plan",  "--planner", "rvp", "--config", p(d / "rvp.yaml"),
+                                         "--out", p(d / "out")};
+       },
+       1,
+       {"rvp.yaml': key 'roi_utility_threshold': expected a number (finite), got '.nan'"},
+       {"out/plan.json"}},
+      {"PlannerConfigInfinity",
+       [](const fs::path& d) {
+         writeText(d / "fvp.yaml", "alpha_per_m: .inf\n");
+         return std::vector<std::string>{"run", "--config", p(d / "fvp.yaml"), "--backend",
+                                         "cpu", "--out",    p(d / "out")};
+       },
+       1,
+       {"fvp.yaml': key 'alpha_per_m': expected a number (finite)"},
+       {"out/result.json"}},
+      {"WorldConfigListAsKey",
+       [](const fs::path& d) {
+         writeText(d / "world.yaml", "[a, b]: 1\n");
+         return std::vector<std::string>{"run", "--world", p(d / "world.yaml"), "--backend",
+                                         "cpu", "--out",   p(d / "out")};
+       },
+       1,
+       {"world.yaml': expected plain text keys"},
+       {"out/result.json"}},
+      {"WorldConfigListAsNumber",
+       [](const fs::path& d) {
+         writeText(d / "world.yaml", "cluster_spread_m: [1, 2]\n");
+         return std::vector<std::string>{"capture", "--world", p(d / "world.yaml"), "--seed",
+                                         "1",       "--out",   p(d / "out")};
+       },
+       1,
+       {"world.yaml': key 'cluster_spread_m': expected a number"},
+       {"out/camera.yaml"}},
+      {"WorldConfigSyntaxError",
+       [](const fs::path& d) {
+         writeText(d / "world.yaml", "cluster_spread_m: [1, 2\n");
+         return std::vector<std::string>{"map", "--world", p(d / "world.yaml"), "--out",
+                                         p(d / "out")};
+       },
+       1,
+       {"world.yaml': cannot read YAML"},
+       {"out/coarse.bt"}},
+      {"MapConfigIsADirectory",
+       [](const fs::path& d) {
+         fs::create_directories(d / "map.yaml");
+         return std::vector<std::string>{"map", "--map-config", p(d / "map.yaml"), "--out",
+                                         p(d / "out")};
+       },
+       2,
+       {"--map-config", "map.yaml"},
+       {"out/coarse.bt"}},
+      {"MapConfigNumberAsText",
+       [](const fs::path& d) {
+         writeText(d / "map.yaml", "fine_voxel_size_m: fine\n");
+         return std::vector<std::string>{"map", "--map-config", p(d / "map.yaml"), "--out",
+                                         p(d / "out")};
+       },
+       1,
+       {"map.yaml': key 'fine_voxel_size_m': expected a number, got 'fine'"},
+       {"out/coarse.bt"}},
+  };
+  return table;
+}
+
+class BadInputs : public ::testing::TestWithParam<BadInput> {};
+
+TEST_P(BadInputs, ExitWithAClearErrorAndWriteNothing) {
+  const BadInput& c = GetParam();
+  const fs::path dir = fs::path(::testing::TempDir()) / ("fvp_bad_inputs_" + c.name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::vector<std::string> argv = {kFvp};
+  for (const std::string& a : c.setup(dir)) argv.push_back(a);
+  const fvp::host::SubprocessResult run = fvp::host::runProgram(argv, "");
+  SCOPED_TRACE("stderr: " + run.stderr_text + "\nstdout: " + run.stdout_text);
+  EXPECT_EQ(run.exit_code, c.exit_code) << "-1 means a signal ended fvp";
+  for (const std::string& m : c.messages)
+    EXPECT_NE(run.stderr_text.find(m), std::string::npos) << "missing: " << m;
+  for (const std::string& a : c.absent) EXPECT_FALSE(fs::exists(dir / a)) << a;
+  EXPECT_EQ(temporaries(dir), std::vector<std::string>{});
+}
+
+INSTANTIATE_TEST_SUITE_P(Fvp, BadInputs, ::testing::ValuesIn(cases()),
+                         [](const auto& info) { return info.param.name; });
+
+// A set whose images hold nothing HSV segmentation or the tag detector can find is not an
+// error: it is sized (to nothing) with printed warnings that fruitlets.json records too.
+TEST(Warnings, GreyCapturesAreSizedWithPrintedAndRecordedWarnings) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "fvp_bad_inputs_grey";
+  fs::remove_all(dir);
+  writeGreyCapture(dir / "set" / "000");
+  writeGreyCapture(dir / "set" / "001");
+  fs::create_directories(dir / "set" / "notes");  // not a capture: skipped with a warning
+  const auto run = fvp::host::runProgram(
+      {kFvp, "size", "--captures", p(dir / "set"), "--backend", "cpu", "--out", p(dir / "out")},
+      "");
+  SCOPED_TRACE(run.stderr_text);
+  ASSERT_EQ(run.exit_code, 0);
+  EXPECT_NE(run.stderr_text.find("fvp: warning: "), std::string::npos);
+  EXPECT_NE(run.stderr_text.find("000: no fruitlet pixels segmented"), std::string::npos);
+  EXPECT_NE(run.stderr_text.find("notes: not a capture (no camera.yaml), skipped"),
+            std::string::npos);
+  EXPECT_NE(run.stderr_text.find("no capture showed the AprilTag"), std::string::npos);
+  std::ifstream in(dir / "out" / "fruitlets.json");
+  const nlohmann::json result = nlohmann::json::parse(in);
+  EXPECT_EQ(result["warnings"].size(), 4u);  // two captures, the skipped folder, no tag
+  EXPECT_EQ(result["captures"][0]["fruitlet_pixels"], 0);
+}
+
+}  // namespace

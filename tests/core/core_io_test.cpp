@@ -1,0 +1,152 @@
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <string>
+
+#include "fvp/host/core/gnuplot.h"
+#include "fvp/host/core/output_directory.h"
+#include "fvp/host/core/subprocess.h"
+
+namespace fs = std::filesystem;
+using namespace fvp::host;
+
+namespace {
+
+fs::path freshDir(const std::string& name) {
+  const fs::path dir = fs::path(::testing::TempDir()) / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+/// Sets an environment variable for the scope, restoring the old value after.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const char* value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old;
+    ::setenv(name, value, 1);
+  }
+  ~ScopedEnv() {
+    if (old_)
+      ::setenv(name_, old_->c_str(), 1);
+    else
+      ::unsetenv(name_);
+  }
+
+ private:
+  const char* name_;
+  std::optional<std::string> old_;
+};
+
+const char* const kScript =
+    "set terminal pngcairo size 200,100\nplot '-' using 1:2 with lines\n0 0\n1 1\ne\n";
+
+TEST(RunProgram, PassesArgumentsVerbatimAndCollectsBothStreams) {
+  // Shell syntax in an argument stays text: no shell ever sees it.
+  const fs::path dir = freshDir("fvp_run_program");
+  const std::string evil = "x'; touch " + (dir / "PWNED").string() + "; echo '";
+  const SubprocessResult r = runProgram({"printf", "%s|", evil, "$HOME"}, "");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_EQ(r.stdout_text, evil + "|$HOME|");
+  EXPECT_FALSE(fs::exists(dir / "PWNED"));
+}
+
+TEST(RunProgram, FeedsLargeInputWhileReadingLargeOutput) {
+  // 4 MB through cat: both pipes fill many times over, so a writer that did not also read
+  // would deadlock.
+  std::string input(4 << 20, 'a');
+  for (std::size_t i = 0; i < input.size(); i += 97) input[i] = char('a' + i % 26);
+  const SubprocessResult r = runProgram({"cat"}, input);
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_EQ(r.stdout_text, input);
+}
+
+TEST(RunProgram, ReportsExitCodesAndAProgramThatStopsReading) {
+  const SubprocessResult r = runProgram({"sh", "-c", "echo oops >&2; exit 3"}, "");
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_EQ(r.stderr_text, "oops\n");
+  // `true` exits without reading 1 MB of input: EPIPE, not a SIGPIPE that kills us.
+  EXPECT_EQ(runProgram({"true"}, std::string(1 << 20, 'x')).exit_code, 0);
+}
+
+TEST(RunProgram, AMissingProgramIsAnErrorNamingIt) {
+  try {
+    runProgram({"fvp-no-such-program"}, "");
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot start 'fvp-no-such-program'"), std::string::npos);
+  }
+}
+
+TEST(Gnuplot, DrawsIntoADirectoryWhoseNameHoldsShellAndGnuplotQuotes) {
+  const fs::path root = freshDir("fvp_gnuplot_quotes");
+  const fs::path dir = root / "x'; touch PWNED; echo '\" `id`";
+  fs::create_directories(dir);
+  const fs::path png = dir / "a'b.png";
+  plotWithGnuplot(kScript, png, "test figure");
+  std::ifstream in(png, std::ios::binary);
+  std::string head(8, '\0');
+  in.read(head.data(), 8);
+  EXPECT_EQ(head, std::string("\x89PNG\r\n\x1a\n", 8));
+  EXPECT_FALSE(fs::exists("PWNED"));
+  EXPECT_FALSE(fs::exists(root / "PWNED"));
+  // Only the figure: no script, log or temporary left beside it.
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
+}
+
+TEST(Gnuplot, MissingGnuplotIsAnErrorAndWritesNothing) {
+  const fs::path dir = freshDir("fvp_gnuplot_missing");
+  const ScopedEnv path("PATH", "/nonexistent");
+  EXPECT_THROW(plotWithGnuplot(kScript, dir / "f.png", "test figure"), std::runtime_error);
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
+TEST(Gnuplot, AScriptErrorIsAnErrorWithGnuplotsMessage) {
+  const fs::path dir = freshDir("fvp_gnuplot_error");
+  try {
+    plotWithGnuplot("set terminal pngcairo\nplot sin(x) with nonsense\n", dir / "f.png", "fig");
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("fig: gnuplot failed"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
+TEST(OutputDirectory, CreatesAMissingDirectoryAndRefusesAFile) {
+  const fs::path dir = freshDir("fvp_output_directory");
+  prepareOutputDirectory(dir / "a" / "b", "--out");
+  EXPECT_TRUE(fs::is_directory(dir / "a" / "b"));
+  EXPECT_TRUE(fs::is_empty(dir / "a" / "b"));
+  std::ofstream(dir / "file") << "x";
+  try {
+    prepareOutputDirectory(dir / "file", "--out");
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "--out '" + (dir / "file").string() + "': exists and is not a directory");
+  }
+  EXPECT_THROW(prepareOutputDirectory(dir / "file" / "sub", "--out"), std::runtime_error);
+}
+
+TEST(OutputDirectory, RemovesOnlyWhatAnEarlierRunWrote) {
+  const fs::path dir = freshDir("fvp_stale_outputs");
+  for (const char* name : {"result.json", "notes.txt", "views/007.png", "views/cover.png",
+                           "views/12.jpg", "views/0001.png"}) {
+    fs::create_directories((dir / name).parent_path());
+    std::ofstream(dir / name) << "x";
+  }
+  fs::create_directories(dir / "report.md");  // a directory is never removed
+  removeStaleOutputs(dir, {"result.json", "report.md", "missing.ply"}, {"views", "none"});
+  EXPECT_FALSE(fs::exists(dir / "result.json"));
+  EXPECT_FALSE(fs::exists(dir / "views/007.png"));
+  EXPECT_FALSE(fs::exists(dir / "views/0001.png"));
+  EXPECT_TRUE(fs::exists(dir / "notes.txt"));
+  EXPECT_TRUE(fs::exists(dir / "views/cover.png"));
+  EXPECT_TRUE(fs::exists(dir / "views/12.jpg"));
+  EXPECT_TRUE(fs::is_directory(dir / "report.md"));
+}
+
+}  // namespace
