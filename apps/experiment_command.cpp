@@ -1,11 +1,13 @@
 // `fvp experiment` and `fvp merge`: the paper's experiment over many worlds, resumable and
 // shardable (DESIGN.md section 9; docs/experiment.md has the cluster recipe).
 #include <unistd.h>
+#include <filesystem>
 #include <iostream>
 #include <memory>
-#include <sstream>
 #include <string>
+#include <tuple>
 
+#include "cli_checks.h"
 #include "commands.h"
 #include "fvp/robot/sim/experiment.h"
 
@@ -25,13 +27,16 @@ void addExperimentCommands(CLI::App& app) {
   cmd->add_option("--planners", opt->planners, "comma-separated planners (fvp, rvp)")
       ->capture_default_str();
   cmd->add_option("--trials", opt->experiment.trials, "worlds (seeds) per planner")
+      ->check(decimalUnsigned())
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd->add_option("--first-seed", opt->experiment.first_seed, "seed of the first world")
+      ->check(decimalUnsigned())
       ->capture_default_str();
   cmd->add_option("--world", opt->world, "world config YAML")->check(CLI::ExistingFile);
   cmd->add_option("--config", opt->config, "planner config YAML")->check(CLI::ExistingFile);
   cmd->add_option("--budget-s", opt->experiment.trial.budget_s, "simulated budget per trial, s")
+      ->check(finiteNumber())
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd->add_option("--backend", opt->experiment.trial.backend, "cpu | opencl | vulkan | auto")
@@ -42,36 +47,42 @@ void addExperimentCommands(CLI::App& app) {
   cmd->add_option("--clock", opt->experiment.trial.clock, "wall | fixed")
       ->check(CLI::IsMember({"wall", "fixed"}))
       ->capture_default_str();
-  cmd->add_option("--max-views", opt->max_views, "stop each trial after this many views");
-  cmd->add_option("--shard", opt->shard, "run shard i of n (0-based), e.g. 0/4");
+  cmd->add_option("--max-views", opt->max_views,
+                  "stop each trial after this many views (0: no limit)")
+      ->check(decimalUnsigned());
+  cmd->add_option("--shard", opt->shard, "run shard i of n (0-based, 0 <= i < n), e.g. 0/4");
   cmd->add_flag("--resume", opt->experiment.resume, "skip trials already in trials.jsonl");
   cmd->add_option("--out", opt->out, "output directory")->required();
   cmd->callback([opt] {
     robot::sim::ExperimentOptions o = opt->experiment;
+    // Every comma-separated name, empty ones too: the runner rejects empty, unknown and
+    // repeated planners with a message.
     o.planners.clear();
-    std::stringstream list(opt->planners);
-    for (std::string p; std::getline(list, p, ',');)
-      if (!p.empty()) o.planners.push_back(p);
-    if (!opt->shard.empty()) {
-      const auto slash = opt->shard.find('/');
-      try {
-        if (slash == std::string::npos) throw std::invalid_argument("no slash");
-        o.shard_index = std::stoi(opt->shard.substr(0, slash));
-        o.shard_count = std::stoi(opt->shard.substr(slash + 1));
-      } catch (const std::exception&) {
-        throw std::invalid_argument("--shard: expected i/n, e.g. 0/4, got '" + opt->shard + "'");
-      }
+    for (std::size_t from = 0;;) {
+      const std::size_t comma = opt->planners.find(',', from);
+      o.planners.push_back(opt->planners.substr(from, comma - from));
+      if (comma == std::string::npos) break;
+      from = comma + 1;
     }
+    if (opt->planners.empty()) o.planners.clear();
+    if (!opt->shard.empty())
+      std::tie(o.shard_index, o.shard_count) = robot::sim::parseShard(opt->shard);
     o.trial.world_config = opt->world;
     o.trial.planner_config = opt->config;
     if (opt->max_views > 0) o.trial.max_views = opt->max_views;
     o.out_dir = opt->out;
     const bool tty = isatty(STDERR_FILENO);
-    robot::sim::runExperiment(o, robot::sim::runTrial, [tty](const std::string& line) {
+    const auto progress = [tty](const std::string& line) {
       std::cerr << (tty ? "\r\033[K" : "") << line << (tty ? "" : "\n") << std::flush;
-    });
+    };
+    // A warning on a line of its own: the next progress line must not overwrite it.
+    const auto warning = [tty](const std::string& line) {
+      std::cerr << (tty ? "\r\033[K" : "") << "fvp: warning: " << line << "\n" << std::flush;
+    };
+    robot::sim::runExperiment(o, robot::sim::runTrial, progress, warning);
     if (tty) std::cerr << "\n";
-    std::cout << "wrote " << opt->out << "/{trials.jsonl, summary.json, table1.md, sizes.png}\n";
+    std::cout << "wrote " << opt->out << "/{manifest.json, trials.jsonl, summary.json, table1.md"
+              << (std::filesystem::exists(o.out_dir / "sizes.png") ? ", sizes.png" : "") << "}\n";
   });
 
   auto merge_out = std::make_shared<std::string>();
@@ -81,7 +92,9 @@ void addExperimentCommands(CLI::App& app) {
   merge->add_option("--out", *merge_out, "merged output directory")->required();
   merge->callback([merge_out, shards] {
     std::vector<std::filesystem::path> dirs(shards->begin(), shards->end());
-    robot::sim::mergeExperiments(dirs, *merge_out);
+    robot::sim::mergeExperiments(dirs, *merge_out, [](const std::string& line) {
+      std::cerr << "fvp: warning: " << line << "\n";
+    });
     std::cout << "merged " << dirs.size() << " shards into " << *merge_out << "\n";
   });
 }

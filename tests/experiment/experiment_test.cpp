@@ -1,10 +1,13 @@
 // The experiment runner with a deterministic stand-in for the trial (a real trial takes
 // minutes): pooled metrics by hand, resume after an interruption, shard + merge equals one
-// run, and clear errors for corrupt files and unwritable directories.
+// run, and clear errors for corrupt files and unwritable directories; the directory's
+// contract (manifest, duplicates, torn lines, schema, empty shards, plot failures).
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "fvp/robot/sim/experiment.h"
@@ -51,6 +54,29 @@ std::string slurp(const fs::path& p) {
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+/// The message of the std::exception that f throws ("" when it throws none).
+template <typename F>
+std::string errorOf(F&& f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
+
+/// The lines of a file.
+std::vector<std::string> linesOf(const fs::path& p) {
+  std::vector<std::string> lines;
+  std::stringstream s(slurp(p));
+  for (std::string line; std::getline(s, line);) lines.push_back(line);
+  return lines;
+}
+
+void writeText(const fs::path& p, const std::string& text) {
+  std::ofstream(p) << text;
 }
 
 ExperimentOptions options(const fs::path& out, int trials) {
@@ -193,6 +219,372 @@ TEST(Experiment, BadOptionsAreErrors) {
   o.shard_index = 2;
   o.shard_count = 2;
   EXPECT_THROW(runExperiment(o, fakeTrial, nullptr), std::invalid_argument);
+}
+
+TEST(Experiment, ATornOnlyLineIsCutBeforeTheNextTrialIsAppended) {
+  const fs::path whole = freshDir("torn_whole"), out = freshDir("torn_only");
+  runExperiment(options(whole, 1), fakeTrial, nullptr);
+  // The first trial dies (the directory has its manifest and an empty trials.jsonl), then a
+  // write cut short leaves a torn first and only line.
+  EXPECT_THROW(
+      runExperiment(
+          options(out, 1),
+          [](const TrialOptions&) -> nlohmann::json { throw std::runtime_error("killed"); },
+          nullptr),
+      std::runtime_error);
+  writeText(out / "trials.jsonl", "{\"planner\": \"fvp\", \"seed\": 1");
+  ExperimentOptions resume = options(out, 1);
+  resume.resume = true;
+  std::vector<std::string> warnings;
+  runExperiment(resume, fakeTrial, nullptr, [&](const std::string& w) { warnings.push_back(w); });
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("line 1 has no newline"), std::string::npos) << warnings[0];
+  // Valid JSONL: every line one trial, and the same file as the uninterrupted run's.
+  EXPECT_EQ(readTrials(out / "trials.jsonl", nullptr).size(), 2u);
+  EXPECT_EQ(slurp(out / "trials.jsonl"), slurp(whole / "trials.jsonl"));
+  resume.resume = true;
+  EXPECT_NO_THROW(runExperiment(resume, fakeTrial, nullptr));
+}
+
+TEST(Experiment, ADuplicatedLineIsAnErrorNamingBothLines) {
+  const fs::path out = freshDir("duplicate_line");
+  runExperiment(options(out, 2), fakeTrial, nullptr);
+  const std::vector<std::string> lines = linesOf(out / "trials.jsonl");
+  ASSERT_EQ(lines.size(), 4u);
+  { std::ofstream(out / "trials.jsonl", std::ios::app) << lines[1] << "\n"; }
+  const std::string error = errorOf([&] { readTrials(out / "trials.jsonl", nullptr); });
+  EXPECT_NE(error.find("trials.jsonl: lines 2 and 5 hold the same trial (row rvp, seed 10)"),
+            std::string::npos)
+      << error;
+  ExperimentOptions resume = options(out, 2);
+  resume.resume = true;
+  EXPECT_NE(errorOf([&] { runExperiment(resume, fakeTrial, nullptr); }).find("lines 2 and 5"),
+            std::string::npos);
+  // The same planner and seed on another engine is another row, not a duplicate.
+  nlohmann::json other = nlohmann::json::parse(lines[0]);
+  other["engine"] = "octomap";
+  writeText(out / "trials.jsonl", lines[0] + "\n" + other.dump() + "\n");
+  EXPECT_EQ(readTrials(out / "trials.jsonl", nullptr).size(), 2u);
+}
+
+TEST(Experiment, DuplicateOrNoPlannersAreErrors) {
+  int calls = 0;
+  const TrialRunner counting = [&](const TrialOptions& o) { return ++calls, fakeTrial(o); };
+  ExperimentOptions o = options(freshDir("duplicate_planners"), 1);
+  o.planners = {"fvp", "fvp"};
+  const std::string error = errorOf([&] { runExperiment(o, counting, nullptr); });
+  EXPECT_NE(error.find("--planners lists 'fvp' twice"), std::string::npos) << error;
+  o.planners = {};
+  EXPECT_NE(errorOf([&] { runExperiment(o, counting, nullptr); }).find("no planners"),
+            std::string::npos);
+  o.planners = {"fvp", ""};
+  EXPECT_THROW(runExperiment(o, counting, nullptr), std::invalid_argument);
+  EXPECT_EQ(calls, 0);
+  EXPECT_FALSE(fs::exists(o.out_dir));
+}
+
+TEST(Experiment, ShardTextIsParsedStrictly) {
+  EXPECT_EQ(parseShard("0/4"), std::make_pair(0, 4));
+  EXPECT_EQ(parseShard("3/4"), std::make_pair(3, 4));
+  EXPECT_EQ(parseShard("12/13"), std::make_pair(12, 13));
+  for (const char* bad : {"0/4x", "1/2/3", "4/4", "0/0", "-1/2", "+1/2", "01/2", "1/02", " 1/2",
+                          "1 /2", "/2", "1/", "1", "", "0x1/2", "1/9999999999"})
+    EXPECT_THROW(parseShard(bad), std::invalid_argument) << bad;
+  EXPECT_NE(errorOf([] { parseShard("0/4x"); }).find("'4x' is not a decimal integer"),
+            std::string::npos);
+}
+
+TEST(Experiment, ResumeWithAChangedSettingIsRefusedNamingIt) {
+  const fs::path out = freshDir("changed_setting");
+  const fs::path world = freshDir("changed_setting_world.yaml");
+  writeText(world, "fruitlets: 5\n");
+  ExperimentOptions o = options(out, 2);
+  o.trial.world_config = world;
+  runExperiment(o, fakeTrial, nullptr);
+  const nlohmann::json manifest = nlohmann::json::parse(slurp(out / "manifest.json"));
+  EXPECT_EQ(manifest["kind"], "run");
+  EXPECT_EQ(manifest["budget_s"], 180.0);
+  EXPECT_EQ(manifest["world_config"]["path"], fs::absolute(world).string());
+  EXPECT_EQ(manifest["world_config"]["fnv1a64"], fnv1a64Hex("fruitlets: 5\n"));
+  EXPECT_EQ(manifest["planner_config"]["path"], "");
+  ExperimentOptions resume = o;
+  resume.resume = true;
+  resume.trial.budget_s = 90;
+  int calls = 0;
+  const TrialRunner counting = [&](const TrialOptions& t) { return ++calls, fakeTrial(t); };
+  const std::string error = errorOf([&] { runExperiment(resume, counting, nullptr); });
+  EXPECT_NE(error.find("manifest.json: this experiment was made with budget_s 180.0, this run "
+                       "asks for 90.0"),
+            std::string::npos)
+      << error;
+  // Each row-defining setting and each part of the run's plan is checked.
+  const auto refused = [&](const std::function<void(ExperimentOptions&)>& change) {
+    ExperimentOptions r = o;
+    r.resume = true;
+    change(r);
+    return errorOf([&] { runExperiment(r, counting, nullptr); });
+  };
+  const std::string clock = refused([](auto& r) { r.trial.clock = "fixed"; });
+  EXPECT_NE(clock.find("clock wall, this run asks for fixed"), std::string::npos) << clock;
+  EXPECT_NE(refused([](auto& r) { r.trial.max_views = 3; }).find("max_views"), std::string::npos);
+  EXPECT_NE(refused([](auto& r) {
+              r.trial.engine = "octomap";
+            }).find("engine (each planner's own), this run asks for octomap"),
+            std::string::npos);
+  EXPECT_NE(refused([](auto& r) { r.planners = {"fvp"}; }).find("planners fvp,rvp"),
+            std::string::npos);
+  EXPECT_NE(refused([](auto& r) { r.trials = 3; }).find("trials 2"), std::string::npos);
+  EXPECT_NE(refused([](auto& r) { r.first_seed = 11; }).find("first_seed 10"), std::string::npos);
+  EXPECT_NE(refused([](auto& r) {
+              r.shard_index = 1;
+              r.shard_count = 2;
+            }).find("shard 0/1, this run asks for 1/2"),
+            std::string::npos);
+  EXPECT_NE(refused([](auto& r) {
+              r.trial.planner_config = r.trial.world_config;
+            }).find("planner_config built-in defaults"),
+            std::string::npos);
+  // An edited config file under the same path is caught by its hash.
+  writeText(world, "fruitlets: 6\n");
+  EXPECT_NE(refused([](auto&) {})
+                .find("world_config " + fs::absolute(world).string() + " (fnv1a64 " +
+                      fnv1a64Hex("fruitlets: 5\n") + ")"),
+            std::string::npos);
+  writeText(world, "fruitlets: 5\n");
+  EXPECT_EQ(refused([](auto&) {}), "");  // the same settings resume
+  EXPECT_EQ(calls, 0);
+}
+
+TEST(Experiment, ADirectoryWithoutAManifestIsNotResumedOrMerged) {
+  // An experiment directory from an fvp before manifests: trials.jsonl only.
+  const fs::path made = freshDir("old_made"), old = freshDir("old_format");
+  runExperiment(options(made, 1), fakeTrial, nullptr);
+  fs::create_directories(old);
+  fs::copy_file(made / "trials.jsonl", old / "trials.jsonl");
+  ExperimentOptions resume = options(old, 1);
+  resume.resume = true;
+  const std::string error = errorOf([&] { runExperiment(resume, fakeTrial, nullptr); });
+  EXPECT_NE(error.find("trials.jsonl: no manifest.json beside it"), std::string::npos) << error;
+  const std::string merge_error = errorOf([&] {
+    mergeExperiments({made, old}, freshDir("old_merged"));
+  });
+  EXPECT_NE(merge_error.find(old.string() + " has trials.jsonl but no manifest.json"),
+            std::string::npos)
+      << merge_error;
+}
+
+TEST(Experiment, MergeRefusesShardsWithDifferentSettingsNamingThem) {
+  const fs::path a = freshDir("clock_wall"), b = freshDir("clock_fixed");
+  ExperimentOptions s0 = options(a, 2), s1 = options(b, 2);
+  s0.shard_count = s1.shard_count = 2;
+  s1.shard_index = 1;
+  s1.trial.clock = "fixed";
+  runExperiment(s0, fakeTrial, nullptr);
+  runExperiment(s1, fakeTrial, nullptr);
+  const fs::path merged = freshDir("clock_merged");
+  const std::string error = errorOf([&] { mergeExperiments({a, b}, merged); });
+  EXPECT_NE(error.find("merge: " + a.string() + " and " + b.string() +
+                       " are different experiments: clock is wall in the first and fixed in "
+                       "the second"),
+            std::string::npos)
+      << error;
+  EXPECT_FALSE(fs::exists(merged));
+  // A different budget too; different planners, seeds and shards merge (below).
+  ExperimentOptions s2 = options(freshDir("budget_90"), 2);
+  s2.trial.budget_s = 90;
+  s2.first_seed = 20;
+  runExperiment(s2, fakeTrial, nullptr);
+  EXPECT_NE(errorOf([&] {
+              mergeExperiments({a, s2.out_dir}, merged);
+            }).find("budget_s is 180.0"),
+            std::string::npos);
+}
+
+TEST(Experiment, AnEmptyShardIsAValidExperimentAndMerges) {
+  const fs::path whole = freshDir("empty_whole");
+  ExperimentOptions w = options(whole, 2);
+  w.planners = {"fvp"};
+  runExperiment(w, fakeTrial, nullptr);
+  std::vector<fs::path> shards;
+  for (int i = 0; i < 4; ++i) {
+    ExperimentOptions s = options(freshDir("empty_shard" + std::to_string(i)), 2);
+    s.planners = {"fvp"};
+    s.shard_index = i;
+    s.shard_count = 4;
+    runExperiment(s, fakeTrial, nullptr);
+    shards.push_back(s.out_dir);
+  }
+  // Shards 2 and 3 of two trials: a manifest, an empty trials.jsonl, reports with no rows.
+  for (int i = 2; i < 4; ++i) {
+    EXPECT_TRUE(fs::exists(shards[i] / "manifest.json"));
+    EXPECT_EQ(slurp(shards[i] / "trials.jsonl"), "");
+    EXPECT_EQ(nlohmann::json::parse(slurp(shards[i] / "summary.json")), nlohmann::json::object());
+    EXPECT_NE(slurp(shards[i] / "table1.md").find("sizes.png: not drawn: no trials"),
+              std::string::npos);
+    ExperimentOptions again = options(shards[i], 2);
+    again.planners = {"fvp"};
+    again.shard_index = i;
+    again.shard_count = 4;
+    again.resume = true;
+    EXPECT_NO_THROW(runExperiment(again, fakeTrial, nullptr));
+  }
+  const fs::path merged = freshDir("empty_merged");
+  mergeExperiments(shards, merged);
+  EXPECT_EQ(slurp(merged / "trials.jsonl"), slurp(whole / "trials.jsonl"));
+  EXPECT_EQ(slurp(merged / "summary.json"), slurp(whole / "summary.json"));
+  const nlohmann::json manifest = nlohmann::json::parse(slurp(merged / "manifest.json"));
+  EXPECT_EQ(manifest["kind"], "merged");
+  EXPECT_EQ(manifest["sources"].size(), 4u);
+  EXPECT_EQ(readManifest(merged / "manifest.json").sources[3], shards[3].string());
+  // Merging again into the merged directory is fine; into a run's directory it is not.
+  EXPECT_NO_THROW(mergeExperiments(shards, merged));
+  EXPECT_NE(errorOf([&] {
+              mergeExperiments({shards[0], shards[1]}, whole);
+            }).find("holds an experiment run"),
+            std::string::npos);
+}
+
+TEST(Experiment, SchemaErrorsNameTheFileTheLineAndTheField) {
+  const fs::path out = freshDir("schema");
+  runExperiment(options(out, 1), fakeTrial, nullptr);
+  const std::vector<std::string> lines = linesOf(out / "trials.jsonl");
+  ASSERT_EQ(lines.size(), 2u);
+  const nlohmann::json good = nlohmann::json::parse(lines[1]);
+  const auto errorFor = [&](const std::string& second_line) {
+    writeText(out / "trials.jsonl", lines[0] + "\n" + second_line + "\n");
+    return errorOf([&] { readTrials(out / "trials.jsonl", nullptr); });
+  };
+  const auto with = [&](const std::string& pointer, const nlohmann::json& value) {
+    nlohmann::json t = good;
+    t[nlohmann::json::json_pointer(pointer)] = value;
+    return t.dump();
+  };
+  const auto without = [&](const std::string& pointer) {
+    nlohmann::json t = good;
+    t[nlohmann::json::json_pointer(pointer).parent_pointer()].erase(
+        nlohmann::json::json_pointer(pointer).back());
+    return t.dump();
+  };
+  const std::string at = (out / "trials.jsonl").string() + ": line 2: ";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {with("/seed", -1), "field 'seed': expected an unsigned integer, got -1"},
+      {with("/seed", 1.5), "field 'seed': expected an unsigned integer, got 1.5"},
+      {"{\"planner\": \"rvp\", \"seed\": 18446744073709551616, \"fruitlets\": []}",
+       "field 'seed': expected an unsigned integer"},
+      {with("/planner", "nbv"), "field 'planner': expected one of fvp,rvp, got \"nbv\""},
+      {without("/planner"), "field 'planner': expected one of fvp,rvp, but it is missing"},
+      {with("/engine", 3), "field 'engine': expected a string"},
+      {with("/views", -3), "field 'views': expected a non-negative integer"},
+      {with("/detections", "2"), "field 'detections': expected a non-negative integer"},
+      {with("/wall_time_s", nullptr), "field 'wall_time_s': expected a finite non-negative"},
+      {without("/fruitlets"), "field 'fruitlets': expected an array of fruitlets"},
+      {with("/fruitlets", nlohmann::json::object()), "field 'fruitlets': expected an array"},
+      {with("/fruitlets", nlohmann::json::array({nlohmann::json{{"gt_size_mm", "x"}}})),
+       "field 'fruitlets[0].gt_size_mm': expected a finite positive number, got \"x\""},
+      {with("/fruitlets/1/gt_size_mm", 0), "field 'fruitlets[1].gt_size_mm': expected a finite"},
+      {with("/fruitlets/0/matched", 1), "field 'fruitlets[0].matched': expected true or false"},
+      {without("/fruitlets/0/est_size_mm"),
+       "field 'fruitlets[0].est_size_mm': expected a finite number (the fruitlet is matched)"},
+      {with("/fruitlets/1", 5), "field 'fruitlets[1]': expected an object"},
+      {with("/fruitlets_paper_sizing/0/est_size_mm", "7"),
+       "field 'fruitlets_paper_sizing[0].est_size_mm': expected a finite number"},
+      {"[]", "expected one trial's result (a JSON object), got []"},
+      {"{\"planner\": ", "expected one trial's result as JSON"},
+  };
+  for (const auto& [line, expected] : cases) {
+    const std::string error = errorFor(line);
+    EXPECT_NE(error.find(at + expected), std::string::npos) << line << "\n -> " << error;
+  }
+  // The unmatched fruitlet's est_size_mm is null in a real trial: fine.
+  EXPECT_EQ(errorFor(with("/fruitlets/1/est_size_mm", nullptr)), "");
+  // A run's manifest is read as strictly.
+  nlohmann::json manifest = nlohmann::json::parse(slurp(out / "manifest.json"));
+  manifest["budget_s"] = "x";
+  writeText(out / "manifest.json", manifest.dump());
+  EXPECT_NE(errorOf([&] {
+              readManifest(out / "manifest.json");
+            }).find("manifest.json: field 'budget_s': expected a finite positive number"),
+            std::string::npos);
+}
+
+TEST(Experiment, ABadTrialResultIsNotAppended) {
+  const fs::path out = freshDir("bad_result");
+  const TrialRunner bad = [](const TrialOptions& o) {
+    nlohmann::json r = fakeTrial(o);
+    if (o.planner == "rvp") r["fruitlets"][0]["est_size_mm"] = NAN;  // written as null
+    return r;
+  };
+  const std::string error = errorOf([&] { runExperiment(options(out, 1), bad, nullptr); });
+  EXPECT_NE(error.find("the result of trial rvp-10: field 'fruitlets[0].est_size_mm'"),
+            std::string::npos)
+      << error;
+  EXPECT_EQ(readTrials(out / "trials.jsonl", nullptr).size(), 1u);
+}
+
+/// Sets an environment variable for a scope.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const std::string& value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old;
+    ::setenv(name, value.c_str(), 1);
+  }
+  ~ScopedEnv() {
+    if (old_)
+      ::setenv(name_, old_->c_str(), 1);
+    else
+      ::unsetenv(name_);
+  }
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  const char* name_;
+  std::optional<std::string> old_;
+};
+
+TEST(Experiment, APlotFailureIsAWarningAndTheReportsStand) {
+  const fs::path out = freshDir("no_gnuplot"), empty_bin = freshDir("no_gnuplot_bin");
+  fs::create_directories(empty_bin);
+  std::vector<std::string> warnings;
+  {
+    const ScopedEnv path("PATH", empty_bin.string());  // no gnuplot to be found
+    EXPECT_NO_THROW(runExperiment(options(out, 2), fakeTrial, nullptr,
+                                  [&](const std::string& w) { warnings.push_back(w); }));
+  }
+  ASSERT_EQ(warnings.size(), 1u);
+  // The reason is plotWithGnuplot's message, whatever it says.
+  EXPECT_NE(warnings[0].find("sizes.png not drawn: size distribution figure"), std::string::npos)
+      << warnings[0];
+  EXPECT_FALSE(fs::exists(out / "sizes.png"));
+  EXPECT_EQ(readTrials(out / "trials.jsonl", nullptr).size(), 4u);
+  EXPECT_EQ(nlohmann::json::parse(slurp(out / "summary.json"))["fvp"]["trials"], 2);
+  const std::string table = slurp(out / "table1.md");
+  EXPECT_NE(table.find("| FVP (ours) | 2 |"), std::string::npos);
+  EXPECT_NE(table.find("sizes.png: not drawn: size distribution figure"), std::string::npos)
+      << table;
+  // With gnuplot back, a resume draws it.
+  ExperimentOptions resume = options(out, 2);
+  resume.resume = true;
+  runExperiment(resume, fakeTrial, nullptr);
+  EXPECT_TRUE(fs::exists(out / "sizes.png"));
+  EXPECT_NE(slurp(out / "table1.md").find("Size distributions: sizes.png."), std::string::npos);
+}
+
+TEST(Experiment, AnOutputPathThatIsARegularFileIsAnErrorBeforeAnyTrial) {
+  const fs::path dir = freshDir("out_is_file");
+  fs::create_directories(dir);
+  writeText(dir / "file", "x");
+  int calls = 0;
+  const std::string error = errorOf([&] {
+    runExperiment(
+        options(dir / "file", 1), [&](const TrialOptions& o) { return ++calls, fakeTrial(o); },
+        nullptr);
+  });
+  EXPECT_NE(error.find("--out '" + (dir / "file").string() + "': exists and is not a directory"),
+            std::string::npos)
+      << error;
+  EXPECT_EQ(calls, 0);
+  EXPECT_EQ(slurp(dir / "file"), "x");
 }
 
 }  // namespace

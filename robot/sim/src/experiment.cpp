@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <climits>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -12,36 +13,30 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <system_error>
 
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/host/core/gnuplot.h"
-#include "trial_parts.h"
+#include "fvp/host/core/output_directory.h"
 
 namespace fvp::robot::sim {
 namespace {
+
+namespace fs = std::filesystem;
 
 std::string trialKey(const std::string& planner, std::uint64_t seed) {
   return planner + "-" + std::to_string(seed);
 }
 
-/// The summary row of a finished trial: its planner, plus the engine when that is not the
-/// planner's default (the "FVP on the octomap engine" ablation is its own row).
-std::string rowKey(const nlohmann::json& trial) {
-  std::string key = trial["planner"].get<std::string>();
-  const std::string engine = trial.value("engine", "");
-  if (!engine.empty() && engine != defaultEngine(key)) key += "-" + engine;
-  return key;
-}
-
 /// Canonical trial order: by world seed, then by row.
 bool bySeedThenRow(const nlohmann::json& a, const nlohmann::json& b) {
-  return std::make_pair(a["seed"].get<std::uint64_t>(), rowKey(a)) <
-         std::make_pair(b["seed"].get<std::uint64_t>(), rowKey(b));
+  return std::make_pair(a.at("seed").get<std::uint64_t>(), trialRowKey(a)) <
+         std::make_pair(b.at("seed").get<std::uint64_t>(), trialRowKey(b));
 }
 
 /// Appends one line with a single write and fsync: a reader sees whole lines, or a last
 /// line cut short by a crash, which readTrials reports and ignores.
-void appendLine(const std::filesystem::path& path, const std::string& line) {
+void appendLine(const fs::path& path, const std::string& line) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
   if (fd < 0) throw std::runtime_error(path.string() + ": cannot open for appending");
   const std::string text = line + "\n";
@@ -52,6 +47,94 @@ void appendLine(const std::filesystem::path& path, const std::string& line) {
     throw std::runtime_error(path.string() + ": appending a trial failed (disk full?)");
 }
 
+/// The bytes of a file; empty when it cannot be read (ok false).
+std::string readBytes(const fs::path& path, bool& ok) {
+  std::ifstream in(path, std::ios::binary);
+  ok = bool(in);
+  std::stringstream buffer;
+  if (ok) buffer << in.rdbuf();
+  return buffer.str();
+}
+
+/// Cuts a last line without its newline (a write cut short) off trials.jsonl, so that the
+/// next append starts on a line of its own. The whole lines are kept byte for byte.
+void cutTornTail(const fs::path& jsonl) {
+  bool ok = false;
+  const std::string text = readBytes(jsonl, ok);
+  if (!ok || text.empty() || text.back() == '\n') return;
+  const std::size_t newline = text.rfind('\n');
+  const std::string kept = newline == std::string::npos ? "" : text.substr(0, newline + 1);
+  host::writeFileAtomically(jsonl, "trials (a torn last line cut off)", kept);
+}
+
+ConfigFileStamp stampOf(const fs::path& path, const std::string& what) {
+  if (path.empty()) return {};
+  bool ok = false;
+  const std::string bytes = readBytes(path, ok);
+  if (!ok) throw std::runtime_error("experiment: cannot read the " + what + " " + path.string());
+  return {fs::absolute(path).lexically_normal().string(), fnv1a64Hex(bytes)};
+}
+
+/// The manifest an experiment with these options has.
+ExperimentManifest manifestOf(const ExperimentOptions& o) {
+  ExperimentManifest m;
+  m.kind = "run";
+  m.budget_s = o.trial.budget_s;
+  m.clock = o.trial.clock;
+  m.max_views = o.trial.max_views.value_or(0);
+  m.world_config = stampOf(o.trial.world_config, "world config");
+  m.planner_config = stampOf(o.trial.planner_config, "planner config");
+  m.engine = o.trial.engine;
+  m.backend = o.trial.backend;
+  m.planners = o.planners;
+  m.trials = o.trials;
+  m.first_seed = o.first_seed;
+  m.shard_index = o.shard_index;
+  m.shard_count = o.shard_count;
+  return m;
+}
+
+void checkOptions(const ExperimentOptions& o) {
+  if (o.trials < 1) throw std::invalid_argument("experiment: --trials must be at least 1");
+  if (o.shard_count < 1 || o.shard_index < 0 || o.shard_index >= o.shard_count)
+    throw std::invalid_argument("experiment: --shard i/n needs 0 <= i < n");
+  if (o.planners.empty())
+    throw std::invalid_argument("experiment: no planners given (--planners, e.g. fvp,rvp)");
+  const auto& known = experimentPlanners();
+  for (std::size_t i = 0; i < o.planners.size(); ++i) {
+    const std::string& p = o.planners[i];
+    if (p.empty()) throw std::invalid_argument("experiment: an empty planner name in --planners");
+    if (std::find(known.begin(), known.end(), p) == known.end())
+      throw std::invalid_argument("experiment: unknown planner '" + p + "' (expected fvp, rvp)");
+    if (std::find(o.planners.begin(), o.planners.begin() + long(i), p) !=
+        o.planners.begin() + long(i))
+      throw std::invalid_argument("experiment: --planners lists '" + p +
+                                  "' twice (each of its trials would run and count twice)");
+  }
+  if (o.first_seed > UINT64_MAX - std::uint64_t(o.trials - 1))
+    throw std::invalid_argument("experiment: --first-seed + --trials runs past the largest seed");
+  if (!std::isfinite(o.trial.budget_s) || o.trial.budget_s <= 0)
+    throw std::invalid_argument("experiment: --budget-s must be a finite positive number");
+  if (o.trial.max_views && *o.trial.max_views < 1)
+    throw std::invalid_argument(
+        "experiment: max_views must be at least 1 when set (unset: no "
+        "limit; --max-views 0)");
+  if (o.trial.clock != "wall" && o.trial.clock != "fixed")
+    throw std::invalid_argument("experiment: --clock must be wall or fixed, not '" + o.trial.clock +
+                                "'");
+  if (!o.trial.engine.empty() && o.trial.engine != "grid" && o.trial.engine != "octomap")
+    throw std::invalid_argument("experiment: --engine must be grid or octomap, not '" +
+                                o.trial.engine + "'");
+}
+
+/// A one-line reason from an exception's text (gnuplot's log may span lines).
+std::string oneLine(std::string text) {
+  for (char& c : text)
+    if (c == '\n' || c == '\r') c = ' ';
+  while (!text.empty() && text.back() == ' ') text.pop_back();
+  return text;
+}
+
 std::string fmt(const nlohmann::json& v, int precision) {
   if (!v.is_number()) return "-";
   std::ostringstream s;
@@ -59,94 +142,117 @@ std::string fmt(const nlohmann::json& v, int precision) {
   return s.str();
 }
 
-/// Pools the fruitlets of some trials under one estimator's field names.
-nlohmann::json pool(const std::vector<const nlohmann::json*>& trials, const char* fruitlets_key,
-                    const char* metrics_key) {
-  std::size_t gt = 0, matched = 0, detections = 0;
+/// Pools the fruitlets of some checked trials under one estimator's field names.
+nlohmann::json pool(const std::vector<const nlohmann::json*>& trials, const char* fruitlets_key) {
+  std::size_t gt = 0, matched = 0;
+  std::uint64_t detections = 0;
   double abs_sum = 0, pct_sum = 0, views = 0, wall = 0;
   for (const nlohmann::json* t : trials) {
-    views += t->value("views", 0);
-    wall += t->value("wall_time_s", 0.0);
-    detections += t->value("detections", 0);
-    for (const auto& f : (*t)[fruitlets_key]) {
+    views += t->contains("views") ? t->at("views").get<double>() : 0.0;
+    wall += t->contains("wall_time_s") ? t->at("wall_time_s").get<double>() : 0.0;
+    detections += t->contains("detections") ? t->at("detections").get<std::uint64_t>() : 0;
+    for (const auto& f : t->at(fruitlets_key)) {
       ++gt;
-      if (!f.value("matched", false)) continue;
+      if (!f.at("matched").get<bool>()) continue;
       ++matched;
-      const double e = std::abs(f["est_size_mm"].get<double>() - f["gt_size_mm"].get<double>());
+      const double truth = f.at("gt_size_mm").get<double>();
+      const double e = std::abs(f.at("est_size_mm").get<double>() - truth);
       abs_sum += e;
-      pct_sum += 100.0 * e / f["gt_size_mm"].get<double>();
+      pct_sum += 100.0 * e / truth;
     }
-    (void)metrics_key;
   }
   const auto opt = [](bool ok, double v) { return ok ? nlohmann::json(v) : nlohmann::json(); };
   const std::size_t n = trials.size();
-  return {
-      {"trials", n},
-      {"gt_fruitlets", gt},
-      {"matched", matched},
-      {"match_percent", opt(gt > 0, gt ? 100.0 * matched / gt : 0.0)},
-      {"mae_mm", opt(matched > 0, matched ? abs_sum / matched : 0.0)},
-      {"mape_percent", opt(matched > 0, matched ? pct_sum / matched : 0.0)},
-      {"precision_percent", opt(detections > 0, detections ? 100.0 * matched / detections : 0.0)},
-      {"mean_views", opt(n > 0, n ? views / n : 0.0)},
-      {"wall_s_per_trial", opt(n > 0, n ? wall / n : 0.0)}};
+  return {{"trials", n},
+          {"gt_fruitlets", gt},
+          {"matched", matched},
+          {"match_percent", opt(gt > 0, gt ? 100.0 * double(matched) / double(gt) : 0.0)},
+          {"mae_mm", opt(matched > 0, matched ? abs_sum / double(matched) : 0.0)},
+          {"mape_percent", opt(matched > 0, matched ? pct_sum / double(matched) : 0.0)},
+          {"precision_percent",
+           opt(detections > 0, detections ? 100.0 * double(matched) / double(detections) : 0.0)},
+          {"mean_views", opt(n > 0, n ? views / double(n) : 0.0)},
+          {"wall_s_per_trial", opt(n > 0, n ? wall / double(n) : 0.0)}};
+}
+
+/// The gnuplot script of Figure 7: ground truth, RVP and FVP sizes (matched fruitlets), box
+/// plots with means.
+std::string sizesFigureScript(const std::vector<nlohmann::json>& trials) {
+  std::map<std::string, std::vector<double>> sizes;
+  for (const auto& t : trials) {
+    const std::string planner = t.at("planner").get<std::string>();
+    if (trialRowKey(t) != planner) continue;  // engine ablations are not in the figure
+    for (const auto& f : t.at("fruitlets")) {
+      if (planner == "fvp") sizes["GT"].push_back(f.at("gt_size_mm").get<double>());
+      if (f.at("matched").get<bool>())
+        sizes[planner == "fvp" ? "FVP" : "RVP"].push_back(f.at("est_size_mm").get<double>());
+    }
+  }
+  if (sizes["GT"].empty())
+    for (const auto& t : trials)
+      for (const auto& f : t.at("fruitlets"))
+        sizes["GT"].push_back(f.at("gt_size_mm").get<double>());
+  std::ostringstream gp;
+  gp << "set terminal pngcairo size 900,600 font 'DejaVu Sans,12'\n"
+     << "set title 'Fruitlet sizes: ground truth and matched estimates (x: mean, line: median)'\n"
+     << "set ylabel 'size (mm)'\nset style fill solid 0.35 border -1\nset style boxplot "
+        "nooutliers\nset style data boxplot\nset boxwidth 0.5\nset grid ytics\n"
+     << "set xtics ('GT' 1, 'RVP' 2, 'FVP' 3)\nset xrange [0.4:3.6]\nunset key\n";
+  const char* order[] = {"GT", "RVP", "FVP"};
+  for (int i = 0; i < 3; ++i) {
+    gp << "$d" << i << " << EOD\n";
+    for (double v : sizes[order[i]]) gp << v << "\n";
+    if (sizes[order[i]].empty()) gp << "NaN\n";
+    gp << "EOD\n";
+  }
+  gp << "$means << EOD\n";
+  for (int i = 0; i < 3; ++i) {
+    double sum = 0;
+    for (double v : sizes[order[i]]) sum += v;
+    gp << i + 1 << " " << (sizes[order[i]].empty() ? NAN : sum / sizes[order[i]].size()) << "\n";
+  }
+  gp << "EOD\nplot $d0 using (1):1 lc rgb '#7f7f7f', $d1 using (2):1 lc rgb '#ff7f0e', "
+        "$d2 using (3):1 lc rgb '#1f77b4', $means using 1:2 with points pt 2 ps 2.5 lw 2 lc rgb "
+        "'black'\n";
+  return gp.str();
 }
 
 }  // namespace
 
-std::vector<nlohmann::json> readTrials(const std::filesystem::path& jsonl,
-                                       const std::function<void(const std::string&)>& warning) {
-  std::vector<nlohmann::json> out;
-  std::ifstream in(jsonl, std::ios::binary);
-  if (!in) return out;
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  const std::string text = buffer.str();
-  std::size_t start = 0, line_no = 0;
-  while (start < text.size()) {
-    ++line_no;
-    const std::size_t end = text.find('\n', start);
-    if (end == std::string::npos) {
-      if (warning)
-        warning(jsonl.string() + ": line " + std::to_string(line_no) +
-                " has no newline (a write cut short); ignored, its trial will run again");
-      break;
-    }
-    const std::string line = text.substr(start, end - start);
-    start = end + 1;
-    if (line.empty()) continue;
-    nlohmann::json j;
-    try {
-      j = nlohmann::json::parse(line);
-    } catch (const nlohmann::json::exception& e) {
-      throw std::runtime_error(jsonl.string() + ": line " + std::to_string(line_no) +
-                               ": expected one trial's result as JSON: " + e.what());
-    }
-    if (!j.is_object() || !j.contains("planner") || !j.contains("seed") || !j.contains("fruitlets"))
-      throw std::runtime_error(jsonl.string() + ": line " + std::to_string(line_no) +
-                               ": expected a trial result with 'planner', 'seed' and 'fruitlets'");
-    out.push_back(std::move(j));
-  }
-  return out;
+std::pair<int, int> parseShard(const std::string& text) {
+  const auto bad = [&text](const std::string& why) {
+    return std::invalid_argument("--shard: expected i/n with 0 <= i < n (e.g. 0/4), got '" + text +
+                                 "': " + why);
+  };
+  const auto number = [&](const std::string& part) {
+    if (part.empty() || part.find_first_not_of("0123456789") != std::string::npos)
+      throw bad("'" + part + "' is not a decimal integer");
+    if (part.size() > 1 && part[0] == '0') throw bad("'" + part + "' has a leading zero");
+    if (part.size() > 9) throw bad("'" + part + "' is too large");
+    return std::stoi(part);
+  };
+  const std::size_t slash = text.find('/');
+  if (slash == std::string::npos) throw bad("no '/'");
+  const int i = number(text.substr(0, slash)), n = number(text.substr(slash + 1));
+  if (n < 1 || i >= n) throw bad("needs 0 <= i < n");
+  return {i, n};
 }
 
 nlohmann::json summarize(const std::vector<nlohmann::json>& trials) {
   std::map<std::string, std::vector<const nlohmann::json*>> by_key;
-  for (const auto& t : trials) {
-    by_key[rowKey(t)].push_back(&t);
-  }
-  nlohmann::ordered_json summary;
+  for (const auto& t : trials) by_key[trialRowKey(t)].push_back(&t);
+  nlohmann::ordered_json summary = nlohmann::ordered_json::object();
   for (const auto& [key, list] : by_key) {
-    summary[key] = pool(list, "fruitlets", "metrics");
+    summary[key] = pool(list, "fruitlets");
     bool paper = true;
     for (const auto* t : list) paper &= t->contains("fruitlets_paper_sizing");
-    if (paper)
-      summary[key + "-paper-sizing"] = pool(list, "fruitlets_paper_sizing", "metrics_paper_sizing");
+    if (paper) summary[key + "-paper-sizing"] = pool(list, "fruitlets_paper_sizing");
   }
   return summary;
 }
 
-void writeReports(const std::filesystem::path& dir, const std::vector<nlohmann::json>& unsorted) {
+bool writeReports(const fs::path& dir, const std::vector<nlohmann::json>& unsorted,
+                  const MessageSink& warning) {
   // A canonical order: sums (and so every figure) do not depend on how trials were run.
   std::vector<nlohmann::json> trials = unsorted;
   std::sort(trials.begin(), trials.end(), bySeedThenRow);
@@ -174,83 +280,89 @@ void writeReports(const std::filesystem::path& dir, const std::vector<nlohmann::
        << fmt(row["match_percent"], 1) << " | " << fmt(row["mae_mm"], 2) << " | "
        << fmt(row["mape_percent"], 2) << " | " << fmt(row["precision_percent"], 1) << " |\n";
   }
-  md << "\nSize distributions: sizes.png.\n";
-  host::writeFileAtomically(dir / "table1.md", "Table 1", md.str());
+  const std::string table = md.str();
+  // The tables first: the figure is an extra that must not cost them.
+  host::writeFileAtomically(dir / "table1.md", "Table 1",
+                            table + "\nSize distributions: sizes.png.\n");
 
-  // Figure 7: ground truth, RVP and FVP sizes (matched fruitlets), box plots with means.
-  std::map<std::string, std::vector<double>> sizes;
-  for (const auto& t : trials) {
-    const std::string planner = t["planner"].get<std::string>();
-    if (rowKey(t) != planner) continue;  // engine ablations are not in the figure
-    for (const auto& f : t["fruitlets"]) {
-      if (planner == "fvp") sizes["GT"].push_back(f["gt_size_mm"].get<double>());
-      if (f.value("matched", false))
-        sizes[planner == "fvp" ? "FVP" : "RVP"].push_back(f["est_size_mm"].get<double>());
+  std::string why_not;
+  if (trials.empty()) {
+    why_not = "no trials";
+  } else {
+    try {
+      host::plotWithGnuplot(sizesFigureScript(trials), dir / "sizes.png",
+                            "size distribution figure");
+      return true;
+    } catch (const std::exception& e) {
+      why_not = oneLine(e.what());
+      if (warning) warning((dir / "sizes.png").string() + " not drawn: " + why_not);
     }
   }
-  if (sizes["GT"].empty())
-    for (const auto& t : trials)
-      for (const auto& f : t["fruitlets"]) sizes["GT"].push_back(f["gt_size_mm"].get<double>());
-  std::ostringstream gp;
-  gp << "set terminal pngcairo size 900,600 font 'DejaVu Sans,12'\n"
-     << "set title 'Fruitlet sizes: ground truth and matched estimates (x: mean, line: median)'\n"
-     << "set ylabel 'size (mm)'\nset style fill solid 0.35 border -1\nset style boxplot "
-        "nooutliers\nset style data boxplot\nset boxwidth 0.5\nset grid ytics\n"
-     << "set xtics ('GT' 1, 'RVP' 2, 'FVP' 3)\nset xrange [0.4:3.6]\nunset key\n";
-  const char* order[] = {"GT", "RVP", "FVP"};
-  for (int i = 0; i < 3; ++i) {
-    gp << "$d" << i << " << EOD\n";
-    for (double v : sizes[order[i]]) gp << v << "\n";
-    if (sizes[order[i]].empty()) gp << "NaN\n";
-    gp << "EOD\n";
-  }
-  gp << "$means << EOD\n";
-  for (int i = 0; i < 3; ++i) {
-    double sum = 0;
-    for (double v : sizes[order[i]]) sum += v;
-    gp << i + 1 << " " << (sizes[order[i]].empty() ? NAN : sum / sizes[order[i]].size()) << "\n";
-  }
-  gp << "EOD\nplot $d0 using (1):1 lc rgb '#7f7f7f', $d1 using (2):1 lc rgb '#ff7f0e', "
-        "$d2 using (3):1 lc rgb '#1f77b4', $means using 1:2 with points pt 2 ps 2.5 lw 2 lc rgb "
-        "'black'\n";
-  host::plotWithGnuplot(gp.str(), dir / "sizes.png", "size distribution figure");
+  std::error_code ignored;
+  fs::remove(dir / "sizes.png", ignored);  // an older figure would not match these tables
+  host::writeFileAtomically(dir / "table1.md", "Table 1",
+                            table + "\nsizes.png: not drawn: " + why_not + "\n");
+  return false;
 }
 
 void runExperiment(const ExperimentOptions& o, const TrialRunner& run_trial,
-                   const std::function<void(const std::string&)>& progress) {
-  if (o.trials < 1) throw std::invalid_argument("experiment: --trials must be at least 1");
-  if (o.shard_count < 1 || o.shard_index < 0 || o.shard_index >= o.shard_count)
-    throw std::invalid_argument("experiment: --shard i/n needs 0 <= i < n");
-  for (const auto& p : o.planners)
-    if (p != "fvp" && p != "rvp")
-      throw std::invalid_argument("experiment: unknown planner '" + p + "' (expected fvp, rvp)");
-  std::filesystem::create_directories(o.out_dir);
-  const std::filesystem::path jsonl = o.out_dir / "trials.jsonl";
-  // Probe that the directory is writable before the first (long) trial.
-  host::writeFileAtomically(o.out_dir / ".fvp-write-check", "output directory check", "");
-  std::filesystem::remove(o.out_dir / ".fvp-write-check");
+                   const MessageSink& progress, const MessageSink& warning_sink) {
+  const MessageSink& warning = warning_sink ? warning_sink : progress;
+  checkOptions(o);
+  const ExperimentManifest manifest = manifestOf(o);
+  host::prepareOutputDirectory(o.out_dir, "experiment: --out");
+  const fs::path jsonl = o.out_dir / "trials.jsonl";
+  const fs::path manifest_path = o.out_dir / "manifest.json";
 
-  std::vector<nlohmann::json> done = readTrials(jsonl, progress);
+  if (fs::exists(manifest_path)) {
+    const ExperimentManifest old = readManifest(manifest_path);
+    if (old.kind != "run")
+      throw std::runtime_error(manifest_path.string() +
+                               ": a merged experiment (kind \"merged\"), not a run: it cannot be "
+                               "resumed or run into; use another --out");
+    if (const auto d = resumeDifference(old, manifest))
+      throw std::runtime_error(manifest_path.string() + ": this experiment was made with " +
+                               d->setting + " " + d->old_value + ", this run asks for " +
+                               d->new_value +
+                               "; its trials would not be comparable. Run with the "
+                               "experiment's settings, or use another --out");
+  } else if (fs::exists(jsonl)) {
+    throw std::runtime_error(jsonl.string() +
+                             ": no manifest.json beside it (made by an fvp before experiment "
+                             "manifests), so the settings its trials ran with are unknown and "
+                             "it is not resumed; run the experiment again in another --out");
+  } else {
+    host::writeFileAtomically(manifest_path, "experiment manifest",
+                              manifest.toJson().dump(2) + "\n");
+  }
+  if (!fs::exists(jsonl)) host::writeFileAtomically(jsonl, "trials", "");
+
+  std::vector<nlohmann::json> done = readTrials(jsonl, warning);
   if (!done.empty() && !o.resume)
     throw std::runtime_error(jsonl.string() + " already holds " + std::to_string(done.size()) +
                              " trials: use --resume to continue, or another --out");
-  std::set<std::string> finished;
-  for (const auto& t : done)
-    finished.insert(trialKey(t["planner"], t["seed"].get<std::uint64_t>()));
-  if (!done.empty()) {
-    // Drop a torn last line so appends start on a fresh line.
-    std::ostringstream whole;
-    for (const auto& t : done) whole << t.dump() << "\n";
-    host::writeFileAtomically(jsonl, "trials", whole.str());
-  }
+  cutTornTail(jsonl);  // appends start on a fresh line
 
   // The (seed, planner) list, seed-major so that planners alternate on the same world.
   std::vector<std::pair<std::string, std::uint64_t>> all;
   for (int i = 0; i < o.trials; ++i)
     for (const auto& p : o.planners) all.emplace_back(p, o.first_seed + std::uint64_t(i));
   std::vector<std::pair<std::string, std::uint64_t>> mine;
+  std::set<std::string> mine_keys;
   for (std::size_t i = 0; i < all.size(); ++i)
-    if (int(i % o.shard_count) == o.shard_index) mine.push_back(all[i]);
+    if (int(i % std::size_t(o.shard_count)) == o.shard_index) {
+      mine.push_back(all[i]);
+      mine_keys.insert(trialKey(all[i].first, all[i].second));
+    }
+  std::set<std::string> finished;
+  for (const auto& t : done) {
+    const std::string key =
+        trialKey(t.at("planner").get<std::string>(), t.at("seed").get<std::uint64_t>());
+    if (!mine_keys.count(key))
+      throw std::runtime_error(jsonl.string() + ": trial " + key +
+                               " is not one of this experiment's (shard's) trials");
+    finished.insert(key);
+  }
 
   const auto start = std::chrono::steady_clock::now();
   const auto elapsed_s = [start] {
@@ -265,6 +377,9 @@ void runExperiment(const ExperimentOptions& o, const TrialRunner& run_trial,
     t.planner = planner;
     t.seed = seed;
     t.out_dir = o.out_dir / "trials" / trialKey(planner, seed);
+    t.on_warning = [&warning, key = trialKey(planner, seed)](const std::string& text) {
+      if (warning) warning("trial " + key + ": " + text);
+    };
     const std::size_t index = ran;
     t.on_progress = [&, index, planner, seed](const TrialProgress& p) {
       const double elapsed = elapsed_s();
@@ -284,38 +399,90 @@ void runExperiment(const ExperimentOptions& o, const TrialRunner& run_trial,
     result.erase("view_log");  // per-view detail stays in the trial's own result.json
     result.erase("plan_log");
     result.erase("clock");
-    appendLine(jsonl, result.dump());
+    // The line as a reader will see it, checked as readTrials checks it: a bad result
+    // fails here instead of poisoning trials.jsonl for every later resume and merge.
+    const std::string line = result.dump();
+    nlohmann::json written = nlohmann::json::parse(line);
+    checkTrial(written, "the result of trial " + trialKey(planner, seed));
+    if (written.at("planner") != planner || written.at("seed").get<std::uint64_t>() != seed)
+      throw std::runtime_error("the result of trial " + trialKey(planner, seed) +
+                               " names another trial: " +
+                               trialKey(written.at("planner").get<std::string>(),
+                                        written.at("seed").get<std::uint64_t>()));
+    appendLine(jsonl, line);
     ++ran;
     finished_s = elapsed_s();
-    done.push_back(std::move(result));
+    done.push_back(std::move(written));
   }
-  writeReports(o.out_dir, done);
+  writeReports(o.out_dir, done, warning);
 }
 
-void mergeExperiments(const std::vector<std::filesystem::path>& shard_dirs,
-                      const std::filesystem::path& out_dir) {
+void mergeExperiments(const std::vector<fs::path>& shard_dirs, const fs::path& out_dir,
+                      const MessageSink& warning) {
   if (shard_dirs.empty()) throw std::invalid_argument("merge: no shard directories given");
+  std::vector<ExperimentManifest> manifests;
   std::vector<nlohmann::json> all;
-  std::set<std::string> seen;
+  std::map<std::string, fs::path> dir_of;  // row-seed -> the directory holding it
+  std::set<fs::path> given;
   for (const auto& dir : shard_dirs) {
-    const std::filesystem::path jsonl = dir / "trials.jsonl";
-    if (!std::filesystem::exists(jsonl))
-      throw std::runtime_error(jsonl.string() + ": not found (not an experiment directory?)");
-    for (auto& t : readTrials(jsonl, nullptr)) {
+    std::error_code ec;
+    if (!given.insert(fs::weakly_canonical(dir, ec)).second)
+      throw std::runtime_error("merge: " + dir.string() + " is given twice");
+    const fs::path manifest_path = dir / "manifest.json", jsonl = dir / "trials.jsonl";
+    if (!fs::exists(manifest_path)) {
+      if (fs::exists(jsonl))
+        throw std::runtime_error("merge: " + dir.string() +
+                                 " has trials.jsonl but no manifest.json (made by an fvp before "
+                                 "experiment manifests): its settings cannot be checked against "
+                                 "the other directories', so it is not merged; run it again");
+      throw std::runtime_error("merge: " + dir.string() +
+                               " is not an experiment directory (no manifest.json)");
+    }
+    manifests.push_back(readManifest(manifest_path));
+    if (const auto d = mergeDifference(manifests.front(), manifests.back()))
+      throw std::runtime_error("merge: " + shard_dirs.front().string() + " and " + dir.string() +
+                               " are different experiments: " + d->setting + " is " + d->old_value +
+                               " in the first and " + d->new_value +
+                               " in the second; their trials would pool into the same rows");
+    if (!fs::exists(jsonl))
+      throw std::runtime_error("merge: " + jsonl.string() +
+                               ": not found (the experiment never started?)");
+    for (auto& t : readTrials(jsonl, warning)) {
       // A row's trial once: the main run and an engine ablation of one planner may merge.
-      const std::string key = trialKey(rowKey(t), t["seed"].get<std::uint64_t>());
-      if (!seen.insert(key).second)
-        throw std::runtime_error(jsonl.string() + ": trial " + key + " is in two shards");
+      const std::string key = trialKey(trialRowKey(t), t.at("seed").get<std::uint64_t>());
+      const auto [it, fresh] = dir_of.emplace(key, dir);
+      if (!fresh)
+        throw std::runtime_error("merge: trial " + key + " is in both " + it->second.string() +
+                                 " and " + dir.string());
       all.push_back(std::move(t));
     }
   }
+  {
+    std::error_code ec;
+    if (given.count(fs::weakly_canonical(out_dir, ec)))
+      throw std::runtime_error("merge: --out " + out_dir.string() +
+                               " is one of the merged directories; merge into another one");
+    const fs::path out_manifest = out_dir / "manifest.json";
+    const bool old_merge = fs::exists(out_manifest) && readManifest(out_manifest).kind == "merged";
+    if (!old_merge && (fs::exists(out_manifest) || fs::exists(out_dir / "trials.jsonl")))
+      throw std::runtime_error("merge: --out " + out_dir.string() +
+                               " holds an experiment run; merge into a new directory (or an "
+                               "earlier merge's)");
+  }
+  host::prepareOutputDirectory(out_dir, "merge: --out");
+  ExperimentManifest merged = manifests.front();
+  merged.kind = "merged";
+  merged.sources.clear();
+  for (const auto& dir : shard_dirs)
+    merged.sources.push_back(fs::absolute(dir).lexically_normal().string());
+  host::writeFileAtomically(out_dir / "manifest.json", "experiment manifest",
+                            merged.toJson().dump(2) + "\n");
   // A canonical order, so that merged output does not depend on the shard split.
   std::sort(all.begin(), all.end(), bySeedThenRow);
-  std::filesystem::create_directories(out_dir);
   std::ostringstream whole;
   for (const auto& t : all) whole << t.dump() << "\n";
   host::writeFileAtomically(out_dir / "trials.jsonl", "merged trials", whole.str());
-  writeReports(out_dir, all);
+  writeReports(out_dir, all, warning);
 }
 
 }  // namespace fvp::robot::sim

@@ -5,14 +5,18 @@
 // (planner, seed) list deterministically; merging shards gives what one run gives.
 // From trials.jsonl: summary.json (per planner, fruitlets pooled over trials), table1.md
 // (next to the paper's Table 1) and sizes.png (the size distributions of Figure 7).
+// DIR/manifest.json records the settings that define the rows; resume and merge refuse a
+// mismatch (experiment_directory.h, docs/experiment.md).
 #pragma once
 
 #include <filesystem>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "fvp/robot/sim/experiment_directory.h"
 #include "fvp/robot/sim/trial.h"
 
 namespace fvp::robot::sim {
@@ -28,31 +32,41 @@ struct ExperimentOptions {
 };
 
 using TrialRunner = std::function<nlohmann::json(const TrialOptions&)>;
+using MessageSink = std::function<void(const std::string&)>;
+
+/// Parses --shard's "i/n": two decimal integers (no sign, no leading zeros), 0 <= i < n.
+/// Throws std::invalid_argument.
+std::pair<int, int> parseShard(const std::string& text);
 
 /// Runs the experiment's trials of this shard (skipping finished ones with resume) and
-/// writes the reports. progress(line) is called with a short status line per event.
-/// Throws std::invalid_argument / std::runtime_error for bad options and files.
+/// writes the reports. Before the first trial: the options are checked, out_dir is made (an
+/// existing non-directory is an error) and probed for writing, and DIR/manifest.json is
+/// written for a new directory or compared with the options for an existing one (a
+/// different setting is an error naming it; trials.jsonl without a manifest is an error).
+/// A torn last line of trials.jsonl is cut off before anything is appended. progress(line)
+/// gets a short status line per event; warning(line) gets warnings (a torn line, a figure
+/// not drawn), or progress when warning is empty. Throws std::invalid_argument /
+/// std::runtime_error for bad options and files.
 void runExperiment(const ExperimentOptions& options, const TrialRunner& run_trial,
-                   const std::function<void(const std::string&)>& progress);
-
-/// Reads trials.jsonl: one JSON object per line. A malformed line is an error naming the file
-/// and the line number, except a last line without its newline (a write cut short), which
-/// is reported through `warning` and ignored.
-std::vector<nlohmann::json> readTrials(const std::filesystem::path& jsonl,
-                                       const std::function<void(const std::string&)>& warning);
+                   const MessageSink& progress, const MessageSink& warning = {});
 
 /// summary.json's object: per planner key {"trials", "gt_fruitlets", "matched",
 /// "match_percent", "mae_mm", "mape_percent", "precision_percent", "mean_views",
 /// "wall_s_per_trial"}, plus "<planner>-paper-sizing" keys where trials carry the paper
-/// estimator's sizes.
+/// estimator's sizes. The trials must have passed checkTrial (readTrials does that).
 nlohmann::json summarize(const std::vector<nlohmann::json>& trials);
 
-/// summary.json, table1.md and sizes.png from trials.jsonl in dir.
-void writeReports(const std::filesystem::path& dir, const std::vector<nlohmann::json>& trials);
+/// summary.json and table1.md from checked trials, then sizes.png: a figure gnuplot cannot
+/// draw is reported through warning and noted in table1.md, and returns false (no stale
+/// sizes.png is left); the reports stand. Returns whether sizes.png was drawn.
+bool writeReports(const std::filesystem::path& dir, const std::vector<nlohmann::json>& trials,
+                  const MessageSink& warning = {});
 
-/// `fvp merge`: combines the trials.jsonl of shard directories into out_dir (duplicate
-/// (planner, seed) trials are an error) and writes the reports.
+/// `fvp merge`: combines the trials.jsonl of experiment directories into out_dir and writes
+/// manifest.json (kind "merged") and the reports. Refused: a directory without a manifest,
+/// directories whose row-defining settings differ (mergeDifference), a trial (row, seed) in
+/// two directories, out_dir among the sources, and an out_dir that holds a run's trials.
 void mergeExperiments(const std::vector<std::filesystem::path>& shard_dirs,
-                      const std::filesystem::path& out_dir);
+                      const std::filesystem::path& out_dir, const MessageSink& warning = {});
 
 }  // namespace fvp::robot::sim

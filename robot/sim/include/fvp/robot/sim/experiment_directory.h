@@ -1,0 +1,98 @@
+// The files of an experiment directory (`fvp experiment` / `fvp merge`, docs/experiment.md)
+// and their contract, read and checked: trials.jsonl (one finished trial a line) and
+// manifest.json (the settings that define the experiment's rows). Depends on nlohmann_json
+// and the standard library only (library fvp_experiment_directory), so that a fuzzing
+// harness can link the readers alone.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace fvp::robot::sim {
+
+/// Reads trials.jsonl: one JSON object per line (empty lines are skipped), each checked
+/// against the fields the reports read (checkTrial). A line that is not a valid trial is an
+/// error `FILE: line N: ...`; the same trial (row key and seed) on two lines is an error
+/// naming both lines. A last line without its newline (a write cut short) is reported
+/// through `warning` and ignored. A missing file holds no trials.
+std::vector<nlohmann::json> readTrials(const std::filesystem::path& jsonl,
+                                       const std::function<void(const std::string&)>& warning);
+
+/// Checks one trial's result object against the fields the reports read; throws
+/// std::runtime_error "`where`: field 'X': expected Y, got Z". The fields: planner (a known
+/// planner), seed (an unsigned integer), engine (a string, optional), views and detections
+/// (non-negative integers, optional), wall_time_s (a finite non-negative number, optional),
+/// fruitlets and fruitlets_paper_sizing (optional) arrays of objects with gt_size_mm (a
+/// finite positive number), matched (a bool) and est_size_mm (a finite number when matched).
+void checkTrial(const nlohmann::json& trial, const std::string& where);
+
+/// The planners an experiment knows ("fvp", "rvp").
+const std::vector<std::string>& experimentPlanners();
+
+/// A trial's summary row: its planner, plus "-<engine>" when that is not the planner's
+/// default engine (fvp: grid, rvp: octomap), so the octomap ablation of FVP is its own row.
+/// The trial must have passed checkTrial.
+std::string trialRowKey(const nlohmann::json& trial);
+
+/// FNV-1a 64 of some bytes as 16 lowercase hex digits (a config file's stamp).
+std::string fnv1a64Hex(std::string_view bytes);
+
+/// A config file an experiment ran with: its path and the hash of its bytes, so that an
+/// edited file is caught. An empty path: the built-in defaults (and an empty hash).
+struct ConfigFileStamp {
+  std::string path;     ///< absolute, for the reader; not compared
+  std::string fnv1a64;  ///< fnv1a64Hex of the file's bytes; compared
+};
+
+/// DIR/manifest.json: written when `fvp experiment` creates DIR (kind "run") or by `fvp
+/// merge` (kind "merged"). Row-defining settings are those that change what a trial
+/// measures; trials with different ones must not be pooled into one Table 1 row.
+struct ExperimentManifest {
+  static constexpr int kFormatVersion = 1;
+  std::string kind = "run";  ///< "run" (fvp experiment) or "merged" (fvp merge)
+  // Row-defining: resume and merge refuse a difference.
+  double budget_s = 0;
+  std::string clock;
+  int max_views = 0;  ///< 0: no limit
+  ConfigFileStamp world_config, planner_config;
+  // The run's own plan (kind "run" only). Resume refuses a difference; merge does not
+  // compare them (shards differ in them by design; the engine is in the row key).
+  std::string engine;  ///< the --engine override; empty: each planner's default
+  std::string backend;
+  std::vector<std::string> planners;
+  int trials = 0;
+  std::uint64_t first_seed = 0;
+  int shard_index = 0, shard_count = 1;
+  /// Kind "merged": the merged directories (absolute paths).
+  std::vector<std::string> sources;
+
+  nlohmann::ordered_json toJson() const;
+};
+
+/// Reads and checks manifest.json; throws std::runtime_error "FILE: ..." (not found, not
+/// JSON, `field 'X': expected Y`, a newer format version).
+ExperimentManifest readManifest(const std::filesystem::path& path);
+
+/// A setting that differs between two manifests, with both values as text.
+struct ManifestDifference {
+  std::string setting, old_value, new_value;
+};
+
+/// The first setting `now` changes against `old` that resume refuses: the row-defining
+/// settings, then engine, planners, trials, first_seed and shard (backend is recorded
+/// only: it picks the compute device, not what a trial measures).
+std::optional<ManifestDifference> resumeDifference(const ExperimentManifest& old,
+                                                   const ExperimentManifest& now);
+
+/// The first row-defining setting in which two experiments differ (what merge refuses):
+/// budget_s, clock, max_views, world_config, planner_config (configs by content hash).
+std::optional<ManifestDifference> mergeDifference(const ExperimentManifest& a,
+                                                  const ExperimentManifest& b);
+
+}  // namespace fvp::robot::sim

@@ -1,0 +1,356 @@
+#include "fvp/robot/sim/experiment_directory.h"
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+namespace fvp::robot::sim {
+namespace {
+
+constexpr const char* kManifestFormat = "fvp-experiment-manifest";
+
+/// A value for an error message: its JSON text, cut short.
+std::string shown(const nlohmann::json& value) {
+  std::string text = value.dump();
+  if (text.size() > 40) text = text.substr(0, 37) + "...";
+  return text;
+}
+
+[[noreturn]] void fieldError(const std::string& where, const std::string& field,
+                             const std::string& expected, const nlohmann::json* got) {
+  std::string message = where + ": field '" + field + "': expected " + expected;
+  message += got ? ", got " + shown(*got) : ", but it is missing";
+  throw std::runtime_error(message);
+}
+
+bool isUnsigned(const nlohmann::json& v) {
+  return v.is_number_unsigned() || (v.is_number_integer() && v.get<std::int64_t>() >= 0);
+}
+
+bool isFinite(const nlohmann::json& v) {
+  return v.is_number() && std::isfinite(v.get<double>());
+}
+
+/// The member `key` of object `o`, or nullptr.
+const nlohmann::json* member(const nlohmann::json& o, const char* key) {
+  const auto it = o.find(key);
+  return it == o.end() ? nullptr : &*it;
+}
+
+void checkFruitlets(const nlohmann::json& trial, const char* key, const std::string& where) {
+  const nlohmann::json* list = member(trial, key);
+  if (!list) return;
+  if (!list->is_array()) fieldError(where, key, "an array of fruitlets", list);
+  for (std::size_t i = 0; i < list->size(); ++i) {
+    const nlohmann::json& f = (*list)[i];
+    const std::string name = std::string(key) + "[" + std::to_string(i) + "]";
+    if (!f.is_object()) fieldError(where, name, "an object", &f);
+    const nlohmann::json* gt = member(f, "gt_size_mm");
+    if (!gt || !isFinite(*gt) || gt->get<double>() <= 0)
+      fieldError(where, name + ".gt_size_mm", "a finite positive number", gt);
+    const nlohmann::json* matched = member(f, "matched");
+    if (!matched || !matched->is_boolean())
+      fieldError(where, name + ".matched", "true or false", matched);
+    if (matched->get<bool>()) {
+      const nlohmann::json* est = member(f, "est_size_mm");
+      if (!est || !isFinite(*est))
+        fieldError(where, name + ".est_size_mm", "a finite number (the fruitlet is matched)", est);
+    }
+  }
+}
+
+std::string defaultEngineOf(const std::string& planner) {
+  // As trial_parts.cpp's defaultEngine, which the trial runs on.
+  return planner == "rvp" ? "octomap" : "grid";
+}
+
+std::string joined(const std::vector<std::string>& list) {
+  std::string out;
+  for (const auto& s : list) out += (out.empty() ? "" : ",") + s;
+  return out;
+}
+
+std::string shownConfig(const ConfigFileStamp& c) {
+  return c.path.empty() ? "built-in defaults" : c.path + " (fnv1a64 " + c.fnv1a64 + ")";
+}
+
+std::string shownMaxViews(int v) {
+  return v == 0 ? "0 (no limit)" : std::to_string(v);
+}
+
+nlohmann::ordered_json configJson(const ConfigFileStamp& c) {
+  return {{"path", c.path}, {"fnv1a64", c.fnv1a64}};
+}
+
+// Manifest field readers: `where` is the file.
+const nlohmann::json& required(const nlohmann::json& o, const char* key, const std::string& where,
+                               const std::string& expected) {
+  const nlohmann::json* v = member(o, key);
+  if (!v) fieldError(where, key, expected, nullptr);
+  return *v;
+}
+
+std::string readString(const nlohmann::json& o, const char* key, const std::string& where) {
+  const nlohmann::json& v = required(o, key, where, "a string");
+  if (!v.is_string()) fieldError(where, key, "a string", &v);
+  return v.get<std::string>();
+}
+
+std::uint64_t readUnsigned(const nlohmann::json& o, const char* key, const std::string& where,
+                           std::uint64_t max, const std::string& expected) {
+  const nlohmann::json& v = required(o, key, where, expected);
+  if (!isUnsigned(v) || v.get<std::uint64_t>() > max) fieldError(where, key, expected, &v);
+  return v.get<std::uint64_t>();
+}
+
+ConfigFileStamp readConfig(const nlohmann::json& o, const char* key, const std::string& where) {
+  const std::string expected = "an object {\"path\": string, \"fnv1a64\": 16 hex digits or \"\"}";
+  const nlohmann::json& v = required(o, key, where, expected);
+  const nlohmann::json* path = v.is_object() ? member(v, "path") : nullptr;
+  const nlohmann::json* hash = v.is_object() ? member(v, "fnv1a64") : nullptr;
+  if (!path || !hash || !path->is_string() || !hash->is_string())
+    fieldError(where, key, expected, &v);
+  ConfigFileStamp c{path->get<std::string>(), hash->get<std::string>()};
+  const bool hex = c.fnv1a64.size() == 16 &&
+                   c.fnv1a64.find_first_not_of("0123456789abcdef") == std::string::npos;
+  if (c.path.empty() ? !c.fnv1a64.empty() : !hex) fieldError(where, key, expected, &v);
+  return c;
+}
+
+}  // namespace
+
+const std::vector<std::string>& experimentPlanners() {
+  static const std::vector<std::string> planners{"fvp", "rvp"};
+  return planners;
+}
+
+void checkTrial(const nlohmann::json& trial, const std::string& where) {
+  if (!trial.is_object())
+    throw std::runtime_error(where + ": expected one trial's result (a JSON object), got " +
+                             shown(trial));
+  const nlohmann::json* planner = member(trial, "planner");
+  const auto& known = experimentPlanners();
+  if (!planner || !planner->is_string() ||
+      std::find(known.begin(), known.end(), planner->get<std::string>()) == known.end())
+    fieldError(where, "planner", "one of " + joined(known), planner);
+  const nlohmann::json* seed = member(trial, "seed");
+  if (!seed || !isUnsigned(*seed)) fieldError(where, "seed", "an unsigned integer", seed);
+  if (const nlohmann::json* engine = member(trial, "engine"); engine && !engine->is_string())
+    fieldError(where, "engine", "a string", engine);
+  for (const char* key : {"views", "detections"})
+    if (const nlohmann::json* v = member(trial, key); v && !isUnsigned(*v))
+      fieldError(where, key, "a non-negative integer", v);
+  if (const nlohmann::json* v = member(trial, "wall_time_s");
+      v && (!isFinite(*v) || v->get<double>() < 0))
+    fieldError(where, "wall_time_s", "a finite non-negative number", v);
+  if (!member(trial, "fruitlets")) fieldError(where, "fruitlets", "an array of fruitlets", nullptr);
+  checkFruitlets(trial, "fruitlets", where);
+  checkFruitlets(trial, "fruitlets_paper_sizing", where);
+}
+
+std::string trialRowKey(const nlohmann::json& trial) {
+  std::string key = trial.at("planner").get<std::string>();
+  const nlohmann::json* engine = member(trial, "engine");
+  const std::string e = engine ? engine->get<std::string>() : "";
+  if (!e.empty() && e != defaultEngineOf(key)) key += "-" + e;
+  return key;
+}
+
+std::vector<nlohmann::json> readTrials(const std::filesystem::path& jsonl,
+                                       const std::function<void(const std::string&)>& warning) {
+  std::vector<nlohmann::json> out;
+  std::ifstream in(jsonl, std::ios::binary);
+  if (!in) return out;
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string text = buffer.str();
+  std::map<std::pair<std::string, std::uint64_t>, std::size_t> line_of;  // (row, seed) -> line
+  std::size_t start = 0, line_no = 0;
+  while (start < text.size()) {
+    ++line_no;
+    const std::size_t end = text.find('\n', start);
+    if (end == std::string::npos) {
+      if (warning)
+        warning(jsonl.string() + ": line " + std::to_string(line_no) +
+                " has no newline (a write cut short); ignored, its trial will run again");
+      break;
+    }
+    const std::string_view line(text.data() + start, end - start);
+    start = end + 1;
+    if (line.empty()) continue;
+    const std::string where = jsonl.string() + ": line " + std::to_string(line_no);
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(line);
+    } catch (const nlohmann::json::exception& e) {
+      throw std::runtime_error(where + ": expected one trial's result as JSON: " + e.what());
+    }
+    checkTrial(j, where);
+    const auto key = std::make_pair(trialRowKey(j), j.at("seed").get<std::uint64_t>());
+    const auto [it, fresh] = line_of.emplace(key, line_no);
+    if (!fresh)
+      throw std::runtime_error(jsonl.string() + ": lines " + std::to_string(it->second) + " and " +
+                               std::to_string(line_no) + " hold the same trial (row " + key.first +
+                               ", seed " + std::to_string(key.second) +
+                               "); remove one of them (a trial counts once)");
+    out.push_back(std::move(j));
+  }
+  return out;
+}
+
+std::string fnv1a64Hex(std::string_view bytes) {
+  std::uint64_t h = 14695981039346656037ull;
+  for (const unsigned char c : bytes) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  static const char* digits = "0123456789abcdef";
+  std::string out(16, '0');
+  for (int i = 15; i >= 0; --i, h >>= 4) out[std::size_t(i)] = digits[h & 15];
+  return out;
+}
+
+nlohmann::ordered_json ExperimentManifest::toJson() const {
+  nlohmann::ordered_json j;
+  j["format"] = kManifestFormat;
+  j["version"] = kFormatVersion;
+  j["kind"] = kind;
+  j["budget_s"] = budget_s;
+  j["clock"] = clock;
+  j["max_views"] = max_views;
+  j["world_config"] = configJson(world_config);
+  j["planner_config"] = configJson(planner_config);
+  if (kind == "merged") {
+    j["sources"] = sources;
+    return j;
+  }
+  j["engine"] = engine;
+  j["backend"] = backend;
+  j["planners"] = planners;
+  j["trials"] = trials;
+  j["first_seed"] = first_seed;
+  j["shard"] = {{"index", shard_index}, {"count", shard_count}};
+  return j;
+}
+
+ExperimentManifest readManifest(const std::filesystem::path& path) {
+  const std::string where = path.string();
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(where + ": cannot read the experiment manifest");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(buffer.str());
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(where + ": expected an experiment manifest as JSON: " + e.what());
+  }
+  if (!j.is_object())
+    throw std::runtime_error(where + ": expected an experiment manifest (a JSON object)");
+  const nlohmann::json* format = member(j, "format");
+  if (!format || *format != kManifestFormat)
+    fieldError(where, "format", std::string("\"") + kManifestFormat + "\"", format);
+  const std::uint64_t version =
+      readUnsigned(j, "version", where, INT_MAX, "a positive integer (the format version)");
+  if (version == 0) fieldError(where, "version", "a positive integer", &j["version"]);
+  if (version > std::uint64_t(ExperimentManifest::kFormatVersion))
+    throw std::runtime_error(where + ": manifest format version " + std::to_string(version) +
+                             " is newer than this fvp reads (" +
+                             std::to_string(ExperimentManifest::kFormatVersion) +
+                             "): use the fvp that made it");
+  ExperimentManifest m;
+  m.kind = readString(j, "kind", where);
+  if (m.kind != "run" && m.kind != "merged")
+    fieldError(where, "kind", "\"run\" or \"merged\"", &j["kind"]);
+  const nlohmann::json& budget = required(j, "budget_s", where, "a finite positive number");
+  if (!isFinite(budget) || budget.get<double>() <= 0)
+    fieldError(where, "budget_s", "a finite positive number", &budget);
+  m.budget_s = budget.get<double>();
+  m.clock = readString(j, "clock", where);
+  m.max_views =
+      int(readUnsigned(j, "max_views", where, INT_MAX, "a non-negative integer (0: no limit)"));
+  m.world_config = readConfig(j, "world_config", where);
+  m.planner_config = readConfig(j, "planner_config", where);
+  if (m.kind == "merged") {
+    const nlohmann::json& sources = required(j, "sources", where, "an array of directories");
+    if (!sources.is_array()) fieldError(where, "sources", "an array of directories", &sources);
+    for (const auto& s : sources) {
+      if (!s.is_string()) fieldError(where, "sources", "an array of directories", &s);
+      m.sources.push_back(s.get<std::string>());
+    }
+    return m;
+  }
+  m.engine = readString(j, "engine", where);
+  m.backend = readString(j, "backend", where);
+  const std::string planners_expected = "a non-empty array of distinct planners (fvp, rvp)";
+  const nlohmann::json& planners = required(j, "planners", where, planners_expected);
+  if (!planners.is_array() || planners.empty())
+    fieldError(where, "planners", planners_expected, &planners);
+  const auto& known = experimentPlanners();
+  for (const auto& p : planners) {
+    const std::string name = p.is_string() ? p.get<std::string>() : "";
+    if (std::find(known.begin(), known.end(), name) == known.end() ||
+        std::find(m.planners.begin(), m.planners.end(), name) != m.planners.end())
+      fieldError(where, "planners", planners_expected, &planners);
+    m.planners.push_back(name);
+  }
+  m.trials = int(readUnsigned(j, "trials", where, INT_MAX, "a positive integer"));
+  if (m.trials == 0) fieldError(where, "trials", "a positive integer", &j["trials"]);
+  m.first_seed = readUnsigned(j, "first_seed", where, UINT64_MAX, "an unsigned integer");
+  const std::string shard_expected = "an object {\"index\": i, \"count\": n} with 0 <= i < n";
+  const nlohmann::json& shard = required(j, "shard", where, shard_expected);
+  const nlohmann::json* index = shard.is_object() ? member(shard, "index") : nullptr;
+  const nlohmann::json* count = shard.is_object() ? member(shard, "count") : nullptr;
+  if (!index || !count || !isUnsigned(*index) || !isUnsigned(*count) ||
+      count->get<std::uint64_t>() > INT_MAX ||
+      index->get<std::uint64_t>() >= count->get<std::uint64_t>())
+    fieldError(where, "shard", shard_expected, &shard);
+  m.shard_index = int(index->get<std::uint64_t>());
+  m.shard_count = int(count->get<std::uint64_t>());
+  return m;
+}
+
+std::optional<ManifestDifference> mergeDifference(const ExperimentManifest& a,
+                                                  const ExperimentManifest& b) {
+  if (a.budget_s != b.budget_s)
+    return ManifestDifference{"budget_s", nlohmann::json(a.budget_s).dump(),
+                              nlohmann::json(b.budget_s).dump()};
+  if (a.clock != b.clock) return ManifestDifference{"clock", a.clock, b.clock};
+  if (a.max_views != b.max_views)
+    return ManifestDifference{"max_views", shownMaxViews(a.max_views), shownMaxViews(b.max_views)};
+  if (a.world_config.fnv1a64 != b.world_config.fnv1a64)
+    return ManifestDifference{"world_config", shownConfig(a.world_config),
+                              shownConfig(b.world_config)};
+  if (a.planner_config.fnv1a64 != b.planner_config.fnv1a64)
+    return ManifestDifference{"planner_config", shownConfig(a.planner_config),
+                              shownConfig(b.planner_config)};
+  return std::nullopt;
+}
+
+std::optional<ManifestDifference> resumeDifference(const ExperimentManifest& old,
+                                                   const ExperimentManifest& now) {
+  if (auto d = mergeDifference(old, now)) return d;
+  const auto engine = [](const std::string& e) { return e.empty() ? "(each planner's own)" : e; };
+  if (old.engine != now.engine)
+    return ManifestDifference{"engine", engine(old.engine), engine(now.engine)};
+  if (old.planners != now.planners)
+    return ManifestDifference{"planners", joined(old.planners), joined(now.planners)};
+  if (old.trials != now.trials)
+    return ManifestDifference{"trials", std::to_string(old.trials), std::to_string(now.trials)};
+  if (old.first_seed != now.first_seed)
+    return ManifestDifference{"first_seed", std::to_string(old.first_seed),
+                              std::to_string(now.first_seed)};
+  if (old.shard_index != now.shard_index || old.shard_count != now.shard_count)
+    return ManifestDifference{
+        "shard", std::to_string(old.shard_index) + "/" + std::to_string(old.shard_count),
+        std::to_string(now.shard_index) + "/" + std::to_string(now.shard_count)};
+  return std::nullopt;
+}
+
+}  // namespace fvp::robot::sim
