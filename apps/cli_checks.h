@@ -47,4 +47,18 @@ inline CLI::Validator finiteNumber() {
       "NUMBER", "finiteNumber");
 }
 
+/// A finite number above zero. (CLI::PositiveNumber prints the largest double, 309 digits,
+/// as its bound.)
+inline CLI::Validator positiveNumber() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        std::string copy = text;
+        if (std::string error = finiteNumber()(copy); !error.empty()) return error;
+        if (!(std::strtod(text.c_str(), nullptr) > 0.0))
+          return "expected a number above 0, got '" + text + "'";
+        return {};
+      },
+      "POSITIVE", "positiveNumber");
+}
+
 }  // namespace fvp::apps

@@ -28,7 +28,7 @@ void addExperimentCommands(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--trials", opt->experiment.trials, "worlds (seeds) per planner")
       ->check(decimalUnsigned())
-      ->check(CLI::PositiveNumber)
+      ->check(positiveNumber())
       ->capture_default_str();
   cmd->add_option("--first-seed", opt->experiment.first_seed, "seed of the first world")
       ->check(decimalUnsigned())
@@ -37,7 +37,7 @@ void addExperimentCommands(CLI::App& app) {
   cmd->add_option("--config", opt->config, "planner config YAML")->check(CLI::ExistingFile);
   cmd->add_option("--budget-s", opt->experiment.trial.budget_s, "simulated budget per trial, s")
       ->check(finiteNumber())
-      ->check(CLI::PositiveNumber)
+      ->check(positiveNumber())
       ->capture_default_str();
   cmd->add_option("--backend", opt->experiment.trial.backend, "cpu | opencl | vulkan | auto")
       ->capture_default_str();

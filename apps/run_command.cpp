@@ -34,7 +34,7 @@ void addRunCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--budget-s", opt->trial.budget_s, "simulated time budget, seconds")
       ->check(finiteNumber())
-      ->check(CLI::PositiveNumber)
+      ->check(positiveNumber())
       ->capture_default_str();
   cmd->add_option("--backend", opt->trial.backend, "compute backend: cpu | opencl | vulkan | auto")
       ->capture_default_str();
@@ -42,8 +42,7 @@ void addRunCommand(CLI::App& app) {
                   "map engine: grid | octomap (default: grid for fvp, octomap for rvp)")
       ->check(CLI::IsMember({"grid", "octomap"}));
   cmd->add_option("--max-views", opt->max_views, "stop after this many views (0: no limit)")
-      ->check(decimalUnsigned())
-      ->check(CLI::NonNegativeNumber);
+      ->check(decimalUnsigned());
   cmd->add_option("--clock", opt->trial.clock,
                   "simulated clock: wall (charge measured compute time) | fixed (a constant)")
       ->check(CLI::IsMember({"wall", "fixed"}))

@@ -4,6 +4,7 @@
 // (*.tmp-*) or result file behind. A second group checks the documented warnings.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -288,6 +289,45 @@ const std::vector<BadInput>& cases() {
        1,
        {"map.yaml': key 'fine_voxel_size_m': expected a number, got 'fine'"},
        {"out/coarse.bt"}},
+      {"BudgetZero",
+       [](const fs::path& d) {
+         return std::vector<std::string>{"run", "--budget-s", "0", "--out", p(d / "out")};
+       },
+       2,
+       {"--budget-s", "expected a number above 0, got '0'"},
+       {"out"}},
+      {"ExperimentPlannerTwice",
+       [](const fs::path& d) {
+         return std::vector<std::string>{"experiment", "--planners", "fvp,fvp",   "--trials",
+                                         "1",          "--out",      p(d / "exp")};
+       },
+       1,
+       {"--planners lists 'fvp' twice"},
+       {"exp/trials.jsonl"}},
+      {"ExperimentShardOfThreeParts",
+       [](const fs::path& d) {
+         return std::vector<std::string>{"experiment", "--shard", "1/2/3", "--out", p(d / "exp")};
+       },
+       1,
+       {"--shard: expected i/n", "'1/2/3'"},
+       {"exp/trials.jsonl"}},
+      {"MergeADirectoryWithoutManifest",
+       [](const fs::path& d) {
+         writeText(d / "old" / "trials.jsonl", "");
+         return std::vector<std::string>{"merge", "--out", p(d / "merged"), p(d / "old")};
+       },
+       1,
+       {"old has trials.jsonl but no manifest.json"},
+       {"merged/trials.jsonl", "merged/table1.md"}},
+      {"MergeOutHoldsShellQuotes",
+       [](const fs::path& d) {
+         writeText(d / "old" / "trials.jsonl", "");
+         return std::vector<std::string>{"merge", "--out", p(d / "x'; touch PWNED; echo '"),
+                                         p(d / "old")};
+       },
+       1,
+       {"no manifest.json"},
+       {"PWNED"}},
   };
   return table;
 }
@@ -308,6 +348,8 @@ TEST_P(BadInputs, ExitWithAClearErrorAndWriteNothing) {
     EXPECT_NE(run.stderr_text.find(m), std::string::npos) << "missing: " << m;
   for (const std::string& a : c.absent) EXPECT_FALSE(fs::exists(dir / a)) << a;
   EXPECT_EQ(temporaries(dir), std::vector<std::string>{});
+  // Bounds are printed as people write them (CLI::PositiveNumber printed 309 digits).
+  EXPECT_EQ(run.stderr_text.find("0000000000000000000000"), std::string::npos);
 }
 
 INSTANTIATE_TEST_SUITE_P(Fvp, BadInputs, ::testing::ValuesIn(cases()),
@@ -335,6 +377,37 @@ TEST(Warnings, GreyCapturesAreSizedWithPrintedAndRecordedWarnings) {
   const nlohmann::json result = nlohmann::json::parse(in);
   EXPECT_EQ(result["warnings"].size(), 4u);  // two captures, the skipped folder, no tag
   EXPECT_EQ(result["captures"][0]["fruitlet_pixels"], 0);
+}
+
+// A figure is an optional extra: without gnuplot the trial still writes result.json and
+// report.md, warns, and records why path.png is missing. The run also removes what an
+// earlier run left in the same --out (a stale view and figure).
+TEST(Warnings, ATrialWithoutGnuplotKeepsItsResultAndClearsAnEarlierRun) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "fvp_bad_inputs_no_gnuplot";
+  fs::remove_all(dir);
+  writeText(dir / "out" / "views" / "099.png", "stale");
+  writeText(dir / "out" / "path.png", "stale");
+  writeText(dir / "out" / "notes.txt", "the user's own file");
+  const char* old_path = std::getenv("PATH");
+  const std::string saved = old_path ? old_path : "";
+  ::setenv("PATH", "/nonexistent", 1);
+  const auto run = fvp::host::runProgram({kFvp, "run", "--seed", "3", "--max-views", "1", "--clock",
+                                          "fixed", "--backend", "cpu", "--out", p(dir / "out")},
+                                         "");
+  ::setenv("PATH", saved.c_str(), 1);
+  SCOPED_TRACE(run.stderr_text);
+  ASSERT_EQ(run.exit_code, 0);
+  EXPECT_NE(run.stderr_text.find("fvp: warning: path.png not drawn"), std::string::npos);
+  std::ifstream in(dir / "out" / "result.json");
+  const nlohmann::json result = nlohmann::json::parse(in);
+  ASSERT_EQ(result["warnings"].size(), 1u);
+  EXPECT_NE(result["warnings"][0].get<std::string>().find("cannot start 'gnuplot'"),
+            std::string::npos);
+  EXPECT_TRUE(fs::exists(dir / "out" / "report.md"));
+  EXPECT_TRUE(fs::exists(dir / "out" / "views" / "000.png"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "views" / "099.png"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "path.png"));
+  EXPECT_TRUE(fs::exists(dir / "out" / "notes.txt"));
 }
 
 }  // namespace
