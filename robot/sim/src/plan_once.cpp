@@ -144,11 +144,11 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
       {"motions", motions},
       {"warnings", warnings}};
   if (!o.out_dir.empty()) {
-    std::filesystem::create_directories(o.out_dir);
+    // The result first, then the extra.
+    host::writeFileAtomically(o.out_dir / "plan.json", "plan", result.dump(2) + "\n");
     host::writePlyColoredPoints(o.out_dir / "candidates.ply", positions, colours,
                                 "fvp candidate camera positions, colour = utility (blue low, red "
                                 "high, grey unscored)");
-    host::writeFileAtomically(o.out_dir / "plan.json", "plan", result.dump(2) + "\n");
   }
   return result;
 }
