@@ -15,10 +15,14 @@
 #include "fvp/accel/backend.h"
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/host/core/output_directory.h"
+#include "fvp/host/nbv/nbv_loop.h"
 #include "fvp/host/planner/view_planner.h"
 #include "fvp/host/session/mapping_session.h"
 #include "fvp/robot/arm_controller.h"
 #include "fvp/robot/arm_model.h"
+#include "fvp/robot/sim/simulated_arm.h"
+#include "fvp/robot/sim/simulated_camera.h"
+#include "fvp/robot/sim/simulated_loop_clock.h"
 #include "fvp/robot/sim/stereo_renderer.h"
 #include "fvp/robot/sim/world.h"
 #include "fvp/robot/sim_clock.h"
@@ -53,13 +57,56 @@ void validate(const TrialOptions& o) {
     throw std::invalid_argument("trial option 'max_views': expected at least 1");
 }
 
-/// Counted expected events of one trial (never errors).
-struct TrialEvents {
-  std::size_t move_attempts = 0, failed_moves = 0, planning_iterations = 0, rejected_clearance = 0,
-              iterations_without_move = 0, views_without_tag = 0, culled_rays = 0,
-              collision_voxels_freed_at_arm = 0;
-  std::int64_t dropped_disparities = 0, saturated_disparities = 0;
-  std::map<std::string, std::size_t> motion_status;
+/// The trial's per-view and per-iteration logs, view images and progress lines, from the
+/// loop's observer hooks.
+class TrialLog : public host::nbv::LoopObserver {
+ public:
+  TrialLog(const TrialParts& parts, const SimulatedCamera& camera, const TrialOptions& options,
+           Clock::time_point wall_start)
+      : parts_(parts), camera_(camera), options_(options), wall_start_(wall_start) {}
+
+  void onView(const host::nbv::ViewEvent& e) override {
+    const host::ViewResult& v = *e.result;
+    views_.push_back({{"index", e.index},
+                      {"position_m", vec3(e.T_world_camera.translation())},
+                      {"tag_detected", v.tag_detected},
+                      {"roi_points", v.roi_points},
+                      {"other_points", v.other_points},
+                      {"render_s", camera_.lastRenderSeconds()},
+                      {"perceive_s", v.perceive_s},
+                      {"mapping_s", v.scan.seconds},
+                      {"tsdf_s", v.tsdf_s},
+                      {"sim_time_s", e.now_s}});
+    if (!options_.out_dir.empty()) parts_.keepViewImage(e.index, *e.frame);
+    if (options_.on_progress)
+      options_.on_progress({e.index + 1, e.now_s, options_.budget_s, secondsSince(wall_start_)});
+  }
+
+  void onPlan(const host::nbv::PlanEvent& e) override {
+    const host::planner::PlanStep& step = *e.step;
+    nlohmann::json timings = nlohmann::json::object();
+    for (const auto& [stage, s] : step.timings_s) timings[stage] = s;
+    plans_.push_back(
+        {{"candidates", step.candidates.size()},
+         {"moved", step.moved()},
+         {"move_attempts", step.move_attempts},
+         {"failed_moves", step.failed_moves},
+         {"sampling_rounds", step.sampling_rounds},
+         {"chosen_utility",
+          step.chosen ? nlohmann::json(step.candidates[*step.chosen].utility) : nlohmann::json()},
+         {"planning_s", e.planning_s},
+         {"timings_s", timings}});
+  }
+
+  const nlohmann::json& views() const { return views_; }
+  const nlohmann::json& plans() const { return plans_; }
+
+ private:
+  const TrialParts& parts_;
+  const SimulatedCamera& camera_;
+  const TrialOptions& options_;
+  Clock::time_point wall_start_;
+  nlohmann::json views_ = nlohmann::json::array(), plans_ = nlohmann::json::array();
 };
 
 }  // namespace
@@ -112,116 +159,18 @@ nlohmann::json runTrial(const TrialOptions& options) {
                              ": the start view is out of the arm's reach");
   ArmController controller(arm, clock, *start);
 
-  TrialEvents events;
-  nlohmann::json view_log = nlohmann::json::array();
-  nlohmann::json plan_log = nlohmann::json::array();
+  // The loop, driven through the simulated camera, arm and clock like a robot's.
+  SimulatedCamera camera(renderer, clock);
+  SimulatedArm sim_arm(controller, workspace);
+  SimulatedLoopClock loop_clock(clock);
+  host::nbv::StopCondition stop = host::nbv::StopCondition::budget(options.budget_s);
+  if (options.max_views) stop = stop || host::nbv::StopCondition::views(*options.max_views);
+  TrialLog log(parts, camera, options, wall_start);
+  host::nbv::NbvLoop loop(parts.session(), parts.planner(), camera, sim_arm, loop_clock);
+  const host::nbv::NbvResult run = loop.run(stop, &log);
+  const host::nbv::NbvEvents& events = run.events;
   std::vector<Eigen::Vector3d> camera_path;
-  double render_wall_s = 0.0, perceive_wall_s = 0.0, planning_wall_s = 0.0,
-         motion_planning_wall_s = 0.0, mapping_wall_s = 0.0, tsdf_wall_s = 0.0;
-  int views = 0;
-  bool capture_next = true;
-  std::size_t collision_map_scans = 0;  // the map's scan count when the arm last got it
-  const auto budget_left = [&] { return clock.now_s() < options.budget_s; };
-  const auto views_left = [&] { return !options.max_views || views < *options.max_views; };
-
-  while (budget_left() && views_left()) {
-    clock.beginIteration();
-    if (capture_next) {
-      const Eigen::Isometry3d T_world_camera = controller.cameraPose();
-      // The trial perceives from the images alone: no ground-truth depth or ids to render.
-      RenderOptions render_options;
-      render_options.ground_truth = false;
-      const host::StereoFrame frame = renderer.render(T_world_camera, render_options);
-      render_wall_s += renderer.lastRenderSeconds();
-      clock.chargeCapture();
-      const ViewOutcome view = parts.addView(frame);
-      perceive_wall_s += view.result.perceive_s;
-      mapping_wall_s += view.mapping_s;
-      tsdf_wall_s += view.tsdf_s;
-      clock.chargeCompute(ClockStage::kMapping, view.mapping_s);
-      clock.chargeCompute(ClockStage::kTsdf, view.tsdf_s);
-      clock.recordUncharged(renderer.lastRenderSeconds(), view.result.perception.sgbm_s);
-      events.dropped_disparities += view.result.perception.droppedDisparities();
-      events.saturated_disparities += view.result.perception.saturated;
-      if (!view.result.tag_detected) ++events.views_without_tag;
-      camera_path.push_back(T_world_camera.translation());
-      view_log.push_back({{"index", views},
-                          {"position_m", vec3(T_world_camera.translation())},
-                          {"tag_detected", view.result.tag_detected},
-                          {"roi_points", view.result.roi_points},
-                          {"other_points", view.result.other_points},
-                          {"render_s", renderer.lastRenderSeconds()},
-                          {"perceive_s", view.result.perceive_s},
-                          {"mapping_s", view.mapping_s},
-                          {"tsdf_s", view.tsdf_s},
-                          {"sim_time_s", clock.now_s()}});
-      if (!options.out_dir.empty()) parts.keepViewImage(views, frame);
-      ++views;
-      if (options.on_progress)
-        options.on_progress({views, clock.now_s(), options.budget_s, secondsSince(wall_start)});
-      if (!budget_left() || !views_left()) break;
-    }
-    host::map::MapEngine* map = parts.map();
-    if (!map) {
-      // No Cluster Region yet: the tag was not seen from the start view. Nothing to plan on;
-      // an expected outcome of a heavily occluded tag, reported, never a crash.
-      break;
-    }
-
-    // The arm's collision map follows the coarse map after new scans only (planning again
-    // after a failed move keeps it); building it is map upkeep, charged as mapping. The
-    // voxels the arm occupies where it stands are freed in it (counted per rebuild, so a
-    // voxel seen again after the next scan counts again).
-    if (collision_map_scans != map->scanCount()) {
-      const auto t_collision = Clock::now();
-      events.collision_voxels_freed_at_arm += controller.setMap(map->coarseOcTree());
-      collision_map_scans = map->scanCount();
-      const double collision_s = secondsSince(t_collision);
-      mapping_wall_s += collision_s;
-      clock.chargeCompute(ClockStage::kMapping, collision_s);
-    }
-    // Plan and move. Planning is charged as its wall time minus the moves it made (the
-    // controller charges motion planning and motion itself).
-    double move_wall_s = 0.0;
-    const host::planner::ReachabilityFn reachable = [&](const Eigen::Isometry3d& T) {
-      return workspace.reachable(T);
-    };
-    const host::planner::MoveToPoseFn move = [&](const Eigen::Isometry3d& T) {
-      const auto t0 = Clock::now();
-      const MotionPlan plan = controller.moveToPose(T);
-      move_wall_s += secondsSince(t0);
-      motion_planning_wall_s += plan.planning_wall_s;
-      ++events.motion_status[toString(plan.status)];
-      return plan.ok();
-    };
-    const auto t_plan = Clock::now();
-    const host::planner::PlanStep step =
-        parts.planner().planAndMove(*map, controller.cameraPose(), reachable, move);
-    const double plan_s = std::max(0.0, secondsSince(t_plan) - move_wall_s);
-    planning_wall_s += plan_s;
-    clock.chargeCompute(ClockStage::kPlanning, plan_s);
-    ++events.planning_iterations;
-    events.move_attempts += step.move_attempts;
-    events.failed_moves += step.failed_moves;
-    events.rejected_clearance += step.rejected_clearance;
-    events.culled_rays += step.culled_rays;
-    nlohmann::json timings = nlohmann::json::object();
-    for (const auto& [stage, s] : step.timings_s) timings[stage] = s;
-    plan_log.push_back(
-        {{"candidates", step.candidates.size()},
-         {"moved", step.moved()},
-         {"move_attempts", step.move_attempts},
-         {"failed_moves", step.failed_moves},
-         {"sampling_rounds", step.sampling_rounds},
-         {"chosen_utility",
-          step.chosen ? nlohmann::json(step.candidates[*step.chosen].utility) : nlohmann::json()},
-         {"planning_s", plan_s},
-         {"timings_s", timings}});
-    // Without a move, a new capture would see the same view: plan again (the planner's
-    // threshold has decayed) until a move succeeds or the budget is spent.
-    capture_next = step.moved();
-    if (!step.moved()) ++events.iterations_without_move;
-  }
+  for (const auto& T : run.camera_poses) camera_path.push_back(T.translation());
 
   // Size, score and write.
   const auto t_size = Clock::now();
@@ -233,7 +182,8 @@ nlohmann::json runTrial(const TrialOptions& options) {
   result["seed"] = options.seed;
   result["engine"] = engine;
   result["backend"] = backend ? std::string(accel::toString(backend->kind())) : "none";
-  result["views"] = views;
+  result["views"] = run.views;
+  result["stop_reason"] = run.stop_reason;
   result["sim_time_s"] = clock.now_s();
   result["budget_s"] = options.budget_s;
   result["wall_time_s"] = secondsSince(wall_start);
@@ -251,17 +201,20 @@ nlohmann::json runTrial(const TrialOptions& options) {
                             {"views_without_tag", events.views_without_tag},
                             {"dropped_disparities", events.dropped_disparities},
                             {"saturated_disparities", events.saturated_disparities},
-                            {"collision_voxels_freed_at_arm", events.collision_voxels_freed_at_arm},
+                            {"collision_voxels_freed_at_arm", events.obstacle_update_count},
+                            {"dropped_frames", events.dropped_frames},
                             {"motion_status", events.motion_status}};
   result["events"] = counted;
-  result["wall_breakdown_s"] = {
-      {"rendering", render_wall_s},  {"perception", perceive_wall_s},
-      {"mapping", mapping_wall_s},   {"tsdf", tsdf_wall_s},
-      {"planning", planning_wall_s}, {"motion_planning", motion_planning_wall_s},
-      {"sizing", sizing_wall_s}};
+  result["wall_breakdown_s"] = {{"rendering", camera.totalRenderSeconds()},
+                                {"perception", run.wall_s.perception},
+                                {"mapping", run.wall_s.mapping},
+                                {"tsdf", run.wall_s.tsdf},
+                                {"planning", run.wall_s.planning},
+                                {"motion_planning", run.wall_s.motion_planning},
+                                {"sizing", sizing_wall_s}};
   result["clock"] = nlohmann::json::parse(clock.toJson());
-  result["view_log"] = view_log;
-  result["plan_log"] = plan_log;
+  result["view_log"] = log.views();
+  result["plan_log"] = log.plans();
   nlohmann::json path = nlohmann::json::array();
   for (const auto& p : camera_path) path.push_back(vec3(p));
   result["camera_path_m"] = path;

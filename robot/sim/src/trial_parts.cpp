@@ -99,6 +99,10 @@ host::map::MapEngine* TrialParts::map() {
   return impl_->session.map();
 }
 
+host::MappingSession& TrialParts::session() {
+  return impl_->session;
+}
+
 host::planner::ViewPlanner& TrialParts::planner() {
   return *impl_->planner;
 }

@@ -53,6 +53,7 @@ class TrialParts {
   /// Null until a view detected the tag.
   host::map::MapEngine* map();
   host::planner::ViewPlanner& planner();
+  host::MappingSession& session();
   /// The trial-level configuration (engine, map, perception, sizing) as JSON.
   nlohmann::json configJson() const;
   /// Writes a small PNG of the view's left image for the report.

@@ -1,0 +1,54 @@
+// The arm the next-best-view loop moves the camera with (a real arm's driver and planner,
+// or the simulated UR5 on its slider). Failures to move are statuses, never exceptions.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <string>
+
+namespace fvp::host::map {
+class MapEngine;
+}
+
+namespace fvp::host::nbv {
+
+enum class MoveStatus {
+  kSuccess,
+  kNoIk,               ///< no inverse-kinematics solution for the pose
+  kNoCollisionFreeIk,  ///< solutions exist, all in collision
+  kStartInvalid,       ///< the current configuration is in collision or off limits
+  kNoPath,             ///< the motion planner gave up
+  kTimeout,            ///< planning ran out of time
+  kRefused,            ///< the arm's driver or its operator refused the motion
+  kExecutionFailed,    ///< the motion started but did not reach the goal
+};
+
+/// "success", "no_ik", ... (the keys of result.json's events.motion_status).
+const char* toString(MoveStatus status);
+
+struct MoveResult {
+  MoveStatus status = MoveStatus::kNoPath;
+  double planning_wall_s = 0.0;  ///< wall time spent planning the motion (for reports)
+  bool ok() const { return status == MoveStatus::kSuccess; }
+};
+
+class Arm {
+ public:
+  virtual ~Arm() = default;
+  /// The left camera's optical-frame pose in the world, now.
+  virtual Eigen::Isometry3d cameraPose() const = 0;
+  /// Whether the camera can be put at this pose at all; cheap, may be optimistic. The
+  /// planner only sends reachable candidates to moveTo.
+  virtual bool reachable(const Eigen::Isometry3d& T_world_camera) const = 0;
+  /// Plans and executes a move of the camera to the pose (blocking).
+  virtual MoveResult moveTo(const Eigen::Isometry3d& T_world_camera) = 0;
+  /// Called after new views reached the map, before planning, so the arm avoids what the
+  /// camera has seen. Returns a count for the log (the simulated arm: voxels it freed where
+  /// it stands); 0 for an arm that does not use the map.
+  virtual std::size_t updateObstacles(map::MapEngine& map) {
+    (void)map;
+    return 0;
+  }
+};
+
+}  // namespace fvp::host::nbv

@@ -1,0 +1,41 @@
+// The clock the next-best-view loop's stop condition reads. On a robot it is the wall clock;
+// in simulation it is a simulated clock that charges each stage (capture, mapping, TSDF,
+// planning, motion) its modelled or measured time.
+#pragma once
+
+#include <chrono>
+
+namespace fvp::host::nbv {
+
+/// The loop's own compute, which a simulated clock charges (measured or fixed).
+enum class LoopStage { kMapping, kTsdf, kPlanning };
+
+class LoopClock {
+ public:
+  virtual ~LoopClock() = default;
+  virtual double now_s() const = 0;
+  /// The start of one loop iteration (a simulated clock keeps per-iteration charges).
+  virtual void beginIteration() {}
+  /// wall_s of loop compute in a stage just ran. A wall clock has counted it already.
+  virtual void chargeCompute(LoopStage stage, double wall_s) {
+    (void)stage;
+    (void)wall_s;
+  }
+  /// Stereo matching's wall time, which a simulated clock does not charge (the capture
+  /// charge stands in for the camera's own depth pipeline).
+  virtual void recordStereoMatching(double wall_s) { (void)wall_s; }
+};
+
+/// Seconds of wall time since construction: the clock of a real robot's loop.
+class SteadyLoopClock : public LoopClock {
+ public:
+  SteadyLoopClock() : start_(std::chrono::steady_clock::now()) {}
+  double now_s() const override {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+
+ private:
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace fvp::host::nbv

@@ -1,0 +1,99 @@
+// The next-best-view loop (paper Algorithm 1's outer loop, DESIGN.md section 9) over narrow
+// interfaces, so it runs the same on a robot and in the simulator: capture through a Camera
+// at the Arm's pose -> perceive and map in the MappingSession -> plan with a ViewPlanner ->
+// move the Arm, until the StopCondition holds. Without a successful move it plans again
+// without a new capture. The loop holds no ground truth: scoring is the caller's.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "fvp/host/nbv/arm.h"
+#include "fvp/host/nbv/camera.h"
+#include "fvp/host/nbv/loop_clock.h"
+#include "fvp/host/nbv/stop_condition.h"
+#include "fvp/host/planner/view_planner.h"
+#include "fvp/host/session/mapping_session.h"
+
+namespace fvp::host::nbv {
+
+/// One captured view, as the loop reports it.
+struct ViewEvent {
+  int index = 0;  ///< 0-based view number
+  Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();
+  const StereoFrame* frame = nullptr;  ///< the frame as captured
+  const ViewResult* result = nullptr;  ///< what the session made of it
+  double now_s = 0.0;                  ///< the loop clock after the view was mapped
+};
+
+/// One planning iteration, as the loop reports it.
+struct PlanEvent {
+  std::size_t iteration = 0;
+  const planner::PlanStep* step = nullptr;
+  double planning_s = 0.0;  ///< planner wall time less the moves it made
+  double now_s = 0.0;
+};
+
+/// Progress, logs and per-iteration timings; every hook is optional.
+class LoopObserver {
+ public:
+  virtual ~LoopObserver() = default;
+  virtual void onView(const ViewEvent& event) { (void)event; }
+  virtual void onPlan(const PlanEvent& event) { (void)event; }
+  virtual void onDroppedFrame(const std::string& detail) { (void)detail; }
+};
+
+struct NbvLoopOptions {
+  /// Frames dropped in a row after which the loop stops ("camera_failed"): a camera that
+  /// never delivers must not spin the loop forever.
+  int max_consecutive_dropped_frames = 10;
+};
+
+/// Counted expected events of a run (never errors).
+struct NbvEvents {
+  std::size_t planning_iterations = 0, iterations_without_move = 0, move_attempts = 0,
+              failed_moves = 0, rejected_clearance = 0, culled_rays = 0, views_without_tag = 0,
+              dropped_frames = 0, obstacle_update_count = 0;
+  std::int64_t dropped_disparities = 0, saturated_disparities = 0;
+  std::map<std::string, std::size_t> motion_status;  ///< toString(MoveStatus) -> count
+};
+
+/// Wall time spent in the loop's parts, seconds.
+struct NbvWallTimes {
+  double capture = 0.0, perception = 0.0, mapping = 0.0, tsdf = 0.0, planning = 0.0,
+         motion_planning = 0.0, moving = 0.0;
+};
+
+struct NbvResult {
+  int views = 0;
+  /// Why the loop stopped: a StopCondition's reason, "no_region" (the first view showed no
+  /// tag: nothing to plan on) or "camera_failed".
+  std::string stop_reason;
+  std::vector<Eigen::Isometry3d> camera_poses;  ///< of each captured view, in order
+  NbvEvents events;
+  NbvWallTimes wall_s;
+};
+
+class NbvLoop {
+ public:
+  /// Every reference must outlive the loop. The session holds the maps and the TSDF and
+  /// may already hold views.
+  NbvLoop(MappingSession& session, planner::ViewPlanner& planner, Camera& camera, Arm& arm,
+          LoopClock& clock, NbvLoopOptions options = {});
+
+  /// Runs until stop holds; the observer (optional) hears of each view and iteration.
+  NbvResult run(const StopCondition& stop, LoopObserver* observer = nullptr);
+
+ private:
+  MappingSession& session_;
+  planner::ViewPlanner& planner_;
+  Camera& camera_;
+  Arm& arm_;
+  LoopClock& clock_;
+  NbvLoopOptions options_;
+};
+
+}  // namespace fvp::host::nbv

@@ -1,0 +1,224 @@
+// NbvLoop's contract, driven by fakes: it captures at the arm's pose, plans again without a
+// capture after a failed move, counts refusals and dropped frames, stops when the stop
+// condition holds (also between a capture and the planning that would follow it), and stops
+// without planning when no view showed the tag.
+#include "fvp/host/nbv/nbv_loop.h"
+
+#include <gtest/gtest.h>
+
+#include <deque>
+#include <optional>
+
+#include "fvp/accel/backend.h"
+#include "fvp/robot/sim/camera_views.h"
+#include "fvp/robot/sim/stereo_renderer.h"
+#include "fvp/robot/sim/world.h"
+
+namespace fvp::host::nbv {
+namespace {
+
+/// Seed 2's orbit: view 0 does not show the tag, view 1 does (as in the session tests).
+const StereoFrame& renderedFrame(std::size_t i) {
+  static const auto world = robot::sim::World::generate(robot::sim::WorldConfig{}, 2);
+  static const robot::sim::StereoRenderer renderer(world);
+  static const auto poses = robot::sim::orbitViews(world, 3, 60.0);
+  static std::optional<StereoFrame> frames[2];
+  if (!frames[i]) {
+    robot::sim::RenderOptions options;
+    options.ground_truth = false;
+    frames[i] = renderer.render(poses[i], options);
+  }
+  return *frames[i];
+}
+
+class FakeClock : public LoopClock {
+ public:
+  double now_s() const override { return now_; }
+  void chargeCompute(LoopStage, double) override { ++compute_charges; }
+  void advance(double s) { now_ += s; }
+  int compute_charges = 0;
+
+ private:
+  double now_ = 0.0;
+};
+
+/// Delivers the tagged frame (or the untagged one), dropping the frames whose capture index
+/// is listed; each capture takes capture_s on the clock.
+class FakeCamera : public Camera {
+ public:
+  FakeCamera(FakeClock& clock, std::size_t frame = 1) : clock_(clock), frame_(frame) {}
+  CaptureResult capture(const Eigen::Isometry3d& T_world_camera) override {
+    clock_.advance(capture_s);
+    poses.push_back(T_world_camera);
+    CaptureResult r;
+    if (drop_all || (!drop.empty() && drop.front() == captures)) {
+      if (!drop.empty() && drop.front() == captures) drop.pop_front();
+      ++captures;
+      r.status = CaptureStatus::kDropped;
+      r.detail = "timeout";
+      return r;
+    }
+    ++captures;
+    r.status = CaptureStatus::kOk;
+    r.frame = renderedFrame(frame_);
+    return r;
+  }
+  std::deque<int> drop;  ///< capture indices to drop, ascending
+  bool drop_all = false;
+  double capture_s = 1.0;
+  int captures = 0;
+  std::vector<Eigen::Isometry3d> poses;
+
+ private:
+  FakeClock& clock_;
+  std::size_t frame_;
+};
+
+/// An arm that refuses every `refuse_every`-th move (1-based), else moves instantly.
+class FakeArm : public Arm {
+ public:
+  Eigen::Isometry3d cameraPose() const override { return pose_; }
+  bool reachable(const Eigen::Isometry3d&) const override { return true; }
+  MoveResult moveTo(const Eigen::Isometry3d& T) override {
+    ++moves;
+    if (refuse_every && moves % refuse_every == 0) return {MoveStatus::kRefused, 0.0};
+    pose_ = T;
+    return {MoveStatus::kSuccess, 0.0};
+  }
+  std::size_t updateObstacles(map::MapEngine&) override { return ++obstacle_updates; }
+  int refuse_every = 0, moves = 0;
+  std::size_t obstacle_updates = 0;
+
+ private:
+  Eigen::Isometry3d pose_ = renderedFrame(1).T_world_camera;
+};
+
+/// Offers one candidate per iteration, 1 cm along x from the current pose.
+class FakePlanner : public planner::ViewPlanner {
+ public:
+  std::string_view name() const override { return "fake"; }
+  std::string configJson() const override { return "{}"; }
+  planner::PlanStep planAndMove(map::MapEngine&, const Eigen::Isometry3d& T_now,
+                                const planner::ReachabilityFn& reachable,
+                                const planner::MoveToPoseFn& move) override {
+    planner::PlanStep step;
+    planner::Candidate c;
+    c.T_world_camera = T_now;
+    c.T_world_camera.translation().x() += 0.01;
+    step.candidates.push_back(c);
+    if (reachable(c.T_world_camera)) {
+      ++step.move_attempts;
+      if (move(c.T_world_camera))
+        step.chosen = 0;
+      else
+        ++step.failed_moves;
+    }
+    ++calls;
+    return step;
+  }
+  int calls = 0;
+};
+
+struct Rig {
+  std::unique_ptr<accel::Backend> backend = accel::createBackend("cpu");
+  MappingSession session{PerceptionConfig{}, "grid", map::MapConfig{}, backend.get()};
+  FakeClock clock;
+  FakeCamera camera{clock};
+  FakeArm arm;
+  FakePlanner planner;
+  NbvResult run(const StopCondition& stop) {
+    return NbvLoop(session, planner, camera, arm, clock).run(stop);
+  }
+};
+
+TEST(NbvLoop, CapturesAtTheArmsPoseUntilTheViewCountAndCountsEachStep) {
+  Rig rig;
+  const NbvResult r = rig.run(StopCondition::views(3));
+  EXPECT_EQ(r.views, 3);
+  EXPECT_EQ(r.stop_reason, "max_views");
+  // Plans after views 1 and 2; the third view meets the stop before any planning.
+  EXPECT_EQ(rig.planner.calls, 2);
+  EXPECT_EQ(r.events.planning_iterations, 2u);
+  EXPECT_EQ(r.events.motion_status.at("success"), 2u);
+  ASSERT_EQ(rig.camera.poses.size(), 3u);
+  EXPECT_NEAR(rig.camera.poses[2].translation().x() - rig.camera.poses[0].translation().x(), 0.02,
+              1e-12);
+  EXPECT_EQ(r.camera_poses.size(), 3u);
+  EXPECT_EQ(rig.arm.obstacle_updates, 2u);  // after each new view that was planned on
+  EXPECT_EQ(r.events.obstacle_update_count, 1u + 2u);
+}
+
+TEST(NbvLoop, ARefusedMoveIsCountedAndPlannedAgainWithoutACapture) {
+  Rig rig;
+  rig.arm.refuse_every = 2;  // every other move refused
+  const NbvResult r = rig.run(StopCondition::views(4));
+  EXPECT_EQ(r.views, 4);
+  EXPECT_EQ(rig.camera.captures, 4);  // no capture after a refused move
+  EXPECT_EQ(r.events.motion_status.at("refused"), 2u);
+  EXPECT_EQ(r.events.motion_status.at("success"), 3u);
+  EXPECT_EQ(r.events.failed_moves, 2u);
+  EXPECT_EQ(r.events.iterations_without_move, 2u);
+  EXPECT_EQ(r.events.planning_iterations, 5u);
+  // The map did not change after a refused move: the arm's obstacles were not rebuilt.
+  EXPECT_EQ(rig.arm.obstacle_updates, 3u);
+}
+
+TEST(NbvLoop, DroppedFramesAreCountedAndCapturedAgain) {
+  Rig rig;
+  rig.camera.drop = {1, 2};  // the second and third captures fail
+  const NbvResult r = rig.run(StopCondition::views(2));
+  EXPECT_EQ(r.views, 2);
+  EXPECT_EQ(r.events.dropped_frames, 2u);
+  EXPECT_EQ(rig.camera.captures, 4);
+  EXPECT_EQ(rig.planner.calls, 1);
+}
+
+TEST(NbvLoop, ACameraThatNeverDeliversStopsTheLoop) {
+  Rig rig;
+  rig.camera.drop_all = true;
+  const NbvResult r = rig.run(StopCondition::views(2));
+  EXPECT_EQ(r.stop_reason, "camera_failed");
+  EXPECT_EQ(r.views, 0);
+  EXPECT_EQ(r.events.dropped_frames, std::size_t(NbvLoopOptions{}.max_consecutive_dropped_frames));
+}
+
+TEST(NbvLoop, ABudgetSpentByACaptureStopsBeforeThePlanningThatWouldFollow) {
+  Rig rig;
+  rig.camera.capture_s = 10.0;
+  const NbvResult r = rig.run(StopCondition::budget(15.0) || StopCondition::views(100));
+  EXPECT_EQ(r.stop_reason, "budget");
+  EXPECT_EQ(r.views, 2);  // at 10 s and 20 s
+  EXPECT_EQ(rig.planner.calls, 1);
+}
+
+TEST(NbvLoop, AUserPredicateStopsTheLoop) {
+  Rig rig;
+  const StopCondition enough({[](const LoopState& s) { return s.iterations >= 3; }, "enough"});
+  const NbvResult r = rig.run(enough || StopCondition::views(100));
+  EXPECT_EQ(r.stop_reason, "enough");
+  EXPECT_EQ(r.events.planning_iterations, 3u);
+}
+
+TEST(NbvLoop, NoTagInTheFirstViewStopsWithoutPlanning) {
+  Rig rig;
+  FakeCamera untagged(rig.clock, 0);
+  const NbvResult r =
+      NbvLoop(rig.session, rig.planner, untagged, rig.arm, rig.clock).run(StopCondition::views(3));
+  EXPECT_EQ(r.stop_reason, "no_region");
+  EXPECT_EQ(r.views, 1);
+  EXPECT_EQ(r.events.views_without_tag, 1u);
+  EXPECT_EQ(rig.planner.calls, 0);
+}
+
+TEST(StopCondition, RefusesNonsenseAndReportsTheFirstThatHolds) {
+  EXPECT_THROW(StopCondition::budget(0.0), std::invalid_argument);
+  EXPECT_THROW(StopCondition::budget(INFINITY), std::invalid_argument);
+  EXPECT_THROW(StopCondition::views(0), std::invalid_argument);
+  const StopCondition both = StopCondition::views(2) || StopCondition::budget(5.0);
+  EXPECT_FALSE(both.check({1, 0, 1.0, 0}));
+  EXPECT_EQ(both.check({2, 0, 9.0, 0}), "max_views");
+  EXPECT_EQ(both.check({1, 0, 9.0, 0}), "budget");
+}
+
+}  // namespace
+}  // namespace fvp::host::nbv
