@@ -61,8 +61,21 @@ PerceptionResult PerceptionPipeline::process(
   PerceptionResult result;
   PerceptionStats timing;
 
+  const cv::Size size(K.width_px, K.height_px);
+  if (!frame.fruitlet_mask.empty() &&
+      (frame.fruitlet_mask.size() != size || frame.fruitlet_mask.type() != CV_8UC1))
+    throw std::invalid_argument(
+        "PerceptionPipeline: the frame's fruitlet_mask must be CV_8UC1 of the image size");
+  if (!frame.disparity_px.empty() &&
+      (frame.disparity_px.size() != size || frame.disparity_px.type() != CV_32FC1))
+    throw std::invalid_argument(
+        "PerceptionPipeline: the frame's disparity_px must be CV_32FC1 of the image size");
+
   auto t0 = std::chrono::steady_clock::now();
-  result.fruitlet_mask = segmenter_.segment(frame.left_bgr);
+  if (!frame.fruitlet_mask.empty())
+    cv::compare(frame.fruitlet_mask, 0, result.fruitlet_mask, cv::CMP_NE);  // as given: 0 / 255
+  else
+    result.fruitlet_mask = segmenter_.segment(frame.left_bgr);
   timing.segmentation_s = secondsSince(t0);
 
   t0 = std::chrono::steady_clock::now();
@@ -99,6 +112,12 @@ PerceptionResult PerceptionPipeline::process(
     result.disparity.coarse_scale = 1;
     result.disparity.stats.fine_samples = static_cast<std::int64_t>(frame.gt_depth_m.total());
     result.disparity.stats.sgbm_s = secondsSince(t0);
+  } else if (!frame.disparity_px.empty()) {
+    // The frame's own disparity, as given, at full resolution everywhere.
+    result.disparity.disparity_px = frame.disparity_px.clone();
+    result.disparity.fine_rect = cv::Rect(0, 0, K.width_px, K.height_px);
+    result.disparity.coarse_scale = 1;
+    result.disparity.stats.fine_samples = static_cast<std::int64_t>(frame.disparity_px.total());
   } else {
     result.disparity = matcher_.compute(frame.left_bgr, frame.right_bgr, fine);
   }

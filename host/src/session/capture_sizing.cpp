@@ -89,14 +89,19 @@ nlohmann::json sizeCaptureSet(const std::filesystem::path& captures_dir,
     frame.right_bgr = capture.right_bgr;
     frame.intrinsics = capture.intrinsics;
     frame.T_world_camera = capture.T_world_camera;
+    // The capture's own mask and disparity (a robot's segmentation and stereo) as given.
+    frame.fruitlet_mask = capture.fruitlet_mask;
+    frame.disparity_px = capture.disparity_px;
     PerceptionResult perceived;
     const ViewResult v = session.addView(frame, &perceived);
     const int fruitlet_px =
         perceived.fruitlet_mask.empty() ? 0 : cv::countNonZero(perceived.fruitlet_mask);
     if (fruitlet_px == 0)
-      warn(dir.string() +
-           ": no fruitlet pixels segmented (HSV thresholds for the simulator's fruitlet "
-           "colours; a grey or real image needs its own mask)");
+      warn(dir.string() + (capture.fruitlet_mask.empty()
+                               ? ": no fruitlet pixels segmented (HSV thresholds for the "
+                                 "simulator's fruitlet colours; a grey or real image needs its "
+                                 "own mask.png)"
+                               : ": its mask.png marks no fruitlet pixel"));
     if (ground_truth.empty() && !capture.ground_truth_json.empty()) {
       ground_truth = capture.ground_truth_json;
       ground_truth_source = (dir / "ground_truth.json").string();

@@ -25,6 +25,10 @@ struct StereoFrame {
   cv::Mat right_bgr;  ///< CV_8UC3, rectified right image
   StereoIntrinsics intrinsics;
   Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();  ///< left camera pose
+  // Optional outside perception, used as given when present (a robot's segmentation network
+  // and stereo matcher); HSV segmentation and SGBM run only when these are empty.
+  cv::Mat fruitlet_mask;  ///< CV_8U, left image size, nonzero = fruitlet
+  cv::Mat disparity_px;   ///< CV_32F, left image size, left-image disparity in pixels, 0 invalid
 
   // Simulation-only ground truth of the left image (empty for real captures).
   cv::Mat gt_depth_m;    ///< CV_32F z-depth per pixel, 0 where nothing was hit
