@@ -11,7 +11,7 @@ namespace fvp::apps {
 
 void addSizeCommand(CLI::App& app) {
   struct Options {
-    std::string captures, out, sizing = "ours", engine = "grid", backend = "auto";
+    std::string captures, out, sizing = "ours", engine = "grid", backend = "auto", config;
   };
   auto opt = std::make_shared<Options>();
   auto* cmd = app.add_subcommand(
@@ -28,11 +28,19 @@ void addSizeCommand(CLI::App& app) {
       ->check(CLI::IsMember({"grid", "octomap"}))
       ->capture_default_str();
   cmd->add_option("--backend", opt->backend, "cpu | opencl | vulkan | auto")->capture_default_str();
+  cmd->add_option("--config", opt->config,
+                  "perception config YAML: the tag (family, id, size), the Cluster Region "
+                  "(offset and radius, or an explicit centre) and HSV thresholds "
+                  "(docs/capture-format.md)")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--out", opt->out, "output directory")->required();
   cmd->callback([opt] {
+    host::PerceptionConfig perception;  // read first: a bad file fails before any work
+    if (!opt->config.empty()) perception = host::PerceptionConfig::fromYamlFile(opt->config);
     std::unique_ptr<accel::Backend> backend;
     if (opt->engine == "grid") backend = accel::createBackend(opt->backend);
     host::CaptureSizingOptions o;
+    o.perception = perception;
     o.estimator = opt->sizing == "paper" ? host::sizing::SizingEstimator::kPaper
                                          : host::sizing::SizingEstimator::kOurs;
     o.engine = opt->engine;
@@ -40,7 +48,9 @@ void addSizeCommand(CLI::App& app) {
     o.on_warning = [](const std::string& text) { std::cerr << "fvp: warning: " << text << "\n"; };
     const nlohmann::json r = host::sizeCaptureSet(opt->captures, o, backend.get());
     std::cout << r["captures"].size() << " captures, Cluster Region "
-              << (r["cluster_region_found"].get<bool>() ? "found" : "NOT found (no tag seen)")
+              << (r["cluster_region_found"].get<bool>()
+                      ? "found"
+                      : "NOT found (no tag seen, no region_center_m)")
               << ", " << r["sized_fruitlets"].size() << " fruitlets sized (" << opt->sizing
               << " estimator)\n"
               << std::fixed << std::setprecision(2);

@@ -10,6 +10,8 @@ void ClusterRegionConfig::validate() const {
     throw std::invalid_argument("cluster region config: radius_m: expected a positive radius");
   if (!center_offset_tag_m.allFinite())
     throw std::invalid_argument("cluster region config: center_offset_tag_m: expected finite");
+  if (center_m && !center_m->allFinite())
+    throw std::invalid_argument("cluster region config: center_m: expected finite");
 }
 
 ClusterRegion ClusterRegion::fromTag(const Eigen::Isometry3d& T_world_tag,

@@ -10,7 +10,14 @@ extern "C" {
 #include <apriltag/apriltag_pose.h>
 #include <apriltag/common/matd.h>
 #include <apriltag/common/zarray.h>
+#include <apriltag/tag16h5.h>
+#include <apriltag/tag25h9.h>
 #include <apriltag/tag36h11.h>
+#include <apriltag/tagCircle21h7.h>
+#include <apriltag/tagCircle49h12.h>
+#include <apriltag/tagCustom48h12.h>
+#include <apriltag/tagStandard41h12.h>
+#include <apriltag/tagStandard52h13.h>
 }
 
 #include "task_runner.h"
@@ -18,6 +25,40 @@ extern "C" {
 #include "fvp/host/core/input_checks.h"
 
 namespace fvp::host {
+
+namespace {
+
+struct FamilyFunctions {
+  const char* name;
+  apriltag_family_t* (*create)();
+  void (*destroy)(apriltag_family_t*);
+};
+
+constexpr FamilyFunctions kFamilies[] = {
+    {"tag36h11", tag36h11_create, tag36h11_destroy},
+    {"tag25h9", tag25h9_create, tag25h9_destroy},
+    {"tag16h5", tag16h5_create, tag16h5_destroy},
+    {"tagStandard41h12", tagStandard41h12_create, tagStandard41h12_destroy},
+    {"tagStandard52h13", tagStandard52h13_create, tagStandard52h13_destroy},
+    {"tagCircle21h7", tagCircle21h7_create, tagCircle21h7_destroy},
+    {"tagCircle49h12", tagCircle49h12_create, tagCircle49h12_destroy},
+    {"tagCustom48h12", tagCustom48h12_create, tagCustom48h12_destroy},
+};
+
+const FamilyFunctions* findFamily(const std::string& name) {
+  for (const FamilyFunctions& f : kFamilies)
+    if (name == f.name) return &f;
+  return nullptr;
+}
+
+std::string familyNames() {
+  std::string names;
+  for (const FamilyFunctions& f : kFamilies)
+    names += (names.empty() ? "" : ", ") + std::string(f.name);
+  return names;
+}
+
+}  // namespace
 
 void AprilTagDetectorConfig::validate() const {
   auto fail = [](const std::string& field, const std::string& expected) {
@@ -27,26 +68,30 @@ void AprilTagDetectorConfig::validate() const {
   if (!(quad_decimate >= 1.0f)) fail("quad_decimate", ">= 1");
   if (quad_sigma < 0.0f) fail("quad_sigma", ">= 0");
   if (max_hamming < 0 || max_hamming > 3) fail("max_hamming", "[0, 3]");
-  if (tag_id < -1) fail("tag_id", "a tag36h11 id or -1 (any)");
+  if (tag_id < -1) fail("tag_id", "a tag id of the family or -1 (any)");
+  if (!findFamily(family)) fail("family", "one of " + familyNames() + ", got '" + family + "'");
   if (threads < 0) fail("threads", ">= 0 (0: all cores)");
 }
 
 struct AprilTagDetector::Impl {
   apriltag_family_t* family = nullptr;
+  void (*destroy_family)(apriltag_family_t*) = nullptr;
   apriltag_detector_t* detector = nullptr;
   ~Impl() {
     if (detector) apriltag_detector_destroy(detector);
-    if (family) tag36h11_destroy(family);
+    if (family) destroy_family(family);
   }
 };
 
 AprilTagDetector::AprilTagDetector(AprilTagDetectorConfig config)
     : config_(config), impl_(std::make_unique<Impl>()) {
   config_.validate();
-  impl_->family = tag36h11_create();
+  const FamilyFunctions& family = *findFamily(config_.family);
+  impl_->family = family.create();
+  impl_->destroy_family = family.destroy;
   impl_->detector = apriltag_detector_create();
   if (!impl_->family || !impl_->detector)
-    throw std::runtime_error("libapriltag: could not create the tag36h11 detector");
+    throw std::runtime_error("libapriltag: could not create the " + config_.family + " detector");
   // The bit-correction table for max_hamming 2..3 is large but tag36h11 needs it only once.
   apriltag_detector_add_family_bits(impl_->detector, impl_->family, config_.max_hamming);
   impl_->detector->quad_decimate = config_.quad_decimate;

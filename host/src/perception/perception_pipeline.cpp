@@ -83,6 +83,8 @@ PerceptionResult PerceptionPipeline::process(
   timing.tag_s = secondsSince(t0);
   if (known_region) {
     result.region = known_region;
+  } else if (config_.region.center_m) {
+    result.region = ClusterRegion(*config_.region.center_m, config_.region.radius_m);
   } else if (result.tag) {
     result.region = ClusterRegion::fromTag(result.tag->T_world_tag, config_.region);
   }

@@ -78,7 +78,7 @@ nlohmann::json sizeCaptureSet(const std::filesystem::path& captures_dir,
     prepareOutputDirectory(options.out_dir, "sizing output directory");
     removeStaleOutputs(options.out_dir, kOutputs);
   }
-  MappingSession session(PerceptionConfig{}, options.engine, map::MapConfig{}, backend);
+  MappingSession session(options.perception, options.engine, map::MapConfig{}, backend);
   session.enableTsdf();
   std::string ground_truth, ground_truth_source;
   nlohmann::json views = nlohmann::json::array();
@@ -118,7 +118,9 @@ nlohmann::json sizeCaptureSet(const std::filesystem::path& captures_dir,
     return c;
   }();
   if (!session.region())
-    warn("no capture showed the AprilTag: no Cluster Region, nothing mapped or sized");
+    warn("no capture showed the AprilTag (" + options.perception.tag.family + " id " +
+         std::to_string(options.perception.tag.tag_id) +
+         ") and no region_center_m is configured: no Cluster Region, nothing mapped or sized");
   const sizing::SizingResult sized = session.sizeFruitlets(config);
   std::vector<eval::GroundTruthFruitlet> truth;
   if (!ground_truth.empty()) truth = eval::groundTruthFromJson(ground_truth, ground_truth_source);

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <optional>
 
 namespace fvp::host {
 
@@ -20,6 +21,9 @@ inline constexpr double kDefaultClusterRadiusM = 0.065;
 struct ClusterRegionConfig {
   Eigen::Vector3d center_offset_tag_m = kDefaultClusterOffsetTagM;
   double radius_m = kDefaultClusterRadiusM;
+  /// An explicit region centre in the world frame: the region is known from the first view
+  /// and no tag is needed (a grower's marked cluster, a region from another sensor).
+  std::optional<Eigen::Vector3d> center_m;
   void validate() const;
 };
 

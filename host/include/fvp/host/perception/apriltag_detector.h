@@ -8,6 +8,7 @@
 #include <mutex>
 #include <opencv2/core.hpp>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "fvp/host/core/stereo_intrinsics.h"
@@ -21,6 +22,9 @@ inline constexpr float kDefaultQuadDecimate = 1.0f;  ///< full resolution: best 
 inline constexpr int kDefaultMaxHamming = 1;
 
 struct AprilTagDetectorConfig {
+  /// libapriltag family: tag36h11 (default), tag25h9, tag16h5, tagStandard41h12,
+  /// tagStandard52h13, tagCircle21h7, tagCircle49h12, tagCustom48h12.
+  std::string family = "tag36h11";
   int tag_id = kDefaultTagId;  ///< the cluster's tag; -1: accept any id (detect() returns the best)
   double tag_size_m = kDefaultTagSizeM;
   float quad_decimate = kDefaultQuadDecimate;

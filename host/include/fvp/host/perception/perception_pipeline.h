@@ -4,6 +4,7 @@
 // -> ROI and non-ROI world-frame clouds.
 #pragma once
 
+#include <filesystem>
 #include <opencv2/core.hpp>
 #include <optional>
 
@@ -29,6 +30,11 @@ struct PerceptionConfig {
   /// Ablation switch (DESIGN.md §8): use the frame's exact gt_depth_m instead of SGBM.
   bool use_exact_depth = false;
   void validate() const;
+  /// The user-facing keys (docs/capture-format.md "Perception configuration"): the tag
+  /// (family, id, size), the Cluster Region (offset from the tag and radius, or an explicit
+  /// centre in the world frame) and the HSV segmentation thresholds; unknown keys, wrong
+  /// types and non-finite numbers are errors naming the file and the key.
+  static PerceptionConfig fromYamlFile(const std::filesystem::path& path);
 };
 
 struct PerceptionResult {

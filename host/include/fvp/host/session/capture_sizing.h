@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "fvp/host/perception/perception_pipeline.h"
 #include "fvp/host/sizing/fruitlet_sizer.h"
 
 namespace fvp::accel {
@@ -19,6 +20,8 @@ class Backend;
 namespace fvp::host {
 
 struct CaptureSizingOptions {
+  /// The tag, the Cluster Region (from the tag, or explicit) and segmentation thresholds.
+  PerceptionConfig perception;
   sizing::SizingEstimator estimator = sizing::SizingEstimator::kOurs;
   std::string engine = "grid";    ///< map engine (grid needs backend)
   std::filesystem::path out_dir;  ///< fruitlets.json, surface.ply, mesh.ply, clusters.ply
