@@ -1,5 +1,5 @@
 // `fvp experiment` and `fvp merge`: the paper's experiment over many worlds, resumable and
-// shardable (DESIGN.md section 9; docs/experiment.md has the cluster recipe).
+// shardable (docs/design.md section 9; docs/experiment.md has the cluster recipe).
 #include <unistd.h>
 #include <filesystem>
 #include <iostream>

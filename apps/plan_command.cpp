@@ -1,5 +1,5 @@
 // `fvp plan`: one planning iteration on a map of K simulated views; writes plan.json and
-// candidates.ply (DESIGN.md section 9).
+// candidates.ply (docs/design.md section 9).
 #include <iostream>
 #include <memory>
 

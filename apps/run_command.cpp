@@ -1,4 +1,4 @@
-// `fvp run`: one simulated trial (DESIGN.md section 9); writes result.json, the maps, the
+// `fvp run`: one simulated trial (docs/design.md section 9); writes result.json, the maps, the
 // TSDF surface, the clusters and report.md to --out and prints a short summary.
 #include <unistd.h>
 #include <iomanip>

@@ -243,7 +243,7 @@ void BM_ScanIntegrateFineBoxOctomapEngine(benchmark::State& state) {
       "lazy updates");
 }
 
-// One planning iteration's map work after a view (DESIGN.md section 5): integrate the view,
+// One planning iteration's map work after a view (docs/design.md section 5): integrate the view,
 // recompute the ROI distance field (paper Eq. 1, max_d 2 cm), extract the frontiers and
 // bring both Embree scenes up to date. Steady state: the map already holds the start view
 // (set up untimed), and the step integrates it again, as a robot holding still would.

@@ -1,4 +1,4 @@
-/* Projective TSDF integration (DESIGN.md section 1 step 2, voxblox's weighting): the
+/* Projective TSDF integration (docs/design.md section 1 step 2, voxblox's weighting): the
  * per-voxel update shared by the cpu backend and kernels/tsdf_integrate.cl; GLSL twin in
  * shaders/fvp_tsdf.glsl.
  *

@@ -1,4 +1,4 @@
-// Heavy: the occlusion statistic (DESIGN.md section 8) of the start views of seeds 1..35,
+// Heavy: the occlusion statistic (docs/design.md section 8) of the start views of seeds 1..35,
 // the number reported for the issue. Ground-truth id renders only (~12 s on 2 cores).
 #include <gtest/gtest.h>
 
@@ -16,7 +16,7 @@ using robot::sim::StereoRenderer;
 using robot::sim::World;
 using robot::sim::WorldConfig;
 
-// Mean occlusion statistic of the start views of seeds 1..35 (DESIGN.md section 8).
+// Mean occlusion statistic of the start views of seeds 1..35 (docs/design.md section 8).
 TEST(PerceptionSimHeavy, OcclusionStatisticOver35Seeds) {
   double sum = 0.0;
   int fruitlets = 0, hidden = 0;

@@ -87,7 +87,7 @@ TEST(StereoMatcher, BlindLeftBandIsInvalidAndCounted) {
 }
 
 // Objects at or beyond the top of the search range (nearer than ~0.17 m) come out at
-// 318-319 px instead of invalid (DESIGN.md section 10): they are rejected and counted.
+// 318-319 px instead of invalid (docs/design.md section 10): they are rejected and counted.
 TEST(StereoMatcher, SaturatedDisparitiesAreRejected) {
   const StereoIntrinsics K = smallCamera();
   const cv::Rect near_patch(600, 50, 200, 140);

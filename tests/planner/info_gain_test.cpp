@@ -212,7 +212,7 @@ TEST(InfoGain, GridAndOctomapEnginesAgree) {
     std::size_t differ = 0;
     for (std::size_t i = 0; i < queries.size(); ++i)
       differ += ra[i].ig != rb[i].ig || ra[i].region_voxels != rb[i].region_voxels;
-    // The engines agree on >= 99.9 % of voxel classes (DESIGN.md section 5); gains over a
+    // The engines agree on >= 99.9 % of voxel classes (docs/design.md section 5); gains over a
     // few hundred voxels each may differ where one voxel does.
     EXPECT_LE(differ, queries.size() / 50) << "mode " << int(mode);
   }

@@ -187,7 +187,7 @@ TEST(Sizing, Eq4OnAnIdealSphereViewPaperShortOursClose) {
   const auto result = sizing::sizeFruitlets({view, view}, pts, nullptr, config);
   ASSERT_EQ(result.fruitlets.size(), 1u);
   const auto& f = result.fruitlets[0];
-  // DESIGN.md section 10: the paper's Eq. 4 sizes ideal spheres a few percent small.
+  // docs/design.md section 10: the paper's Eq. 4 sizes ideal spheres a few percent small.
   EXPECT_LT(f.size_paper_mm, 10.0);
   EXPECT_GT(f.size_paper_mm, 9.0);
   EXPECT_NEAR(f.size_ours_mm, 10.0, 0.15);

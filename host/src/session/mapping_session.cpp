@@ -94,7 +94,7 @@ void MappingSession::integrate(std::size_t index, const LabeledClouds& clouds) {
   ViewResult& view = views_[index];
   view.scan = map_->integrate(clouds);
   view.integrated = true;
-  // The TSDF of the fine map (DESIGN.md section 5) is fed here next: the same clouds, in the
+  // The TSDF of the fine map (docs/design.md section 5) is fed here next: the same clouds, in the
   // same order, once the region is known.
 }
 

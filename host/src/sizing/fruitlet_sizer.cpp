@@ -12,7 +12,7 @@ namespace fvp::host::sizing {
 namespace {
 
 // The hull runs through the centres of the segment's boundary pixels, inside the true
-// silhouette: measured ~0.6 px short across on rendered spheres (DESIGN.md section 10).
+// silhouette: measured ~0.6 px short across on rendered spheres (docs/design.md section 10).
 constexpr double kHullShortfallPx = 0.6;
 
 double median(std::vector<double> v) {

@@ -1,4 +1,4 @@
-// moveToPose (DESIGN.md section 7): IK along the slider's travel -> the valid, collision-free
+// moveToPose (docs/design.md section 7): IK along the slider's travel -> the valid, collision-free
 // solution nearest the current configuration -> OMPL (RRTConnect by default) in the 7-D
 // joint space with an ArmCollisionChecker behind OMPL's StateValidityChecker -> path
 // simplification -> a Trajectory within the velocity and acceleration limits. The nearest

@@ -1,4 +1,4 @@
-// The simulated clock (DESIGN.md section 7): every iteration is charged a fixed capture time
+// The simulated clock (docs/design.md section 7): every iteration is charged a fixed capture time
 // (exposure + a GPU stereo network), the measured wall time of mapping, TSDF integration,
 // planning and motion planning, and the trajectory's duration. Mode `fixed` charges a
 // constant per compute stage instead of the measured time, for deterministic tests. Every

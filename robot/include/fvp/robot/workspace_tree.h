@@ -1,4 +1,4 @@
-// The workspace tree (DESIGN.md section 7, the paper's reachability filter): N random joint
+// The workspace tree (docs/design.md section 7, the paper's reachability filter): N random joint
 // configurations (free of self and static collision) put their camera position and viewing
 // direction into a counting grid of position cells x cube-map direction bins. A viewpoint is
 // reachable when its cell and direction bin were hit at least workspace_min_count times.

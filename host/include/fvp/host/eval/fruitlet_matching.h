@@ -1,4 +1,4 @@
-// Scoring against ground truth (DESIGN.md section 9): a one-to-one assignment of detected
+// Scoring against ground truth (docs/design.md section 9): a one-to-one assignment of detected
 // fruitlet centres to ground-truth centres closer than the gate (5 mm), maximising the number
 // of matched pairs and, among those, minimising the summed distance; then Match Percent,
 // MAE, MAPE and precision.

@@ -1,5 +1,5 @@
 // A sizing result scored against ground truth, as result.json and fruitlets.json hold it:
-// every ground-truth fruitlet with its match, the detections, the metrics (DESIGN.md
+// every ground-truth fruitlet with its match, the detections, the metrics (docs/design.md
 // section 9), for the chosen estimator and for the other one on the same measurements.
 #pragma once
 

@@ -1,4 +1,4 @@
-// Geometry and sensor model of the coarse and fine maps (DESIGN.md section 5, issue 4).
+// Geometry and sensor model of the coarse and fine maps (docs/design.md section 5, issue 4).
 #pragma once
 
 #include <Eigen/Core>

@@ -2,7 +2,7 @@
 // "grid" (flat bricked storage the compute kernels read; default for FVP) and "octomap"
 // (octomap::OcTree coarse + an ROI octree fine; the papers' reference, default for RVP).
 //
-// Semantics (OctoMap's, DESIGN.md section 5): log-odds hit/miss with clamping; occupied
+// Semantics (OctoMap's, docs/design.md section 5): log-odds hit/miss with clamping; occupied
 // when p > occupied_prob; unknown = never updated. One scan updates each voxel once: the
 // union of voxels crossed by the rays, minus the end-point voxels, is free; end-point
 // voxels are hits. ROI (fine map only): a second log-odds per voxel, a hit where any ROI

@@ -1,4 +1,4 @@
-// OctoMap's probabilistic occupancy model (DESIGN.md section 5), shared by both map
+// OctoMap's probabilistic occupancy model (docs/design.md section 5), shared by both map
 // engines so they agree voxel for voxel.
 #pragma once
 

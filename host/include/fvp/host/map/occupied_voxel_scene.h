@@ -1,6 +1,6 @@
 // An Embree 3 scene over the occupied voxels of a map grid, answering first-hit and
 // occlusion queries (terminate information-gain rays at the first occluder, cull candidate
-// views whose line of sight is blocked; DESIGN.md section 4).
+// views whose line of sight is blocked; docs/design.md section 4).
 //
 // Geometry: one Embree quad mesh per 8x8x8 brick holding the exposed faces of the brick's
 // occupied voxels (faces between two occupied voxels are left out; each face belongs to

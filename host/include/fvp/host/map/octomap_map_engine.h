@@ -1,4 +1,4 @@
-// The "octomap" map engine (DESIGN.md section 5): the papers' reference. Coarse map: an
+// The "octomap" map engine (docs/design.md section 5): the papers' reference. Coarse map: an
 // octomap::OcTree at coarse_voxel_size_m over the observation box; fine map: a RoiOcTree
 // (occupancy + ROI log-odds) at fine_voxel_size_m over the Cluster Region.
 //

@@ -1,5 +1,5 @@
 // The one preparation of a view's clouds for both map engines, so that they cut and count
-// points identically (DESIGN.md section 5): the grid engine uploads the result to its scan
+// points identically (docs/design.md section 5): the grid engine uploads the result to its scan
 // kernels as is, the octomap engine walks its rays with computeRayKeys.
 #pragma once
 

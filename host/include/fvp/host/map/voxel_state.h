@@ -17,7 +17,7 @@ inline VoxelClass classifyLogOdds(float log_odds, float occupied_log_odds) {
 }
 
 /// What a map knows about one voxel. ROI is meaningful for fine maps only: a voxel is ROI
-/// when its ROI log-odds is above 0 (DESIGN.md section 5).
+/// when its ROI log-odds is above 0 (docs/design.md section 5).
 struct VoxelState {
   VoxelClass occupancy = VoxelClass::kUnknown;
   bool roi = false;

@@ -1,4 +1,4 @@
-// The next-best-view loop (paper Algorithm 1's outer loop, DESIGN.md section 9) over narrow
+// The next-best-view loop (paper Algorithm 1's outer loop, docs/design.md section 9) over narrow
 // interfaces, so it runs the same on a robot and in the simulator: capture through a Camera
 // at the Arm's pose -> perceive and map in the MappingSession -> plan with a ViewPlanner ->
 // move the Arm, until the StopCondition holds. Without a successful move it plans again

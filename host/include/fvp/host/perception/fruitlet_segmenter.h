@@ -1,7 +1,7 @@
 // HSV segmentation of fruitlets (paper, "Perception"): any hue of the fruitlet palette counts
 // as fruitlet; leaves (green), bark (brown) and the tag (black/white) are rejected by hue or
 // saturation. Hue and saturation do not change with the flash's inverse-square falloff, so
-// the value threshold only has to reject the dark noise floor: keep it low (DESIGN.md §10:
+// the value threshold only has to reject the dark noise floor: keep it low (docs/design.md §10:
 // the flash falls off 4x from 0.2 to 0.4 m).
 #pragma once
 

@@ -1,4 +1,4 @@
-// Occlusion statistic of a view (DESIGN.md §8): per fruitlet, the fraction of its silhouette
+// Occlusion statistic of a view (docs/design.md §8): per fruitlet, the fraction of its silhouette
 // that is visible compared with a render of the same view without leaves, from the
 // simulator's object-id layers.
 #pragma once

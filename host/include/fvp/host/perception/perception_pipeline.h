@@ -1,4 +1,4 @@
-// The perception chain of one view (paper, "Perception"; DESIGN.md §1 step 1):
+// The perception chain of one view (paper, "Perception"; docs/design.md §1 step 1):
 // HSV segmentation -> AprilTag -> Cluster Region -> SGBM (full resolution over the band
 // covering the Cluster Region and the segmented fruitlets, reduced resolution elsewhere)
 // -> ROI and non-ROI world-frame clouds.
@@ -27,7 +27,7 @@ struct PerceptionConfig {
   ClusterRegionConfig region;
   ProjectionConfig projection;
   int band_margin_px = kDefaultBandMarginPx;  ///< added around the fine rectangle
-  /// Ablation switch (DESIGN.md §8): use the frame's exact gt_depth_m instead of SGBM.
+  /// Ablation switch (docs/design.md §8): use the frame's exact gt_depth_m instead of SGBM.
   bool use_exact_depth = false;
   void validate() const;
   /// The user-facing keys (docs/capture-format.md "Perception configuration"): the tag

@@ -1,10 +1,11 @@
-// Disparity by OpenCV StereoSGBM (DESIGN.md §8 reference configuration), computed where it is
+// Disparity by OpenCV StereoSGBM (docs/design.md §8 reference configuration), computed where it is
 // needed: a full-resolution pass over the requested fine rectangle (the Cluster Region's image
 // band) and a cheaper reduced-resolution pass for everything else (the coarse map). Both are
 // split into a fixed number of overlapping row strips run on all cores (OpenCV's MODE_SGBM is
 // single-threaded; a fixed count keeps the result the same on every machine). Pitfalls handled
-// (DESIGN.md §10): saturated disparities at the top of the search range (objects nearer than ~0.17
-// m) are rejected, and the left band where SGBM has no match is marked invalid; both are counted.
+// (docs/design.md §10): saturated disparities at the top of the search range (objects nearer
+// than ~0.17 m) are rejected, and the left band where SGBM has no match is marked invalid; both
+// are counted.
 #pragma once
 
 #include <opencv2/calib3d.hpp>

@@ -1,4 +1,4 @@
-// Information gain of viewpoint candidates (paper Eq. 1-2, DESIGN.md section 6) over a
+// Information gain of viewpoint candidates (paper Eq. 1-2, docs/design.md section 6) over a
 // compact read-only snapshot of the maps, rebuilt once per planning iteration:
 // 2 bytes per fine voxel (in-region bit, occupied bit, Eq. 1 weight quantised to 1/8192)
 // and 1 byte per coarse voxel (occupied), instead of the maps' 8-byte integration voxels,

@@ -1,4 +1,4 @@
-// The FVP planner's parameters (paper, "Viewpoint Planning" and Algorithm 1; DESIGN.md
+// The FVP planner's parameters (paper, "Viewpoint Planning" and Algorithm 1; docs/design.md
 // section 6): sampling, information gain, utility and threshold decay. Every field is a key
 // of the same name in host/config/planner_default.yaml, which documents the defaults.
 #pragma once

@@ -1,5 +1,5 @@
 // RVP, the baseline the paper compares with (Zaenker et al. 2020, roi_viewpoint_planner as
-// its public code did it in 2020; DESIGN.md section 6), behind the same ViewPlanner
+// its public code did it in 2020; docs/design.md section 6), behind the same ViewPlanner
 // interface as FVP:
 // - ROI targets: free voxels 6-adjacent to an ROI voxel with an unknown 6-neighbour (the ROI
 //   contour); a candidate is target + random unit direction x U(sensor_min, sensor_max),

@@ -1,4 +1,4 @@
-// The one interface the trial loop drives a viewpoint planner through (DESIGN.md section 6):
+// The one interface the trial loop drives a viewpoint planner through (docs/design.md section 6):
 // FVP (ours, Algorithm 1 over ROI-targeted + exploration candidates scored by paper Eq. 1-3)
 // and RVP (Zaenker et al. 2020) both implement it, so `fvp run --planner fvp|rvp` and
 // `fvp plan` share one path. The arm is reached through two callbacks, so the host planner

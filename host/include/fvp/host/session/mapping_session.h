@@ -1,4 +1,4 @@
-// The per-view mapping session (DESIGN.md section 5): one stereo view at a time through
+// The per-view mapping session (docs/design.md section 5): one stereo view at a time through
 // perception into the maps, so that the trial loop, `fvp map` and capture replay share one
 // path. The session owns the perception pipeline, the Cluster Region (from the first view
 // whose AprilTag is detected) and the map engine, created once the region is known. Views

@@ -1,4 +1,4 @@
-// Fruitlet sizing (paper, "Fruitlet Sizing", Figure 5; DESIGN.md sections 1 and 10): surface
+// Fruitlet sizing (paper, "Fruitlet Sizing", Figure 5; docs/design.md sections 1 and 10): surface
 // points -> keep those in ROI-occupied fine voxels -> statistical outlier removal -> DBSCAN
 // -> for each cluster and each captured image: reproject, take the fruitlet segment it falls
 // on, convex hull, least-squares ellipse, Eq. 4 (size = minor axis * baseline / max

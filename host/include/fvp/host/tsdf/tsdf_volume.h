@@ -1,4 +1,4 @@
-// The fruitlets' TSDF (paper, "Fruitlet Sizing"; DESIGN.md section 1 step 2): a brick layer
+// The fruitlets' TSDF (paper, "Fruitlet Sizing"; docs/design.md section 1 step 2): a brick layer
 // (host/map/brick_layer.h) of 8^3-voxel bricks at 0.5 mm over a bounded box (the Cluster
 // Region's cube), bricks allocated only inside the truncation band of ROI points, with two
 // channels, distance and weight, fed by projective integration of each view's ROI depth

@@ -1,4 +1,4 @@
-// The paper's experiment (DESIGN.md section 9, `fvp experiment` / `fvp merge`): every
+// The paper's experiment (docs/design.md section 9, `fvp experiment` / `fvp merge`): every
 // planner on the same worlds, one trial per (planner, seed); each finished trial is one line
 // of DIR/trials.jsonl, appended atomically (one write, then fsync), so an interrupted run
 // loses at most the trial in flight and --resume skips what is there. Shards partition the

@@ -1,4 +1,4 @@
-// One planning iteration on a simulated map (DESIGN.md section 9, `fvp plan`): a world from
+// One planning iteration on a simulated map (docs/design.md section 9, `fvp plan`): a world from
 // a seed, a map from K views orbiting the cluster, then one planAndMove of the chosen planner
 // with the workspace tree as the reachability filter and the real motion planner moving the
 // arm from the world's start configuration. Writes plan.json and candidates.ply (camera

@@ -1,5 +1,5 @@
 // Embree ray-traced rectified stereo pair of a World, as the flash stereo camera sees it
-// (DESIGN.md section 8): point light at the camera with inverse-square falloff, Lambertian
+// (docs/design.md section 8): point light at the camera with inverse-square falloff, Lambertian
 // surfaces with procedural texture, anti-aliasing, sensor noise; plus the left camera's
 // exact depth and per-pixel object ids (ground truth for tests and ablations only).
 //

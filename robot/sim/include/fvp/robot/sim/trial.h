@@ -1,4 +1,4 @@
-// One simulated trial (DESIGN.md section 9, `fvp run`): a world from a seed, the start view,
+// One simulated trial (docs/design.md section 9, `fvp run`): a world from a seed, the start view,
 // the AprilTag -> Cluster Region, then planning iterations until the simulated budget is
 // spent (capture -> perceive -> maps + TSDF -> sample -> score -> move), then sizing and
 // scoring against ground truth. The experiment runner (`fvp experiment`) calls it once per
@@ -41,7 +41,7 @@ struct TrialOptions {
   std::function<void(const std::string&)> on_warning;
 };
 
-/// Runs one trial and returns its result.json object (the contract of DESIGN.md section 9),
+/// Runs one trial and returns its result.json object (the contract of docs/design.md section 9),
 /// also written atomically to out_dir/result.json when out_dir is set. out_dir is checked
 /// before the trial starts and the files an earlier trial left there are removed; result.json
 /// is written before the extras (maps, clouds, figures), and a figure that cannot be drawn is

@@ -1,4 +1,4 @@
-// A simulated orchard world around one fruitlet cluster (DESIGN.md section 8), generated
+// A simulated orchard world around one fruitlet cluster (docs/design.md section 8), generated
 // from one integer seed and a WorldConfig, so every trial is reproducible.
 //
 // World frame: origin at the trunk's base, z up. The fruiting branch runs roughly along

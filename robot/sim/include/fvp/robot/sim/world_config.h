@@ -1,4 +1,4 @@
-// Parameters of world generation (DESIGN.md section 8). Every field is a documented YAML
+// Parameters of world generation (docs/design.md section 8). Every field is a documented YAML
 // key of the same name; the defaults reproduce the paper's protocol. The keys, their units
 // and ranges are listed in robot/sim/config/world_default.yaml and docs/simulation.md.
 //
