@@ -1,10 +1,12 @@
-// fvp::robot::ArmConfig::fromYamlFile (robot/src/arm_config.cpp) on a file holding the input.
-// A config it accepts must pass validate() (what a config built in code must pass).
+// fvp::robot::ArmConfig::fromYamlFile (robot/src/arm_config.cpp) on a file holding the input. A
+// config it accepts must pass validate() (what a config built in code must pass) and hold only
+// finite numbers.
 #include <yaml-cpp/yaml.h>
 
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "config_checks.h"
 #include "fuzz_support.h"
 #include "fvp/robot/arm_config.h"
 
@@ -29,6 +31,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       std::fprintf(stderr, "fvp fuzz: an accepted config fails validate(): %s\n", e.what());
       std::abort();
     }
+    fz::requireFiniteJson(config->toJson());
   }
   return 0;
 }
