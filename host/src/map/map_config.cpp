@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "fvp/host/core/yaml_config.h"
 #include "fvp/host/map/map_config.h"
 #include "fvp/host/map/occupancy_model.h"
 
@@ -106,7 +107,7 @@ MapConfig MapConfig::fromYamlFile(const std::filesystem::path& path) {
       {"occupied_prob", [&](auto& n, auto& k) { config.model.occupied_prob = number(n, k); }},
   };
   for (const auto& entry : root) {
-    const std::string key = entry.first.as<std::string>();
+    const std::string key = keyString(entry.first, source);
     const auto it = keys.find(key);
     if (it == keys.end()) {
       std::string known;

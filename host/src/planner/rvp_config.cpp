@@ -49,7 +49,7 @@ RvpConfig RvpConfig::fromYamlFile(const std::filesystem::path& path) {
   RvpConfig c;
   if (root.IsNull()) return c;
   for (const auto& item : root) {
-    const std::string key = item.first.as<std::string>();
+    const std::string key = keyString(item.first, source);
     const KeySpec& spec = findKeySpec(keySpecs(), key, source);
     try {
       spec.read(c, item.second);

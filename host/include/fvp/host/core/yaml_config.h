@@ -27,6 +27,15 @@ inline YAML::Node readYamlMapping(const std::filesystem::path& path, const std::
   return root;
 }
 
+/// A mapping key as text. Throws std::invalid_argument naming the source when the key is no
+/// scalar (`[a]: 1`, `{}: 1`), where yaml-cpp's as<std::string>() throws its own exception.
+inline std::string keyString(const YAML::Node& key, const std::string& source) {
+  if (key.IsScalar()) return key.Scalar();
+  if (key.IsNull()) return "null";  // what as<std::string>() gives: `~: 1` is an unknown key
+  throw std::invalid_argument(source + ": expected keys that are names, got a " +
+                              (key.IsSequence() ? "list" : "mapping") + " as a key");
+}
+
 /// The spec whose `name` is key; throws std::invalid_argument listing the known keys.
 template <typename KeySpec>
 const KeySpec& findKeySpec(const std::vector<KeySpec>& specs, const std::string& key,
