@@ -123,7 +123,7 @@ ArmConfig ArmConfig::fromYamlFile(const std::filesystem::path& path) {
     return config;
   }
   for (const auto& entry : root) {
-    const std::string key = host::keyText(entry.first, source);
+    const std::string key = host::keyString(entry.first, source);
     const KeySpec* spec = &host::findKeySpec(keySpecs(), key, source);
     const YAML::Node& value = entry.second;
     const std::string where = source + ": key '" + key + "'";

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iterator>
+#include <limits>
 #include <numbers>
 #include <ostream>
 #include <random>
@@ -234,13 +235,30 @@ std::optional<WorkspaceTree> WorkspaceTree::load(const std::filesystem::path& pa
   ok = ok && get(bytes, pos, tree.resolution_m_);
   for (int i = 0; i < 3; ++i) ok = ok && get(bytes, pos, dims[i]);
   ok = ok && get(bytes, pos, edge) && get(bytes, pos, min_count) && get(bytes, pos, entries);
-  if (!ok || edge < 1 || edge > 64 || min_count < 1 || dims[0] < 1 || dims[1] < 1 || dims[2] < 1)
+  if (!ok || pos + sizeof(stored_sum) > bytes.size() || edge < 1 || edge > 64 || min_count < 1 ||
+      dims[0] < 1 || dims[1] < 1 || dims[2] < 1)
     return fail("bad header");
+  // The grid's placement must be finite and its cells of positive size: queries divide by
+  // the resolution and rotate by the yaw.
+  if (!tree.slider_origin_m_.allFinite() || !std::isfinite(tree.slider_yaw_rad_) ||
+      !tree.origin_m_.allFinite() || !std::isfinite(tree.resolution_m_) ||
+      !(tree.resolution_m_ > 0.0))
+    return fail("bad header (non-finite grid placement or resolution)");
   tree.dims_ = {dims[0], dims[1], dims[2]};
   tree.bins_per_edge_ = edge;
   tree.min_count_ = min_count;
-  const std::uint64_t cells = static_cast<std::uint64_t>(tree.dims_.cast<std::int64_t>().prod());
-  if (entries != cells * static_cast<std::uint64_t>(tree.directionBins()) ||
+  // The counts the rest of the file holds bound the cells before they are multiplied (the
+  // product of three int32 overflows), and cell indices are ints.
+  const std::uint64_t held = (bytes.size() - pos - sizeof(stored_sum)) / sizeof(std::uint16_t);
+  const std::uint64_t bins = static_cast<std::uint64_t>(tree.directionBins());
+  std::uint64_t cells = 1;
+  for (int i = 0; i < 3; ++i) {
+    if (static_cast<std::uint64_t>(dims[i]) > held / (cells * bins))
+      return fail("size does not match its header");
+    cells *= static_cast<std::uint64_t>(dims[i]);
+  }
+  if (cells > static_cast<std::uint64_t>(std::numeric_limits<int>::max()) ||
+      entries != cells * bins ||
       pos + entries * sizeof(std::uint16_t) + sizeof(stored_sum) != bytes.size())
     return fail("size does not match its header");
   tree.counts_.resize(entries);
@@ -273,9 +291,9 @@ WorkspaceTree WorkspaceTree::loadOrBuild(const ArmModel& arm, std::ostream& log)
 int WorkspaceTree::cellIndex(const Eigen::Vector3d& p_world) const {
   const Eigen::Vector3d p = R_slider_world_ * (p_world - slider_origin_m_);
   const Eigen::Vector3d u = (p - origin_m_) / resolution_m_;
-  if (!(u.array() >= 0.0).all()) return -1;
+  // Compared as doubles before the cast: a far (or NaN) point does not fit an int.
+  if (!(u.array() >= 0.0).all() || !(u.array() < dims_.cast<double>().array()).all()) return -1;
   const Eigen::Vector3i k = u.array().floor().cast<int>();
-  if ((k.array() >= dims_.array()).any()) return -1;
   return (k.z() * dims_.y() + k.y()) * dims_.x() + k.x();
 }
 

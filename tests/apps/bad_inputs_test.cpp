@@ -251,7 +251,7 @@ const std::vector<BadInput>& cases() {
                                          "cpu", "--out",   p(d / "out")};
        },
        1,
-       {"world.yaml': expected plain text keys"},
+       {"world.yaml': expected keys that are names, got a list as a key"},
        {"out/result.json"}},
       {"WorldConfigListAsNumber",
        [](const fs::path& d) {

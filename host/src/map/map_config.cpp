@@ -97,7 +97,7 @@ MapConfig MapConfig::fromYamlFile(const std::filesystem::path& path) {
       {"occupied_prob", [&](auto& n, auto& k) { config.model.occupied_prob = number(n, k); }},
   };
   for (const auto& entry : root) {
-    const std::string key = keyText(entry.first, source);
+    const std::string key = keyString(entry.first, source);
     const auto it = keys.find(key);
     if (it == keys.end()) {
       std::string known;

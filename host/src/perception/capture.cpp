@@ -2,8 +2,12 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <climits>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
@@ -118,6 +122,10 @@ void readCameraYaml(const fs::path& file, Capture& c) {
   StereoIntrinsics& K = c.intrinsics;
   K.width_px = readInt(root, file, "width", "a positive integer image width (pixels)");
   K.height_px = readInt(root, file, "height", "a positive integer image height (pixels)");
+  if (static_cast<std::int64_t>(K.width_px) * K.height_px > kMaxCapturePixels)
+    fail(file, "fields 'width' x 'height'",
+         "at most " + std::to_string(kMaxCapturePixels) + " pixels, got " +
+             std::to_string(K.width_px) + "x" + std::to_string(K.height_px));
   auto positive = [&](const std::string& key, const std::string& what) {
     const double x = readNumber(root, file, key, what);
     if (!(x > 0.0) || !std::isfinite(x))
@@ -178,13 +186,35 @@ cv::Mat readImage(const fs::path& file, int flags, const StereoIntrinsics& K, bo
     if (required) fail(file, "file", "an image (required), it is missing");
     return {};
   }
-  cv::Mat im = cv::imread(file.string(), flags);
-  if (im.empty()) fail(file, "image", "a readable PNG");
-  if (im.cols != K.width_px || im.rows != K.height_px)
+  std::ifstream in(file, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!in.good() && !in.eof()) fail(file, "file", "a readable image, cannot read it");
+  // Only a PNG of camera.yaml's size reaches the decoder: OpenCV picks its decoder from the
+  // content (a PPM or TIFF named left.png would be decoded too) and allocates the image its
+  // header claims before it reads a pixel, so 100 bytes could ask for gigabytes. A PNG opens
+  // with its 8-byte signature and the IHDR chunk: length, "IHDR", width, height (big-endian).
+  static constexpr unsigned char kPngSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (bytes.size() < 24 || bytes.size() > std::size_t{INT_MAX} ||
+      std::memcmp(bytes.data(), kPngSignature, 8) != 0 || bytes.compare(12, 4, "IHDR") != 0)
+    fail(file, "image", "a PNG file (signature and IHDR header)");
+  const auto be32 = [&](std::size_t at) {
+    std::uint32_t v = 0;
+    for (std::size_t i = 0; i < 4; ++i) v = (v << 8) | static_cast<unsigned char>(bytes[at + i]);
+    return v;
+  };
+  const std::uint32_t png_width = be32(16), png_height = be32(20);
+  const auto sizeError = [&](std::uint64_t w, std::uint64_t h) {
     fail(file, "image size",
          std::to_string(K.width_px) + "x" + std::to_string(K.height_px) +
-             " (camera.yaml width x height), got " + std::to_string(im.cols) + "x" +
-             std::to_string(im.rows));
+             " (camera.yaml width x height), got " + std::to_string(w) + "x" + std::to_string(h));
+  };
+  if (png_width != static_cast<std::uint32_t>(K.width_px) ||
+      png_height != static_cast<std::uint32_t>(K.height_px))
+    sizeError(png_width, png_height);
+  cv::Mat im = cv::imdecode(
+      cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, const_cast<char*>(bytes.data())), flags);
+  if (im.empty()) fail(file, "image", "a readable PNG");
+  if (im.cols != K.width_px || im.rows != K.height_px) sizeError(im.cols, im.rows);
   return im;
 }
 

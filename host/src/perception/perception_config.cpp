@@ -79,7 +79,7 @@ PerceptionConfig PerceptionConfig::fromYamlFile(const std::filesystem::path& pat
   PerceptionConfig config;
   if (!root.IsNull())
     for (const auto& item : root) {
-      const std::string key = keyText(item.first, source);
+      const std::string key = keyString(item.first, source);
       findKeySpec(keySpecs(), key, source)
           .read(config, item.second, source + ": key '" + key + "'");
     }

@@ -65,7 +65,7 @@ PlannerConfig PlannerConfig::fromYamlFile(const std::filesystem::path& path) {
   PlannerConfig config;
   if (root.IsNull()) return config;
   for (const auto& item : root) {
-    const std::string key = keyText(item.first, source);
+    const std::string key = keyString(item.first, source);
     findKeySpec(keySpecs(), key, source).read(config, item.second, source + ": key '" + key + "'");
   }
   config.validate(source);

@@ -381,7 +381,8 @@ void runExperiment(const ExperimentOptions& o, const TrialRunner& run_trial,
       if (warning) warning("trial " + key + ": " + text);
     };
     const std::size_t index = ran;
-    t.on_progress = [&, index, planner, seed](const TrialProgress& p) {
+    // Init-captures: clang 14 (the libFuzzer build) cannot capture structured bindings.
+    t.on_progress = [&, index, planner = planner, seed = seed](const TrialProgress& p) {
       const double elapsed = elapsed_s();
       std::ostringstream line;
       line << "trial " << index + 1 << "/" << todo << " (" << planner << ", seed " << seed

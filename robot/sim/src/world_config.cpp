@@ -123,7 +123,7 @@ WorldConfig WorldConfig::fromYamlFile(const std::filesystem::path& path) {
     return config;
   }
   for (const auto& entry : root) {
-    const std::string key = host::keyText(entry.first, source);
+    const std::string key = host::keyString(entry.first, source);
     const KeySpec* spec = &host::findKeySpec(keySpecs(), key, source);
     const std::string where = source + ": key '" + key + "'";
     if (std::holds_alternative<int WorldConfig::*>(spec->member))

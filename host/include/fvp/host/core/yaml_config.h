@@ -34,10 +34,13 @@ inline YAML::Node readYamlMapping(const std::filesystem::path& path, const std::
   return root;
 }
 
-/// A mapping key as text; a key that is a list or a mapping is an error naming the source.
-inline std::string keyText(const YAML::Node& key, const std::string& source) {
-  if (!key.IsScalar()) throw std::invalid_argument(source + ": expected plain text keys");
-  return key.Scalar();
+/// A mapping key as text. Throws std::invalid_argument naming the source when the key is no
+/// scalar (`[a]: 1`, `{}: 1`), where yaml-cpp's as<std::string>() throws its own exception.
+inline std::string keyString(const YAML::Node& key, const std::string& source) {
+  if (key.IsScalar()) return key.Scalar();
+  if (key.IsNull()) return "null";  // what as<std::string>() gives: `~: 1` is an unknown key
+  throw std::invalid_argument(source + ": expected keys that are names, got a " +
+                              (key.IsSequence() ? "list" : "mapping") + " as a key");
 }
 
 /// node as T: a scalar that converts to T and, for floating point, is finite (yaml-cpp

@@ -8,19 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "fvp/host/eval/ground_truth.h"
 #include "fvp/host/sizing/fruitlet_sizer.h"
 
 namespace fvp::host::eval {
-
-struct GroundTruthFruitlet {
-  Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
-  double size_mm = 0.0;
-};
-
-/// The fruitlets of a ground_truth.json (the simulator's World::groundTruthJson): throws
-/// std::runtime_error naming `source` and the field when it is malformed.
-std::vector<GroundTruthFruitlet> groundTruthFromJson(const std::string& text,
-                                                     const std::string& source);
 
 /// {"fruitlets": [{"gt_center_m", "gt_size_mm", "matched", "est_center_m", "est_size_mm",
 /// "center_error_mm"}], "detections", "metrics": {"match_percent", "mae_mm", "mape_percent",

@@ -36,7 +36,13 @@ float decodeRoiColor(const octomap::ColorOcTreeNode::Color& color);
 
 /// Coarse map -> .bt (atomically). Throws std::runtime_error naming the file on failure.
 void writeCoarseBt(const octomap::OcTree& tree, const std::filesystem::path& bt_path);
-/// .bt -> OcTree. Throws std::runtime_error naming the file when it is not a readable .bt.
+/// Resolutions readCoarseBt accepts (metres): OctoMap's 16-bit keys stay well-scaled.
+inline constexpr double kMinBtResolutionM = 1e-6;
+inline constexpr double kMaxBtResolutionM = 1e3;
+/// .bt -> OcTree. Throws std::runtime_error naming the file when it is not a readable .bt:
+/// the header (id, size, res in [kMinBtResolutionM, kMaxBtResolutionM]) and the node data
+/// are checked before OctoMap reads them (the data must end with the tree, hold as many
+/// nodes as the header says and no inner node below the tree's depth of 16).
 std::unique_ptr<octomap::OcTree> readCoarseBt(const std::filesystem::path& bt_path);
 
 /// The fine tree as the ColorOcTree written to .ot files: same node structure, occupancy

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <string>
@@ -20,6 +21,9 @@
 namespace fvp::host {
 
 inline constexpr double kDefaultDisparityScale = 16.0;  ///< OpenCV's fixed point (1/16 px)
+/// Largest image readCapture accepts, width x height (64 Mi pixels, e.g. 8192 x 8192): the
+/// images and their per-pixel working copies must fit in memory.
+inline constexpr std::int64_t kMaxCapturePixels = std::int64_t{1} << 26;
 
 struct Capture {
   cv::Mat left_bgr;  ///< CV_8UC3 (a grey PNG is read as CV_8UC3 too)

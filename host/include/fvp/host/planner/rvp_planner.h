@@ -22,27 +22,10 @@
 #include <string>
 
 #include "fvp/host/planner/info_gain_evaluator.h"
+#include "fvp/host/planner/rvp_config.h"
 #include "fvp/host/planner/view_planner.h"
 
 namespace fvp::host::planner {
-
-struct RvpConfig {
-  int roi_samples = 100;          ///< paper's protocol
-  int exploration_samples = 100;  ///< paper's protocol
-  double sensor_min_m = 0.3;      ///< Zaenker's sensor range
-  double sensor_max_m = 0.5;
-  double alpha_per_m = 0.2;            ///< utility = IG - alpha * distance
-  double roi_utility_threshold = 0.2;  ///< the ROI set is used above this
-  int exploration_rays_x = 8, exploration_rays_y = 6;
-  double exploration_fov_x_deg = 80.0;
-  /// Half-edge of the box around the Cluster Region centre that exploration positions are
-  /// drawn from (the reachable workspace near the cluster; reachability filters it).
-  double exploration_box_half_m = 0.5;
-  std::int64_t seed = 1;
-  static RvpConfig fromYamlFile(const std::filesystem::path& path);
-  void validate(const std::string& source = "rvp config") const;
-  std::string toJson() const;
-};
 
 class RvpPlanner : public ViewPlanner {
  public:
