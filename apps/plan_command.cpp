@@ -32,9 +32,19 @@ void addPlanCommand(CLI::App& app) {
       ->check(CLI::IsMember({"grid", "octomap"}));
   cmd->add_option("--world", *world, "world config YAML")->check(CLI::ExistingFile);
   cmd->add_option("--config", *config, "planner config YAML")->check(CLI::ExistingFile);
+  auto captures = std::make_shared<std::string>(), perception = std::make_shared<std::string>();
+  cmd->add_option("--captures", *captures,
+                  "plan from a robot's capture set (docs/capture-format.md) instead of "
+                  "simulated views: the next best view from where the last capture was taken")
+      ->check(CLI::ExistingDirectory);
+  cmd->add_option("--perception-config", *perception,
+                  "perception config YAML for --captures (tag, Cluster Region, HSV)")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--out", *out, "output directory")->required();
-  cmd->callback([opt, world, config, out] {
+  cmd->callback([opt, world, config, out, captures, perception] {
     robot::sim::PlanOnceOptions o = *opt;
+    o.captures_dir = *captures;
+    o.perception_config = *perception;
     o.world_config = *world;
     o.planner_config = *config;
     o.out_dir = *out;

@@ -9,9 +9,12 @@
 #include "fvp/accel/backend.h"
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/host/core/output_directory.h"
+#include "fvp/host/perception/capture.h"
 #include "fvp/host/perception/ply_io.h"
 #include "fvp/host/planner/fvp_planner.h"
 #include "fvp/host/planner/rvp_planner.h"
+#include "fvp/host/session/capture_sizing.h"
+#include "fvp/host/session/mapping_session.h"
 #include "fvp/robot/arm_controller.h"
 #include "fvp/robot/sim/camera_views.h"
 #include "fvp/robot/sim/simulated_mapping.h"
@@ -44,13 +47,16 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
     host::removeStaleOutputs(o.out_dir, {"plan.json", "candidates.ply"});
   }
   const std::string engine = o.engine.empty() ? defaultEngine(o.planner) : o.engine;
-  const WorldConfig world_config =
-      o.world_config.empty() ? WorldConfig{} : WorldConfig::fromYamlFile(o.world_config);
-  const World world = World::generate(world_config, o.seed);
+  const bool from_captures = !o.captures_dir.empty();
+  // Checked first: a bad config fails before anything is mapped.
+  const host::PerceptionConfig perception =
+      o.perception_config.empty() ? host::PerceptionConfig{}
+                                  : host::PerceptionConfig::fromYamlFile(o.perception_config);
+  std::vector<std::filesystem::path> capture_dirs;
+  if (from_captures) capture_dirs = host::listCaptures(o.captures_dir);
 
   std::unique_ptr<accel::Backend> backend;
   if (engine == "grid" || o.backend != "auto") backend = accel::createBackend(o.backend);
-  // The planner (and its config file) before the views are mapped: a bad config fails fast.
   std::unique_ptr<host::planner::ViewPlanner> planner;
   if (o.planner == "fvp")
     planner = std::make_unique<host::planner::FvpPlanner>(
@@ -62,47 +68,89 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
         o.planner_config.empty() ? host::planner::RvpConfig{}
                                  : host::planner::RvpConfig::fromYamlFile(o.planner_config),
         o.seed);
-  SimulatedMappingOptions mapping;
-  mapping.engine = engine;
-  mapping.map = plannerMapConfig(o.planner, engine);
-  mapping.render.noise_seed = o.seed;
-  const auto t_map = std::chrono::steady_clock::now();
-  SimulatedMapping mapped =
-      mapSimulatedViews(world, orbitViews(world, o.views, 90.0), mapping, backend.get());
-  const double map_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_map).count();
-  if (!mapped.map)
-    throw std::runtime_error("plan: no view detected the AprilTag: no Cluster Region, no map");
-
-  ArmConfig arm_config;
-  arm_config.workspace_cache_dir = defaultCacheDir();
-  const ArmModel arm(arm_config);
-  std::ostringstream log;
-  const WorkspaceTree workspace = WorkspaceTree::loadOrBuild(arm, log);
+  const host::map::MapConfig map_config = plannerMapConfig(o.planner, engine);
   nlohmann::json warnings = nlohmann::json::array();
-  std::istringstream log_lines(log.str());
-  for (std::string line; std::getline(log_lines, line);)
-    if (line.rfind("warning: ", 0) == 0) warnings.push_back(line.substr(9));
-  SimClock clock = SimClock::fromConfig(arm_config);
-  const auto start = ArmController::startConfiguration(arm, world.startCameraPose());
-  if (!start) throw std::runtime_error("plan: the start view is out of the arm's reach");
-  ArmController controller(arm, clock, *start);
-  controller.setMap(mapped.map->coarseOcTree());
-
   nlohmann::json motions = nlohmann::json::array();
-  const auto t_plan = std::chrono::steady_clock::now();
-  const host::planner::PlanStep step = planner->planAndMove(
-      *mapped.map, controller.cameraPose(),
-      [&](const Eigen::Isometry3d& T) { return workspace.reachable(T); },
-      [&](const Eigen::Isometry3d& T) {
-        const MotionPlan plan = controller.moveToPose(T);
-        motions.push_back({{"status", toString(plan.status)},
-                           {"planning_s", plan.planning_wall_s},
-                           {"duration_s", plan.ok() ? plan.trajectory.duration_s() : 0.0}});
-        return plan.ok();
-      });
-  const double plan_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_plan).count();
+  const auto t_map = std::chrono::steady_clock::now();
+  host::planner::PlanStep step;
+  double map_s = 0.0;
+  const auto since = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  };
+  std::chrono::steady_clock::time_point t_plan;
+
+  if (from_captures) {
+    // A robot's captures: the map from every view (their own masks and disparities as
+    // given), the camera where the last view was taken. The robot's own planner makes the
+    // move, so every candidate counts as reachable and the best one is chosen.
+    host::MappingSession session(perception, engine, map_config, backend.get());
+    Eigen::Isometry3d T_now = Eigen::Isometry3d::Identity();
+    for (const auto& dir : capture_dirs) {
+      const host::Capture capture = host::readCapture(dir);
+      host::StereoFrame frame;
+      frame.left_bgr = capture.left_bgr;
+      frame.right_bgr = capture.right_bgr;
+      frame.intrinsics = capture.intrinsics;
+      frame.T_world_camera = capture.T_world_camera;
+      frame.fruitlet_mask = capture.fruitlet_mask;
+      frame.disparity_px = capture.disparity_px;
+      session.addView(frame);
+      T_now = capture.T_world_camera;
+    }
+    map_s = since(t_map);
+    if (!session.map())
+      throw std::runtime_error("plan: no capture in " + o.captures_dir.string() +
+                               " showed the AprilTag (" + perception.tag.family + " id " +
+                               std::to_string(perception.tag.tag_id) +
+                               ") and no region_center_m is configured: no Cluster Region, "
+                               "no map");
+    t_plan = std::chrono::steady_clock::now();
+    step = planner->planAndMove(
+        *session.map(), T_now, [](const Eigen::Isometry3d&) { return true; },
+        [&](const Eigen::Isometry3d&) {
+          motions.push_back({{"status", "not_planned"}});
+          return true;
+        });
+  } else {
+    const WorldConfig world_config =
+        o.world_config.empty() ? WorldConfig{} : WorldConfig::fromYamlFile(o.world_config);
+    const World world = World::generate(world_config, o.seed);
+    SimulatedMappingOptions mapping;
+    mapping.engine = engine;
+    mapping.map = map_config;
+    mapping.render.noise_seed = o.seed;
+    SimulatedMapping mapped =
+        mapSimulatedViews(world, orbitViews(world, o.views, 90.0), mapping, backend.get());
+    map_s = since(t_map);
+    if (!mapped.map)
+      throw std::runtime_error("plan: no view detected the AprilTag: no Cluster Region, no map");
+
+    ArmConfig arm_config;
+    arm_config.workspace_cache_dir = defaultCacheDir();
+    const ArmModel arm(arm_config);
+    std::ostringstream log;
+    const WorkspaceTree workspace = WorkspaceTree::loadOrBuild(arm, log);
+    std::istringstream log_lines(log.str());
+    for (std::string line; std::getline(log_lines, line);)
+      if (line.rfind("warning: ", 0) == 0) warnings.push_back(line.substr(9));
+    SimClock clock = SimClock::fromConfig(arm_config);
+    const auto start = ArmController::startConfiguration(arm, world.startCameraPose());
+    if (!start) throw std::runtime_error("plan: the start view is out of the arm's reach");
+    ArmController controller(arm, clock, *start);
+    controller.setMap(mapped.map->coarseOcTree());
+    t_plan = std::chrono::steady_clock::now();
+    step = planner->planAndMove(
+        *mapped.map, controller.cameraPose(),
+        [&](const Eigen::Isometry3d& T) { return workspace.reachable(T); },
+        [&](const Eigen::Isometry3d& T) {
+          const MotionPlan plan = controller.moveToPose(T);
+          motions.push_back({{"status", toString(plan.status)},
+                             {"planning_s", plan.planning_wall_s},
+                             {"duration_s", plan.ok() ? plan.trajectory.duration_s() : 0.0}});
+          return plan.ok();
+        });
+  }
+  const double plan_s = since(t_plan);
 
   nlohmann::json candidates = nlohmann::json::array();
   std::vector<Eigen::Vector3f> positions;
@@ -132,9 +180,10 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
       {"config", nlohmann::json::parse(planner->configJson())},
       {"planner", o.planner},
       {"seed", o.seed},
-      {"views", o.views},
+      {"views", from_captures ? int(capture_dirs.size()) : o.views},
+      {"source", from_captures ? o.captures_dir.string() : std::string("simulated")},
       {"engine", engine},
-      {"fine_map_extent", host::map::toString(mapping.map.fine_map_extent)},
+      {"fine_map_extent", host::map::toString(map_config.fine_map_extent)},
       {"backend", backend ? std::string(accel::toString(backend->kind())) : "none"},
       {"move_attempts", step.move_attempts},
       {"failed_moves", step.failed_moves},

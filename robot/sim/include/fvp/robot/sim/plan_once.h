@@ -20,6 +20,11 @@ struct PlanOnceOptions {
   std::string engine;  ///< empty: the planner's default
   std::filesystem::path world_config, planner_config;
   std::filesystem::path out_dir;  ///< plan.json, candidates.ply
+  /// A robot's capture set (docs/capture-format.md) instead of simulated views: the map
+  /// from every capture, the camera at the last capture's pose; every candidate is taken
+  /// as reachable (the robot's own planner makes the move) and the best is chosen.
+  std::filesystem::path captures_dir;
+  std::filesystem::path perception_config;  ///< tag, Cluster Region, HSV (fvp size --config)
 };
 
 /// Returns plan.json's object: {"chosen", "candidates": [{"kind", "position_m", "target_m",
