@@ -1,27 +1,47 @@
-// readTrials (trials.jsonl of an experiment directory; robot/sim/src/experiment.cpp) on a file
-// holding the input. Its source list in fuzz/CMakeLists.txt is FVP_FUZZ_TRIALS_SOURCES.
+// The readers of an experiment directory (robot/sim/src/experiment_directory.cpp) on a file
+// holding the input: readTrials (trials.jsonl) and readManifest (manifest.json). Every trial
+// readTrials accepts must pass checkTrial (the fields the reports read), and a manifest
+// readManifest accepts must write back (toJson) and read again to the same JSON.
 #include <nlohmann/json.hpp>
 
 #include "fuzz_support.h"
-#include "fvp/robot/sim/experiment.h"
+#include "fvp/robot/sim/experiment_directory.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   namespace fz = fvp::fuzz;
+  namespace sim = fvp::robot::sim;
   const std::filesystem::path path = fz::scratchDir() / "trials.jsonl";
   fz::writeFile(path, data, size);
   try {
     std::size_t warnings = 0;
     const std::vector<nlohmann::json> trials =
-        fvp::robot::sim::readTrials(path, [&](const std::string&) { ++warnings; });
+        sim::readTrials(path, [&](const std::string&) { ++warnings; });
     for (const nlohmann::json& t : trials) {
-      if (!t.is_object() || !t.contains("planner") || !t.contains("seed") ||
-          !t.contains("fruitlets"))
+      try {
+        sim::checkTrial(t, "fuzz");
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "fvp fuzz: an accepted trial fails checkTrial: %s\n", e.what());
         std::abort();
+      }
     }
   } catch (const nlohmann::json::exception& e) {
     fz::reportEscapedException("nlohmann_json", e);
   } catch (const std::exception&) {
     // Rejected: expected for most inputs.
+  }
+  const std::filesystem::path manifest_path = fz::scratchDir() / "manifest.json";
+  fz::writeFile(manifest_path, data, size);
+  try {
+    const sim::ExperimentManifest manifest = sim::readManifest(manifest_path);
+    const std::string text = manifest.toJson().dump();
+    fz::writeFile(manifest_path, text);
+    if (sim::readManifest(manifest_path).toJson().dump() != text) {
+      std::fprintf(stderr, "fvp fuzz: a manifest does not survive writing and reading\n");
+      std::abort();
+    }
+  } catch (const nlohmann::json::exception& e) {
+    fz::reportEscapedException("nlohmann_json", e);
+  } catch (const std::exception&) {
   }
   return 0;
 }
