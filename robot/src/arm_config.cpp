@@ -163,7 +163,9 @@ std::string ArmConfig::toJson() const {
         },
         spec.member);
   }
-  return json.dump();
+  // workspace_cache_dir is a path: any bytes (a YAML file's, $HOME's), not always UTF-8, which
+  // JSON needs. Invalid bytes become U+FFFD instead of a type_error thrown at the end of a run.
+  return json.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
 }
 
 }  // namespace fvp::robot
