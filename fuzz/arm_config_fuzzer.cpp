@@ -1,37 +1,9 @@
-// fvp::robot::ArmConfig::fromYamlFile (robot/src/arm_config.cpp) on a file holding the input. A
-// config it accepts must pass validate() (what a config built in code must pass) and hold only
-// finite numbers.
-#include <yaml-cpp/yaml.h>
-
-#include <nlohmann/json.hpp>
-#include <optional>
-
+// fvp::robot::ArmConfig::fromYamlFile (robot/src/arm_config.cpp) on a file holding the input
+// (fvp::fuzz::fuzzConfigReader: what counts as a finding).
 #include "config_checks.h"
-#include "fuzz_support.h"
 #include "fvp/robot/arm_config.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  namespace fz = fvp::fuzz;
-  const std::filesystem::path path = fz::scratchDir() / "arm_config.yaml";
-  fz::writeFile(path, data, size);
-  std::optional<fvp::robot::ArmConfig> config;
-  try {
-    config = fvp::robot::ArmConfig::fromYamlFile(path);
-  } catch (const YAML::Exception& e) {
-    fz::reportEscapedException("yaml-cpp", e);
-  } catch (const nlohmann::json::exception& e) {
-    fz::reportEscapedException("nlohmann_json", e);
-  } catch (const std::exception&) {
-    // Rejected: expected for most inputs.
-  }
-  if (config) {
-    try {
-      config->validate();
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "fvp fuzz: an accepted config fails validate(): %s\n", e.what());
-      std::abort();
-    }
-    fz::requireFiniteJson(config->toJson());
-  }
+  fvp::fuzz::fuzzConfigReader<fvp::robot::ArmConfig>(data, size, "arm_config.yaml");
   return 0;
 }

@@ -1,34 +1,9 @@
-// fvp::host::map::MapConfig::fromYamlFile (host/src/map/map_config.cpp) on a file holding the
-// input. A config it accepts must pass validate() (what a config built in code must pass).
-#include <yaml-cpp/yaml.h>
-
-#include <nlohmann/json.hpp>
-#include <optional>
-
-#include "fuzz_support.h"
+// fvp::host::map::MapConfig::fromYamlFile (host/src/map/map_config.cpp) on a file holding the input
+// (fvp::fuzz::fuzzConfigReader: what counts as a finding).
+#include "config_checks.h"
 #include "fvp/host/map/map_config.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  namespace fz = fvp::fuzz;
-  const std::filesystem::path path = fz::scratchDir() / "map_config.yaml";
-  fz::writeFile(path, data, size);
-  std::optional<fvp::host::map::MapConfig> config;
-  try {
-    config = fvp::host::map::MapConfig::fromYamlFile(path);
-  } catch (const YAML::Exception& e) {
-    fz::reportEscapedException("yaml-cpp", e);
-  } catch (const nlohmann::json::exception& e) {
-    fz::reportEscapedException("nlohmann_json", e);
-  } catch (const std::exception&) {
-    // Rejected: expected for most inputs.
-  }
-  if (config) {
-    try {
-      config->validate();
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "fvp fuzz: an accepted config fails validate(): %s\n", e.what());
-      std::abort();
-    }
-  }
+  fvp::fuzz::fuzzConfigReader<fvp::host::map::MapConfig>(data, size, "map_config.yaml");
   return 0;
 }

@@ -280,6 +280,17 @@ void writeCapture(const fs::path& dir, const Capture& c) {
   writeFileAtomically(dir / kCamera, "camera", cameraYaml(c));
 }
 
+StereoFrame toStereoFrame(const Capture& c) {
+  StereoFrame frame;
+  frame.left_bgr = c.left_bgr;
+  frame.right_bgr = c.right_bgr;
+  frame.intrinsics = c.intrinsics;
+  frame.T_world_camera = c.T_world_camera;
+  frame.fruitlet_mask = c.fruitlet_mask;
+  frame.disparity_px = c.disparity_px;
+  return frame;
+}
+
 Capture readCapture(const fs::path& dir) {
   if (!fs::is_directory(dir)) throw std::runtime_error(dir.string() + ": not a capture directory");
   Capture c;

@@ -84,14 +84,7 @@ nlohmann::json sizeCaptureSet(const std::filesystem::path& captures_dir,
   nlohmann::json views = nlohmann::json::array();
   for (const auto& dir : dirs) {
     const Capture capture = readCapture(dir);
-    StereoFrame frame;
-    frame.left_bgr = capture.left_bgr;
-    frame.right_bgr = capture.right_bgr;
-    frame.intrinsics = capture.intrinsics;
-    frame.T_world_camera = capture.T_world_camera;
-    // The capture's own mask and disparity (a robot's segmentation and stereo) as given.
-    frame.fruitlet_mask = capture.fruitlet_mask;
-    frame.disparity_px = capture.disparity_px;
+    const StereoFrame frame = toStereoFrame(capture);  // its own mask and disparity as given
     PerceptionResult perceived;
     const ViewResult v = session.addView(frame, &perceived);
     const int fruitlet_px =

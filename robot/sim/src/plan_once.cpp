@@ -87,14 +87,7 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
     Eigen::Isometry3d T_now = Eigen::Isometry3d::Identity();
     for (const auto& dir : capture_dirs) {
       const host::Capture capture = host::readCapture(dir);
-      host::StereoFrame frame;
-      frame.left_bgr = capture.left_bgr;
-      frame.right_bgr = capture.right_bgr;
-      frame.intrinsics = capture.intrinsics;
-      frame.T_world_camera = capture.T_world_camera;
-      frame.fruitlet_mask = capture.fruitlet_mask;
-      frame.disparity_px = capture.disparity_px;
-      session.addView(frame);
+      session.addView(host::toStereoFrame(capture));
       T_now = capture.T_world_camera;
     }
     map_s = since(t_map);

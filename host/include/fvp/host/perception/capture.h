@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "fvp/host/core/stereo_intrinsics.h"
+#include "fvp/host/perception/stereo_frame.h"
 
 namespace fvp::host {
 
@@ -43,6 +44,10 @@ struct Capture {
 /// name and renamed, so no file is ever half-written. Throws std::runtime_error (naming the
 /// file) on I/O failure and std::invalid_argument for inconsistent sizes.
 void writeCapture(const std::filesystem::path& dir, const Capture& capture);
+
+/// The capture as the frame perception takes: the pair, intrinsics, pose, and the capture's
+/// own mask and disparity (used as given when present).
+StereoFrame toStereoFrame(const Capture& capture);
 
 /// Reads and validates a capture; throws std::runtime_error whose message names the file,
 /// the field and what was expected.
