@@ -61,16 +61,24 @@ RvpConfig RvpConfig::fromYamlFile(const std::filesystem::path& path) {
 }
 
 void RvpConfig::validate(const std::string& source) const {
-  require(roi_samples >= 0 && exploration_samples >= 0 && roi_samples + exploration_samples > 0,
-          source, "roi_samples", "non-negative sample counts, not both 0");
+  // Each count bounded before they are added (two large ints overflow), the rays so that
+  // nx * ny stays an int; every double in a finite range (`!(x >= lo)` style: NaN fails).
+  require(roi_samples >= 0 && roi_samples <= 10'000'000, source, "roi_samples",
+          "0 to 10000000 candidates");
+  require(exploration_samples >= 0 && exploration_samples <= 10'000'000, source,
+          "exploration_samples", "0 to 10000000 candidates");
+  require(roi_samples + exploration_samples > 0, source, "roi_samples",
+          "non-negative sample counts, not both 0");
   require(sensor_min_m > 0.0 && sensor_max_m >= sensor_min_m && sensor_max_m < 5.0, source,
           "sensor_max_m", "0 < sensor_min_m <= sensor_max_m < 5 m");
   require(alpha_per_m >= 0.0 && alpha_per_m < 100.0, source, "alpha_per_m",
           "a cost weight in [0, 100) per metre");
-  require(std::isfinite(roi_utility_threshold), source, "roi_utility_threshold",
-          "a finite utility");
-  require(exploration_rays_x >= 1 && exploration_rays_y >= 1, source, "exploration_rays_x",
-          "at least one ray per axis");
+  require(roi_utility_threshold >= -10.0 && roi_utility_threshold <= 10.0, source,
+          "roi_utility_threshold", "a utility in [-10, 10]");
+  require(exploration_rays_x >= 1 && exploration_rays_x <= 256, source, "exploration_rays_x",
+          "1 to 256 rays");
+  require(exploration_rays_y >= 1 && exploration_rays_y <= 256, source, "exploration_rays_y",
+          "1 to 256 rays");
   require(exploration_fov_x_deg > 0.0 && exploration_fov_x_deg < 170.0, source,
           "exploration_fov_x_deg", "an angle in (0, 170) degrees");
   require(exploration_box_half_m > 0.0 && exploration_box_half_m < 5.0, source,
