@@ -10,25 +10,13 @@
 #include <optional>
 
 #include "fvp/accel/backend.h"
-#include "fvp/robot/sim/camera_views.h"
-#include "fvp/robot/sim/stereo_renderer.h"
-#include "fvp/robot/sim/world.h"
+#include "seed2_orbit_frames.h"
 
 namespace fvp::host::nbv {
 namespace {
 
-/// Seed 2's orbit: view 0 does not show the tag, view 1 does (as in the session tests).
 const StereoFrame& renderedFrame(std::size_t i) {
-  static const auto world = robot::sim::World::generate(robot::sim::WorldConfig{}, 2);
-  static const robot::sim::StereoRenderer renderer(world);
-  static const auto poses = robot::sim::orbitViews(world, 3, 60.0);
-  static std::optional<StereoFrame> frames[2];
-  if (!frames[i]) {
-    robot::sim::RenderOptions options;
-    options.ground_truth = false;
-    frames[i] = renderer.render(poses[i], options);
-  }
-  return *frames[i];
+  return test::seed2OrbitFrame(i);
 }
 
 class FakeClock : public LoopClock {

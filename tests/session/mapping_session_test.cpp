@@ -10,35 +10,20 @@
 #include <vector>
 
 #include "fvp/accel/backend.h"
-#include "fvp/robot/sim/camera_views.h"
-#include "fvp/robot/sim/stereo_renderer.h"
-#include "fvp/robot/sim/world.h"
+#include "seed2_orbit_frames.h"
 
 namespace fvp::host {
 namespace {
 
-// Seed 2's orbit over 60 degrees: the first view does not see the tag, the middle one (the
-// start view's direction) does. Full resolution (the tag detector's working point); each
-// view is rendered once per test program, when a test first needs it (ctest runs every
-// test in its own process).
+// Seed 2's orbit over 60 degrees (seed2_orbit_frames.h): the first view does not see the
+// tag, the middle one does.
 class MappingSessionTest : public ::testing::Test {
  protected:
   static const StereoFrame& untagged() { return frame(0); }
   static const StereoFrame& tagged() { return frame(1); }
 
  private:
-  static const StereoFrame& frame(std::size_t i) {
-    static const auto world = robot::sim::World::generate(robot::sim::WorldConfig{}, 2);
-    static const robot::sim::StereoRenderer renderer(world);
-    static const auto poses = robot::sim::orbitViews(world, 3, 60.0);
-    static std::optional<StereoFrame> frames[2];
-    if (!frames[i]) {
-      robot::sim::RenderOptions options;
-      options.ground_truth = false;
-      frames[i] = renderer.render(poses[i], options);
-    }
-    return *frames[i];
-  }
+  static const StereoFrame& frame(std::size_t i) { return test::seed2OrbitFrame(i); }
 };
 
 std::vector<std::array<int, 3>> sorted(std::vector<std::array<int, 3>> v) {

@@ -47,21 +47,12 @@ void appendLine(const fs::path& path, const std::string& line) {
     throw std::runtime_error(path.string() + ": appending a trial failed (disk full?)");
 }
 
-/// The bytes of a file; empty when it cannot be read (ok false).
-std::string readBytes(const fs::path& path, bool& ok) {
-  std::ifstream in(path, std::ios::binary);
-  ok = bool(in);
-  std::stringstream buffer;
-  if (ok) buffer << in.rdbuf();
-  return buffer.str();
-}
-
 /// Cuts a last line without its newline (a write cut short) off trials.jsonl, so that the
 /// next append starts on a line of its own. The whole lines are kept byte for byte.
 void cutTornTail(const fs::path& jsonl) {
-  bool ok = false;
-  const std::string text = readBytes(jsonl, ok);
-  if (!ok || text.empty() || text.back() == '\n') return;
+  const std::optional<std::string> bytes = readFileBytes(jsonl);
+  if (!bytes || bytes->empty() || bytes->back() == '\n') return;
+  const std::string& text = *bytes;
   const std::size_t newline = text.rfind('\n');
   const std::string kept = newline == std::string::npos ? "" : text.substr(0, newline + 1);
   host::writeFileAtomically(jsonl, "trials (a torn last line cut off)", kept);
@@ -69,10 +60,9 @@ void cutTornTail(const fs::path& jsonl) {
 
 ConfigFileStamp stampOf(const fs::path& path, const std::string& what) {
   if (path.empty()) return {};
-  bool ok = false;
-  const std::string bytes = readBytes(path, ok);
-  if (!ok) throw std::runtime_error("experiment: cannot read the " + what + " " + path.string());
-  return {fs::absolute(path).lexically_normal().string(), fnv1a64Hex(bytes)};
+  const std::optional<std::string> bytes = readFileBytes(path);
+  if (!bytes) throw std::runtime_error("experiment: cannot read the " + what + " " + path.string());
+  return {fs::absolute(path).lexically_normal().string(), fnv1a64Hex(*bytes)};
 }
 
 /// The manifest an experiment with these options has.

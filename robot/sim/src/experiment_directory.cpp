@@ -162,14 +162,20 @@ std::string trialRowKey(const nlohmann::json& trial) {
   return key;
 }
 
+std::optional<std::string> readFileBytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::nullopt;
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
 std::vector<nlohmann::json> readTrials(const std::filesystem::path& jsonl,
                                        const std::function<void(const std::string&)>& warning) {
   std::vector<nlohmann::json> out;
-  std::ifstream in(jsonl, std::ios::binary);
-  if (!in) return out;
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  const std::string text = buffer.str();
+  const std::optional<std::string> bytes = readFileBytes(jsonl);
+  if (!bytes) return out;
+  const std::string& text = *bytes;
   std::map<std::pair<std::string, std::uint64_t>, std::size_t> line_of;  // (row, seed) -> line
   std::size_t start = 0, line_no = 0;
   while (start < text.size()) {
@@ -241,13 +247,11 @@ nlohmann::ordered_json ExperimentManifest::toJson() const {
 
 ExperimentManifest readManifest(const std::filesystem::path& path) {
   const std::string where = path.string();
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(where + ": cannot read the experiment manifest");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
+  const std::optional<std::string> bytes = readFileBytes(path);
+  if (!bytes) throw std::runtime_error(where + ": cannot read the experiment manifest");
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(buffer.str());
+    j = nlohmann::json::parse(*bytes);
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(where + ": expected an experiment manifest as JSON: " + e.what());
   }

@@ -121,11 +121,8 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
     ArmConfig arm_config;
     arm_config.workspace_cache_dir = defaultCacheDir();
     const ArmModel arm(arm_config);
-    std::ostringstream log;
-    const WorkspaceTree workspace = WorkspaceTree::loadOrBuild(arm, log);
-    std::istringstream log_lines(log.str());
-    for (std::string line; std::getline(log_lines, line);)
-      if (line.rfind("warning: ", 0) == 0) warnings.push_back(line.substr(9));
+    const WorkspaceTree workspace =
+        loadWorkspaceTree(arm, [&](const std::string& text) { warnings.push_back(text); });
     SimClock clock = SimClock::fromConfig(arm_config);
     const auto start = ArmController::startConfiguration(arm, world.startCameraPose());
     if (!start) throw std::runtime_error("plan: the start view is out of the arm's reach");

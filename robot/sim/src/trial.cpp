@@ -147,11 +147,7 @@ nlohmann::json runTrial(const TrialOptions& options) {
   arm_config.clock = options.clock;
   if (arm_config.workspace_cache_dir.empty()) arm_config.workspace_cache_dir = defaultCacheDir();
   const ArmModel arm(arm_config);
-  std::ostringstream arm_log;
-  const WorkspaceTree workspace = WorkspaceTree::loadOrBuild(arm, arm_log);
-  std::istringstream arm_log_lines(arm_log.str());
-  for (std::string line; std::getline(arm_log_lines, line);)
-    if (line.rfind("warning: ", 0) == 0) warn(line.substr(9));
+  const WorkspaceTree workspace = loadWorkspaceTree(arm, warn);
   SimClock clock = SimClock::fromConfig(arm_config);
   const auto start = ArmController::startConfiguration(arm, world.startCameraPose());
   if (!start)
@@ -221,7 +217,7 @@ nlohmann::json runTrial(const TrialOptions& options) {
 
   result["warnings"] = warnings;
   if (!options.out_dir.empty())
-    parts.writeOutputs(result, world, camera_path, options.out_dir, warn);
+    parts.writeOutputs(result, world, camera_path, options.out_dir, options.on_warning);
   return result;
 }
 

@@ -48,6 +48,16 @@ std::string defaultCacheDir() {
   return (std::filesystem::temp_directory_path() / "fvp-cache").string();
 }
 
+WorkspaceTree loadWorkspaceTree(const ArmModel& arm,
+                                const std::function<void(const std::string&)>& warn) {
+  std::ostringstream log;
+  WorkspaceTree tree = WorkspaceTree::loadOrBuild(arm, log);
+  std::istringstream lines(log.str());
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind("warning: ", 0) == 0) warn(line.substr(9));
+  return tree;
+}
+
 struct TrialParts::Impl {
   Impl(const TrialOptions& options, const std::string& engine, accel::Backend* backend)
       : options(options),

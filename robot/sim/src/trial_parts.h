@@ -18,6 +18,7 @@
 #include "fvp/host/session/mapping_session.h"
 #include "fvp/robot/sim/trial.h"
 #include "fvp/robot/sim/world.h"
+#include "fvp/robot/workspace_tree.h"
 
 namespace fvp::accel {
 class Backend;
@@ -36,6 +37,11 @@ host::map::MapConfig plannerMapConfig(const std::string& planner, const std::str
 /// Where the workspace tree is cached between trials: $FVP_CACHE_DIR, else
 /// $XDG_CACHE_HOME/fvp, else ~/.cache/fvp, else a directory under the system temp dir.
 std::string defaultCacheDir();
+/// The arm's workspace tree from its cache (built and cached when missing or stale); each
+/// warning the cache gave (a stale or unreadable file, a cache it could not write) goes to
+/// warn, without its "warning: " prefix.
+WorkspaceTree loadWorkspaceTree(const ArmModel& arm,
+                                const std::function<void(const std::string&)>& warn);
 
 /// What one view did, with the wall times the clock charges.
 struct ViewOutcome {

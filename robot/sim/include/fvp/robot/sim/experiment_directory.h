@@ -16,6 +16,10 @@
 
 namespace fvp::robot::sim {
 
+/// A file's bytes; nothing when it cannot be opened (the directory's readers and the
+/// experiment runner share it).
+std::optional<std::string> readFileBytes(const std::filesystem::path& path);
+
 /// Reads trials.jsonl: one JSON object per line (empty lines are skipped), each checked
 /// against the fields the reports read (checkTrial). A line that is not a valid trial is an
 /// error `FILE: line N: ...`; the same trial (row key and seed) on two lines is an error
