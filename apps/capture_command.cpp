@@ -17,9 +17,10 @@
 #include "fvp/host/core/input_checks.h"
 #include "fvp/host/core/output_directory.h"
 #include "fvp/host/perception/capture.h"
-#include "fvp/host/perception/occlusion_statistic.h"
 #include "fvp/host/perception/perception_pipeline.h"
 #include "fvp/robot/sim/camera_views.h"
+#include "fvp/robot/sim/object_ids.h"
+#include "fvp/robot/sim/occlusion_statistic.h"
 #include "fvp/robot/sim/stereo_renderer.h"
 #include "fvp/robot/sim/world.h"
 
@@ -152,12 +153,13 @@ void addCaptureCommand(CLI::App& app) {
         opt->pose.empty() ? world.startCameraPose() : parsePose(opt->pose);
 
     robot::sim::StereoRenderer renderer(world);
-    const host::StereoFrame frame = renderer.render(T_world_camera);
+    const robot::sim::RenderedView view = renderer.renderWithGroundTruth(T_world_camera);
+    const host::StereoFrame& frame = view.frame;
     const double render_s = renderer.lastRenderSeconds();
     robot::sim::RenderOptions no_leaves;  // ids only: for the occlusion statistic
     no_leaves.with_leaves = false;
     no_leaves.images = false;
-    const host::StereoFrame bare = renderer.render(T_world_camera, no_leaves);
+    const robot::sim::RenderedView bare = renderer.renderWithGroundTruth(T_world_camera, no_leaves);
     const double bare_render_s = renderer.lastRenderSeconds();
 
     host::PerceptionConfig config;
@@ -180,7 +182,8 @@ void addCaptureCommand(CLI::App& app) {
     capture.ground_truth_json = world.groundTruthJson();
     host::writeCapture(opt->out, capture);
 
-    const auto occlusion = host::OcclusionStatistic::compute(frame.gt_object_id, bare.gt_object_id);
+    const auto occlusion = robot::sim::OcclusionStatistic::compute(view.ground_truth.object_id,
+                                                                   bare.ground_truth.object_id);
     const auto& K = frame.intrinsics;
     const cv::Rect fine = result.disparity.fine_rect;
     std::cout << std::fixed << std::setprecision(1);
@@ -229,7 +232,7 @@ void addCaptureCommand(CLI::App& app) {
               << "occlusion      visible fraction of each fruitlet's "
                  "silhouette vs a render without leaves:\n";
     for (const auto& f : occlusion.fruitlets())
-      std::cout << "  fruitlet " << f.object_id - host::kFirstFruitletId << "   "
+      std::cout << "  fruitlet " << f.object_id - robot::sim::kFirstFruitletId << "   "
                 << (f.unoccluded_px > 0 ? std::to_string(f.visible_fraction).substr(0, 5)
                                         : std::string("out of view"))
                 << "  (" << f.visible_px << " of " << f.unoccluded_px << " px)\n";

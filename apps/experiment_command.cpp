@@ -9,6 +9,7 @@
 
 #include "cli_checks.h"
 #include "commands.h"
+#include "fvp/host/map/map_engine_registry.h"
 #include "fvp/robot/sim/experiment.h"
 
 namespace fvp::apps {
@@ -43,7 +44,7 @@ void addExperimentCommands(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--engine", opt->experiment.trial.engine,
                   "map engine for every planner (default: each planner's own)")
-      ->check(CLI::IsMember({"grid", "octomap"}));
+      ->check(CLI::IsMember(host::map::MapEngineRegistry::instance().names()));
   cmd->add_option("--clock", opt->experiment.trial.clock, "wall | fixed")
       ->check(CLI::IsMember({"wall", "fixed"}))
       ->capture_default_str();

@@ -11,6 +11,7 @@
 #include "fvp/accel/backend.h"
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/host/core/output_directory.h"
+#include "fvp/host/map/map_engine_registry.h"
 #include "fvp/robot/sim/camera_views.h"
 #include "fvp/robot/sim/simulated_mapping.h"
 
@@ -49,7 +50,7 @@ void addMapCommand(CLI::App& app) {
       ->check(CLI::Range(0.0, 360.0))
       ->capture_default_str();
   cmd->add_option("--engine", opt->engine, "map engine: grid | octomap")
-      ->check(CLI::IsMember({"grid", "octomap"}))
+      ->check(CLI::IsMember(host::map::MapEngineRegistry::instance().names()))
       ->capture_default_str();
   cmd->add_option("--backend", opt->backend,
                   "compute backend for the grid engine: cpu | opencl | vulkan | auto")
@@ -63,7 +64,7 @@ void addMapCommand(CLI::App& app) {
         opt->world_file.empty() ? WorldConfig{} : WorldConfig::fromYamlFile(opt->world_file);
     const auto world = robot::sim::World::generate(config, opt->seed);
     std::unique_ptr<accel::Backend> backend;
-    if (opt->engine == "grid") backend = accel::createBackend(opt->backend);
+    if (host::map::mapEngineNeedsBackend(opt->engine)) backend = accel::createBackend(opt->backend);
     robot::sim::SimulatedMappingOptions options;
     options.engine = opt->engine;
     if (!opt->map_config_file.empty())

@@ -5,6 +5,8 @@
 
 #include "cli_checks.h"
 #include "commands.h"
+#include "fvp/host/map/map_engine_registry.h"
+#include "fvp/host/planner/planner_registry.h"
 #include "fvp/robot/sim/plan_once.h"
 
 namespace fvp::apps {
@@ -18,7 +20,7 @@ void addPlanCommand(CLI::App& app) {
       "One planning iteration on a map of K simulated views; write plan.json and "
       "candidates.ply to --out");
   cmd->add_option("--planner", opt->planner, "fvp | rvp")
-      ->check(CLI::IsMember({"fvp", "rvp"}))
+      ->check(CLI::IsMember(host::planner::PlannerRegistry::instance().names()))
       ->capture_default_str();
   cmd->add_option("--seed", opt->seed, "world seed")
       ->check(decimalUnsigned())
@@ -29,7 +31,7 @@ void addPlanCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--backend", opt->backend, "cpu | opencl | vulkan | auto")->capture_default_str();
   cmd->add_option("--engine", opt->engine, "grid | octomap (default: the planner's)")
-      ->check(CLI::IsMember({"grid", "octomap"}));
+      ->check(CLI::IsMember(host::map::MapEngineRegistry::instance().names()));
   cmd->add_option("--world", *world, "world config YAML")->check(CLI::ExistingFile);
   cmd->add_option("--config", *config, "planner config YAML")->check(CLI::ExistingFile);
   auto captures = std::make_shared<std::string>(), perception = std::make_shared<std::string>();

@@ -8,6 +8,8 @@
 
 #include "cli_checks.h"
 #include "commands.h"
+#include "fvp/host/map/map_engine_registry.h"
+#include "fvp/host/planner/planner_registry.h"
 #include "fvp/robot/sim/trial.h"
 
 namespace fvp::apps {
@@ -23,7 +25,7 @@ void addRunCommand(CLI::App& app) {
                                  "Run one simulated trial; write result.json and report.md "
                                  "to --out");
   cmd->add_option("--planner", opt->trial.planner, "viewpoint planner: fvp | rvp")
-      ->check(CLI::IsMember({"fvp", "rvp"}))
+      ->check(CLI::IsMember(host::planner::PlannerRegistry::instance().names()))
       ->capture_default_str();
   cmd->add_option("--seed", opt->trial.seed, "world seed")
       ->check(decimalUnsigned())
@@ -40,7 +42,7 @@ void addRunCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--engine", opt->trial.engine,
                   "map engine: grid | octomap (default: grid for fvp, octomap for rvp)")
-      ->check(CLI::IsMember({"grid", "octomap"}));
+      ->check(CLI::IsMember(host::map::MapEngineRegistry::instance().names()));
   cmd->add_option("--max-views", opt->max_views, "stop after this many views (0: no limit)")
       ->check(decimalUnsigned());
   cmd->add_option("--clock", opt->trial.clock,

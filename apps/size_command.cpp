@@ -5,6 +5,7 @@
 
 #include "commands.h"
 #include "fvp/accel/backend.h"
+#include "fvp/host/map/map_engine_registry.h"
 #include "fvp/host/session/capture_sizing.h"
 
 namespace fvp::apps {
@@ -25,7 +26,7 @@ void addSizeCommand(CLI::App& app) {
       ->check(CLI::IsMember({"ours", "paper"}))
       ->capture_default_str();
   cmd->add_option("--engine", opt->engine, "map engine: grid | octomap")
-      ->check(CLI::IsMember({"grid", "octomap"}))
+      ->check(CLI::IsMember(host::map::MapEngineRegistry::instance().names()))
       ->capture_default_str();
   cmd->add_option("--backend", opt->backend, "cpu | opencl | vulkan | auto")->capture_default_str();
   cmd->add_option("--config", opt->config,
@@ -38,7 +39,7 @@ void addSizeCommand(CLI::App& app) {
     host::PerceptionConfig perception;  // read first: a bad file fails before any work
     if (!opt->config.empty()) perception = host::PerceptionConfig::fromYamlFile(opt->config);
     std::unique_ptr<accel::Backend> backend;
-    if (opt->engine == "grid") backend = accel::createBackend(opt->backend);
+    if (host::map::mapEngineNeedsBackend(opt->engine)) backend = accel::createBackend(opt->backend);
     host::CaptureSizingOptions o;
     o.perception = perception;
     o.estimator = opt->sizing == "paper" ? host::sizing::SizingEstimator::kPaper

@@ -10,12 +10,12 @@
 #include <random>
 #include <sstream>
 
-#include "fvp/robot/arm_controller.h"
+#include "fvp/robot/sim/arm_controller.h"
 #include "fvp/robot/sim/camera_views.h"
 #include "fvp/robot/sim/world.h"
+#include "fvp/robot/sim/world_occupancy.h"
 #include "fvp/robot/ur5_kinematics.h"
 #include "fvp/robot/workspace_tree.h"
-#include "fvp/robot/world_occupancy.h"
 
 namespace fvp::bench {
 namespace {
@@ -172,11 +172,11 @@ void BM_MotionPlan(benchmark::State& state) {
   for (int w = 0; w < kWorlds; ++w) {
     const auto world = robot::sim::World::generate(robot::sim::WorldConfig{}, 500 + w);
     const Eigen::Vector3d c = world.clusterCenter_m();
-    const auto tree =
-        robot::worldOccupancy(world, 0.01, Eigen::AlignedBox3d(c.array() - 0.6, c.array() + 0.6));
+    const auto tree = robot::sim::worldOccupancy(
+        world, 0.01, Eigen::AlignedBox3d(c.array() - 0.6, c.array() + 0.6));
     checkers.push_back(std::make_unique<robot::ArmCollisionChecker>(arm));
     checkers.back()->setMap(*tree);
-    const auto start = robot::ArmController::startConfiguration(arm, world.startCameraPose());
+    const auto start = robot::sim::ArmController::startConfiguration(arm, world.startCameraPose());
     if (!start) {
       state.SkipWithError("motion plan: a start view is unreachable");
       return;

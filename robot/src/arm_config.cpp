@@ -54,9 +54,6 @@ const std::vector<KeySpec>& keySpecs() {
       {"workspace_min_count", &ArmConfig::workspace_min_count, 1, 65535},
       {"workspace_seed", &ArmConfig::workspace_seed, 0, 9e15},
       {"workspace_cache_dir", &ArmConfig::workspace_cache_dir},
-      {"clock", &ArmConfig::clock},
-      {"capture_time_s", &ArmConfig::capture_time_s, 0.0, 60.0},
-      {"fixed_stage_time_s", &ArmConfig::fixed_stage_time_s, 0.0, 60.0},
   };
   return specs;
 }
@@ -107,10 +104,6 @@ void ArmConfig::validate(const std::string& source) const {
     for (const std::string& name : knownPlanners()) list += (list.empty() ? "" : ", ") + name;
     throw std::invalid_argument(source + ": key 'planner' = '" + planner +
                                 "' is not a known OMPL planner; expected one of " + list);
-  }
-  if (clock != "wall" && clock != "fixed") {
-    throw std::invalid_argument(source + ": key 'clock' = '" + clock +
-                                "'; expected 'wall' or 'fixed'");
   }
 }
 

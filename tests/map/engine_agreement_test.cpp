@@ -292,7 +292,6 @@ TEST(EngineAgreement, AgreeOnASimulatedCaptureSequence) {
   std::swap(poses[0], poses[1]);  // the start view (the middle one) first: it sees the tag
   for (const auto& pose : poses) {
     robot::sim::RenderOptions render;
-    render.ground_truth = false;
     const PerceptionResult seen = perception.process(renderer.render(pose, render), region);
     if (!region) {
       ASSERT_TRUE(seen.region.has_value()) << "the first view must see the tag";

@@ -88,3 +88,16 @@ message("${last_output}")
 if(NOT last_output MATCHES "fvp_consumer: all checks passed")
   message(FATAL_ERROR "the consumer did not report success")
 endif()
+
+# The Python module from the prefix (PYTHON: the interpreter it was built for; unset when
+# fvp was built without it): found there alone, imported, and asked something.
+if(PYTHON)
+  file(GLOB_RECURSE module ${prefix}/fvp.*.so)
+  if(NOT module)
+    message(FATAL_ERROR "not installed: the fvp Python module")
+  endif()
+  get_filename_component(module_dir ${module} DIRECTORY)
+  run("import fvp from the prefix" ${CMAKE_COMMAND} -E env PYTHONPATH=${module_dir}
+      ${PYTHON} -c "import fvp; assert fvp.__file__.startswith('${prefix}'), fvp.__file__; assert fvp.planners()[:2] == ['fvp', 'rvp']; assert fvp.backends()['cpu'] == 'available'; print('python: fvp from', fvp.__file__)")
+  message("${last_output}")
+endif()

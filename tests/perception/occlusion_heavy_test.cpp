@@ -4,13 +4,15 @@
 
 #include <iostream>
 
-#include "fvp/host/perception/occlusion_statistic.h"
+#include "fvp/robot/sim/object_ids.h"
+#include "fvp/robot/sim/occlusion_statistic.h"
 #include "fvp/robot/sim/stereo_renderer.h"
 #include "fvp/robot/sim/world.h"
 
 namespace fvp::host {
 namespace {
 
+using robot::sim::OcclusionStatistic;
 using robot::sim::RenderOptions;
 using robot::sim::StereoRenderer;
 using robot::sim::World;
@@ -25,9 +27,11 @@ TEST(PerceptionSimHeavy, OcclusionStatisticOver35Seeds) {
     const StereoRenderer renderer(world);
     RenderOptions ids;
     ids.images = false;
-    const cv::Mat with = renderer.render(world.startCameraPose(), ids).gt_object_id;
+    const cv::Mat with =
+        renderer.renderWithGroundTruth(world.startCameraPose(), ids).ground_truth.object_id;
     ids.with_leaves = false;
-    const cv::Mat without = renderer.render(world.startCameraPose(), ids).gt_object_id;
+    const cv::Mat without =
+        renderer.renderWithGroundTruth(world.startCameraPose(), ids).ground_truth.object_id;
     const auto s = OcclusionStatistic::compute(with, without);
     std::cout << "[ measured ] seed " << seed << ": mean visible fraction "
               << s.meanVisibleFraction() << " over " << s.fruitletsInView() << " fruitlets\n";

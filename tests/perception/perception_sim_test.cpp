@@ -12,16 +12,24 @@
 #include "fvp/host/perception/apriltag_detector.h"
 #include "fvp/host/perception/cluster_region_image.h"
 #include "fvp/host/perception/fruitlet_segmenter.h"
-#include "fvp/host/perception/occlusion_statistic.h"
 #include "fvp/host/perception/perception_pipeline.h"
 #include "fvp/host/perception/stereo_matcher.h"
+#include "fvp/robot/sim/object_ids.h"
+#include "fvp/robot/sim/occlusion_statistic.h"
 #include "fvp/robot/sim/stereo_renderer.h"
 #include "fvp/robot/sim/world.h"
 
 namespace fvp::host {
 namespace {
 
+using robot::sim::isFruitletId;
+using robot::sim::kBackgroundId;
+using robot::sim::kFirstFruitletId;
+using robot::sim::kFirstLeafId;
+using robot::sim::kMaxFruitlets;
+using robot::sim::OcclusionStatistic;
 using robot::sim::RenderConfig;
+using robot::sim::RenderedView;
 using robot::sim::RenderOptions;
 using robot::sim::StereoRenderer;
 using robot::sim::World;
@@ -61,6 +69,21 @@ Eigen::Isometry3d lookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& targ
 // is black (noise only) in the image: no camera can segment it. Truth is therefore the id
 // layer restricted to lit pixels (brightest channel >= kLitMin, 5 sigma above the noise);
 // "half visible" counts lit pixels against the leafless render.
+TEST(OcclusionStatistic, FractionsFromIdMaps) {
+  cv::Mat with(10, 10, CV_32S, cv::Scalar(kBackgroundId)), without = with.clone();
+  without(cv::Rect(0, 0, 4, 5)).setTo(kFirstFruitletId);      // 20 px
+  without(cv::Rect(5, 0, 5, 2)).setTo(kFirstFruitletId + 1);  // 10 px
+  with(cv::Rect(0, 0, 4, 5)).setTo(kFirstFruitletId);
+  with(cv::Rect(0, 0, 4, 2)).setTo(kFirstLeafId);      // 12 of 20 visible
+  with(cv::Rect(5, 0, 5, 2)).setTo(kFirstLeafId + 3);  // 0 of 10 visible
+  const auto s = OcclusionStatistic::compute(with, without);
+  ASSERT_EQ(s.fruitlets().size(), 2u);
+  EXPECT_DOUBLE_EQ(s.fruitlets()[0].visible_fraction, 0.6);
+  EXPECT_DOUBLE_EQ(s.fruitlets()[1].visible_fraction, 0.0);
+  EXPECT_EQ(s.fruitletsInView(), 2);
+  EXPECT_DOUBLE_EQ(s.meanVisibleFraction(), 0.3);
+}
+
 TEST(PerceptionSim, SegmentationIoUOnStartViews) {
   const StereoIntrinsics K = windowCamera(640, 640, 319.5, 319.5);
   RenderConfig rc;
@@ -72,12 +95,14 @@ TEST(PerceptionSim, SegmentationIoUOnStartViews) {
   for (std::uint64_t seed = 1; seed <= 6; ++seed) {
     const World world = World::generate(WorldConfig{}, seed);
     const StereoRenderer renderer(world, rc);
-    const StereoFrame frame = renderer.render(world.startCameraPose());
+    const RenderedView frame_view = renderer.renderWithGroundTruth(world.startCameraPose());
+    const host::StereoFrame& frame = frame_view.frame;
     RenderOptions bare;
     bare.with_leaves = false;
     bare.images = false;
-    const cv::Mat ids_bare = renderer.render(world.startCameraPose(), bare).gt_object_id;
-    const auto occlusion = OcclusionStatistic::compute(frame.gt_object_id, ids_bare);
+    const cv::Mat ids_bare =
+        renderer.renderWithGroundTruth(world.startCameraPose(), bare).ground_truth.object_id;
+    const auto occlusion = OcclusionStatistic::compute(frame_view.ground_truth.object_id, ids_bare);
     const cv::Mat mask = segmenter.segment(frame.left_bgr);
     constexpr int kLitMin = 10;
     cv::Mat brightest;
@@ -99,14 +124,14 @@ TEST(PerceptionSim, SegmentationIoUOnStartViews) {
         }(),
         brightest);
     const cv::Mat lit = brightest >= kLitMin;
-    cv::Mat all_fruit = (frame.gt_object_id >= kFirstFruitletId) &
-                        (frame.gt_object_id < kFirstFruitletId + kMaxFruitlets);
+    cv::Mat all_fruit = (frame_view.ground_truth.object_id >= kFirstFruitletId) &
+                        (frame_view.ground_truth.object_id < kFirstFruitletId + kMaxFruitlets);
     cv::Mat near_fruit;
     cv::dilate(all_fruit, near_fruit, cv::getStructuringElement(cv::MORPH_ELLIPSE, {7, 7}));
     stray += cv::countNonZero(mask & ~near_fruit);
     fruit_px += cv::countNonZero(all_fruit);
     for (const auto& f : occlusion.fruitlets()) {
-      const cv::Mat gt = (frame.gt_object_id == f.object_id) & lit;
+      const cv::Mat gt = (frame_view.ground_truth.object_id == f.object_id) & lit;
       const double lit_fraction =
           f.unoccluded_px ? static_cast<double>(cv::countNonZero(gt)) / f.unoccluded_px : 0.0;
       if (lit_fraction < 0.5) continue;
@@ -151,16 +176,17 @@ TEST(PerceptionSim, DisparityDepthErrorOnFruitletsAtPointThreeMetres) {
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
     const World world = World::generate(wc, seed);
     const StereoRenderer renderer(world, rc);
-    const StereoFrame frame = renderer.render(world.startCameraPose());
+    const RenderedView frame_view = renderer.renderWithGroundTruth(world.startCameraPose());
+    const StereoFrame& frame = frame_view.frame;
     const ClusterRegion region(world.clusterCenter_m(), 0.05);
     const cv::Rect band = clusterRegionImageBounds(region, K, frame.T_world_camera);
     const DisparityResult r = StereoMatcher().compute(frame.left_bgr, frame.right_bgr, band);
     sgbm_s += r.stats.sgbm_s;
     for (int v = 0; v < K.height_px; ++v)
       for (int u = 0; u < K.width_px; ++u) {
-        if (!isFruitletId(frame.gt_object_id.at<int>(v, u))) continue;
+        if (!isFruitletId(frame_view.ground_truth.object_id.at<int>(v, u))) continue;
         const float d = r.disparity_px.at<float>(v, u);
-        const double z = frame.gt_depth_m.at<float>(v, u);
+        const double z = frame_view.ground_truth.depth_m.at<float>(v, u);
         if (d <= 0.0f) continue;
         err_m.push_back(std::abs(K.depthFromDisparity(d) - z));
         depth_sum += z;
@@ -190,7 +216,6 @@ TEST(PerceptionSim, AprilTagPoseAtPointThreeMetres) {
     const Eigen::Isometry3d T_world_camera = lookAt(eye, T_world_tag.translation());
     const StereoRenderer renderer(world, rc);
     RenderOptions opts;
-    opts.ground_truth = false;
     const StereoFrame frame = renderer.render(T_world_camera, opts);
     AprilTagDetectorConfig config;
     config.tag_size_m = world.tag().tag_size_m;

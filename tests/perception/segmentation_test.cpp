@@ -5,7 +5,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fvp/host/perception/fruitlet_segmenter.h"
-#include "fvp/host/perception/occlusion_statistic.h"
 #include "fvp/host/perception/stereo_frame.h"
 #include "synthetic_scenes.h"
 
@@ -73,21 +72,6 @@ TEST(FruitletSegmenter, BadConfigNamesTheField) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("min_saturation"), std::string::npos);
   }
-}
-
-TEST(OcclusionStatistic, FractionsFromIdMaps) {
-  cv::Mat with(10, 10, CV_32S, cv::Scalar(kBackgroundId)), without = with.clone();
-  without(cv::Rect(0, 0, 4, 5)).setTo(kFirstFruitletId);      // 20 px
-  without(cv::Rect(5, 0, 5, 2)).setTo(kFirstFruitletId + 1);  // 10 px
-  with(cv::Rect(0, 0, 4, 5)).setTo(kFirstFruitletId);
-  with(cv::Rect(0, 0, 4, 2)).setTo(kFirstLeafId);      // 12 of 20 visible
-  with(cv::Rect(5, 0, 5, 2)).setTo(kFirstLeafId + 3);  // 0 of 10 visible
-  const auto s = OcclusionStatistic::compute(with, without);
-  ASSERT_EQ(s.fruitlets().size(), 2u);
-  EXPECT_DOUBLE_EQ(s.fruitlets()[0].visible_fraction, 0.6);
-  EXPECT_DOUBLE_EQ(s.fruitlets()[1].visible_fraction, 0.0);
-  EXPECT_EQ(s.fruitletsInView(), 2);
-  EXPECT_DOUBLE_EQ(s.meanVisibleFraction(), 0.3);
 }
 
 }  // namespace

@@ -7,7 +7,7 @@
 
 #include "fvp/robot/arm_collision_checker.h"
 #include "fvp/robot/sim/world.h"
-#include "fvp/robot/world_occupancy.h"
+#include "fvp/robot/sim/world_occupancy.h"
 
 namespace fvp::robot {
 namespace {
@@ -220,7 +220,7 @@ TEST(ArmCollisionChecker, StartViewOfAWorldIsFreeInItsFullMap) {
   const auto world = sim::World::generate(sim::WorldConfig{}, 1);
   const Eigen::AlignedBox3d bounds(Eigen::Vector3d(-1.5, -1.5, 0.0),
                                    Eigen::Vector3d(1.5, 1.5, 2.5));
-  const auto tree = worldOccupancy(world, 0.01, bounds);
+  const auto tree = sim::worldOccupancy(world, 0.01, bounds);
   EXPECT_GT(tree->getNumLeafNodes(), 1000u);
   ArmCollisionChecker checker(arm);
   checker.setMap(*tree);

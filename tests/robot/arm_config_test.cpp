@@ -35,13 +35,11 @@ TEST(ArmConfig, DefaultFileMatchesDefaults) {
 }
 
 TEST(ArmConfig, ReadsValuesAndVectors) {
-  const ArmConfig c = ArmConfig::fromYamlFile(writeTemp(
-      "good",
-      "slider_travel_m: 2.0\nslider_origin_m: [0.1, -0.9, 0.6]\nplanner: PRM\nclock: fixed\n"));
+  const ArmConfig c = ArmConfig::fromYamlFile(
+      writeTemp("good", "slider_travel_m: 2.0\nslider_origin_m: [0.1, -0.9, 0.6]\nplanner: PRM\n"));
   EXPECT_EQ(c.slider_travel_m, 2.0);
   EXPECT_EQ(c.slider_origin_m, Eigen::Vector3d(0.1, -0.9, 0.6));
   EXPECT_EQ(c.planner, "PRM");
-  EXPECT_EQ(c.clock, "fixed");
 }
 
 TEST(ArmConfig, ErrorsNameFileAndKey) {
@@ -54,8 +52,9 @@ TEST(ArmConfig, ErrorsNameFileAndKey) {
   EXPECT_NE(e.find("key 'slider_origin_m': expected a list of 3 numbers"), std::string::npos) << e;
   e = errorOf("planner: Dijkstra\n");
   EXPECT_NE(e.find("'planner'"), std::string::npos) << e;
-  e = errorOf("clock: sundial\n");
-  EXPECT_NE(e.find("'clock'"), std::string::npos) << e;
+  // The simulated clock is the simulator's (robot/sim/sim_clock.h), not the arm's.
+  e = errorOf("clock: fixed\n");
+  EXPECT_NE(e.find("unknown key 'clock'"), std::string::npos) << e;
   e = errorOf("ik_slider_samples: many\n");
   EXPECT_NE(e.find("key 'ik_slider_samples': expected an integer"), std::string::npos) << e;
 }

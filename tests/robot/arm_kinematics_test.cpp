@@ -4,14 +4,15 @@
 #include <iostream>
 #include <random>
 
-#include "fvp/robot/arm_controller.h"
 #include "fvp/robot/arm_model.h"
+#include "fvp/robot/sim/arm_controller.h"
 #include "fvp/robot/sim/camera_views.h"
 #include "fvp/robot/sim/world.h"
 #include "fvp/robot/ur5_kinematics.h"
 
 namespace fvp::robot {
 namespace {
+using sim::ArmController;
 
 double rotationError(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
   return Eigen::AngleAxisd(a.transpose() * b).angle();

@@ -3,10 +3,14 @@
 #include <gtest/gtest.h>
 
 #include "fvp/robot/motion_planner.h"
+#include "fvp/robot/sim/arm_controller.h"
 #include "planning_queries.h"
 
 namespace fvp::robot {
 namespace {
+using sim::ArmController;
+using sim::ClockStage;
+using sim::SimClock;
 
 TEST(MotionPlanner, SucceedsOnRandomFeasibleQueriesInClutteredWorlds) {
   // A success-rate test, not a speed test (BM_MotionPlan measures speed): a generous limit

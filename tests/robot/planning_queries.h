@@ -12,12 +12,14 @@
 #include <random>
 #include <vector>
 
-#include "fvp/robot/arm_controller.h"
+#include "fvp/robot/sim/arm_controller.h"
 #include "fvp/robot/sim/camera_views.h"
 #include "fvp/robot/sim/world.h"
-#include "fvp/robot/world_occupancy.h"
+#include "fvp/robot/sim/world_occupancy.h"
 
 namespace fvp::robot::testing {
+using sim::ArmController;
+using sim::SimClock;
 
 struct QueryStats {
   int feasible = 0, succeeded = 0, infeasible = 0, path_invalid = 0;
@@ -75,7 +77,7 @@ inline QueryStats runPlanningQueries(int worlds, int queries_per_world, std::uin
         sim::World::generate(sim::WorldConfig{}, seed + static_cast<std::uint64_t>(w));
     const Eigen::Vector3d c = world.clusterCenter_m();
     const Eigen::AlignedBox3d box(c.array() - 0.6, c.array() + 0.6);
-    const auto tree = worldOccupancy(world, 0.01, box);
+    const auto tree = sim::worldOccupancy(world, 0.01, box);
     SimClock clock(SimClock::Mode::kFixed, 0.2, 0.1);
     const auto start = ArmController::startConfiguration(arm, world.startCameraPose());
     EXPECT_TRUE(start.has_value());

@@ -3,9 +3,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "fvp/robot/sim_clock.h"
+#include "fvp/robot/sim/sim_clock.h"
 
-namespace fvp::robot {
+namespace fvp::robot::sim {
 namespace {
 
 TEST(SimClock, AddsUpToTheSumOfItsCharges) {
@@ -46,13 +46,11 @@ TEST(SimClock, FixedModeChargesConstantsAndKeepsTheMeasuredTime) {
   EXPECT_THROW(clock.chargeMotion(-1.0), std::invalid_argument);
 }
 
-TEST(SimClock, FromConfig) {
-  ArmConfig config;
-  config.clock = "fixed";
-  EXPECT_EQ(SimClock::fromConfig(config).mode(), SimClock::Mode::kFixed);
-  config.clock = "wall";
-  EXPECT_EQ(SimClock::fromConfig(config).mode(), SimClock::Mode::kWall);
+TEST(SimClock, ModeFromString) {
+  EXPECT_EQ(SimClock::modeFromString("fixed"), SimClock::Mode::kFixed);
+  EXPECT_EQ(SimClock::modeFromString("wall"), SimClock::Mode::kWall);
+  EXPECT_THROW(SimClock::modeFromString("sundial"), std::invalid_argument);
 }
 
 }  // namespace
-}  // namespace fvp::robot
+}  // namespace fvp::robot::sim

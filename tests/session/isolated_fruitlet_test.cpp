@@ -32,7 +32,6 @@ TEST_P(IsolatedFruitlet, BothEstimatorsSizeItWithinAThirdOfAMillimetre) {
   session.enableTsdf();
   const robot::sim::StereoRenderer renderer(world);
   robot::sim::RenderOptions options;
-  options.ground_truth = false;
   for (const auto& pose : robot::sim::orbitViews(world, 8, 180.0))
     session.addView(renderer.render(pose, options));
   ASSERT_TRUE(session.region().has_value());

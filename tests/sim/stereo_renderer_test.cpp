@@ -1,6 +1,7 @@
 #include "fvp/robot/sim/stereo_renderer.h"
 
-#include "fvp/host/perception/occlusion_statistic.h"
+#include "fvp/robot/sim/object_ids.h"
+#include "fvp/robot/sim/occlusion_statistic.h"
 
 #include <gtest/gtest.h>
 
@@ -51,10 +52,10 @@ struct SilhouetteStats {
 };
 
 // Compares the ground-truth layers with the exact cone of rays tangent to the sphere.
-SilhouetteStats compareSphere(const host::StereoFrame& frame, const Eigen::Vector3d& c_camera,
+SilhouetteStats compareSphere(const RenderedView& view, const Eigen::Vector3d& c_camera,
                               double radius_m) {
   SilhouetteStats stats;
-  const host::StereoIntrinsics& in = frame.intrinsics;
+  const host::StereoIntrinsics& in = view.frame.intrinsics;
   const double half_angle = std::asin(radius_m / c_camera.norm());
   const Eigen::Vector3d axis = c_camera.normalized();
   for (int v = 0; v < in.height_px; ++v) {
@@ -62,7 +63,7 @@ SilhouetteStats compareSphere(const host::StereoFrame& frame, const Eigen::Vecto
       const Eigen::Vector3d ray = in.unproject(u, v, 1.0);
       const double angle = std::acos(std::clamp(ray.normalized().dot(axis), -1.0, 1.0));
       const bool predicted = angle < half_angle;
-      const bool rendered = frame.gt_object_id.at<std::int32_t>(v, u) == host::kFirstFruitletId;
+      const bool rendered = view.ground_truth.object_id.at<std::int32_t>(v, u) == kFirstFruitletId;
       stats.predicted_px += predicted;
       stats.rendered_px += rendered;
       if (predicted != rendered) {
@@ -77,8 +78,8 @@ SilhouetteStats compareSphere(const host::StereoFrame& frame, const Eigen::Vecto
         const double c = c_camera.squaredNorm() - radius_m * radius_m;
         const double disc = std::max(0.0, b * b - 4.0 * a * c);
         const double z = (-b - std::sqrt(disc)) / (2.0 * a);
-        stats.max_depth_error_m =
-            std::max(stats.max_depth_error_m, std::abs(frame.gt_depth_m.at<float>(v, u) - z));
+        stats.max_depth_error_m = std::max(stats.max_depth_error_m,
+                                           std::abs(view.ground_truth.depth_m.at<float>(v, u) - z));
       }
     }
   }
@@ -97,8 +98,8 @@ TEST(StereoRenderer, SphereSilhouetteAndDepthAreExact) {
     const World world =
         World::fromParts({sphere(T_world_camera * c_camera, kRadiusM)}, {}, {}, std::nullopt);
     const StereoRenderer renderer(world, config);
-    const host::StereoFrame frame = renderer.render(T_world_camera);
-    const SilhouetteStats stats = compareSphere(frame, c_camera, kRadiusM);
+    const RenderedView view = renderer.renderWithGroundTruth(T_world_camera);
+    const SilhouetteStats stats = compareSphere(view, c_camera, kRadiusM);
     std::cout << "sphere at " << c_camera.transpose() << ": predicted " << stats.predicted_px
               << " px, rendered " << stats.rendered_px << " px, mismatched " << stats.mismatched_px
               << " (max " << stats.max_mismatch_edge_px << " px from the edge), max depth error "
@@ -112,7 +113,7 @@ TEST(StereoRenderer, SphereSilhouetteAndDepthAreExact) {
     // equivalent radius, against the exact cone. The Lambertian limb is dark, so allow the
     // edge to lose up to 1 px.
     cv::Mat grey;
-    cv::cvtColor(frame.left_bgr, grey, cv::COLOR_BGR2GRAY);
+    cv::cvtColor(view.frame.left_bgr, grey, cv::COLOR_BGR2GRAY);
     const double lit_px = cv::countNonZero(grey > 0);
     const double radius_px_image = std::sqrt(lit_px / M_PI);
     const double radius_px_exact = std::sqrt(stats.predicted_px / M_PI);
@@ -148,13 +149,17 @@ TEST(StereoRenderer, DeterministicAcrossThreadCountsAndNoiseDiffersPerView) {
   config.intrinsics = smallIntrinsics(240, 180);
   config.intrinsics.fx_px = config.intrinsics.fy_px = 300.0;
   config.threads = 1;
-  const host::StereoFrame one = StereoRenderer(world, config).render(world.startCameraPose());
+  const RenderedView one_view =
+      StereoRenderer(world, config).renderWithGroundTruth(world.startCameraPose());
+  const host::StereoFrame& one = one_view.frame;
   config.threads = 2;
   const StereoRenderer renderer(world, config);
-  const host::StereoFrame two = renderer.render(world.startCameraPose());
+  const RenderedView two_view = renderer.renderWithGroundTruth(world.startCameraPose());
+  const host::StereoFrame& two = two_view.frame;
   EXPECT_EQ(cv::norm(one.left_bgr, two.left_bgr, cv::NORM_INF), 0.0);
   EXPECT_EQ(cv::norm(one.right_bgr, two.right_bgr, cv::NORM_INF), 0.0);
-  EXPECT_EQ(cv::norm(one.gt_depth_m, two.gt_depth_m, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(one_view.ground_truth.depth_m, two_view.ground_truth.depth_m, cv::NORM_INF),
+            0.0);
   Eigen::Isometry3d moved = world.startCameraPose();
   moved.translation().x() += 1e-9;
   const host::StereoFrame other = renderer.render(moved);
@@ -174,28 +179,29 @@ TEST(StereoRenderer, AdaptiveAntialiasingMatchesFullSupersampling) {
     config.samples_per_pixel = spp;
     config.adaptive_antialiasing = adaptive;
     const StereoRenderer renderer(world, config);
-    const host::StereoFrame frame = renderer.render(world.startCameraPose());
+    const RenderedView view = renderer.renderWithGroundTruth(world.startCameraPose());
     if (seconds != nullptr) *seconds = renderer.lastRenderSeconds();
-    return frame;
+    return view;
   };
   double full_s = 0.0, adaptive_s = 0.0;
-  const host::StereoFrame reference = renderWith(16, false, nullptr);
-  const host::StereoFrame full = renderWith(4, false, &full_s);
-  const host::StereoFrame adaptive = renderWith(4, true, &adaptive_s);
+  const RenderedView reference = renderWith(16, false, nullptr);
+  const RenderedView full = renderWith(4, false, &full_s);
+  const RenderedView adaptive = renderWith(4, true, &adaptive_s);
   const auto meanAbs = [](const cv::Mat& a, const cv::Mat& b) {
     return cv::norm(a, b, cv::NORM_L1) / static_cast<double>(a.total() * a.channels());
   };
   for (const bool left : {true, false}) {
-    const cv::Mat& ref = left ? reference.left_bgr : reference.right_bgr;
-    const double full_error = meanAbs(left ? full.left_bgr : full.right_bgr, ref);
-    const double adaptive_error = meanAbs(left ? adaptive.left_bgr : adaptive.right_bgr, ref);
+    const cv::Mat& ref = left ? reference.frame.left_bgr : reference.frame.right_bgr;
+    const double full_error = meanAbs(left ? full.frame.left_bgr : full.frame.right_bgr, ref);
+    const double adaptive_error =
+        meanAbs(left ? adaptive.frame.left_bgr : adaptive.frame.right_bgr, ref);
     std::cout << (left ? "left" : "right") << ": mean |error| vs 16 spp: full 4 spp " << full_error
               << ", adaptive " << adaptive_error << " grey levels\n";
     EXPECT_LT(adaptive_error, 1.5 * full_error + 0.05);
   }
   std::cout << "render time: full 4 spp " << full_s << " s, adaptive " << adaptive_s << " s\n";
   // The ground truth does not depend on the shading.
-  EXPECT_EQ(cv::norm(full.gt_depth_m, adaptive.gt_depth_m, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(full.ground_truth.depth_m, adaptive.ground_truth.depth_m, cv::NORM_INF), 0.0);
 }
 
 TEST(StereoRenderer, FlashExposureNotSaturatedAt20cmAndBrightAt40cm) {
@@ -230,17 +236,17 @@ TEST(StereoRenderer, IdsCoverEveryObjectKindInAGeneratedWorld) {
   const StereoRenderer renderer(world, config);
   RenderOptions options;
   options.images = false;
-  const host::StereoFrame frame = renderer.render(world.startCameraPose(), options);
-  EXPECT_TRUE(frame.left_bgr.empty());
+  const RenderedView frame_view = renderer.renderWithGroundTruth(world.startCameraPose(), options);
+  EXPECT_TRUE(frame_view.frame.left_bgr.empty());
   bool fruitlet = false, leaf = false, tag = false;
-  for (int v = 0; v < frame.gt_object_id.rows; ++v) {
-    for (int u = 0; u < frame.gt_object_id.cols; ++u) {
-      const int id = frame.gt_object_id.at<std::int32_t>(v, u);
-      fruitlet |= host::isFruitletId(id);
-      leaf |= id >= host::kFirstLeafId && id < host::kTreeId;
-      tag |= id == host::kTagId;
-      const float depth = frame.gt_depth_m.at<float>(v, u);
-      EXPECT_EQ(id == host::kBackgroundId, depth == 0.0f);
+  for (int v = 0; v < frame_view.ground_truth.object_id.rows; ++v) {
+    for (int u = 0; u < frame_view.ground_truth.object_id.cols; ++u) {
+      const int id = frame_view.ground_truth.object_id.at<std::int32_t>(v, u);
+      fruitlet |= isFruitletId(id);
+      leaf |= id >= kFirstLeafId && id < kTreeId;
+      tag |= id == kTagId;
+      const float depth = frame_view.ground_truth.depth_m.at<float>(v, u);
+      EXPECT_EQ(id == kBackgroundId, depth == 0.0f);
     }
   }
   EXPECT_TRUE(fruitlet);
@@ -272,10 +278,12 @@ TEST(StereoRenderer, FullResolutionStartViewTimingAndOcclusion) {
     const StereoRenderer renderer(w, config);
     RenderOptions ids;
     ids.images = false;
-    const cv::Mat with_leaves = renderer.render(w.startCameraPose(), ids).gt_object_id;
+    const cv::Mat with_leaves =
+        renderer.renderWithGroundTruth(w.startCameraPose(), ids).ground_truth.object_id;
     ids.with_leaves = false;
-    const cv::Mat without_leaves = renderer.render(w.startCameraPose(), ids).gt_object_id;
-    const auto stat = host::OcclusionStatistic::compute(with_leaves, without_leaves);
+    const cv::Mat without_leaves =
+        renderer.renderWithGroundTruth(w.startCameraPose(), ids).ground_truth.object_id;
+    const auto stat = OcclusionStatistic::compute(with_leaves, without_leaves);
     fraction_sum += stat.meanVisibleFraction() * stat.fruitletsInView();
     fruitlets += stat.fruitletsInView();
   }

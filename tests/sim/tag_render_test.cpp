@@ -52,7 +52,6 @@ TEST(TagRender, DetectedInStartViewWithRightIdAndPose) {
     config.tag_id = 7 * static_cast<int>(seed);
     const World world = World::generate(config, seed);
     RenderOptions options;
-    options.ground_truth = false;
     const StereoRenderer renderer(world);
     const host::StereoFrame frame = renderer.render(world.startCameraPose(), options);
     cv::Mat grey;

@@ -19,7 +19,6 @@ inline const host::StereoFrame& seed2OrbitFrame(std::size_t i) {
   static std::optional<host::StereoFrame> frames[2];
   if (!frames[i]) {
     robot::sim::RenderOptions options;
-    options.ground_truth = false;
     frames[i] = renderer.render(poses[i], options);
   }
   return *frames[i];

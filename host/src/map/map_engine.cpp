@@ -4,8 +4,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "fvp/host/map/grid_map_engine.h"
-#include "fvp/host/map/octomap_map_engine.h"
+#include "fvp/host/map/map_engine_registry.h"
 
 namespace fvp::host::map {
 
@@ -38,18 +37,15 @@ void MapEngine::refreshScene(MapLevel level, OccupiedVoxelScene& scene, bool) {
 }
 
 void checkMapEngineChoice(std::string_view engine, const accel::Backend* backend) {
-  if (engine != "grid" && engine != "octomap")
-    throw std::invalid_argument("unknown map engine '" + std::string(engine) +
-                                "': expected grid or octomap");
-  if (engine == "grid" && !backend)
-    throw std::invalid_argument("map engine 'grid' needs a compute backend");
+  const MapEngineEntry& entry = MapEngineRegistry::instance().at(engine);
+  if (entry.needs_backend && !backend)
+    throw std::invalid_argument("map engine '" + entry.name + "' needs a compute backend");
 }
 
 std::unique_ptr<MapEngine> createMapEngine(std::string_view engine, const MapConfig& config,
                                            const ClusterRegion& region, accel::Backend* backend) {
   checkMapEngineChoice(engine, backend);
-  if (engine == "grid") return std::make_unique<GridMapEngine>(config, region, *backend);
-  return std::make_unique<OctomapMapEngine>(config, region);
+  return MapEngineRegistry::instance().at(engine).create(config, region, backend);
 }
 
 }  // namespace fvp::host::map

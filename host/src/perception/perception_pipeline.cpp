@@ -14,21 +14,6 @@ double secondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// Exact disparity of the simulator's depth layer (ablation only).
-cv::Mat disparityFromDepth(const cv::Mat& depth_m, const StereoIntrinsics& K) {
-  if (depth_m.type() != CV_32F || depth_m.cols != K.width_px || depth_m.rows != K.height_px)
-    throw std::invalid_argument(
-        "use_exact_depth: the frame's gt_depth_m must be CV_32F of the image size (simulated "
-        "frames only)");
-  cv::Mat d = cv::Mat::zeros(depth_m.size(), CV_32F);
-  for (int v = 0; v < depth_m.rows; ++v)
-    for (int u = 0; u < depth_m.cols; ++u) {
-      const float z = depth_m.at<float>(v, u);
-      if (z > 0.0f) d.at<float>(v, u) = static_cast<float>(K.fx_px * K.baseline_m / z);
-    }
-  return d;
-}
-
 }  // namespace
 
 void PerceptionConfig::validate() const {
@@ -104,17 +89,7 @@ PerceptionResult PerceptionPipeline::process(
   }
 
   SampleGrid grid;
-  if (config_.use_exact_depth) {
-    if (frame.gt_depth_m.empty())
-      throw std::invalid_argument(
-          "PerceptionPipeline: use_exact_depth needs the frame's gt_depth_m (simulation only)");
-    t0 = std::chrono::steady_clock::now();
-    result.disparity.disparity_px = disparityFromDepth(frame.gt_depth_m, K);
-    result.disparity.fine_rect = cv::Rect(0, 0, K.width_px, K.height_px);
-    result.disparity.coarse_scale = 1;
-    result.disparity.stats.fine_samples = static_cast<std::int64_t>(frame.gt_depth_m.total());
-    result.disparity.stats.sgbm_s = secondsSince(t0);
-  } else if (!frame.disparity_px.empty()) {
+  if (!frame.disparity_px.empty()) {
     // The frame's own disparity, as given, at full resolution everywhere.
     result.disparity.disparity_px = frame.disparity_px.clone();
     result.disparity.fine_rect = cv::Rect(0, 0, K.width_px, K.height_px);

@@ -18,6 +18,7 @@
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/host/core/gnuplot.h"
 #include "fvp/host/core/output_directory.h"
+#include "fvp/host/map/map_engine_registry.h"
 
 namespace fvp::robot::sim {
 namespace {
@@ -112,8 +113,9 @@ void checkOptions(const ExperimentOptions& o) {
   if (o.trial.clock != "wall" && o.trial.clock != "fixed")
     throw std::invalid_argument("experiment: --clock must be wall or fixed, not '" + o.trial.clock +
                                 "'");
-  if (!o.trial.engine.empty() && o.trial.engine != "grid" && o.trial.engine != "octomap")
-    throw std::invalid_argument("experiment: --engine must be grid or octomap, not '" +
+  if (!o.trial.engine.empty() && !host::map::MapEngineRegistry::instance().contains(o.trial.engine))
+    throw std::invalid_argument("experiment: --engine must be one of " +
+                                host::map::MapEngineRegistry::instance().knownNames() + ", not '" +
                                 o.trial.engine + "'");
 }
 

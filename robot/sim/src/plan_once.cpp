@@ -9,13 +9,13 @@
 #include "fvp/accel/backend.h"
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/host/core/output_directory.h"
+#include "fvp/host/map/map_engine_registry.h"
 #include "fvp/host/perception/capture.h"
 #include "fvp/host/perception/ply_io.h"
-#include "fvp/host/planner/fvp_planner.h"
-#include "fvp/host/planner/rvp_planner.h"
+#include "fvp/host/planner/planner_registry.h"
 #include "fvp/host/session/capture_sizing.h"
 #include "fvp/host/session/mapping_session.h"
-#include "fvp/robot/arm_controller.h"
+#include "fvp/robot/sim/arm_controller.h"
 #include "fvp/robot/sim/camera_views.h"
 #include "fvp/robot/sim/simulated_mapping.h"
 #include "fvp/robot/workspace_tree.h"
@@ -39,8 +39,10 @@ std::array<std::uint8_t, 3> colour(double t) {
 }  // namespace
 
 nlohmann::json planOnce(const PlanOnceOptions& o) {
-  if (o.planner != "fvp" && o.planner != "rvp")
-    throw std::invalid_argument("plan: --planner: expected fvp or rvp, got '" + o.planner + "'");
+  if (!host::planner::PlannerRegistry::instance().contains(o.planner))
+    throw std::invalid_argument("plan: --planner: expected one of " +
+                                host::planner::PlannerRegistry::instance().knownNames() +
+                                ", got '" + o.planner + "'");
   if (o.views < 1) throw std::invalid_argument("plan: --views: expected at least 1");
   if (!o.out_dir.empty()) {
     host::prepareOutputDirectory(o.out_dir, "plan output directory");
@@ -56,19 +58,11 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
   if (from_captures) capture_dirs = host::listCaptures(o.captures_dir);
 
   std::unique_ptr<accel::Backend> backend;
-  if (engine == "grid" || o.backend != "auto") backend = accel::createBackend(o.backend);
-  std::unique_ptr<host::planner::ViewPlanner> planner;
-  if (o.planner == "fvp")
-    planner = std::make_unique<host::planner::FvpPlanner>(
-        o.planner_config.empty() ? host::planner::PlannerConfig{}
-                                 : host::planner::PlannerConfig::fromYamlFile(o.planner_config),
-        o.seed, backend.get());
-  else
-    planner = std::make_unique<host::planner::RvpPlanner>(
-        o.planner_config.empty() ? host::planner::RvpConfig{}
-                                 : host::planner::RvpConfig::fromYamlFile(o.planner_config),
-        o.seed);
-  const host::map::MapConfig map_config = plannerMapConfig(o.planner, engine);
+  if (host::map::mapEngineNeedsBackend(engine) || o.backend != "auto")
+    backend = accel::createBackend(o.backend);
+  const std::unique_ptr<host::planner::ViewPlanner> planner =
+      host::planner::createPlanner(o.planner, o.planner_config, o.seed, backend.get());
+  const host::map::MapConfig map_config = host::planner::plannerMapConfig(o.planner, engine);
   nlohmann::json warnings = nlohmann::json::array();
   nlohmann::json motions = nlohmann::json::array();
   const auto t_map = std::chrono::steady_clock::now();
@@ -123,7 +117,7 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
     const ArmModel arm(arm_config);
     const WorkspaceTree workspace =
         loadWorkspaceTree(arm, [&](const std::string& text) { warnings.push_back(text); });
-    SimClock clock = SimClock::fromConfig(arm_config);
+    SimClock clock(SimClock::Mode::kWall);
     const auto start = ArmController::startConfiguration(arm, world.startCameraPose());
     if (!start) throw std::runtime_error("plan: the start view is out of the arm's reach");
     ArmController controller(arm, clock, *start);

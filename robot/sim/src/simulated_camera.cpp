@@ -7,7 +7,6 @@ SimulatedCamera::SimulatedCamera(const StereoRenderer& renderer, SimClock& clock
 
 host::nbv::CaptureResult SimulatedCamera::capture(const Eigen::Isometry3d& T_world_camera) {
   RenderOptions options;
-  options.ground_truth = false;
   host::nbv::CaptureResult out;
   out.frame = renderer_.render(T_world_camera, options);
   out.status = host::nbv::CaptureStatus::kOk;

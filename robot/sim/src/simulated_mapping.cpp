@@ -20,7 +20,6 @@ SimulatedMapping mapSimulatedViews(const World& world, const std::vector<Eigen::
     view.T_world_camera = pose;
     const auto t0 = std::chrono::steady_clock::now();
     RenderOptions render_options;
-    render_options.ground_truth = false;
     const host::StereoFrame frame = renderer.render(pose, render_options);
     view.render_s = secondsSince(t0);
     const host::ViewResult seen = session.addView(frame);

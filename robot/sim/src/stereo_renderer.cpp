@@ -1,4 +1,5 @@
 #include "fvp/robot/sim/stereo_renderer.h"
+#include "fvp/robot/sim/object_ids.h"
 
 #include <omp.h>
 
@@ -85,7 +86,7 @@ struct StereoRenderer::Impl {
   double tag_cell_m = 0.0;  ///< edge of one tag cell
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
-  std::atomic<double> last_seconds{0.0};
+  mutable std::atomic<double> last_seconds{0.0};
 
   Impl(const World& w, const RenderConfig& c) : world(w), config(c) {}
   ~Impl() {
@@ -106,21 +107,23 @@ struct StereoRenderer::Impl {
   ShadedSample radiance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
                         const Eigen::Vector3d& flash, bool with_leaves) const;
   int threadCount() const { return config.threads > 0 ? config.threads : omp_get_max_threads(); }
+  /// The pair (unless options.images is false) and, when truth is set, the exact layers.
+  host::StereoFrame render(const Eigen::Isometry3d& T_world_camera, const RenderOptions& options,
+                           GroundTruthImages* truth) const;
 };
 
 void StereoRenderer::Impl::build() {
   for (const Fruitlet& f : world.fruitlets()) {
-    primitives.push_back(detail::makeEllipsoid(f, host::kFirstFruitletId + f.index));
+    primitives.push_back(detail::makeEllipsoid(f, kFirstFruitletId + f.index));
   }
   for (std::size_t i = 0; i < world.branches().size(); ++i) {
-    primitives.push_back(
-        detail::makeCapsule(world.branches()[i], static_cast<int>(i), host::kTreeId));
+    primitives.push_back(detail::makeCapsule(world.branches()[i], static_cast<int>(i), kTreeId));
   }
   for (const Leaf& leaf : world.leaves()) {
-    primitives.push_back(detail::makeLeaf(leaf, host::kFirstLeafId + leaf.index));
+    primitives.push_back(detail::makeLeaf(leaf, kFirstLeafId + leaf.index));
   }
   if (world.hasTag()) {
-    primitives.push_back(detail::makePlate(world.tag(), host::kTagId));
+    primitives.push_back(detail::makePlate(world.tag(), kTagId));
     tag_cells = tag36h11Image(world.tag().tag_id);
     tag_cell_m = world.tag().tag_size_m / tag36h11WidthAtBorder();
   }
@@ -369,8 +372,31 @@ const RenderConfig& StereoRenderer::config() const {
 
 host::StereoFrame StereoRenderer::render(const Eigen::Isometry3d& T_world_camera,
                                          const RenderOptions& options) const {
+  if (!options.exact_disparity) return impl_->render(T_world_camera, options, nullptr);
+  return renderWithGroundTruth(T_world_camera, options).frame;
+}
+
+RenderedView StereoRenderer::renderWithGroundTruth(const Eigen::Isometry3d& T_world_camera,
+                                                   const RenderOptions& options) const {
+  RenderedView view;
+  view.frame = impl_->render(T_world_camera, options, &view.ground_truth);
+  if (options.exact_disparity) {
+    const host::StereoIntrinsics& K = view.frame.intrinsics;
+    const cv::Mat& depth = view.ground_truth.depth_m;
+    view.frame.disparity_px = cv::Mat::zeros(depth.size(), CV_32F);
+    for (int v = 0; v < depth.rows; ++v)
+      for (int u = 0; u < depth.cols; ++u)
+        if (const float z = depth.at<float>(v, u); z > 0.0f)
+          view.frame.disparity_px.at<float>(v, u) = static_cast<float>(K.fx_px * K.baseline_m / z);
+  }
+  return view;
+}
+
+host::StereoFrame StereoRenderer::Impl::render(const Eigen::Isometry3d& T_world_camera,
+                                               const RenderOptions& options,
+                                               GroundTruthImages* truth) const {
   const auto start = std::chrono::steady_clock::now();
-  const Impl& im = *impl_;
+  const Impl& im = *this;
   const host::StereoIntrinsics& in = im.config.intrinsics;
   host::StereoFrame frame;
   frame.intrinsics = in;
@@ -380,9 +406,9 @@ host::StereoFrame StereoRenderer::render(const Eigen::Isometry3d& T_world_camera
     frame.left_bgr.create(height, width, CV_8UC3);
     frame.right_bgr.create(height, width, CV_8UC3);
   }
-  if (options.ground_truth) {
-    frame.gt_depth_m = cv::Mat::zeros(height, width, CV_32F);
-    frame.gt_object_id = cv::Mat::zeros(height, width, CV_32S);
+  if (truth) {
+    truth->depth_m = cv::Mat::zeros(height, width, CV_32F);
+    truth->object_id = cv::Mat::zeros(height, width, CV_32S);
   }
   const Eigen::Matrix3d R = T_world_camera.linear();
   const std::array<Eigen::Vector3d, 2> eyes = {
@@ -447,12 +473,12 @@ host::StereoFrame StereoRenderer::render(const Eigen::Isometry3d& T_world_camera
       for (int col = 0; col < width; ++col) {
         const std::uint64_t pixel_seed =
             detail::hashCombine(view_seed, static_cast<std::uint64_t>(row) * width + col);
-        if (options.ground_truth) {
+        if (truth) {
           const Hit hit = im.trace(eyes[0], rayDir(col, row), options.with_leaves);
           if (hit.primitive >= 0) {
             // The direction has unit z in the camera frame, so t is the z-depth.
-            frame.gt_depth_m.at<float>(row, col) = static_cast<float>(hit.t);
-            frame.gt_object_id.at<std::int32_t>(row, col) = im.primitives[hit.primitive].object_id;
+            truth->depth_m.at<float>(row, col) = static_cast<float>(hit.t);
+            truth->object_id.at<std::int32_t>(row, col) = im.primitives[hit.primitive].object_id;
           }
         }
         if (!options.images) continue;
@@ -508,7 +534,7 @@ host::StereoFrame StereoRenderer::render(const Eigen::Isometry3d& T_world_camera
     }
   }
   if (error) std::rethrow_exception(error);
-  impl_->last_seconds.store(
+  last_seconds.store(
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   return frame;
 }

@@ -11,21 +11,23 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "fvp/accel/backend.h"
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/host/core/output_directory.h"
+#include "fvp/host/map/map_engine_registry.h"
 #include "fvp/host/nbv/nbv_loop.h"
+#include "fvp/host/planner/planner_registry.h"
 #include "fvp/host/planner/view_planner.h"
 #include "fvp/host/session/mapping_session.h"
-#include "fvp/robot/arm_controller.h"
 #include "fvp/robot/arm_model.h"
+#include "fvp/robot/sim/arm_controller.h"
 #include "fvp/robot/sim/simulated_arm.h"
 #include "fvp/robot/sim/simulated_camera.h"
 #include "fvp/robot/sim/simulated_loop_clock.h"
 #include "fvp/robot/sim/stereo_renderer.h"
 #include "fvp/robot/sim/world.h"
-#include "fvp/robot/sim_clock.h"
 #include "fvp/robot/workspace_tree.h"
 #include "trial_parts.h"
 
@@ -42,16 +44,18 @@ nlohmann::json vec3(const Eigen::Vector3d& v) {
 }
 
 void validate(const TrialOptions& o) {
-  if (o.planner != "fvp" && o.planner != "rvp")
-    throw std::invalid_argument("trial option 'planner': expected fvp or rvp, got '" + o.planner +
-                                "'");
+  if (!host::planner::PlannerRegistry::instance().contains(o.planner))
+    throw std::invalid_argument("trial option 'planner': expected one of " +
+                                host::planner::PlannerRegistry::instance().knownNames() +
+                                ", got '" + o.planner + "'");
   if (!(o.budget_s > 0.0) || !std::isfinite(o.budget_s))
     throw std::invalid_argument("trial option 'budget_s': expected a positive number of seconds");
   if (o.clock != "wall" && o.clock != "fixed")
     throw std::invalid_argument("trial option 'clock': expected wall or fixed, got '" + o.clock +
                                 "'");
-  if (!o.engine.empty() && o.engine != "grid" && o.engine != "octomap")
-    throw std::invalid_argument("trial option 'engine': expected grid or octomap, got '" +
+  if (!o.engine.empty() && !host::map::MapEngineRegistry::instance().contains(o.engine))
+    throw std::invalid_argument("trial option 'engine': expected one of " +
+                                host::map::MapEngineRegistry::instance().knownNames() + ", got '" +
                                 o.engine + "'");
   if (o.max_views && *o.max_views < 1)
     throw std::invalid_argument("trial option 'max_views': expected at least 1");
@@ -111,58 +115,79 @@ class TrialLog : public host::nbv::LoopObserver {
 
 }  // namespace
 
-nlohmann::json runTrial(const TrialOptions& options) {
-  validate(options);
-  if (!options.out_dir.empty()) {
-    host::prepareOutputDirectory(options.out_dir, "trial output directory");
-    host::removeStaleOutputs(options.out_dir, TrialParts::outputFiles(), {"views"});
+struct Trial::Impl {
+  explicit Impl(TrialOptions opts) : options(std::move(opts)) {
+    validate(options);
+    if (!options.out_dir.empty()) {
+      host::prepareOutputDirectory(options.out_dir, "trial output directory");
+      host::removeStaleOutputs(options.out_dir, TrialParts::outputFiles(), {"views"});
+    }
+    engine = options.engine.empty() ? defaultEngine(options.planner) : options.engine;
+
+    // Maps (and TSDF) fed view by view, the planner, and the sizing at the end. First: a
+    // missing backend or a bad planner config fails before the world and the arm are built.
+    if (host::map::mapEngineNeedsBackend(engine) || options.backend != "auto")
+      backend = accel::createBackend(options.backend);
+    parts = std::make_unique<TrialParts>(options, engine, backend.get());
+
+    // The world and the simulated camera.
+    const WorldConfig world_config = options.world_config.empty()
+                                         ? WorldConfig{}
+                                         : WorldConfig::fromYamlFile(options.world_config);
+    world = std::make_unique<World>(World::generate(world_config, options.seed));
+    RenderConfig render_config;
+    render_config.noise_seed = options.seed;
+    renderer = std::make_unique<StereoRenderer>(*world, render_config);
+
+    // The arm, its workspace tree and the simulated clock.
+    if (arm_config.workspace_cache_dir.empty()) arm_config.workspace_cache_dir = defaultCacheDir();
+    arm = std::make_unique<ArmModel>(arm_config);
+    workspace = std::make_unique<WorkspaceTree>(
+        loadWorkspaceTree(*arm, [this](const std::string& text) { warn(text); }));
+    clock = std::make_unique<SimClock>(SimClock::modeFromString(options.clock));
+    const auto start = ArmController::startConfiguration(*arm, world->startCameraPose());
+    if (!start)
+      throw std::runtime_error("world seed " + std::to_string(options.seed) +
+                               ": the start view is out of the arm's reach");
+    controller = std::make_unique<ArmController>(*arm, *clock, *start);
+    camera = std::make_unique<SimulatedCamera>(*renderer, *clock);
+    sim_arm = std::make_unique<SimulatedArm>(*controller, *workspace);
   }
-  std::vector<std::string> warnings;
-  const auto warn = [&](const std::string& text) {
+
+  void warn(const std::string& text) {
     warnings.push_back(text);
     if (options.on_warning) options.on_warning(text);
-  };
-  const auto wall_start = Clock::now();
-  const std::string engine =
-      options.engine.empty() ? defaultEngine(options.planner) : options.engine;
+  }
 
-  // Maps (and TSDF) fed view by view, the planner, and the sizing at the end. First: a
-  // missing backend or a bad planner config fails before the world and the arm are built.
+  nlohmann::json run(host::nbv::Camera& loop_camera, host::nbv::Arm& loop_arm);
+
+  TrialOptions options;
+  Clock::time_point wall_start = Clock::now();
+  std::vector<std::string> warnings;
+  std::string engine;
   std::unique_ptr<accel::Backend> backend;
-  if (engine == "grid" || options.backend != "auto")
-    backend = accel::createBackend(options.backend);
-  TrialParts parts(options, engine, backend.get());
-
-  // The world and the simulated camera.
-  const WorldConfig world_config = options.world_config.empty()
-                                       ? WorldConfig{}
-                                       : WorldConfig::fromYamlFile(options.world_config);
-  const World world = World::generate(world_config, options.seed);
-  RenderConfig render_config;
-  render_config.noise_seed = options.seed;
-  const StereoRenderer renderer(world, render_config);
-
-  // The arm, its workspace tree and the simulated clock.
+  std::unique_ptr<TrialParts> parts;
+  std::unique_ptr<World> world;
+  std::unique_ptr<StereoRenderer> renderer;
   ArmConfig arm_config;
-  arm_config.clock = options.clock;
-  if (arm_config.workspace_cache_dir.empty()) arm_config.workspace_cache_dir = defaultCacheDir();
-  const ArmModel arm(arm_config);
-  const WorkspaceTree workspace = loadWorkspaceTree(arm, warn);
-  SimClock clock = SimClock::fromConfig(arm_config);
-  const auto start = ArmController::startConfiguration(arm, world.startCameraPose());
-  if (!start)
-    throw std::runtime_error("world seed " + std::to_string(options.seed) +
-                             ": the start view is out of the arm's reach");
-  ArmController controller(arm, clock, *start);
+  std::unique_ptr<ArmModel> arm;
+  std::unique_ptr<WorkspaceTree> workspace;
+  std::unique_ptr<SimClock> clock;
+  std::unique_ptr<ArmController> controller;
+  std::unique_ptr<SimulatedCamera> camera;
+  std::unique_ptr<SimulatedArm> sim_arm;
+  bool ran = false;
+};
 
-  // The loop, driven through the simulated camera, arm and clock like a robot's.
-  SimulatedCamera camera(renderer, clock);
-  SimulatedArm sim_arm(controller, workspace);
-  SimulatedLoopClock loop_clock(clock);
+nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& loop_arm) {
+  if (ran) throw std::logic_error("Trial::run: a trial runs once (its world and clock are spent)");
+  ran = true;
+  // The loop, driven through the camera, arm and clock like a robot's.
+  SimulatedLoopClock loop_clock(*clock);
   host::nbv::StopCondition stop = host::nbv::StopCondition::budget(options.budget_s);
   if (options.max_views) stop = stop || host::nbv::StopCondition::views(*options.max_views);
-  TrialLog log(parts, camera, options, wall_start);
-  host::nbv::NbvLoop loop(parts.session(), parts.planner(), camera, sim_arm, loop_clock);
+  TrialLog log(*parts, *camera, options, wall_start);
+  host::nbv::NbvLoop loop(parts->session(), parts->planner(), loop_camera, loop_arm, loop_clock);
   const host::nbv::NbvResult run = loop.run(stop, &log);
   const host::nbv::NbvEvents& events = run.events;
   std::vector<Eigen::Vector3d> camera_path;
@@ -170,7 +195,7 @@ nlohmann::json runTrial(const TrialOptions& options) {
 
   // Size, score and write.
   const auto t_size = Clock::now();
-  nlohmann::json sizing = parts.sizeAndScore(world, options.out_dir);
+  nlohmann::json sizing = parts->sizeAndScore(*world, options.out_dir);
   const double sizing_wall_s = secondsSince(t_size);
 
   nlohmann::json result;
@@ -180,13 +205,13 @@ nlohmann::json runTrial(const TrialOptions& options) {
   result["backend"] = backend ? std::string(accel::toString(backend->kind())) : "none";
   result["views"] = run.views;
   result["stop_reason"] = run.stop_reason;
-  result["sim_time_s"] = clock.now_s();
+  result["sim_time_s"] = clock->now_s();
   result["budget_s"] = options.budget_s;
   result["wall_time_s"] = secondsSince(wall_start);
-  result["status"] = parts.map() ? "ok" : "no_tag";
-  result["config"] = {{"planner", nlohmann::json::parse(parts.planner().configJson())},
+  result["status"] = parts->map() ? "ok" : "no_tag";
+  result["config"] = {{"planner", nlohmann::json::parse(parts->planner().configJson())},
                       {"arm", nlohmann::json::parse(arm_config.toJson())},
-                      {"trial", parts.configJson()}};
+                      {"trial", parts->configJson()}};
   for (auto& [key, value] : sizing.items()) result[key] = value;
   nlohmann::json counted = {{"planning_iterations", events.planning_iterations},
                             {"iterations_without_move", events.iterations_without_move},
@@ -201,14 +226,14 @@ nlohmann::json runTrial(const TrialOptions& options) {
                             {"dropped_frames", events.dropped_frames},
                             {"motion_status", events.motion_status}};
   result["events"] = counted;
-  result["wall_breakdown_s"] = {{"rendering", camera.totalRenderSeconds()},
+  result["wall_breakdown_s"] = {{"rendering", camera->totalRenderSeconds()},
                                 {"perception", run.wall_s.perception},
                                 {"mapping", run.wall_s.mapping},
                                 {"tsdf", run.wall_s.tsdf},
                                 {"planning", run.wall_s.planning},
                                 {"motion_planning", run.wall_s.motion_planning},
                                 {"sizing", sizing_wall_s}};
-  result["clock"] = nlohmann::json::parse(clock.toJson());
+  result["clock"] = nlohmann::json::parse(clock->toJson());
   result["view_log"] = log.views();
   result["plan_log"] = log.plans();
   nlohmann::json path = nlohmann::json::array();
@@ -217,8 +242,31 @@ nlohmann::json runTrial(const TrialOptions& options) {
 
   result["warnings"] = warnings;
   if (!options.out_dir.empty())
-    parts.writeOutputs(result, world, camera_path, options.out_dir, options.on_warning);
+    parts->writeOutputs(result, *world, camera_path, options.out_dir, options.on_warning);
   return result;
+}
+
+Trial::Trial(TrialOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
+Trial::~Trial() = default;
+
+host::nbv::Camera& Trial::simulatedCamera() {
+  return *impl_->camera;
+}
+
+host::nbv::Arm& Trial::simulatedArm() {
+  return *impl_->sim_arm;
+}
+
+nlohmann::json Trial::run() {
+  return impl_->run(*impl_->camera, *impl_->sim_arm);
+}
+
+nlohmann::json Trial::run(host::nbv::Camera& camera, host::nbv::Arm& arm) {
+  return impl_->run(camera, arm);
+}
+
+nlohmann::json runTrial(const TrialOptions& options) {
+  return Trial(options).run();
 }
 
 }  // namespace fvp::robot::sim

@@ -15,8 +15,7 @@
 #include "fvp/host/eval/sizing_score.h"
 #include "fvp/host/map/map_config.h"
 #include "fvp/host/perception/ply_io.h"
-#include "fvp/host/planner/fvp_planner.h"
-#include "fvp/host/planner/rvp_planner.h"
+#include "fvp/host/planner/planner_registry.h"
 #include "fvp/host/sizing/fruitlet_sizer.h"
 #include "fvp/host/tsdf/tsdf_volume.h"
 
@@ -29,14 +28,7 @@ constexpr int kReportImageWidthPx = 360;
 }  // namespace
 
 std::string defaultEngine(const std::string& planner) {
-  return planner == "rvp" ? "octomap" : "grid";
-}
-
-host::map::MapConfig plannerMapConfig(const std::string& planner, const std::string& engine) {
-  host::map::MapConfig config;
-  if (planner == "rvp" && engine == "octomap")
-    config.fine_map_extent = host::map::FineMapExtent::kObservationBox;
-  return config;
+  return host::planner::PlannerRegistry::instance().at(planner).default_engine;
 }
 
 std::string defaultCacheDir() {
@@ -63,22 +55,11 @@ struct TrialParts::Impl {
       : options(options),
         engine(engine),
         backend(backend),
-        map_config(plannerMapConfig(options.planner, engine)),
+        map_config(host::planner::plannerMapConfig(options.planner, engine)),
         session(host::PerceptionConfig{}, engine, map_config, backend) {
     session.enableTsdf();
-    if (options.planner == "fvp") {
-      const host::planner::PlannerConfig config =
-          options.planner_config.empty()
-              ? host::planner::PlannerConfig{}
-              : host::planner::PlannerConfig::fromYamlFile(options.planner_config);
-      planner = std::make_unique<host::planner::FvpPlanner>(config, options.seed, backend);
-    } else {
-      const host::planner::RvpConfig config =
-          options.planner_config.empty()
-              ? host::planner::RvpConfig{}
-              : host::planner::RvpConfig::fromYamlFile(options.planner_config);
-      planner = std::make_unique<host::planner::RvpPlanner>(config, options.seed);
-    }
+    planner = host::planner::createPlanner(options.planner, options.planner_config, options.seed,
+                                           backend);
   }
 
   TrialOptions options;

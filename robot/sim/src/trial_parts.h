@@ -26,14 +26,9 @@ class Backend;
 
 namespace fvp::robot::sim {
 
-/// The map engine a planner runs on unless --engine says otherwise (FVP: grid, RVP: octomap,
-/// as the original did).
+/// The map engine a planner runs on unless --engine says otherwise (its registry entry's:
+/// FVP grid, RVP octomap, as the original did).
 std::string defaultEngine(const std::string& planner);
-/// The maps a planner runs on: RVP on the octomap engine gets the paper's setting, one 1 mm
-/// ROI octree over the whole observation space (fine_map_extent observation_box); every
-/// other combination the coarse + fine (Cluster Region) pair. The grid engine has no
-/// whole-space fine map, so `--engine grid` runs RVP on the pair (docs/planner.md).
-host::map::MapConfig plannerMapConfig(const std::string& planner, const std::string& engine);
 /// Where the workspace tree is cached between trials: $FVP_CACHE_DIR, else
 /// $XDG_CACHE_HOME/fvp, else ~/.cache/fvp, else a directory under the system temp dir.
 std::string defaultCacheDir();

@@ -1,4 +1,5 @@
 #include "fvp/robot/sim/world.h"
+#include "fvp/robot/sim/object_ids.h"
 
 #include "fvp/robot/sim/camera_views.h"
 
@@ -395,7 +396,7 @@ std::string World::groundTruthJson() const {
   json["fruitlets"] = nlohmann::ordered_json::array();
   for (const Fruitlet& f : fruitlets_) {
     json["fruitlets"].push_back({{"index", f.index},
-                                 {"object_id", host::kFirstFruitletId + f.index},
+                                 {"object_id", kFirstFruitletId + f.index},
                                  {"center_m", toJson(f.center_m)},
                                  {"gt_size_mm", f.gtSizeMm()},
                                  {"radius_m", f.radius_m},

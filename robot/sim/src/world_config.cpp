@@ -1,4 +1,5 @@
 #include "fvp/robot/sim/world_config.h"
+#include "fvp/robot/sim/object_ids.h"
 
 #include "fvp/host/core/yaml_config.h"
 
@@ -32,8 +33,8 @@ constexpr double kTagFamilyCodes = 587;  // tag36h11 has 587 codes: ids 0..586
 
 const std::vector<KeySpec>& keySpecs() {
   static const std::vector<KeySpec> specs = {
-      {"min_fruitlets", &WorldConfig::min_fruitlets, 1, host::kMaxFruitlets},
-      {"max_fruitlets", &WorldConfig::max_fruitlets, 1, host::kMaxFruitlets, "min_fruitlets"},
+      {"min_fruitlets", &WorldConfig::min_fruitlets, 1, kMaxFruitlets},
+      {"max_fruitlets", &WorldConfig::max_fruitlets, 1, kMaxFruitlets, "min_fruitlets"},
       {"min_radius_m", &WorldConfig::min_radius_m, 0.0005, 0.05},
       {"max_radius_m", &WorldConfig::max_radius_m, 0.0005, 0.05, "min_radius_m"},
       {"min_elongation", &WorldConfig::min_elongation, 0.5, 2.0},

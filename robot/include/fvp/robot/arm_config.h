@@ -49,9 +49,6 @@ inline constexpr int kDefaultWorkspaceDirectionBins = 3;
 inline constexpr int kDefaultWorkspaceMinCount = 1;
 inline constexpr std::int64_t kDefaultWorkspaceSeed = 1;
 inline constexpr const char* kDefaultWorkspaceCacheDir = "";
-inline constexpr const char* kDefaultClock = "wall";
-inline constexpr double kDefaultCaptureTimeS = 0.2;
-inline constexpr double kDefaultFixedStageTimeS = 0.1;
 
 struct ArmConfig {
   // Slider (joint 0, prismatic) and the UR5's mount on its carriage.
@@ -86,10 +83,6 @@ struct ArmConfig {
   int workspace_min_count = kDefaultWorkspaceMinCount;
   std::int64_t workspace_seed = kDefaultWorkspaceSeed;
   std::string workspace_cache_dir = kDefaultWorkspaceCacheDir;  ///< "": no cache
-  // Simulated clock.
-  std::string clock = kDefaultClock;  ///< "wall" or "fixed"
-  double capture_time_s = kDefaultCaptureTimeS;
-  double fixed_stage_time_s = kDefaultFixedStageTimeS;  ///< per compute stage, clock "fixed"
 
   /// Reads a YAML file; missing keys keep their defaults; unknown keys, wrong types and
   /// out-of-range values throw std::invalid_argument naming the file and the key.

@@ -116,12 +116,14 @@ class MapEngine {
   SceneState scenes_[2];
 };
 
-/// Throws std::invalid_argument unless engine is "grid" with a backend or "octomap": what
-/// createMapEngine checks, for callers that create the engine later (MappingSession).
+/// Throws std::invalid_argument unless engine is registered (map_engine_registry.h) and has
+/// a backend if it needs one: what createMapEngine checks, for callers that create the
+/// engine later (MappingSession).
 void checkMapEngineChoice(std::string_view engine, const accel::Backend* backend);
 
-/// engine: "grid" (needs a compute backend) or "octomap" (backend ignored, may be null).
-/// Throws std::invalid_argument for an unknown engine name or a bad config.
+/// An engine by its registered name: "grid" (needs a compute backend), "octomap" (backend
+/// ignored, may be null), or one a program added. Throws std::invalid_argument for an
+/// unknown engine name or a bad config.
 std::unique_ptr<MapEngine> createMapEngine(std::string_view engine, const MapConfig& config,
                                            const ClusterRegion& region, accel::Backend* backend);
 

@@ -27,8 +27,6 @@ struct PerceptionConfig {
   ClusterRegionConfig region;
   ProjectionConfig projection;
   int band_margin_px = kDefaultBandMarginPx;  ///< added around the fine rectangle
-  /// Ablation switch (docs/design.md §8): use the frame's exact gt_depth_m instead of SGBM.
-  bool use_exact_depth = false;
   void validate() const;
   /// The user-facing keys (docs/capture-format.md "Perception configuration"): the tag
   /// (family, id, size), the Cluster Region (offset from the tag and radius, or an explicit

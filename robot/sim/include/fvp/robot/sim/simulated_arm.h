@@ -4,7 +4,7 @@
 #pragma once
 
 #include "fvp/host/nbv/arm.h"
-#include "fvp/robot/arm_controller.h"
+#include "fvp/robot/sim/arm_controller.h"
 #include "fvp/robot/workspace_tree.h"
 
 namespace fvp::robot::sim {

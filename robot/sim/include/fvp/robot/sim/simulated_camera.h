@@ -3,8 +3,8 @@
 #pragma once
 
 #include "fvp/host/nbv/camera.h"
+#include "fvp/robot/sim/sim_clock.h"
 #include "fvp/robot/sim/stereo_renderer.h"
-#include "fvp/robot/sim_clock.h"
 
 namespace fvp::robot::sim {
 

@@ -3,7 +3,7 @@
 #pragma once
 
 #include "fvp/host/nbv/loop_clock.h"
-#include "fvp/robot/sim_clock.h"
+#include "fvp/robot/sim/sim_clock.h"
 
 namespace fvp::robot::sim {
 

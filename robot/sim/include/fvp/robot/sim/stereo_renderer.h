@@ -42,9 +42,23 @@ struct RenderConfig {
 };
 
 struct RenderOptions {
-  bool with_leaves = true;   ///< false: render without leaves (occlusion statistic)
-  bool ground_truth = true;  ///< fill gt_depth_m and gt_object_id
-  bool images = true;        ///< false: skip the pair (left_bgr/right_bgr stay empty)
+  bool with_leaves = true;  ///< false: render without leaves (occlusion statistic)
+  bool images = true;       ///< false: skip the pair (left_bgr/right_bgr stay empty)
+  /// The frame's disparity_px from the exact depth, as a robot's own stereo would hand it
+  /// over (the exact-depth ablation of docs/design.md section 8; SGBM does not run then).
+  bool exact_disparity = false;
+};
+
+/// The simulator's exact layers of the left image: what no real camera gives.
+struct GroundTruthImages {
+  cv::Mat depth_m;    ///< CV_32F z-depth per pixel, 0 where nothing was hit
+  cv::Mat object_id;  ///< CV_32S object id (object_ids.h) of the surface at the pixel centre
+};
+
+/// A rendered frame with its ground truth beside it.
+struct RenderedView {
+  host::StereoFrame frame;
+  GroundTruthImages ground_truth;
 };
 
 class StereoRenderer {
@@ -59,6 +73,9 @@ class StereoRenderer {
   /// Renders the pair seen from T_world_camera (the left camera's optical frame).
   host::StereoFrame render(const Eigen::Isometry3d& T_world_camera,
                            const RenderOptions& options = {}) const;
+  /// The same, with the exact depth and object ids of the left image.
+  RenderedView renderWithGroundTruth(const Eigen::Isometry3d& T_world_camera,
+                                     const RenderOptions& options = {}) const;
   /// Wall time of the last render() call, seconds.
   double lastRenderSeconds() const;
 

@@ -8,9 +8,15 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+
+namespace fvp::host::nbv {
+class Arm;
+class Camera;
+}  // namespace fvp::host::nbv
 
 namespace fvp::robot::sim {
 
@@ -50,6 +56,33 @@ struct TrialOptions {
 /// expected events (failed motions, IK failures, dropped disparities, empty clusters) are
 /// counted in the result, never thrown.
 nlohmann::json runTrial(const TrialOptions& options);
+
+/// One trial built and not yet run: the world, the simulated camera, arm and clock, the
+/// mapping session and the planner (construction checks the options, the configs and the
+/// backend, and clears out_dir). run() drives the next-best-view loop through the
+/// simulated camera and arm, or through the caller's own, which may wrap these (the Python
+/// bindings' proof that the loop takes a user's camera and arm); the loop's clock is the
+/// simulated one either way. A trial runs once.
+class Trial {
+ public:
+  explicit Trial(TrialOptions options);
+  ~Trial();
+  Trial(const Trial&) = delete;
+  Trial& operator=(const Trial&) = delete;
+
+  /// The renderer at the given pose, each capture charged to the simulated clock.
+  host::nbv::Camera& simulatedCamera();
+  /// The UR5 on its slider: workspace-tree reachability, IK + OMPL, charged moves.
+  host::nbv::Arm& simulatedArm();
+
+  /// The result.json object, as runTrial's. Throws std::logic_error when called twice.
+  nlohmann::json run();
+  nlohmann::json run(host::nbv::Camera& camera, host::nbv::Arm& arm);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 /// A short, readable summary of a result.json object: sizes against ground truth, views,
 /// simulated and wall time (what `fvp run` and scripts/demo print).

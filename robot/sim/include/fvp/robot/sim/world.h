@@ -16,13 +16,14 @@
 #include <string>
 #include <vector>
 
+#include "fvp/robot/sim/object_ids.h"
 #include "fvp/robot/sim/world_config.h"
 
 namespace fvp::robot::sim {
 
 /// An ellipsoid fruitlet with semi-axes (r, r, e*r) along the columns of R_world_fruitlet.
 struct Fruitlet {
-  int index = 0;  ///< 0-based; object id is host::kFirstFruitletId + index
+  int index = 0;  ///< 0-based; object id is kFirstFruitletId + index
   Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
   Eigen::Matrix3d R_world_fruitlet = Eigen::Matrix3d::Identity();
   double radius_m = 0.0;                          ///< r: equatorial semi-axis

@@ -1,4 +1,5 @@
-// The simulated clock (docs/design.md section 7): every iteration is charged a fixed capture time
+// The simulated clock (docs/design.md section 7), a simulator part (a robot's loop runs on
+// the wall clock): every iteration is charged a fixed capture time
 // (exposure + a GPU stereo network), the measured wall time of mapping, TSDF integration,
 // planning and motion planning, and the trajectory's duration. Mode `fixed` charges a
 // constant per compute stage instead of the measured time, for deterministic tests. Every
@@ -8,9 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "fvp/robot/arm_config.h"
-
-namespace fvp::robot {
+namespace fvp::robot::sim {
 
 enum class ClockStage { kCapture, kMapping, kTsdf, kPlanning, kMotionPlanning, kMotion };
 inline constexpr int kClockStages = 6;
@@ -25,12 +24,16 @@ struct IterationCharges {
   double total_s() const;
 };
 
+inline constexpr double kDefaultCaptureTimeS = 0.2;     ///< exposure + a GPU stereo network
+inline constexpr double kDefaultFixedStageTimeS = 0.1;  ///< per compute stage, mode fixed
+
 class SimClock {
  public:
   enum class Mode { kWall, kFixed };
-  SimClock(Mode mode, double capture_time_s, double fixed_stage_time_s);
-  /// From ArmConfig's clock, capture_time_s and fixed_stage_time_s keys.
-  static SimClock fromConfig(const ArmConfig& config);
+  SimClock(Mode mode, double capture_time_s = kDefaultCaptureTimeS,
+           double fixed_stage_time_s = kDefaultFixedStageTimeS);
+  /// "wall" or "fixed" (fvp run --clock); throws std::invalid_argument otherwise.
+  static Mode modeFromString(const std::string& mode);
 
   /// Opens the next iteration's record (charges before the first call open one).
   void beginIteration();
@@ -56,4 +59,4 @@ class SimClock {
   std::vector<IterationCharges> iterations_;
 };
 
-}  // namespace fvp::robot
+}  // namespace fvp::robot::sim

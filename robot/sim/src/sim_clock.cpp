@@ -1,9 +1,9 @@
-#include "fvp/robot/sim_clock.h"
+#include "fvp/robot/sim/sim_clock.h"
 
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
-namespace fvp::robot {
+namespace fvp::robot::sim {
 
 const char* toString(ClockStage stage) {
   switch (stage) {
@@ -35,10 +35,10 @@ SimClock::SimClock(Mode mode, double capture_time_s, double fixed_stage_time_s)
     throw std::invalid_argument("SimClock: capture and fixed stage times must be >= 0");
 }
 
-SimClock SimClock::fromConfig(const ArmConfig& config) {
-  config.validate();
-  return SimClock(config.clock == "fixed" ? Mode::kFixed : Mode::kWall, config.capture_time_s,
-                  config.fixed_stage_time_s);
+SimClock::Mode SimClock::modeFromString(const std::string& mode) {
+  if (mode == "wall") return Mode::kWall;
+  if (mode == "fixed") return Mode::kFixed;
+  throw std::invalid_argument("simulated clock: expected mode wall or fixed, got '" + mode + "'");
 }
 
 void SimClock::beginIteration() {
@@ -100,4 +100,4 @@ std::string SimClock::toJson() const {
   return json.dump();
 }
 
-}  // namespace fvp::robot
+}  // namespace fvp::robot::sim

@@ -1,9 +1,9 @@
-#include "fvp/robot/world_occupancy.h"
+#include "fvp/robot/sim/world_occupancy.h"
 
 #include <cmath>
 #include <numbers>
 
-namespace fvp::robot {
+namespace fvp::robot::sim {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -30,7 +30,7 @@ int stepsFor(double length_m, double step_m) {
   return std::max(1, static_cast<int>(std::ceil(length_m / step_m)));
 }
 
-void markCylinder(Marker& m, const sim::BranchSegment& b) {
+void markCylinder(Marker& m, const BranchSegment& b) {
   const Eigen::Vector3d axis = b.end_m - b.start_m;
   const double length = axis.norm();
   const Eigen::Vector3d dir = axis / length;
@@ -49,7 +49,7 @@ void markCylinder(Marker& m, const sim::BranchSegment& b) {
   }
 }
 
-void markLeaf(Marker& m, const sim::Leaf& leaf) {
+void markLeaf(Marker& m, const Leaf& leaf) {
   const int nx = stepsFor(2.0 * leaf.half_length_m, m.step());
   const int ny = stepsFor(2.0 * leaf.half_width_m, m.step());
   for (int i = 0; i <= nx; ++i) {
@@ -64,7 +64,7 @@ void markLeaf(Marker& m, const sim::Leaf& leaf) {
   }
 }
 
-void markEllipsoid(Marker& m, const sim::Fruitlet& f) {
+void markEllipsoid(Marker& m, const Fruitlet& f) {
   const Eigen::Vector3d axes = f.semiAxes_m();
   const int n = stepsFor(kPi * axes.maxCoeff(), m.step());
   for (int i = 0; i <= n; ++i) {
@@ -78,7 +78,7 @@ void markEllipsoid(Marker& m, const sim::Fruitlet& f) {
   }
 }
 
-void markPlate(Marker& m, const sim::AprilTagPlacement& tag) {
+void markPlate(Marker& m, const AprilTagPlacement& tag) {
   const double half = 0.5 * tag.plate_size_m;
   const int n = stepsFor(tag.plate_size_m, m.step());
   for (int i = 0; i <= n; ++i) {
@@ -91,17 +91,17 @@ void markPlate(Marker& m, const sim::AprilTagPlacement& tag) {
 
 }  // namespace
 
-std::unique_ptr<octomap::OcTree> worldOccupancy(const sim::World& world, double resolution_m,
+std::unique_ptr<octomap::OcTree> worldOccupancy(const World& world, double resolution_m,
                                                 const Eigen::AlignedBox3d& bounds) {
   auto tree = std::make_unique<octomap::OcTree>(resolution_m);
   // A third of a voxel between samples, so hardly any voxel a surface crosses is missed.
   Marker marker(*tree, bounds, resolution_m / 3.0);
-  for (const sim::BranchSegment& b : world.branches()) markCylinder(marker, b);
-  for (const sim::Leaf& leaf : world.leaves()) markLeaf(marker, leaf);
-  for (const sim::Fruitlet& f : world.fruitlets()) markEllipsoid(marker, f);
+  for (const BranchSegment& b : world.branches()) markCylinder(marker, b);
+  for (const Leaf& leaf : world.leaves()) markLeaf(marker, leaf);
+  for (const Fruitlet& f : world.fruitlets()) markEllipsoid(marker, f);
   if (world.hasTag()) markPlate(marker, world.tag());
   tree->updateInnerOccupancy();
   return tree;
 }
 
-}  // namespace fvp::robot
+}  // namespace fvp::robot::sim

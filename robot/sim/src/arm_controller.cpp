@@ -1,6 +1,6 @@
-#include "fvp/robot/arm_controller.h"
+#include "fvp/robot/sim/arm_controller.h"
 
-namespace fvp::robot {
+namespace fvp::robot::sim {
 
 ArmController::ArmController(const ArmModel& arm, SimClock& clock, const JointVector& start)
     : arm_(arm), clock_(clock), checker_(arm), planner_(checker_), joints_(start) {}
@@ -23,4 +23,4 @@ MotionPlan ArmController::moveToPose(const Eigen::Isometry3d& T_world_camera) {
   return plan;
 }
 
-}  // namespace fvp::robot
+}  // namespace fvp::robot::sim

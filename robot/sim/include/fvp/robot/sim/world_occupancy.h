@@ -11,10 +11,10 @@
 
 #include "fvp/robot/sim/world.h"
 
-namespace fvp::robot {
+namespace fvp::robot::sim {
 
 /// Occupied voxels of `world` at `resolution_m`, limited to `bounds` (world frame).
-std::unique_ptr<octomap::OcTree> worldOccupancy(const sim::World& world, double resolution_m,
+std::unique_ptr<octomap::OcTree> worldOccupancy(const World& world, double resolution_m,
                                                 const Eigen::AlignedBox3d& bounds);
 
-}  // namespace fvp::robot
+}  // namespace fvp::robot::sim

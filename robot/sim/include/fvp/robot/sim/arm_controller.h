@@ -8,9 +8,9 @@
 
 #include "fvp/robot/arm_collision_checker.h"
 #include "fvp/robot/motion_planner.h"
-#include "fvp/robot/sim_clock.h"
+#include "fvp/robot/sim/sim_clock.h"
 
-namespace fvp::robot {
+namespace fvp::robot::sim {
 
 class ArmController {
  public:
@@ -43,4 +43,4 @@ class ArmController {
   JointVector joints_;
 };
 
-}  // namespace fvp::robot
+}  // namespace fvp::robot::sim

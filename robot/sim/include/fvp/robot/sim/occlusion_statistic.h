@@ -6,7 +6,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-namespace fvp::host {
+namespace fvp::robot::sim {
 
 struct FruitletVisibility {
   int object_id = 0;
@@ -33,4 +33,4 @@ class OcclusionStatistic {
   int in_view_ = 0;
 };
 
-}  // namespace fvp::host
+}  // namespace fvp::robot::sim

@@ -1,12 +1,12 @@
-#include "fvp/host/perception/occlusion_statistic.h"
+#include "fvp/robot/sim/occlusion_statistic.h"
 
 #include <algorithm>
 #include <map>
 #include <stdexcept>
 
-#include "fvp/host/perception/stereo_frame.h"
+#include "fvp/robot/sim/object_ids.h"
 
-namespace fvp::host {
+namespace fvp::robot::sim {
 
 OcclusionStatistic OcclusionStatistic::compute(const cv::Mat& with_leaves,
                                                const cv::Mat& without_leaves) {
@@ -42,4 +42,4 @@ OcclusionStatistic OcclusionStatistic::compute(const cv::Mat& with_leaves,
   return out;
 }
 
-}  // namespace fvp::host
+}  // namespace fvp::robot::sim

@@ -1,0 +1,104 @@
+// fvp.sim: the simulator's trials. A Trial exposes its simulated camera and arm, so that a
+// Python camera and arm can wrap them and drive the same loop (tests/test_trial_loop.py).
+#include <pybind11/functional.h>
+#include <pybind11/stl.h>
+
+#include "bindings.h"
+#include "conversions.h"
+#include "fvp/host/nbv/arm.h"
+#include "fvp/host/nbv/camera.h"
+#include "fvp/robot/sim/trial.h"
+
+namespace fvp::python {
+namespace {
+
+robot::sim::TrialOptions trialOptions(const std::string& planner, std::uint64_t seed,
+                                      double budget_s, const std::optional<int>& max_views,
+                                      const std::string& clock, const std::string& backend,
+                                      const std::string& engine, const std::string& world_config,
+                                      const std::string& planner_config,
+                                      const std::string& out_dir) {
+  robot::sim::TrialOptions o;
+  o.planner = planner;
+  o.seed = seed;
+  o.budget_s = budget_s;
+  o.max_views = max_views;
+  o.clock = clock;
+  o.backend = backend;
+  o.engine = engine;
+  o.world_config = world_config;
+  o.planner_config = planner_config;
+  o.out_dir = out_dir;
+  // Warnings stay in result["warnings"]; Python callers read them there.
+  return o;
+}
+
+// The keyword arguments of fvp run, in one place for Trial and run_trial.
+#define FVP_TRIAL_ARGS                                                                         \
+  py::kw_only(), py::arg("planner") = "fvp", py::arg("seed") = 1, py::arg("budget_s") = 180.0, \
+                 py::arg("max_views") = py::none(), py::arg("clock") = "wall",                 \
+                 py::arg("backend") = "auto", py::arg("engine") = "",                          \
+                 py::arg("world_config") = "", py::arg("planner_config") = "",                 \
+                 py::arg("out_dir") = ""
+
+}  // namespace
+
+void bindSim(py::module_& m) {
+  py::module_ sim = m.def_submodule("sim", "The simulated orchard and its trials (fvp run).");
+
+  py::class_<robot::sim::Trial>(sim, "Trial",
+                                "One simulated trial, built and not yet run (fvp run's options "
+                                "as keywords). Its camera and arm are the simulator's.")
+      .def(py::init([](const std::string& planner, std::uint64_t seed, double budget_s,
+                       std::optional<int> max_views, const std::string& clock,
+                       const std::string& backend, const std::string& engine,
+                       const std::string& world_config, const std::string& planner_config,
+                       const std::string& out_dir) {
+             return std::make_unique<robot::sim::Trial>(
+                 trialOptions(planner, seed, budget_s, max_views, clock, backend, engine,
+                              world_config, planner_config, out_dir));
+           }),
+           FVP_TRIAL_ARGS)
+      .def_property_readonly(
+          "camera", [](robot::sim::Trial& t) -> host::nbv::Camera& { return t.simulatedCamera(); },
+          py::return_value_policy::reference_internal,
+          "The simulated camera (fvp.Camera): renders at a pose, charged to the simulated clock.")
+      .def_property_readonly(
+          "arm", [](robot::sim::Trial& t) -> host::nbv::Arm& { return t.simulatedArm(); },
+          py::return_value_policy::reference_internal,
+          "The simulated UR5 on its slider (fvp.Arm): IK + OMPL, charged moves.")
+      .def(
+          "run",
+          [](robot::sim::Trial& t, host::nbv::Camera* camera, host::nbv::Arm* arm) {
+            nlohmann::json result;
+            {
+              py::gil_scoped_release release;
+              result = t.run(camera ? *camera : t.simulatedCamera(), arm ? *arm : t.simulatedArm());
+            }
+            return jsonToPython(result);
+          },
+          py::arg("camera") = nullptr, py::arg("arm") = nullptr,
+          "Runs the loop through camera and arm (default: the simulator's), scores against the "
+          "world and returns result.json's object. A trial runs once.");
+
+  sim.def(
+      "run_trial",
+      [](const std::string& planner, std::uint64_t seed, double budget_s,
+         std::optional<int> max_views, const std::string& clock, const std::string& backend,
+         const std::string& engine, const std::string& world_config,
+         const std::string& planner_config, const std::string& out_dir) {
+        const robot::sim::TrialOptions o =
+            trialOptions(planner, seed, budget_s, max_views, clock, backend, engine, world_config,
+                         planner_config, out_dir);
+        nlohmann::json result;
+        {
+          py::gil_scoped_release release;
+          result = robot::sim::runTrial(o);
+        }
+        return jsonToPython(result);
+      },
+      FVP_TRIAL_ARGS, "fvp run as a function: result.json's object.");
+  m.attr("run_trial") = sim.attr("run_trial");
+}
+
+}  // namespace fvp::python

@@ -1,0 +1,41 @@
+// The parts of the fvp Python module, each binding one area into the module.
+#pragma once
+
+#include <pybind11/pybind11.h>
+
+#include <memory>
+#include <string>
+
+#include "fvp/accel/backend.h"
+#include "fvp/host/planner/view_planner.h"
+#include "fvp/host/session/mapping_session.h"
+
+namespace fvp::python {
+
+namespace py = pybind11;
+
+/// A backend by name ("cpu", "opencl", "vulkan", "auto"); "none" (or an engine that needs
+/// none with "auto") gives null. An unavailable backend asked for by name is an error.
+std::unique_ptr<accel::Backend> backendFor(const std::string& name, const std::string& engine);
+
+/// fvp.MappingSession: the session with the backend it runs on.
+struct Session {
+  Session(const host::PerceptionConfig& perception, const std::string& engine,
+          const std::string& backend_name, const std::string& planner, bool tsdf);
+  std::unique_ptr<accel::Backend> backend;
+  std::string engine;
+  std::unique_ptr<host::MappingSession> session;
+};
+
+/// fvp.Planner: a registered planner with the backend its kernels run on.
+struct Planner {
+  Planner(const std::string& name, const std::string& config_yaml, std::uint64_t seed,
+          const std::string& backend_name);
+  std::unique_ptr<accel::Backend> backend;
+  std::unique_ptr<host::planner::ViewPlanner> planner;
+};
+
+void bindNbv(py::module_& m);  ///< Camera, Arm, StopCondition, run_nbv
+void bindSim(py::module_& m);  ///< fvp.sim: Trial, run_trial
+
+}  // namespace fvp::python
