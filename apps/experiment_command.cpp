@@ -10,13 +10,13 @@
 #include "cli_checks.h"
 #include "commands.h"
 #include "fvp/host/map/map_engine_registry.h"
-#include "fvp/robot/sim/experiment.h"
+#include "fvp/trials/experiment.h"
 
 namespace fvp::apps {
 
 void addExperimentCommands(CLI::App& app) {
   struct Options {
-    robot::sim::ExperimentOptions experiment;
+    trials::ExperimentOptions experiment;
     std::string planners = "fvp,rvp", shard, world, config, out;
     int max_views = 0;
   };
@@ -55,7 +55,7 @@ void addExperimentCommands(CLI::App& app) {
   cmd->add_flag("--resume", opt->experiment.resume, "skip trials already in trials.jsonl");
   cmd->add_option("--out", opt->out, "output directory")->required();
   cmd->callback([opt] {
-    robot::sim::ExperimentOptions o = opt->experiment;
+    trials::ExperimentOptions o = opt->experiment;
     // Every comma-separated name, empty ones too: the runner rejects empty, unknown and
     // repeated planners with a message.
     o.planners.clear();
@@ -67,7 +67,7 @@ void addExperimentCommands(CLI::App& app) {
     }
     if (opt->planners.empty()) o.planners.clear();
     if (!opt->shard.empty())
-      std::tie(o.shard_index, o.shard_count) = robot::sim::parseShard(opt->shard);
+      std::tie(o.shard_index, o.shard_count) = trials::parseShard(opt->shard);
     o.trial.world_config = opt->world;
     o.trial.planner_config = opt->config;
     if (opt->max_views > 0) o.trial.max_views = opt->max_views;
@@ -80,7 +80,7 @@ void addExperimentCommands(CLI::App& app) {
     const auto warning = [tty](const std::string& line) {
       std::cerr << (tty ? "\r\033[K" : "") << "fvp: warning: " << line << "\n" << std::flush;
     };
-    robot::sim::runExperiment(o, robot::sim::runTrial, progress, warning);
+    trials::runExperiment(o, trials::runTrial, progress, warning);
     if (tty) std::cerr << "\n";
     std::cout << "wrote " << opt->out << "/{manifest.json, trials.jsonl, summary.json, table1.md"
               << (std::filesystem::exists(o.out_dir / "sizes.png") ? ", sizes.png" : "") << "}\n";
@@ -93,7 +93,7 @@ void addExperimentCommands(CLI::App& app) {
   merge->add_option("--out", *merge_out, "merged output directory")->required();
   merge->callback([merge_out, shards] {
     std::vector<std::filesystem::path> dirs(shards->begin(), shards->end());
-    robot::sim::mergeExperiments(dirs, *merge_out, [](const std::string& line) {
+    trials::mergeExperiments(dirs, *merge_out, [](const std::string& line) {
       std::cerr << "fvp: warning: " << line << "\n";
     });
     std::cout << "merged " << dirs.size() << " shards into " << *merge_out << "\n";

@@ -7,12 +7,12 @@
 #include "commands.h"
 #include "fvp/host/map/map_engine_registry.h"
 #include "fvp/host/planner/planner_registry.h"
-#include "fvp/robot/sim/plan_once.h"
+#include "fvp/trials/plan_once.h"
 
 namespace fvp::apps {
 
 void addPlanCommand(CLI::App& app) {
-  auto opt = std::make_shared<robot::sim::PlanOnceOptions>();
+  auto opt = std::make_shared<trials::PlanOnceOptions>();
   auto world = std::make_shared<std::string>(), config = std::make_shared<std::string>(),
        out = std::make_shared<std::string>();
   auto* cmd = app.add_subcommand(
@@ -44,13 +44,13 @@ void addPlanCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", *out, "output directory")->required();
   cmd->callback([opt, world, config, out, captures, perception] {
-    robot::sim::PlanOnceOptions o = *opt;
+    trials::PlanOnceOptions o = *opt;
     o.captures_dir = *captures;
     o.perception_config = *perception;
     o.world_config = *world;
     o.planner_config = *config;
     o.out_dir = *out;
-    const nlohmann::json plan = robot::sim::planOnce(o);
+    const nlohmann::json plan = trials::planOnce(o);
     for (const auto& w : plan["warnings"])
       std::cerr << "fvp: warning: " << w.get<std::string>() << "\n";
     std::size_t reachable = 0;

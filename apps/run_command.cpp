@@ -10,13 +10,13 @@
 #include "commands.h"
 #include "fvp/host/map/map_engine_registry.h"
 #include "fvp/host/planner/planner_registry.h"
-#include "fvp/robot/sim/trial.h"
+#include "fvp/trials/trial.h"
 
 namespace fvp::apps {
 
 void addRunCommand(CLI::App& app) {
   struct Options {
-    robot::sim::TrialOptions trial;
+    trials::TrialOptions trial;
     std::string world, config, out;
     int max_views = 0;
   };
@@ -51,13 +51,13 @@ void addRunCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--out", opt->out, "output directory")->required();
   cmd->callback([opt] {
-    robot::sim::TrialOptions trial = opt->trial;
+    trials::TrialOptions trial = opt->trial;
     trial.world_config = opt->world;
     trial.planner_config = opt->config;
     trial.out_dir = opt->out;
     if (opt->max_views > 0) trial.max_views = opt->max_views;
     const bool tty = isatty(STDERR_FILENO);
-    trial.on_progress = [tty](const robot::sim::TrialProgress& p) {
+    trial.on_progress = [tty](const trials::TrialProgress& p) {
       std::cerr << (tty ? "\r" : "") << "view " << p.views << "  sim " << std::fixed
                 << std::setprecision(1) << p.sim_time_s << " / " << p.budget_s << " s  wall "
                 << p.wall_time_s << " s" << (tty ? "   " : "\n") << std::flush;
@@ -65,9 +65,9 @@ void addRunCommand(CLI::App& app) {
     trial.on_warning = [tty](const std::string& text) {
       std::cerr << (tty ? "\n" : "") << "fvp: warning: " << text << "\n";
     };
-    const nlohmann::json result = robot::sim::runTrial(trial);
+    const nlohmann::json result = trials::runTrial(trial);
     if (tty) std::cerr << "\n";
-    std::cout << robot::sim::trialSummary(result)
+    std::cout << trials::trialSummary(result)
               << "report: " << (std::filesystem::path(opt->out) / "report.md").string() << "\n";
   });
 }

@@ -37,6 +37,7 @@ install(TARGETS ${FVP_EXPORTED_LIBRARIES} fvp
 install(
   DIRECTORY ${PROJECT_SOURCE_DIR}/accel/include/ ${PROJECT_SOURCE_DIR}/host/include/
             ${PROJECT_SOURCE_DIR}/robot/include/ ${PROJECT_SOURCE_DIR}/robot/sim/include/
+            ${PROJECT_SOURCE_DIR}/trials/include/
   DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/kernels/
   DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/fvp/kernels

@@ -1,15 +1,15 @@
-// The readers of an experiment directory (robot/sim/src/experiment_directory.cpp) on a file
+// The readers of an experiment directory (trials/src/experiment_directory.cpp) on a file
 // holding the input: readTrials (trials.jsonl) and readManifest (manifest.json). Every trial
 // readTrials accepts must pass checkTrial (the fields the reports read), and a manifest
 // readManifest accepts must write back (toJson) and read again to the same JSON.
 #include <nlohmann/json.hpp>
 
 #include "fuzz_support.h"
-#include "fvp/robot/sim/experiment_directory.h"
+#include "fvp/trials/experiment_directory.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   namespace fz = fvp::fuzz;
-  namespace sim = fvp::robot::sim;
+  namespace sim = fvp::trials;
   const std::filesystem::path path = fz::scratchDir() / "trials.jsonl";
   fz::writeFile(path, data, size);
   try {

@@ -7,18 +7,17 @@
 #include "conversions.h"
 #include "fvp/host/nbv/arm.h"
 #include "fvp/host/nbv/camera.h"
-#include "fvp/robot/sim/trial.h"
+#include "fvp/trials/trial.h"
 
 namespace fvp::python {
 namespace {
 
-robot::sim::TrialOptions trialOptions(const std::string& planner, std::uint64_t seed,
-                                      double budget_s, const std::optional<int>& max_views,
-                                      const std::string& clock, const std::string& backend,
-                                      const std::string& engine, const std::string& world_config,
-                                      const std::string& planner_config,
-                                      const std::string& out_dir) {
-  robot::sim::TrialOptions o;
+trials::TrialOptions trialOptions(const std::string& planner, std::uint64_t seed, double budget_s,
+                                  const std::optional<int>& max_views, const std::string& clock,
+                                  const std::string& backend, const std::string& engine,
+                                  const std::string& world_config,
+                                  const std::string& planner_config, const std::string& out_dir) {
+  trials::TrialOptions o;
   o.planner = planner;
   o.seed = seed;
   o.budget_s = budget_s;
@@ -46,30 +45,30 @@ robot::sim::TrialOptions trialOptions(const std::string& planner, std::uint64_t 
 void bindSim(py::module_& m) {
   py::module_ sim = m.def_submodule("sim", "The simulated orchard and its trials (fvp run).");
 
-  py::class_<robot::sim::Trial>(sim, "Trial",
-                                "One simulated trial, built and not yet run (fvp run's options "
-                                "as keywords). Its camera and arm are the simulator's.")
+  py::class_<trials::Trial>(sim, "Trial",
+                            "One simulated trial, built and not yet run (fvp run's options "
+                            "as keywords). Its camera and arm are the simulator's.")
       .def(py::init([](const std::string& planner, std::uint64_t seed, double budget_s,
                        std::optional<int> max_views, const std::string& clock,
                        const std::string& backend, const std::string& engine,
                        const std::string& world_config, const std::string& planner_config,
                        const std::string& out_dir) {
-             return std::make_unique<robot::sim::Trial>(
+             return std::make_unique<trials::Trial>(
                  trialOptions(planner, seed, budget_s, max_views, clock, backend, engine,
                               world_config, planner_config, out_dir));
            }),
            FVP_TRIAL_ARGS)
       .def_property_readonly(
-          "camera", [](robot::sim::Trial& t) -> host::nbv::Camera& { return t.simulatedCamera(); },
+          "camera", [](trials::Trial& t) -> host::nbv::Camera& { return t.simulatedCamera(); },
           py::return_value_policy::reference_internal,
           "The simulated camera (fvp.Camera): renders at a pose, charged to the simulated clock.")
       .def_property_readonly(
-          "arm", [](robot::sim::Trial& t) -> host::nbv::Arm& { return t.simulatedArm(); },
+          "arm", [](trials::Trial& t) -> host::nbv::Arm& { return t.simulatedArm(); },
           py::return_value_policy::reference_internal,
           "The simulated UR5 on its slider (fvp.Arm): IK + OMPL, charged moves.")
       .def(
           "run",
-          [](robot::sim::Trial& t, host::nbv::Camera* camera, host::nbv::Arm* arm) {
+          [](trials::Trial& t, host::nbv::Camera* camera, host::nbv::Arm* arm) {
             nlohmann::json result;
             {
               py::gil_scoped_release release;
@@ -87,13 +86,13 @@ void bindSim(py::module_& m) {
          std::optional<int> max_views, const std::string& clock, const std::string& backend,
          const std::string& engine, const std::string& world_config,
          const std::string& planner_config, const std::string& out_dir) {
-        const robot::sim::TrialOptions o =
+        const trials::TrialOptions o =
             trialOptions(planner, seed, budget_s, max_views, clock, backend, engine, world_config,
                          planner_config, out_dir);
         nlohmann::json result;
         {
           py::gil_scoped_release release;
-          result = robot::sim::runTrial(o);
+          result = trials::runTrial(o);
         }
         return jsonToPython(result);
       },

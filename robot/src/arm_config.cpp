@@ -58,6 +58,18 @@ const std::vector<KeySpec>& keySpecs() {
   return specs;
 }
 
+/// The file's keys: each spec's member read as its type.
+const std::vector<host::YamlKey<ArmConfig>>& yamlKeys() {
+  static const std::vector<host::YamlKey<ArmConfig>> keys = [] {
+    std::vector<host::YamlKey<ArmConfig>> out;
+    for (const KeySpec& spec : keySpecs())
+      std::visit([&](auto member) { out.push_back(host::yamlField(spec.name, member)); },
+                 spec.member);
+    return out;
+  }();
+  return keys;
+}
+
 void checkRange(const std::string& source, const KeySpec& spec, double value) {
   // `!(a <= b)` also rejects NaN.
   if (!(value >= spec.lo) || !(value <= spec.hi)) {
@@ -109,35 +121,8 @@ void ArmConfig::validate(const std::string& source) const {
 
 ArmConfig ArmConfig::fromYamlFile(const std::filesystem::path& path) {
   const std::string source = "arm config '" + path.string() + "'";
-  const YAML::Node root = host::readYamlMapping(path, source);
   ArmConfig config;
-  if (root.IsNull()) {
-    config.validate(source);
-    return config;
-  }
-  for (const auto& entry : root) {
-    const std::string key = host::keyString(entry.first, source);
-    const KeySpec* spec = &host::findKeySpec(keySpecs(), key, source);
-    const YAML::Node& value = entry.second;
-    const std::string where = source + ": key '" + key + "'";
-    std::visit(
-        [&](auto field) {
-          using T = std::decay_t<decltype(config.*field)>;
-          if constexpr (std::is_same_v<T, Eigen::Vector3d>) {
-            if (!value.IsSequence() || value.size() != 3)
-              throw std::invalid_argument(where + ": expected a list of 3 numbers");
-            for (int i = 0; i < 3; ++i)
-              (config.*field)[i] = host::readScalar<double>(value[i], where, "a list of 3 numbers");
-          } else {
-            const char* expected = std::is_same_v<T, std::string> ? "a string"
-                                   : std::is_floating_point_v<T>  ? "a number"
-                                   : std::is_same_v<T, bool>      ? "true or false"
-                                                                  : "an integer";
-            config.*field = host::readScalar<T>(value, where, expected);
-          }
-        },
-        spec->member);
-  }
+  host::readYamlConfig(path, source, yamlKeys(), config);
   config.validate(source);
   return config;
 }

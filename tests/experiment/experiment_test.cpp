@@ -10,9 +10,9 @@
 #include <optional>
 #include <sstream>
 
-#include "fvp/robot/sim/experiment.h"
+#include "fvp/trials/experiment.h"
 
-namespace fvp::robot::sim {
+namespace fvp::trials {
 namespace {
 
 namespace fs = std::filesystem;
@@ -588,4 +588,4 @@ TEST(Experiment, AnOutputPathThatIsARegularFileIsAnErrorBeforeAnyTrial) {
 }
 
 }  // namespace
-}  // namespace fvp::robot::sim
+}  // namespace fvp::trials

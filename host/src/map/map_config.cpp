@@ -1,8 +1,6 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
-#include <functional>
-#include <map>
 #include <stdexcept>
 #include <string>
 
@@ -20,6 +18,34 @@ void requireRange(double value, double lo, double hi, const std::string& field, 
                                 (open ? "(" : "[") + formatNumber(lo) + ", " + formatNumber(hi) +
                                 (open ? ")" : "]"));
   }
+}
+
+using C = MapConfig;
+
+const std::vector<YamlKey<C>>& yamlKeys() {
+  static const std::vector<YamlKey<C>> keys = {
+      yamlField("coarse_voxel_size_m", &C::coarse_voxel_size_m),
+      yamlField("fine_voxel_size_m", &C::fine_voxel_size_m),
+      yamlField("observation_min_m", &C::observation_min_m),
+      yamlField("observation_max_m", &C::observation_max_m),
+      {"fine_map_extent",
+       [](C& c, const YAML::Node& n, const std::string& where) {
+         c.fine_map_extent =
+             parseFineMapExtent(readScalar<std::string>(n, where, "a string"), where);
+       }},
+      yamlField("sensor_max_range_m", &C::sensor_max_range_m),
+      yamlField<C>(
+          "prob_hit", [](C & c) -> auto& { return c.model.prob_hit; }),
+      yamlField<C>(
+          "prob_miss", [](C & c) -> auto& { return c.model.prob_miss; }),
+      yamlField<C>(
+          "clamp_min", [](C & c) -> auto& { return c.model.clamp_min; }),
+      yamlField<C>(
+          "clamp_max", [](C & c) -> auto& { return c.model.clamp_max; }),
+      yamlField<C>(
+          "occupied_prob", [](C & c) -> auto& { return c.model.occupied_prob; }),
+  };
+  return keys;
 }
 
 }  // namespace
@@ -68,44 +94,8 @@ void MapConfig::validate(const std::string& source) const {
 
 MapConfig MapConfig::fromYamlFile(const std::filesystem::path& path) {
   const std::string source = "map config '" + path.string() + "'";
-  const YAML::Node root = readYamlMapping(path, source);
   MapConfig config;
-  if (root.IsNull()) return config;
-  auto number = [&](const YAML::Node& node, const std::string& key) {
-    return readScalar<double>(node, source + ": key '" + key + "'", "a number");
-  };
-  auto vector3 = [&](const YAML::Node& node, const std::string& key) {
-    if (!node.IsSequence() || node.size() != 3)
-      throw std::invalid_argument(source + ": " + key + ": expected a list of 3 numbers [x, y, z]");
-    return Eigen::Vector3d(number(node[0], key), number(node[1], key), number(node[2], key));
-  };
-  const std::map<std::string, std::function<void(const YAML::Node&, const std::string&)>> keys = {
-      {"coarse_voxel_size_m", [&](auto& n, auto& k) { config.coarse_voxel_size_m = number(n, k); }},
-      {"fine_voxel_size_m", [&](auto& n, auto& k) { config.fine_voxel_size_m = number(n, k); }},
-      {"observation_min_m", [&](auto& n, auto& k) { config.observation_min_m = vector3(n, k); }},
-      {"observation_max_m", [&](auto& n, auto& k) { config.observation_max_m = vector3(n, k); }},
-      {"fine_map_extent",
-       [&](auto& n, auto& k) {
-         config.fine_map_extent = parseFineMapExtent(
-             n.IsScalar() ? n.template as<std::string>() : "", source + ": " + k);
-       }},
-      {"sensor_max_range_m", [&](auto& n, auto& k) { config.sensor_max_range_m = number(n, k); }},
-      {"prob_hit", [&](auto& n, auto& k) { config.model.prob_hit = number(n, k); }},
-      {"prob_miss", [&](auto& n, auto& k) { config.model.prob_miss = number(n, k); }},
-      {"clamp_min", [&](auto& n, auto& k) { config.model.clamp_min = number(n, k); }},
-      {"clamp_max", [&](auto& n, auto& k) { config.model.clamp_max = number(n, k); }},
-      {"occupied_prob", [&](auto& n, auto& k) { config.model.occupied_prob = number(n, k); }},
-  };
-  for (const auto& entry : root) {
-    const std::string key = keyString(entry.first, source);
-    const auto it = keys.find(key);
-    if (it == keys.end()) {
-      std::string known;
-      for (const auto& [name, _] : keys) known += (known.empty() ? "" : ", ") + name;
-      throw std::invalid_argument(source + ": unknown key '" + key + "' (known: " + known + ")");
-    }
-    it->second(entry.second, key);
-  }
+  readYamlConfig(path, source, yamlKeys(), config);
   config.validate(source);
   return config;
 }

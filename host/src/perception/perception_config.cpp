@@ -1,5 +1,4 @@
 // PerceptionConfig::fromYamlFile: the keys a user sets for their own orchard and tags.
-#include <functional>
 #include <string>
 #include <vector>
 
@@ -9,18 +8,7 @@
 namespace fvp::host {
 namespace {
 
-struct KeySpec {
-  const char* name;
-  std::function<void(PerceptionConfig&, const YAML::Node&, const std::string&)> read;
-};
-
-Eigen::Vector3d vector3(const YAML::Node& node, const std::string& where) {
-  if (!node.IsSequence() || node.size() != 3)
-    throw std::invalid_argument(where + ": expected a list of 3 numbers [x, y, z] in metres");
-  return {readScalar<double>(node[0], where, "a number"),
-          readScalar<double>(node[1], where, "a number"),
-          readScalar<double>(node[2], where, "a number")};
-}
+using C = PerceptionConfig;
 
 /// Hue ranges in degrees [[from, to], ...] (wrapping through 0 when from > to) -> OpenCV's
 /// half-degree hues.
@@ -42,47 +30,40 @@ std::vector<HueRange> hueRanges(const YAML::Node& node, const std::string& where
   return out;
 }
 
-const std::vector<KeySpec>& keySpecs() {
-  static const std::vector<KeySpec> specs = {
-      {"tag_family",
-       [](auto& c, auto& n, auto& w) { c.tag.family = readScalar<std::string>(n, w, "a name"); }},
-      {"tag_id",
-       [](auto& c, auto& n, auto& w) { c.tag.tag_id = readScalar<int>(n, w, "an integer"); }},
-      {"tag_size_m",
-       [](auto& c, auto& n, auto& w) { c.tag.tag_size_m = readScalar<double>(n, w, "a number"); }},
-      {"tag_max_hamming",
-       [](auto& c, auto& n, auto& w) { c.tag.max_hamming = readScalar<int>(n, w, "an integer"); }},
-      {"region_radius_m",
-       [](auto& c, auto& n, auto& w) { c.region.radius_m = readScalar<double>(n, w, "a number"); }},
-      {"region_offset_tag_m",
-       [](auto& c, auto& n, auto& w) { c.region.center_offset_tag_m = vector3(n, w); }},
-      {"region_center_m", [](auto& c, auto& n, auto& w) { c.region.center_m = vector3(n, w); }},
+const std::vector<YamlKey<C>>& yamlKeys() {
+  static const std::vector<YamlKey<C>> keys = {
+      yamlField<C>(
+          "tag_family", [](C & c) -> auto& { return c.tag.family; }),
+      yamlField<C>(
+          "tag_id", [](C & c) -> auto& { return c.tag.tag_id; }),
+      yamlField<C>(
+          "tag_size_m", [](C & c) -> auto& { return c.tag.tag_size_m; }),
+      yamlField<C>(
+          "tag_max_hamming", [](C & c) -> auto& { return c.tag.max_hamming; }),
+      yamlField<C>(
+          "region_radius_m", [](C & c) -> auto& { return c.region.radius_m; }),
+      yamlField<C>(
+          "region_offset_tag_m", [](C & c) -> auto& { return c.region.center_offset_tag_m; }),
+      yamlField<C>(
+          "region_center_m", [](C & c) -> auto& { return c.region.center_m; }),
       {"hsv_fruitlet_hues_deg",
-       [](auto& c, auto& n, auto& w) { c.segmentation.fruitlet_hues = hueRanges(n, w); }},
-      {"hsv_min_saturation",
-       [](auto& c, auto& n, auto& w) {
-         c.segmentation.min_saturation = readScalar<int>(n, w, "an integer in [0, 255]");
+       [](C& c, const YAML::Node& n, const std::string& where) {
+         c.segmentation.fruitlet_hues = hueRanges(n, where);
        }},
-      {"hsv_min_value",
-       [](auto& c, auto& n, auto& w) {
-         c.segmentation.min_value = readScalar<int>(n, w, "an integer in [0, 255]");
-       }},
+      yamlField<C>(
+          "hsv_min_saturation", [](C & c) -> auto& { return c.segmentation.min_saturation; }),
+      yamlField<C>(
+          "hsv_min_value", [](C & c) -> auto& { return c.segmentation.min_value; }),
   };
-  return specs;
+  return keys;
 }
 
 }  // namespace
 
 PerceptionConfig PerceptionConfig::fromYamlFile(const std::filesystem::path& path) {
   const std::string source = "perception config '" + path.string() + "'";
-  const YAML::Node root = readYamlMapping(path, source);
   PerceptionConfig config;
-  if (!root.IsNull())
-    for (const auto& item : root) {
-      const std::string key = keyString(item.first, source);
-      findKeySpec(keySpecs(), key, source)
-          .read(config, item.second, source + ": key '" + key + "'");
-    }
+  readYamlConfig(path, source, yamlKeys(), config);
   try {
     config.validate();
   } catch (const std::invalid_argument& e) {

@@ -1,6 +1,5 @@
 #include "fvp/host/planner/planner_config.h"
 
-#include <functional>
 #include <nlohmann/json.hpp>
 #include <vector>
 
@@ -9,48 +8,27 @@
 namespace fvp::host::planner {
 namespace {
 
-struct KeySpec {
-  const char* name;
-  std::function<void(PlannerConfig&, const YAML::Node&, const std::string&)> read;
-};
+using C = PlannerConfig;
 
-template <typename T>
-T as(const YAML::Node& node, const std::string& where, const char* expected) {
-  return readScalar<T>(node, where, expected);
-}
-
-const std::vector<KeySpec>& keySpecs() {
-  static const std::vector<KeySpec> specs = {
-      {"roi_samples",
-       [](auto& c, auto& n, auto& w) { c.roi_samples = as<int>(n, w, "an integer"); }},
-      {"exploration_samples",
-       [](auto& c, auto& n, auto& w) { c.exploration_samples = as<int>(n, w, "an integer"); }},
-      {"sensor_min_m",
-       [](auto& c, auto& n, auto& w) { c.sensor_min_m = as<double>(n, w, "a number"); }},
-      {"sensor_max_m",
-       [](auto& c, auto& n, auto& w) { c.sensor_max_m = as<double>(n, w, "a number"); }},
-      {"max_d_m", [](auto& c, auto& n, auto& w) { c.max_d_m = as<double>(n, w, "a number"); }},
-      {"alpha_per_m",
-       [](auto& c, auto& n, auto& w) { c.alpha_per_m = as<double>(n, w, "a number"); }},
-      {"utility_threshold",
-       [](auto& c, auto& n, auto& w) { c.utility_threshold = as<double>(n, w, "a number"); }},
-      {"threshold_decay",
-       [](auto& c, auto& n, auto& w) { c.threshold_decay = as<double>(n, w, "a number"); }},
-      {"max_sampling_rounds",
-       [](auto& c, auto& n, auto& w) { c.max_sampling_rounds = as<int>(n, w, "an integer"); }},
-      {"seed", [](auto& c, auto& n, auto& w) { c.seed = as<std::int64_t>(n, w, "an integer"); }},
-      {"camera_clearance_m",
-       [](auto& c, auto& n, auto& w) { c.camera_clearance_m = as<double>(n, w, "a number"); }},
-      {"gain_mode",
-       [](auto& c, auto& n, auto& w) { c.gain_mode = as<std::string>(n, w, "a string"); }},
-      {"frustum_rays_x",
-       [](auto& c, auto& n, auto& w) { c.frustum_rays_x = as<int>(n, w, "an integer"); }},
-      {"frustum_rays_y",
-       [](auto& c, auto& n, auto& w) { c.frustum_rays_y = as<int>(n, w, "an integer"); }},
-      {"embree_cull",
-       [](auto& c, auto& n, auto& w) { c.embree_cull = as<bool>(n, w, "true or false"); }},
+const std::vector<YamlKey<C>>& yamlKeys() {
+  static const std::vector<YamlKey<C>> keys = {
+      yamlField("roi_samples", &C::roi_samples),
+      yamlField("exploration_samples", &C::exploration_samples),
+      yamlField("sensor_min_m", &C::sensor_min_m),
+      yamlField("sensor_max_m", &C::sensor_max_m),
+      yamlField("max_d_m", &C::max_d_m),
+      yamlField("alpha_per_m", &C::alpha_per_m),
+      yamlField("utility_threshold", &C::utility_threshold),
+      yamlField("threshold_decay", &C::threshold_decay),
+      yamlField("max_sampling_rounds", &C::max_sampling_rounds),
+      yamlField("seed", &C::seed),
+      yamlField("camera_clearance_m", &C::camera_clearance_m),
+      yamlField("gain_mode", &C::gain_mode),
+      yamlField("frustum_rays_x", &C::frustum_rays_x),
+      yamlField("frustum_rays_y", &C::frustum_rays_y),
+      yamlField("embree_cull", &C::embree_cull),
   };
-  return specs;
+  return keys;
 }
 
 void require(bool ok, const std::string& source, const char* key, const std::string& expected) {
@@ -61,13 +39,8 @@ void require(bool ok, const std::string& source, const char* key, const std::str
 
 PlannerConfig PlannerConfig::fromYamlFile(const std::filesystem::path& path) {
   const std::string source = "planner config '" + path.string() + "'";
-  const YAML::Node root = readYamlMapping(path, source);
   PlannerConfig config;
-  if (root.IsNull()) return config;
-  for (const auto& item : root) {
-    const std::string key = keyString(item.first, source);
-    findKeySpec(keySpecs(), key, source).read(config, item.second, source + ": key '" + key + "'");
-  }
+  readYamlConfig(path, source, yamlKeys(), config);
   config.validate(source);
   return config;
 }

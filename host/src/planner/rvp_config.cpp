@@ -1,9 +1,7 @@
 #include "fvp/host/planner/rvp_config.h"
 
 #include <cmath>
-#include <functional>
 #include <nlohmann/json.hpp>
-#include <type_traits>
 #include <vector>
 
 #include "fvp/host/core/yaml_config.h"
@@ -11,34 +9,23 @@
 namespace fvp::host::planner {
 namespace {
 
-struct KeySpec {
-  const char* name;
-  std::function<void(RvpConfig&, const YAML::Node&, const std::string&)> read;
-};
+using C = RvpConfig;
 
-/// A spec that reads key into member as an integer or a finite number.
-template <typename T>
-KeySpec field(const char* name, T RvpConfig::*member) {
-  return {name, [member](RvpConfig& c, const YAML::Node& n, const std::string& where) {
-            c.*member = readScalar<T>(n, where, std::is_integral_v<T> ? "an integer" : "a number");
-          }};
-}
-
-const std::vector<KeySpec>& keySpecs() {
-  static const std::vector<KeySpec> specs = {
-      field("roi_samples", &RvpConfig::roi_samples),
-      field("exploration_samples", &RvpConfig::exploration_samples),
-      field("sensor_min_m", &RvpConfig::sensor_min_m),
-      field("sensor_max_m", &RvpConfig::sensor_max_m),
-      field("alpha_per_m", &RvpConfig::alpha_per_m),
-      field("roi_utility_threshold", &RvpConfig::roi_utility_threshold),
-      field("exploration_rays_x", &RvpConfig::exploration_rays_x),
-      field("exploration_rays_y", &RvpConfig::exploration_rays_y),
-      field("exploration_fov_x_deg", &RvpConfig::exploration_fov_x_deg),
-      field("exploration_box_half_m", &RvpConfig::exploration_box_half_m),
-      field("seed", &RvpConfig::seed),
+const std::vector<YamlKey<C>>& yamlKeys() {
+  static const std::vector<YamlKey<C>> keys = {
+      yamlField("roi_samples", &C::roi_samples),
+      yamlField("exploration_samples", &C::exploration_samples),
+      yamlField("sensor_min_m", &C::sensor_min_m),
+      yamlField("sensor_max_m", &C::sensor_max_m),
+      yamlField("alpha_per_m", &C::alpha_per_m),
+      yamlField("roi_utility_threshold", &C::roi_utility_threshold),
+      yamlField("exploration_rays_x", &C::exploration_rays_x),
+      yamlField("exploration_rays_y", &C::exploration_rays_y),
+      yamlField("exploration_fov_x_deg", &C::exploration_fov_x_deg),
+      yamlField("exploration_box_half_m", &C::exploration_box_half_m),
+      yamlField("seed", &C::seed),
   };
-  return specs;
+  return keys;
 }
 
 void require(bool ok, const std::string& source, const char* key, const char* expected) {
@@ -49,13 +36,8 @@ void require(bool ok, const std::string& source, const char* key, const char* ex
 
 RvpConfig RvpConfig::fromYamlFile(const std::filesystem::path& path) {
   const std::string source = "rvp config '" + path.string() + "'";
-  const YAML::Node root = readYamlMapping(path, source);
   RvpConfig c;
-  if (root.IsNull()) return c;
-  for (const auto& item : root) {
-    const std::string key = keyString(item.first, source);
-    findKeySpec(keySpecs(), key, source).read(c, item.second, source + ": key '" + key + "'");
-  }
+  readYamlConfig(path, source, yamlKeys(), c);
   c.validate(source);
   return c;
 }

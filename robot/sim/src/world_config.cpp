@@ -10,8 +10,6 @@
 #include <stdexcept>
 #include <variant>
 
-#include "fvp/host/perception/stereo_frame.h"
-
 namespace fvp::robot::sim {
 namespace {
 
@@ -66,6 +64,18 @@ const std::vector<KeySpec>& keySpecs() {
   return specs;
 }
 
+/// The file's keys: each spec's member read as its type.
+const std::vector<host::YamlKey<WorldConfig>>& yamlKeys() {
+  static const std::vector<host::YamlKey<WorldConfig>> keys = [] {
+    std::vector<host::YamlKey<WorldConfig>> out;
+    for (const KeySpec& spec : keySpecs())
+      std::visit([&](auto member) { out.push_back(host::yamlField(spec.name, member)); },
+                 spec.member);
+    return out;
+  }();
+  return keys;
+}
+
 double valueOf(const WorldConfig& config, const Member& member) {
   return std::visit([&](auto field) { return static_cast<double>(config.*field); }, member);
 }
@@ -117,23 +127,8 @@ void WorldConfig::validate(const std::string& source) const {
 
 WorldConfig WorldConfig::fromYamlFile(const std::filesystem::path& path) {
   const std::string source = "world config '" + path.string() + "'";
-  const YAML::Node root = host::readYamlMapping(path, source);
   WorldConfig config;
-  if (root.IsNull()) {
-    config.validate(source);
-    return config;
-  }
-  for (const auto& entry : root) {
-    const std::string key = host::keyString(entry.first, source);
-    const KeySpec* spec = &host::findKeySpec(keySpecs(), key, source);
-    const std::string where = source + ": key '" + key + "'";
-    if (std::holds_alternative<int WorldConfig::*>(spec->member))
-      config.*std::get<int WorldConfig::*>(spec->member) =
-          host::readScalar<int>(entry.second, where, "an integer");
-    else
-      config.*std::get<double WorldConfig::*>(spec->member) =
-          host::readScalar<double>(entry.second, where, "a number");
-  }
+  host::readYamlConfig(path, source, yamlKeys(), config);
   config.validate(source);
   return config;
 }

@@ -1,12 +1,17 @@
-// What the YAML config readers (world, arm) share: reading the file as a mapping, finding a
-// key in a table of key specs, and printing numbers in error messages. Errors name the
-// source (e.g. "arm config 'F'") and what was expected.
+// The one reader of fvp's YAML config files (world, arm, map, planner, RVP, perception): a
+// file is a mapping of known keys, each read by its entry in the config's key table
+// (YamlKey); unknown keys, wrong types and non-finite numbers are errors naming the source
+// (e.g. "arm config 'F'") and the key, and what was expected. Range checks are the config's
+// own validate().
 #pragma once
 
 #include <yaml-cpp/yaml.h>
 
+#include <Eigen/Core>
 #include <cmath>
 #include <filesystem>
+#include <functional>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -71,6 +76,83 @@ const KeySpec& findKeySpec(const std::vector<KeySpec>& specs, const std::string&
   std::string known;
   for (const KeySpec& spec : specs) known += (known.empty() ? "" : ", ") + std::string(spec.name);
   throw std::invalid_argument(source + ": unknown key '" + key + "' (known keys: " + known + ")");
+}
+
+/// A list of 3 finite numbers [x, y, z].
+inline Eigen::Vector3d readVector3(const YAML::Node& node, const std::string& where) {
+  const std::string expected = "a list of 3 numbers [x, y, z]";
+  if (!node.IsSequence() || node.size() != 3)
+    throw std::invalid_argument(where + ": expected " + expected);
+  return {readScalar<double>(node[0], where, expected),
+          readScalar<double>(node[1], where, expected),
+          readScalar<double>(node[2], where, expected)};
+}
+
+/// One key of a config file: its name and how its value is read into the config (`where`
+/// names the source and the key for errors).
+template <typename Config>
+struct YamlKey {
+  const char* name;
+  std::function<void(Config& config, const YAML::Node& value, const std::string& where)> read;
+};
+
+/// A value of type T from a node: integers, finite numbers, booleans, strings, 3-vectors and
+/// optional 3-vectors.
+template <typename T>
+T readYamlValue(const YAML::Node& node, const std::string& where) {
+  if constexpr (std::is_same_v<T, Eigen::Vector3d>) {
+    return readVector3(node, where);
+  } else if constexpr (std::is_same_v<T, std::optional<Eigen::Vector3d>>) {
+    return readVector3(node, where);
+  } else if constexpr (std::is_same_v<T, std::string>) {
+    return readScalar<T>(node, where, "a string");
+  } else if constexpr (std::is_same_v<T, bool>) {
+    return readScalar<T>(node, where, "true or false");
+  } else if constexpr (std::is_floating_point_v<T>) {
+    return readScalar<T>(node, where, "a number");
+  } else {
+    static_assert(std::is_integral_v<T>, "readYamlValue: no reader for this type");
+    return readScalar<T>(node, where, "an integer");
+  }
+}
+
+/// The key that reads its value into config.*member.
+template <typename Config, typename T>
+YamlKey<Config> yamlField(const char* name, T Config::*member) {
+  return {name, [member](Config& c, const YAML::Node& n, const std::string& where) {
+            c.*member = readYamlValue<T>(n, where);
+          }};
+}
+
+/// The key that reads its value into field(config), a member of a member.
+template <typename Config, typename Field>
+YamlKey<Config> yamlField(const char* name, Field field) {
+  return {name, [field](Config& c, const YAML::Node& n, const std::string& where) {
+            auto& target = field(c);
+            target = readYamlValue<std::decay_t<decltype(target)>>(n, where);
+          }};
+}
+
+/// Reads the file's keys into config (missing keys keep config's values): each key by its
+/// entry in keys, an unknown key an error listing the known ones. Checking the values is
+/// the caller's (validate()).
+template <typename Config>
+void readYamlConfig(const std::filesystem::path& path, const std::string& source,
+                    const std::vector<YamlKey<Config>>& keys, Config& config) {
+  const YAML::Node root = readYamlMapping(path, source);
+  if (root.IsNull()) return;
+  for (const auto& item : root) {
+    const std::string key = keyString(item.first, source);
+    findKeySpec(keys, key, source).read(config, item.second, source + ": key '" + key + "'");
+  }
+}
+
+/// The names of a key table, in its order.
+template <typename Config>
+std::vector<std::string> yamlKeyNames(const std::vector<YamlKey<Config>>& keys) {
+  std::vector<std::string> names;
+  for (const auto& key : keys) names.emplace_back(key.name);
+  return names;
 }
 
 /// A number as an error message shows it (shortest stream form).

@@ -1,4 +1,4 @@
-#include "fvp/robot/sim/trial.h"
+#include "fvp/trials/trial.h"
 
 #include <chrono>
 #include <cmath>
@@ -31,7 +31,10 @@
 #include "fvp/robot/workspace_tree.h"
 #include "trial_parts.h"
 
-namespace fvp::robot::sim {
+namespace fvp::trials {
+// The simulator's parts and the arm, by their short names.
+using namespace fvp::robot;
+using namespace fvp::robot::sim;
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -269,9 +272,9 @@ nlohmann::json runTrial(const TrialOptions& options) {
   return Trial(options).run();
 }
 
-}  // namespace fvp::robot::sim
+}  // namespace fvp::trials
 
-namespace fvp::robot::sim {
+namespace fvp::trials {
 
 std::string trialSummary(const nlohmann::json& result) {
   std::ostringstream s;
@@ -312,4 +315,4 @@ std::string trialSummary(const nlohmann::json& result) {
   return s.str();
 }
 
-}  // namespace fvp::robot::sim
+}  // namespace fvp::trials

@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-namespace fvp::robot::sim {
+namespace fvp::trials {
 
 struct PlanOnceOptions {
   std::string planner = "fvp";  ///< fvp | rvp
@@ -31,4 +31,4 @@ struct PlanOnceOptions {
 /// "ig", "utility", "reachable"}], "timings_s", "config", ...}.
 nlohmann::json planOnce(const PlanOnceOptions& options);
 
-}  // namespace fvp::robot::sim
+}  // namespace fvp::trials

@@ -18,7 +18,7 @@ class Arm;
 class Camera;
 }  // namespace fvp::host::nbv
 
-namespace fvp::robot::sim {
+namespace fvp::trials {
 
 /// Where a running trial is, for progress displays.
 struct TrialProgress {
@@ -88,4 +88,4 @@ class Trial {
 /// simulated and wall time (what `fvp run` and scripts/demo print).
 std::string trialSummary(const nlohmann::json& result);
 
-}  // namespace fvp::robot::sim
+}  // namespace fvp::trials

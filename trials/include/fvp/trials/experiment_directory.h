@@ -14,7 +14,7 @@
 #include <string_view>
 #include <vector>
 
-namespace fvp::robot::sim {
+namespace fvp::trials {
 
 /// A file's bytes; nothing when it cannot be opened (the directory's readers and the
 /// experiment runner share it).
@@ -99,4 +99,4 @@ std::optional<ManifestDifference> resumeDifference(const ExperimentManifest& old
 std::optional<ManifestDifference> mergeDifference(const ExperimentManifest& a,
                                                   const ExperimentManifest& b);
 
-}  // namespace fvp::robot::sim
+}  // namespace fvp::trials

@@ -1,4 +1,4 @@
-#include "fvp/robot/sim/experiment.h"
+#include "fvp/trials/experiment.h"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -20,7 +20,7 @@
 #include "fvp/host/core/output_directory.h"
 #include "fvp/host/map/map_engine_registry.h"
 
-namespace fvp::robot::sim {
+namespace fvp::trials {
 namespace {
 
 namespace fs = std::filesystem;
@@ -478,4 +478,4 @@ void mergeExperiments(const std::vector<fs::path>& shard_dirs, const fs::path& o
   writeReports(out_dir, all, warning);
 }
 
-}  // namespace fvp::robot::sim
+}  // namespace fvp::trials

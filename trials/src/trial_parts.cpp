@@ -19,7 +19,10 @@
 #include "fvp/host/sizing/fruitlet_sizer.h"
 #include "fvp/host/tsdf/tsdf_volume.h"
 
-namespace fvp::robot::sim {
+namespace fvp::trials {
+// The simulator's parts and the arm, by their short names.
+using namespace fvp::robot;
+using namespace fvp::robot::sim;
 namespace {
 
 // Report pictures of the views: small enough that a report of 60 views stays light.
@@ -121,9 +124,9 @@ void TrialParts::keepViewImage(int index, const host::StereoFrame& frame) const 
       std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
 }
 
-}  // namespace fvp::robot::sim
+}  // namespace fvp::trials
 
-namespace fvp::robot::sim {
+namespace fvp::trials {
 namespace {
 
 std::string fmt(double v, int precision) {
@@ -260,9 +263,9 @@ void TrialParts::writeOutputs(nlohmann::json& result, const World& world,
   host::writeFileAtomically(out_dir / "report.md", "trial report", md.str());
 }
 
-}  // namespace fvp::robot::sim
+}  // namespace fvp::trials
 
-namespace fvp::robot::sim {
+namespace fvp::trials {
 
 nlohmann::json TrialParts::sizeAndScore(const World& world, const std::filesystem::path&) {
   impl_->sizing = impl_->session.sizeFruitlets(impl_->sizing_config);
@@ -282,4 +285,4 @@ nlohmann::json TrialParts::sizeAndScore(const World& world, const std::filesyste
   return out;
 }
 
-}  // namespace fvp::robot::sim
+}  // namespace fvp::trials

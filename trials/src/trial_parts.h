@@ -16,15 +16,15 @@
 #include "fvp/host/perception/stereo_frame.h"
 #include "fvp/host/planner/view_planner.h"
 #include "fvp/host/session/mapping_session.h"
-#include "fvp/robot/sim/trial.h"
 #include "fvp/robot/sim/world.h"
 #include "fvp/robot/workspace_tree.h"
+#include "fvp/trials/trial.h"
 
 namespace fvp::accel {
 class Backend;
 }
 
-namespace fvp::robot::sim {
+namespace fvp::trials {
 
 /// The map engine a planner runs on unless --engine says otherwise (its registry entry's:
 /// FVP grid, RVP octomap, as the original did).
@@ -35,8 +35,8 @@ std::string defaultCacheDir();
 /// The arm's workspace tree from its cache (built and cached when missing or stale); each
 /// warning the cache gave (a stale or unreadable file, a cache it could not write) goes to
 /// warn, without its "warning: " prefix.
-WorkspaceTree loadWorkspaceTree(const ArmModel& arm,
-                                const std::function<void(const std::string&)>& warn);
+robot::WorkspaceTree loadWorkspaceTree(const robot::ArmModel& arm,
+                                       const std::function<void(const std::string&)>& warn);
 
 /// What one view did, with the wall times the clock charges.
 struct ViewOutcome {
@@ -61,11 +61,11 @@ class TrialParts {
   void keepViewImage(int index, const host::StereoFrame& frame) const;
   /// Sizes the fruitlets from the views so far and scores them against the world's ground
   /// truth: {"fruitlets", "detections", "metrics", ...} of result.json.
-  nlohmann::json sizeAndScore(const World& world, const std::filesystem::path& out_dir);
+  nlohmann::json sizeAndScore(const robot::sim::World& world, const std::filesystem::path& out_dir);
   /// result.json first, then the maps, surface, clusters, the camera-path figure and
   /// report.md, each atomically, into out_dir. A figure that cannot be drawn is passed to
   /// warn and added to result["warnings"] (result.json is written again then).
-  void writeOutputs(nlohmann::json& result, const World& world,
+  void writeOutputs(nlohmann::json& result, const robot::sim::World& world,
                     const std::vector<Eigen::Vector3d>& camera_path,
                     const std::filesystem::path& out_dir,
                     const std::function<void(const std::string&)>& warn) const;
@@ -77,4 +77,4 @@ class TrialParts {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace fvp::robot::sim
+}  // namespace fvp::trials

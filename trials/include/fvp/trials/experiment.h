@@ -16,10 +16,10 @@
 #include <utility>
 #include <vector>
 
-#include "fvp/robot/sim/experiment_directory.h"
-#include "fvp/robot/sim/trial.h"
+#include "fvp/trials/experiment_directory.h"
+#include "fvp/trials/trial.h"
 
-namespace fvp::robot::sim {
+namespace fvp::trials {
 
 struct ExperimentOptions {
   std::vector<std::string> planners{"fvp", "rvp"};
@@ -69,4 +69,4 @@ bool writeReports(const std::filesystem::path& dir, const std::vector<nlohmann::
 void mergeExperiments(const std::vector<std::filesystem::path>& shard_dirs,
                       const std::filesystem::path& out_dir, const MessageSink& warning = {});
 
-}  // namespace fvp::robot::sim
+}  // namespace fvp::trials

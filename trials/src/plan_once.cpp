@@ -1,4 +1,4 @@
-#include "fvp/robot/sim/plan_once.h"
+#include "fvp/trials/plan_once.h"
 
 #include <algorithm>
 #include <chrono>
@@ -21,7 +21,10 @@
 #include "fvp/robot/workspace_tree.h"
 #include "trial_parts.h"
 
-namespace fvp::robot::sim {
+namespace fvp::trials {
+// The simulator's parts and the arm, by their short names.
+using namespace fvp::robot;
+using namespace fvp::robot::sim;
 namespace {
 
 nlohmann::json vec3(const Eigen::Vector3d& v) {
@@ -186,4 +189,4 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
   return result;
 }
 
-}  // namespace fvp::robot::sim
+}  // namespace fvp::trials

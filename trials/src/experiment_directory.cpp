@@ -1,4 +1,4 @@
-#include "fvp/robot/sim/experiment_directory.h"
+#include "fvp/trials/experiment_directory.h"
 
 #include <algorithm>
 #include <climits>
@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <utility>
 
-namespace fvp::robot::sim {
+namespace fvp::trials {
 namespace {
 
 constexpr const char* kManifestFormat = "fvp-experiment-manifest";
@@ -357,4 +357,4 @@ std::optional<ManifestDifference> resumeDifference(const ExperimentManifest& old
   return std::nullopt;
 }
 
-}  // namespace fvp::robot::sim
+}  // namespace fvp::trials
