@@ -289,7 +289,7 @@ PYBIND11_MODULE(fvp, m) {
   py::class_<Planner>(m, "Planner", "A registered viewpoint planner (fvp.planners()).")
       .def(py::init<const std::string&, const std::string&, std::uint64_t, const std::string&>(),
            py::arg("name") = "fvp", py::arg("config") = "", py::arg("seed") = 1,
-           py::arg("backend") = "cpu")
+           py::arg("backend") = "auto")
       .def_property_readonly("name",
                              [](const Planner& p) { return std::string(p.planner->name()); })
       .def_property_readonly("config",
@@ -364,7 +364,7 @@ PYBIND11_MODULE(fvp, m) {
         return ig;
       },
       py::arg("session"), py::arg("poses"), py::arg("targets"), py::arg("mode") = "single_ray",
-      py::arg("max_d_m") = 0.02, py::arg("backend") = "cpu",
+      py::arg("max_d_m") = 0.02, py::arg("backend") = "auto",
       "Information gain (paper Eq. 1-2) of N camera poses (N, 4, 4) looking at targets "
       "(N, 3) on the session's maps, in one batch: an (N,) array.");
 

@@ -47,6 +47,8 @@ const std::vector<KeySpec>& keySpecs() {
       {"planner", &ArmConfig::planner},
       {"planning_time_s", &ArmConfig::planning_time_s, 1e-3, 600.0},
       {"simplify_time_s", &ArmConfig::simplify_time_s, 0.0, 60.0},
+      {"reproducible_planning_checks", &ArmConfig::reproducible_planning_checks, 100, 1e9},
+      {"reproducible_simplify_checks", &ArmConfig::reproducible_simplify_checks, 0, 1e9},
       {"validity_step_rad", &ArmConfig::validity_step_rad, 1e-4, 0.5},
       {"workspace_samples", &ArmConfig::workspace_samples, 1000, 1e10},
       {"workspace_resolution_m", &ArmConfig::workspace_resolution_m, 0.005, 0.5},

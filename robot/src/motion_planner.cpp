@@ -4,6 +4,7 @@
 #include <ompl/base/StateValidityChecker.h>
 #include <ompl/base/goals/GoalStates.h>
 #include <ompl/base/spaces/RealVectorStateSpace.h>
+#include <ompl/geometric/PathSimplifier.h>
 #include <ompl/geometric/SimpleSetup.h>
 #include <ompl/geometric/planners/est/EST.h>
 #include <ompl/geometric/planners/kpiece/BKPIECE1.h>
@@ -109,6 +110,38 @@ ob::PlannerPtr makePlanner(const std::string& name, const ob::SpaceInformationPt
   throw std::invalid_argument("arm config: key 'planner' = '" + name + "' is not a known planner");
 }
 
+// Reproducible planning: OMPL's random number generators are seeded from one global seed
+// sequence, so a query's samples depend on every query (and thread) before it. These
+// subclasses seed their own generator per query instead.
+class SeededSampler : public ob::RealVectorStateSampler {
+ public:
+  SeededSampler(const ob::StateSpace* space, std::uint32_t seed) : RealVectorStateSampler(space) {
+    rng_.setLocalSeed(seed);
+  }
+};
+class SeededRRTConnect : public og::RRTConnect {
+ public:
+  SeededRRTConnect(const ob::SpaceInformationPtr& si, std::uint32_t seed) : RRTConnect(si) {
+    rng_.setLocalSeed(seed);
+  }
+};
+class SeededPathSimplifier : public og::PathSimplifier {
+ public:
+  SeededPathSimplifier(const ob::SpaceInformationPtr& si, std::uint32_t seed) : PathSimplifier(si) {
+    rng_.setLocalSeed(seed);
+  }
+};
+
+/// A nonzero 32-bit seed of (seed, query) (OMPL ignores 0).
+std::uint32_t querySeed(std::uint64_t seed, std::uint64_t query) {
+  std::uint64_t x = seed * 0x9E3779B97F4A7C15ull + query + 1;
+  x ^= x >> 31;
+  x *= 0xBF58476D1CE4E5B9ull;
+  x ^= x >> 29;
+  const auto s = static_cast<std::uint32_t>(x ^ (x >> 32));
+  return s == 0 ? 1u : s;
+}
+
 double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -131,6 +164,12 @@ const char* toString(MotionStatus status) {
       return "timeout";
   }
   return "unknown";
+}
+
+void MotionPlanner::setReproducible(std::uint64_t seed) {
+  reproducible_ = true;
+  seed_ = seed;
+  queries_ = 0;
 }
 
 MotionPlanner::MotionPlanner(const ArmCollisionChecker& checker) : checker_(checker) {
@@ -167,10 +206,9 @@ MotionPlan MotionPlanner::moveToPose(const JointVector& current,
   // The nearest solution first, for a share of the time: most plans take a few tens of ms.
   // A goal in a pocket of the map cannot be reached at all, so then every distinct solution
   // becomes a goal state of one more query for the rest of the time.
-  const double time_s = checker_.arm().config().planning_time_s;
-  plan = plan_(current, {goals.front()}, goals.size() > 1 ? kNearestShare * time_s : time_s);
+  plan = plan_(current, {goals.front()}, goals.size() > 1 ? kNearestShare : 1.0);
   if (!plan.ok() && plan.status != MotionStatus::kStartInvalid && goals.size() > 1) {
-    plan = plan_(current, goals, (1.0 - kNearestShare) * time_s);
+    plan = plan_(current, goals, 1.0 - kNearestShare);
   }
   plan.ik_solutions = static_cast<int>(solutions.size());
   plan.planning_wall_s = secondsSince(start);
@@ -178,11 +216,11 @@ MotionPlan MotionPlanner::moveToPose(const JointVector& current,
 }
 
 MotionPlan MotionPlanner::planToJoints(const JointVector& current, const JointVector& goal) const {
-  return plan_(current, {goal}, checker_.arm().config().planning_time_s);
+  return plan_(current, {goal}, 1.0);
 }
 
 MotionPlan MotionPlanner::plan_(const JointVector& current, const std::vector<JointVector>& goals,
-                                double time_s) const {
+                                double share) const {
   const auto start_time = Clock::now();
   const ArmModel& arm = checker_.arm();
   const ArmConfig& config = arm.config();
@@ -213,7 +251,15 @@ MotionPlan MotionPlanner::plan_(const JointVector& current, const std::vector<Jo
   // motion validator also bounds how far the arm sweeps between checks.
   si->setStateValidityCheckingResolution(config.validity_step_rad / space->getMaximumExtent());
   si->setMotionValidator(std::make_shared<ArmMotionValidator>(si, checker_));
-  setup.setPlanner(makePlanner(config.planner, si));
+  const std::uint32_t seed = querySeed(seed_, queries_++);
+  if (reproducible_) {
+    space->setStateSamplerAllocator([seed](const ob::StateSpace* s) -> ob::StateSamplerPtr {
+      return std::make_shared<SeededSampler>(s, seed);
+    });
+  }
+  setup.setPlanner(reproducible_ && config.planner == "RRTConnect"
+                       ? std::make_shared<SeededRRTConnect>(si, seed)
+                       : makePlanner(config.planner, si));
 
   ob::ScopedState<> start(space);
   for (int j = 0; j < kArmJoints; ++j) start[j] = current[j];
@@ -225,14 +271,28 @@ MotionPlan MotionPlanner::plan_(const JointVector& current, const std::vector<Jo
     goal_states->addState(state);
   }
   setup.setGoal(goal_states);
-  const ob::PlannerStatus solved = setup.solve(time_s);
+  // Reproducible: a budget of validity checks (the same on any machine, under any load).
+  const auto checksBudget = [&](std::int64_t checks) {
+    const std::uint64_t until = checker_.checks() + static_cast<std::uint64_t>(checks);
+    return ob::PlannerTerminationCondition([this, until] { return checker_.checks() >= until; });
+  };
+  const ob::PlannerStatus solved =
+      reproducible_ ? setup.solve(checksBudget(static_cast<std::int64_t>(
+                          share * static_cast<double>(config.reproducible_planning_checks))))
+                    : setup.solve(share * config.planning_time_s);
   if (solved != ob::PlannerStatus::EXACT_SOLUTION) {
     const bool out_of_time =
         solved == ob::PlannerStatus::TIMEOUT || solved == ob::PlannerStatus::APPROXIMATE_SOLUTION;
     return finish(out_of_time ? MotionStatus::kTimeout : MotionStatus::kNoPath);
   }
-  if (config.simplify_time_s > 0.0) setup.simplifySolution(config.simplify_time_s);
-  const og::PathGeometric& path = setup.getSolutionPath();
+  og::PathGeometric& path = setup.getSolutionPath();
+  if (reproducible_) {
+    if (config.reproducible_simplify_checks > 0)
+      SeededPathSimplifier(si, seed).simplify(path,
+                                              checksBudget(config.reproducible_simplify_checks));
+  } else if (config.simplify_time_s > 0.0) {
+    setup.simplifySolution(config.simplify_time_s);
+  }
   std::vector<JointVector> waypoints;
   waypoints.reserve(path.getStateCount());
   for (std::size_t i = 0; i < path.getStateCount(); ++i)

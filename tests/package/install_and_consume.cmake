@@ -97,7 +97,10 @@ if(PYTHON)
     message(FATAL_ERROR "not installed: the fvp Python module")
   endif()
   get_filename_component(module_dir ${module} DIRECTORY)
-  run("import fvp from the prefix" ${CMAKE_COMMAND} -E env PYTHONPATH=${module_dir}
+  # PYTHON_ENV: what a sanitizer build needs in the interpreter's environment (LD_PRELOAD),
+  # entries separated by '|'.
+  string(REPLACE "|" ";" PYTHON_ENV "${PYTHON_ENV}")
+  run("import fvp from the prefix" ${CMAKE_COMMAND} -E env PYTHONPATH=${module_dir} ${PYTHON_ENV}
       ${PYTHON} -c "import fvp; assert fvp.__file__.startswith('${prefix}'), fvp.__file__; assert fvp.planners()[:2] == ['fvp', 'rvp']; assert fvp.backends()['cpu'] == 'available'; print('python: fvp from', fvp.__file__)")
   message("${last_output}")
 endif()

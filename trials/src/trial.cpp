@@ -153,6 +153,9 @@ struct Trial::Impl {
       throw std::runtime_error("world seed " + std::to_string(options.seed) +
                                ": the start view is out of the arm's reach");
     controller = std::make_unique<ArmController>(*arm, *clock, *start);
+    // A fixed clock is for runs that repeat: then the moves must repeat too.
+    if (clock->mode() == SimClock::Mode::kFixed)
+      controller->setReproducibleMotionPlanning(options.seed);
     camera = std::make_unique<SimulatedCamera>(*renderer, *clock);
     sim_arm = std::make_unique<SimulatedArm>(*controller, *workspace);
   }

@@ -31,10 +31,6 @@ const std::vector<YamlKey<C>>& yamlKeys() {
   return keys;
 }
 
-void require(bool ok, const std::string& source, const char* key, const std::string& expected) {
-  if (!ok) throw std::invalid_argument(source + ": key '" + key + "': expected " + expected);
-}
-
 }  // namespace
 
 PlannerConfig PlannerConfig::fromYamlFile(const std::filesystem::path& path) {
@@ -46,31 +42,33 @@ PlannerConfig PlannerConfig::fromYamlFile(const std::filesystem::path& path) {
 }
 
 void PlannerConfig::validate(const std::string& source) const {
-  require(roi_samples >= 0 && roi_samples <= 10'000'000, source, "roi_samples",
-          "0 to 10000000 candidates");
-  require(exploration_samples >= 0 && exploration_samples <= 10'000'000, source,
-          "exploration_samples", "0 to 10000000 candidates");
-  require(roi_samples + exploration_samples > 0, source, "roi_samples",
-          "at least one candidate per round (roi_samples + exploration_samples > 0)");
-  require(sensor_min_m > 0.0 && sensor_min_m < 5.0, source, "sensor_min_m",
-          "a distance in (0, 5) m");
-  require(sensor_max_m >= sensor_min_m && sensor_max_m < 5.0, source, "sensor_max_m",
-          "a distance in [sensor_min_m, 5) m");
-  require(max_d_m > 0.0 && max_d_m < 1.0, source, "max_d_m", "a distance in (0, 1) m");
-  require(alpha_per_m >= 0.0 && alpha_per_m < 100.0, source, "alpha_per_m",
-          "a cost weight in [0, 100) per metre");
-  require(utility_threshold >= -10.0 && utility_threshold <= 10.0, source, "utility_threshold",
-          "a utility in [-10, 10]");
-  require(threshold_decay > 0.0 && threshold_decay < 1.0, source, "threshold_decay",
-          "a factor b in (0, 1)");
-  require(camera_clearance_m >= 0.0 && camera_clearance_m < 1.0, source, "camera_clearance_m",
-          "a distance in [0, 1) m");
-  require(gain_mode == "single_ray" || gain_mode == "frustum", source, "gain_mode",
-          "single_ray or frustum");
-  require(frustum_rays_x >= 1 && frustum_rays_x <= 256, source, "frustum_rays_x", "1 to 256 rays");
-  require(frustum_rays_y >= 1 && frustum_rays_y <= 256, source, "frustum_rays_y", "1 to 256 rays");
-  require(max_sampling_rounds >= 1 && max_sampling_rounds <= 1000, source, "max_sampling_rounds",
-          "1 to 1000 rounds");
+  requireKey(roi_samples >= 0 && roi_samples <= 10'000'000, source, "roi_samples",
+             "0 to 10000000 candidates");
+  requireKey(exploration_samples >= 0 && exploration_samples <= 10'000'000, source,
+             "exploration_samples", "0 to 10000000 candidates");
+  requireKey(roi_samples + exploration_samples > 0, source, "roi_samples",
+             "at least one candidate per round (roi_samples + exploration_samples > 0)");
+  requireKey(sensor_min_m > 0.0 && sensor_min_m < 5.0, source, "sensor_min_m",
+             "a distance in (0, 5) m");
+  requireKey(sensor_max_m >= sensor_min_m && sensor_max_m < 5.0, source, "sensor_max_m",
+             "a distance in [sensor_min_m, 5) m");
+  requireKey(max_d_m > 0.0 && max_d_m < 1.0, source, "max_d_m", "a distance in (0, 1) m");
+  requireKey(alpha_per_m >= 0.0 && alpha_per_m < 100.0, source, "alpha_per_m",
+             "a cost weight in [0, 100) per metre");
+  requireKey(utility_threshold >= -10.0 && utility_threshold <= 10.0, source, "utility_threshold",
+             "a utility in [-10, 10]");
+  requireKey(threshold_decay > 0.0 && threshold_decay < 1.0, source, "threshold_decay",
+             "a factor b in (0, 1)");
+  requireKey(camera_clearance_m >= 0.0 && camera_clearance_m < 1.0, source, "camera_clearance_m",
+             "a distance in [0, 1) m");
+  requireKey(gain_mode == "single_ray" || gain_mode == "frustum", source, "gain_mode",
+             "single_ray or frustum");
+  requireKey(frustum_rays_x >= 1 && frustum_rays_x <= 256, source, "frustum_rays_x",
+             "1 to 256 rays");
+  requireKey(frustum_rays_y >= 1 && frustum_rays_y <= 256, source, "frustum_rays_y",
+             "1 to 256 rays");
+  requireKey(max_sampling_rounds >= 1 && max_sampling_rounds <= 1000, source, "max_sampling_rounds",
+             "1 to 1000 rounds");
 }
 
 std::string PlannerConfig::toJson() const {

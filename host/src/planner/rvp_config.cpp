@@ -28,10 +28,6 @@ const std::vector<YamlKey<C>>& yamlKeys() {
   return keys;
 }
 
-void require(bool ok, const std::string& source, const char* key, const char* expected) {
-  if (!ok) throw std::invalid_argument(source + ": key '" + key + "': expected " + expected);
-}
-
 }  // namespace
 
 RvpConfig RvpConfig::fromYamlFile(const std::filesystem::path& path) {
@@ -45,26 +41,26 @@ RvpConfig RvpConfig::fromYamlFile(const std::filesystem::path& path) {
 void RvpConfig::validate(const std::string& source) const {
   // Each count bounded before they are added (two large ints overflow), the rays so that
   // nx * ny stays an int; every double in a finite range (`!(x >= lo)` style: NaN fails).
-  require(roi_samples >= 0 && roi_samples <= 10'000'000, source, "roi_samples",
-          "0 to 10000000 candidates");
-  require(exploration_samples >= 0 && exploration_samples <= 10'000'000, source,
-          "exploration_samples", "0 to 10000000 candidates");
-  require(roi_samples + exploration_samples > 0, source, "roi_samples",
-          "non-negative sample counts, not both 0");
-  require(sensor_min_m > 0.0 && sensor_max_m >= sensor_min_m && sensor_max_m < 5.0, source,
-          "sensor_max_m", "0 < sensor_min_m <= sensor_max_m < 5 m");
-  require(alpha_per_m >= 0.0 && alpha_per_m < 100.0, source, "alpha_per_m",
-          "a cost weight in [0, 100) per metre");
-  require(roi_utility_threshold >= -10.0 && roi_utility_threshold <= 10.0, source,
-          "roi_utility_threshold", "a utility in [-10, 10]");
-  require(exploration_rays_x >= 1 && exploration_rays_x <= 256, source, "exploration_rays_x",
-          "1 to 256 rays");
-  require(exploration_rays_y >= 1 && exploration_rays_y <= 256, source, "exploration_rays_y",
-          "1 to 256 rays");
-  require(exploration_fov_x_deg > 0.0 && exploration_fov_x_deg < 170.0, source,
-          "exploration_fov_x_deg", "an angle in (0, 170) degrees");
-  require(exploration_box_half_m > 0.0 && exploration_box_half_m < 5.0, source,
-          "exploration_box_half_m", "a distance in (0, 5) m");
+  requireKey(roi_samples >= 0 && roi_samples <= 10'000'000, source, "roi_samples",
+             "0 to 10000000 candidates");
+  requireKey(exploration_samples >= 0 && exploration_samples <= 10'000'000, source,
+             "exploration_samples", "0 to 10000000 candidates");
+  requireKey(roi_samples + exploration_samples > 0, source, "roi_samples",
+             "non-negative sample counts, not both 0");
+  requireKey(sensor_min_m > 0.0 && sensor_max_m >= sensor_min_m && sensor_max_m < 5.0, source,
+             "sensor_max_m", "0 < sensor_min_m <= sensor_max_m < 5 m");
+  requireKey(alpha_per_m >= 0.0 && alpha_per_m < 100.0, source, "alpha_per_m",
+             "a cost weight in [0, 100) per metre");
+  requireKey(roi_utility_threshold >= -10.0 && roi_utility_threshold <= 10.0, source,
+             "roi_utility_threshold", "a utility in [-10, 10]");
+  requireKey(exploration_rays_x >= 1 && exploration_rays_x <= 256, source, "exploration_rays_x",
+             "1 to 256 rays");
+  requireKey(exploration_rays_y >= 1 && exploration_rays_y <= 256, source, "exploration_rays_y",
+             "1 to 256 rays");
+  requireKey(exploration_fov_x_deg > 0.0 && exploration_fov_x_deg < 170.0, source,
+             "exploration_fov_x_deg", "an angle in (0, 170) degrees");
+  requireKey(exploration_box_half_m > 0.0 && exploration_box_half_m < 5.0, source,
+             "exploration_box_half_m", "a distance in (0, 5) m");
 }
 
 std::string RvpConfig::toJson() const {

@@ -39,6 +39,10 @@ inline constexpr int kDefaultIkSliderSamples = 25;
 inline constexpr const char* kDefaultPlanner = "RRTConnect";
 inline constexpr double kDefaultPlanningTimeS = 1.0;
 inline constexpr double kDefaultSimplifyTimeS = 0.1;
+// About the checks planning_time_s and simplify_time_s allow at the measured rate of
+// BM_MotionPlan (docs/robot.md: validity checks per second on a 2-core AMD EPYC).
+inline constexpr std::int64_t kDefaultReproduciblePlanningChecks = 660000;
+inline constexpr std::int64_t kDefaultReproducibleSimplifyChecks = 66000;
 // A 0.01 rad joint-space step moves no point of the arm more than ~1.7 cm (levers of up to
 // ~1.2 m over seven joints), so a state between two checked ones is within ~0.85 cm of one:
 // inside the 1 cm padding, the real (unpadded) arm never touches an occupied voxel.
@@ -75,6 +79,10 @@ struct ArmConfig {
   std::string planner = kDefaultPlanner;            ///< OMPL geometric planner name
   double planning_time_s = kDefaultPlanningTimeS;
   double simplify_time_s = kDefaultSimplifyTimeS;
+  /// Reproducible planning (MotionPlanner::setReproducible, fvp run --clock fixed): the
+  /// budgets in validity checks that stand in for planning_time_s and simplify_time_s.
+  std::int64_t reproducible_planning_checks = kDefaultReproduciblePlanningChecks;
+  std::int64_t reproducible_simplify_checks = kDefaultReproducibleSimplifyChecks;
   double validity_step_rad = kDefaultValidityStepRad;  ///< joint-space step of motion checks
   // Workspace tree.
   std::int64_t workspace_samples = kDefaultWorkspaceSamples;

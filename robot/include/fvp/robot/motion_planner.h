@@ -44,15 +44,26 @@ class MotionPlanner {
   explicit MotionPlanner(const ArmCollisionChecker& checker);
 
   MotionPlan moveToPose(const JointVector& current, const Eigen::Isometry3d& T_world_camera) const;
+
+  /// From now on every query is reproducible: OMPL's sampler, planner and path simplifier
+  /// are seeded from seed and the query's number, and planning and simplification stop after
+  /// a number of validity checks (ArmConfig reproducible_*_checks) instead of a time, so the
+  /// same queries on the same map give the same paths on any machine and under any load.
+  /// For RRTConnect (the default); other OMPL planners keep their global seeding.
+  void setReproducible(std::uint64_t seed);
   /// Planning between two configurations (the goal must be valid).
   MotionPlan planToJoints(const JointVector& current, const JointVector& goal) const;
 
  private:
-  /// One OMPL query to any of `goals` (all valid) within time_s.
+  /// One OMPL query to any of `goals` (all valid) within a share of the budget (time_s, or
+  /// the same share of the reproducible check budget).
   MotionPlan plan_(const JointVector& current, const std::vector<JointVector>& goals,
-                   double time_s) const;
+                   double share) const;
 
   const ArmCollisionChecker& checker_;
+  bool reproducible_ = false;
+  std::uint64_t seed_ = 0;
+  mutable std::uint64_t queries_ = 0;  ///< OMPL queries so far (each gets its own seed)
 };
 
 }  // namespace fvp::robot

@@ -155,6 +155,12 @@ std::vector<std::string> yamlKeyNames(const std::vector<YamlKey<Config>>& keys) 
   return names;
 }
 
+/// For validate(): throws std::invalid_argument "SOURCE: key 'KEY': expected EXPECTED" unless ok.
+inline void requireKey(bool ok, const std::string& source, const char* key,
+                       const std::string& expected) {
+  if (!ok) throw std::invalid_argument(source + ": key '" + key + "': expected " + expected);
+}
+
 /// A number as an error message shows it (shortest stream form).
 inline std::string formatNumber(double value) {
   std::ostringstream out;

@@ -31,6 +31,10 @@ class ArmController {
   /// "executes" the motion. Never throws for planning failures.
   MotionPlan moveToPose(const Eigen::Isometry3d& T_world_camera);
 
+  /// Motion planning as MotionPlanner::setReproducible (fvp run --clock fixed): the same
+  /// moves on any machine and under any load.
+  void setReproducibleMotionPlanning(std::uint64_t seed) { planner_.setReproducible(seed); }
+
   const JointVector& joints() const { return joints_; }
   Eigen::Isometry3d cameraPose() const { return arm_.T_world_camera(joints_); }
   const ArmCollisionChecker& checker() const { return checker_; }
