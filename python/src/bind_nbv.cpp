@@ -58,7 +58,10 @@ class PyArm : public host::nbv::Arm {
   }
   bool reachable(const Eigen::Isometry3d& T_world_camera) const override {
     py::gil_scoped_acquire gil;
-    return method("reachable")(poseToArray(T_world_camera)).cast<bool>();
+    const py::object out = method("reachable")(poseToArray(T_world_camera));
+    // None is a forgotten return, not "unreachable".
+    if (out.is_none()) throw std::invalid_argument("fvp.Arm.reachable: expected a bool, got None");
+    return out.cast<bool>();
   }
   MoveResult moveTo(const Eigen::Isometry3d& T_world_camera) override {
     py::gil_scoped_acquire gil;
@@ -250,6 +253,7 @@ void bindNbv(py::module_& m) {
         host::nbv::NbvResult result;
         {
           py::gil_scoped_release release;
+          const std::scoped_lock lock(session.mutex, planner.mutex);
           result = loop.run(stop, hooks ? &*hooks : nullptr);
         }
         return nbvResultToDict(result);

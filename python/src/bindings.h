@@ -4,6 +4,7 @@
 #include <pybind11/pybind11.h>
 
 #include <memory>
+#include <mutex>
 #include <string>
 
 #include "fvp/accel/backend.h"
@@ -25,6 +26,10 @@ struct Session {
   std::unique_ptr<accel::Backend> backend;
   std::string engine;
   std::unique_ptr<host::MappingSession> session;
+  /// Python threads may share a session. Every call locks it after releasing the GIL: a
+  /// lock taken while holding the GIL could deadlock against a loop that calls back into
+  /// Python while holding it.
+  mutable std::mutex mutex;
 };
 
 /// fvp.Planner: a registered planner with the backend its kernels run on.
@@ -33,6 +38,7 @@ struct Planner {
           const std::string& backend_name);
   std::unique_ptr<accel::Backend> backend;
   std::unique_ptr<host::planner::ViewPlanner> planner;
+  std::mutex mutex;  ///< as Session::mutex
 };
 
 void bindNbv(py::module_& m);  ///< Camera, Arm, StopCondition, run_nbv

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 
 #include "fvp/host/core/input_checks.h"
@@ -18,10 +19,26 @@ py::array_t<T, py::array::c_style | py::array::forcecast> asArray(const py::hand
   return array;
 }
 
+/// Image data must already have one of the numpy kinds given ('u' unsigned, 'i' signed,
+/// 'b' bool, 'f' float; itemsize 1 when only_bytes): a float image in 0..1 or a uint16 one
+/// would otherwise be cast silently into nonsense.
+void requireKind(const py::handle& object, const std::string& kinds, bool only_bytes,
+                 const std::string& what, const std::string& expected) {
+  const py::array array = py::array::ensure(object);
+  if (!array) throw std::invalid_argument(what + ": expected " + expected);
+  const py::dtype dtype = array.dtype();
+  if (kinds.find(dtype.kind()) == std::string::npos || (only_bytes && dtype.itemsize() != 1))
+    throw std::invalid_argument(what + ": expected " + expected + ", got dtype " +
+                                std::string(py::str(static_cast<const py::handle&>(dtype))));
+}
+
+/// Wildcard sides (-1) must be 1 .. INT_MAX (an OpenCV image side).
 void requireShape(const py::array& array, std::vector<py::ssize_t> shape, const std::string& what) {
   bool ok = array.ndim() == py::ssize_t(shape.size());
-  for (std::size_t i = 0; ok && i < shape.size(); ++i)
-    ok = shape[i] < 0 || array.shape(py::ssize_t(i)) == shape[i];
+  for (std::size_t i = 0; ok && i < shape.size(); ++i) {
+    const py::ssize_t side = array.shape(py::ssize_t(i));
+    ok = shape[i] < 0 ? side >= 1 && side <= std::numeric_limits<int>::max() : side == shape[i];
+  }
   if (ok) return;
   std::string expected = "(", got = "(";
   for (std::size_t i = 0; i < shape.size(); ++i)
@@ -71,6 +88,7 @@ py::array_t<double> vectorToArray(const Eigen::Vector3d& v) {
 }
 
 cv::Mat bgrFromArray(const py::handle& object, const std::string& what) {
+  if (!object.is_none()) requireKind(object, "u", true, what, "a uint8 BGR image");
   const auto array = asArray<std::uint8_t>(object, what);
   requireShape(array, {-1, -1, 3}, what);
   cv::Mat image(int(array.shape(0)), int(array.shape(1)), CV_8UC3);
@@ -79,6 +97,7 @@ cv::Mat bgrFromArray(const py::handle& object, const std::string& what) {
 }
 
 cv::Mat maskFromArray(const py::handle& object, const std::string& what) {
+  if (!object.is_none()) requireKind(object, "uib", false, what, "an integer or bool mask");
   const auto array = asArray<std::int64_t>(object, what);
   requireShape(array, {-1, -1}, what);
   cv::Mat mask(int(array.shape(0)), int(array.shape(1)), CV_8U);
@@ -88,6 +107,7 @@ cv::Mat maskFromArray(const py::handle& object, const std::string& what) {
 }
 
 cv::Mat floatImageFromArray(const py::handle& object, const std::string& what) {
+  if (!object.is_none()) requireKind(object, "fui", false, what, "a disparity image (numbers)");
   const auto array = asArray<float>(object, what);
   requireShape(array, {-1, -1}, what);
   cv::Mat image(int(array.shape(0)), int(array.shape(1)), CV_32F);

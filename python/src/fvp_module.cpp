@@ -246,18 +246,30 @@ PYBIND11_MODULE(fvp, m) {
             host::ViewResult v;
             {
               py::gil_scoped_release release;
+              const std::lock_guard lock(s.mutex);
               v = s.session->addView(frame);
             }
             return viewResultToDict(v);
           },
           py::arg("frame"), "Perceives a frame and integrates it; returns what the view did.")
-      .def_property_readonly("views", [](const Session& s) { return s.session->views().size(); })
+      .def_property_readonly("views",
+                             [](const Session& s) {
+                               py::gil_scoped_release release;
+                               const std::lock_guard lock(s.mutex);
+                               return s.session->views().size();
+                             })
       .def_property_readonly("region",
                              [](const Session& s) -> py::object {
-                               if (!s.session->region()) return py::none();
+                               std::optional<host::ClusterRegion> region;
+                               {
+                                 py::gil_scoped_release release;
+                                 const std::lock_guard lock(s.mutex);
+                                 region = s.session->region();
+                               }
+                               if (!region) return py::none();
                                py::dict d;
-                               d["center_m"] = vectorToArray(s.session->region()->center_m());
-                               d["radius_m"] = s.session->region()->radius_m();
+                               d["center_m"] = vectorToArray(region->center_m());
+                               d["radius_m"] = region->radius_m();
                                return d;
                              })
       .def_property_readonly(
@@ -265,7 +277,15 @@ PYBIND11_MODULE(fvp, m) {
           py::return_value_policy::reference_internal)
       .def(
           "surface_points",
-          [](const Session& s) { return pointsToArray(s.session->surfacePoints()); },
+          [](const Session& s) {
+            std::vector<Eigen::Vector3f> points;
+            {
+              py::gil_scoped_release release;
+              const std::lock_guard lock(s.mutex);
+              points = s.session->surfacePoints();
+            }
+            return pointsToArray(points);
+          },
           "The TSDF's surface points, (N, 3) float32, metres.")
       .def(
           "size_fruitlets",
@@ -275,6 +295,7 @@ PYBIND11_MODULE(fvp, m) {
             host::sizing::SizingResult sized;
             {
               py::gil_scoped_release release;
+              const std::lock_guard lock(s.mutex);
               sized = s.session->sizeFruitlets(config);
             }
             py::dict out = jsonToPython(host::eval::sizingDetails(sized));
@@ -300,19 +321,26 @@ PYBIND11_MODULE(fvp, m) {
           "next_best_view",
           [](Planner& p, Session& s, const py::handle& T_now,
              const std::function<bool(py::array_t<double>)>& reachable) {
-            host::map::MapEngine& map = requireMap(s, "next_best_view");
             const Eigen::Isometry3d T = poseFromArray(T_now, "next_best_view T_world_camera");
             std::optional<Eigen::Isometry3d> chosen;
-            // The robot makes the move: the best candidate is taken.
-            const host::planner::PlanStep step = p.planner->planAndMove(
-                map, T,
-                [&](const Eigen::Isometry3d& pose) {
-                  return reachable ? reachable(poseToArray(pose)) : true;
-                },
-                [&](const Eigen::Isometry3d& pose) {
-                  chosen = pose;
-                  return true;
-                });
+            host::planner::PlanStep step;
+            {
+              py::gil_scoped_release release;
+              const std::scoped_lock lock(p.mutex, s.mutex);
+              host::map::MapEngine& map = requireMap(s, "next_best_view");
+              // The robot makes the move: the best candidate is taken.
+              step = p.planner->planAndMove(
+                  map, T,
+                  [&](const Eigen::Isometry3d& pose) {
+                    if (!reachable) return true;
+                    py::gil_scoped_acquire gil;
+                    return reachable(poseToArray(pose));
+                  },
+                  [&](const Eigen::Isometry3d& pose) {
+                    chosen = pose;
+                    return true;
+                  });
+            }
             py::dict d;
             d["T_world_camera"] = chosen ? py::object(poseToArray(*chosen)) : py::none();
             d["chosen"] = step.chosen ? py::object(py::int_(*step.chosen)) : py::none();
@@ -331,7 +359,6 @@ PYBIND11_MODULE(fvp, m) {
       "info_gain",
       [](Session& s, const py::handle& poses, const py::handle& targets, const std::string& mode,
          double max_d_m, const std::string& backend_name) {
-        host::map::MapEngine& map = requireMap(s, "info_gain");
         auto P = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(poses);
         auto X = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(targets);
         if (!P || P.ndim() != 3 || P.shape(1) != 4 || P.shape(2) != 4)
@@ -355,6 +382,8 @@ PYBIND11_MODULE(fvp, m) {
         std::vector<host::planner::GainResult> gains;
         {
           py::gil_scoped_release release;
+          const std::lock_guard lock(s.mutex);
+          host::map::MapEngine& map = requireMap(s, "info_gain");
           host::planner::InfoGainEvaluator evaluator(config, backend.get());
           evaluator.refresh(map);
           gains = evaluator.evaluate(queries);

@@ -85,6 +85,13 @@ def test_bad_input_names_the_argument(seed2_frames):
     f = seed2_frames[0]
     with pytest.raises(ValueError, match="left"):
         fvp.StereoFrame(np.zeros((10, 10, 3), np.uint8), f.right, f.intrinsics, f.T_world_camera)
+    with pytest.raises(ValueError, match="left: expected a uint8 BGR image, got dtype float32"):
+        fvp.StereoFrame((f.left / 255.0).astype(np.float32), f.right, f.intrinsics,
+                        f.T_world_camera)
+    with pytest.raises(ValueError, match="right: expected shape"):
+        fvp.StereoFrame(f.left, np.zeros((0, 4, 3), np.uint8), f.intrinsics, f.T_world_camera)
+    with pytest.raises(ValueError, match="fruitlet_mask: expected an integer or bool mask"):
+        numpy_frame(f, fruitlet_mask=np.full(f.left.shape[:2], 0.5))
     bad_pose = np.array(f.T_world_camera)
     bad_pose[:3, :3] *= 2.0
     with pytest.raises(ValueError, match="T_world_camera"):

@@ -127,7 +127,9 @@ class SeededRRTConnect : public og::RRTConnect {
 };
 class SeededPathSimplifier : public og::PathSimplifier {
  public:
-  SeededPathSimplifier(const ob::SpaceInformationPtr& si, std::uint32_t seed) : PathSimplifier(si) {
+  SeededPathSimplifier(const ob::SpaceInformationPtr& si, const ob::GoalPtr& goal,
+                       std::uint32_t seed)
+      : PathSimplifier(si, goal) {
     rng_.setLocalSeed(seed);
   }
 };
@@ -287,9 +289,14 @@ MotionPlan MotionPlanner::plan_(const JointVector& current, const std::vector<Jo
   }
   og::PathGeometric& path = setup.getSolutionPath();
   if (reproducible_) {
-    if (config.reproducible_simplify_checks > 0)
-      SeededPathSimplifier(si, seed).simplify(path,
-                                              checksBudget(config.reproducible_simplify_checks));
+    if (config.reproducible_simplify_checks > 0) {
+      // As SimpleSetup::simplifySolution: with the goal (it may move the end to a nearer goal
+      // state), and a simplification that cannot be checked valid is not taken.
+      const og::PathGeometric planned = path;
+      if (!SeededPathSimplifier(si, setup.getProblemDefinition()->getGoal(), seed)
+               .simplify(path, checksBudget(config.reproducible_simplify_checks)))
+        path = planned;
+    }
   } else if (config.simplify_time_s > 0.0) {
     setup.simplifySolution(config.simplify_time_s);
   }

@@ -1,6 +1,7 @@
 // Parameters of the arm (docs/design.md section 7): the slider's placement relative to the
 // simulated tree, the UR5's limits, the hand-eye transform, collision geometry, motion
-// planning, the workspace tree and the simulated clock. Every field is a YAML key of the
+// planning (and its reproducible budgets) and the workspace tree; the simulated clock is the
+// simulator's (robot/sim/sim_clock.h). Every field is a YAML key of the
 // same name, documented in robot/config/arm_default.yaml and docs/robot.md.
 #pragma once
 
