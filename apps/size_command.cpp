@@ -42,8 +42,7 @@ void addSizeCommand(CLI::App& app) {
     if (host::map::mapEngineNeedsBackend(opt->engine)) backend = accel::createBackend(opt->backend);
     host::CaptureSizingOptions o;
     o.perception = perception;
-    o.estimator = opt->sizing == "paper" ? host::sizing::SizingEstimator::kPaper
-                                         : host::sizing::SizingEstimator::kOurs;
+    o.estimator = host::sizing::parseSizingEstimator(opt->sizing);
     o.engine = opt->engine;
     o.out_dir = opt->out;
     o.on_warning = [](const std::string& text) { std::cerr << "fvp: warning: " << text << "\n"; };

@@ -27,9 +27,15 @@ std::unique_ptr<accel::Backend> backendFor(const std::string& name, const std::s
                                   "' needs a compute backend");
     return nullptr;
   }
-  if (name == "auto" && !host::map::mapEngineNeedsBackend(engine)) return nullptr;
-  return accel::createBackend(name);
+  return host::map::createBackendFor(engine, name);
 }
+
+namespace {
+/// "none" (the planner's kernels on the host), else the named backend.
+std::unique_ptr<accel::Backend> backendOrNone(const std::string& name) {
+  return name == "none" ? nullptr : accel::createBackend(name);
+}
+}  // namespace
 
 Session::Session(const host::PerceptionConfig& perception, const std::string& engine_name,
                  const std::string& backend_name, const std::string& planner, bool tsdf)
@@ -41,7 +47,7 @@ Session::Session(const host::PerceptionConfig& perception, const std::string& en
 
 Planner::Planner(const std::string& name, const std::string& config_yaml, std::uint64_t seed,
                  const std::string& backend_name)
-    : backend(backend_name == "none" ? nullptr : accel::createBackend(backend_name)) {
+    : backend(backendOrNone(backend_name)) {
   planner = host::planner::createPlanner(name, config_yaml, seed, backend.get());
 }
 
@@ -97,19 +103,6 @@ py::dict candidatesToDict(const std::vector<host::planner::Candidate>& candidate
   return d;
 }
 
-host::planner::GainMode gainMode(const std::string& mode) {
-  if (mode == "single_ray") return host::planner::GainMode::kSingleRay;
-  if (mode == "frustum") return host::planner::GainMode::kFrustum;
-  throw std::invalid_argument("info_gain: mode: expected single_ray or frustum, got '" + mode +
-                              "'");
-}
-
-host::sizing::SizingEstimator estimatorFor(const std::string& name) {
-  if (name == "ours") return host::sizing::SizingEstimator::kOurs;
-  if (name == "paper") return host::sizing::SizingEstimator::kPaper;
-  throw std::invalid_argument("estimator: expected ours or paper, got '" + name + "'");
-}
-
 }  // namespace
 
 }  // namespace fvp::python
@@ -118,14 +111,6 @@ PYBIND11_MODULE(fvp, m) {
   using namespace fvp;
   using namespace fvp::python;
   m.doc() = "fvp: fruitlet sizing with next-best-view planning (docs/python.md)";
-
-  py::register_exception_translator([](std::exception_ptr p) {
-    try {
-      if (p) std::rethrow_exception(p);
-    } catch (const std::invalid_argument& e) {
-      PyErr_SetString(PyExc_ValueError, e.what());
-    }
-  });
 
   m.def(
       "planners", [] { return host::planner::PlannerRegistry::instance().names(); },
@@ -184,19 +169,7 @@ PYBIND11_MODULE(fvp, m) {
                f.fruitlet_mask = maskFromArray(fruitlet_mask, "StereoFrame fruitlet_mask");
              if (!disparity_px.is_none())
                f.disparity_px = floatImageFromArray(disparity_px, "StereoFrame disparity_px");
-             const cv::Size size(intrinsics.width_px, intrinsics.height_px);
-             const auto check = [&](const cv::Mat& image, const char* name) {
-               if (!image.empty() && image.size() != size)
-                 throw std::invalid_argument(
-                     std::string("StereoFrame ") + name + ": expected " +
-                     std::to_string(size.height) + " x " + std::to_string(size.width) +
-                     " pixels (the intrinsics'), got " + std::to_string(image.rows) + " x " +
-                     std::to_string(image.cols));
-             };
-             check(f.left_bgr, "left");
-             check(f.right_bgr, "right");
-             check(f.fruitlet_mask, "fruitlet_mask");
-             check(f.disparity_px, "disparity_px");
+             host::checkStereoFrame(f, "StereoFrame");
              return f;
            }),
            py::arg("left"), py::arg("right"), py::arg("intrinsics"), py::arg("T_world_camera"),
@@ -291,7 +264,7 @@ PYBIND11_MODULE(fvp, m) {
           "size_fruitlets",
           [](const Session& s, const std::string& estimator) {
             host::sizing::SizingConfig config;
-            config.estimator = estimatorFor(estimator);
+            config.estimator = host::sizing::parseSizingEstimator(estimator);
             host::sizing::SizingResult sized;
             {
               py::gil_scoped_release release;
@@ -374,11 +347,10 @@ PYBIND11_MODULE(fvp, m) {
               py::array_t<double>(3, X.data(i, 0)), "info_gain targets[" + std::to_string(i) + "]");
         }
         host::planner::InfoGainConfig config;
-        config.mode = gainMode(mode);
+        config.mode = host::planner::parseGainMode(mode);
         config.max_d_m = max_d_m;
         config.validate();
-        const std::unique_ptr<accel::Backend> backend =
-            backend_name == "none" ? nullptr : accel::createBackend(backend_name);
+        const std::unique_ptr<accel::Backend> backend = backendOrNone(backend_name);
         std::vector<host::planner::GainResult> gains;
         {
           py::gil_scoped_release release;
@@ -403,7 +375,7 @@ PYBIND11_MODULE(fvp, m) {
          const std::string& estimator, const std::string& engine, const std::string& backend_name) {
         host::CaptureSizingOptions options;
         if (!config.empty()) options.perception = host::PerceptionConfig::fromYamlFile(config);
-        options.estimator = estimatorFor(estimator);
+        options.estimator = host::sizing::parseSizingEstimator(estimator);
         options.engine = engine;
         options.out_dir = out_dir;
         const std::unique_ptr<accel::Backend> backend = backendFor(backend_name, engine);

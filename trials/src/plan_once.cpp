@@ -60,9 +60,7 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
   std::vector<std::filesystem::path> capture_dirs;
   if (from_captures) capture_dirs = host::listCaptures(o.captures_dir);
 
-  std::unique_ptr<accel::Backend> backend;
-  if (host::map::mapEngineNeedsBackend(engine) || o.backend != "auto")
-    backend = accel::createBackend(o.backend);
+  const std::unique_ptr<accel::Backend> backend = host::map::createBackendFor(engine, o.backend);
   const std::unique_ptr<host::planner::ViewPlanner> planner =
       host::planner::createPlanner(o.planner, o.planner_config, o.seed, backend.get());
   const host::map::MapConfig map_config = host::planner::plannerMapConfig(o.planner, engine);

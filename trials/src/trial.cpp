@@ -129,8 +129,7 @@ struct Trial::Impl {
 
     // Maps (and TSDF) fed view by view, the planner, and the sizing at the end. First: a
     // missing backend or a bad planner config fails before the world and the arm are built.
-    if (host::map::mapEngineNeedsBackend(engine) || options.backend != "auto")
-      backend = accel::createBackend(options.backend);
+    backend = host::map::createBackendFor(engine, options.backend);
     parts = std::make_unique<TrialParts>(options, engine, backend.get());
 
     // The world and the simulated camera.

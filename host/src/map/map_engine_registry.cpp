@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "fvp/accel/backend.h"
+
 #include "fvp/host/map/grid_map_engine.h"
 #include "fvp/host/map/octomap_map_engine.h"
 
@@ -31,6 +33,12 @@ void MapEngineRegistry::add(MapEngineEntry entry) {
 
 bool mapEngineNeedsBackend(std::string_view engine) {
   return MapEngineRegistry::instance().at(engine).needs_backend;
+}
+
+std::unique_ptr<accel::Backend> createBackendFor(std::string_view engine,
+                                                 std::string_view backend_name) {
+  if (!mapEngineNeedsBackend(engine) && backend_name == "auto") return nullptr;
+  return accel::createBackend(backend_name);
 }
 
 }  // namespace fvp::host::map

@@ -35,26 +35,33 @@ PerceptionPipeline::PerceptionPipeline(PerceptionConfig config)
       tag_detector_(config_.tag),
       projector_(config_.projection) {}
 
+void checkStereoFrame(const StereoFrame& frame, const std::string& source) {
+  const StereoIntrinsics& K = frame.intrinsics;
+  checkIntrinsics(K, source + ": camera model");
+  checkPose(frame.T_world_camera, source, "T_world_camera");
+  const cv::Size size(K.width_px, K.height_px);
+  const auto check = [&](const cv::Mat& image, const char* field, int type, const char* kind,
+                         bool required) {
+    if (image.empty() ? !required : image.size() == size && image.type() == type) return;
+    throw std::invalid_argument(
+        source + ": " + field + ": expected a " + kind + " image of " +
+        std::to_string(size.height) + " x " + std::to_string(size.width) +
+        " pixels (the intrinsics'), got " +
+        (image.empty() ? std::string("none")
+                       : std::to_string(image.rows) + " x " + std::to_string(image.cols)));
+  };
+  check(frame.left_bgr, "left", CV_8UC3, "BGR", true);
+  check(frame.right_bgr, "right", CV_8UC3, "BGR", false);
+  check(frame.fruitlet_mask, "fruitlet_mask", CV_8UC1, "CV_8U mask", false);
+  check(frame.disparity_px, "disparity_px", CV_32FC1, "CV_32F disparity", false);
+}
+
 PerceptionResult PerceptionPipeline::process(
     const StereoFrame& frame, const std::optional<ClusterRegion>& known_region) const {
+  checkStereoFrame(frame, "stereo frame");
   const StereoIntrinsics& K = frame.intrinsics;
-  checkIntrinsics(K, "stereo frame: camera model");
-  checkPose(frame.T_world_camera, "stereo frame", "T_world_camera");
-  if (frame.left_bgr.empty() || frame.left_bgr.cols != K.width_px ||
-      frame.left_bgr.rows != K.height_px)
-    throw std::invalid_argument("PerceptionPipeline: left image does not match the intrinsics");
   PerceptionResult result;
   PerceptionStats timing;
-
-  const cv::Size size(K.width_px, K.height_px);
-  if (!frame.fruitlet_mask.empty() &&
-      (frame.fruitlet_mask.size() != size || frame.fruitlet_mask.type() != CV_8UC1))
-    throw std::invalid_argument(
-        "PerceptionPipeline: the frame's fruitlet_mask must be CV_8UC1 of the image size");
-  if (!frame.disparity_px.empty() &&
-      (frame.disparity_px.size() != size || frame.disparity_px.type() != CV_32FC1))
-    throw std::invalid_argument(
-        "PerceptionPipeline: the frame's disparity_px must be CV_32FC1 of the image size");
 
   auto t0 = std::chrono::steady_clock::now();
   if (!frame.fruitlet_mask.empty())

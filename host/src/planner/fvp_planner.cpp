@@ -29,7 +29,7 @@ InfoGainConfig gainConfig(const PlannerConfig& config) {
   config.validate();
   InfoGainConfig g;
   g.max_d_m = config.max_d_m;
-  g.mode = config.gain_mode == "frustum" ? GainMode::kFrustum : GainMode::kSingleRay;
+  g.mode = parseGainMode(config.gain_mode);
   g.frustum_rays_x = config.frustum_rays_x;
   g.frustum_rays_y = config.frustum_rays_y;
   g.embree_cull = config.embree_cull;

@@ -11,6 +11,13 @@
 #include "fvp/host/map/occupied_voxel_scene.h"
 
 namespace fvp::host::planner {
+
+GainMode parseGainMode(std::string_view name) {
+  if (name == "single_ray") return GainMode::kSingleRay;
+  if (name == "frustum") return GainMode::kFrustum;
+  throw std::invalid_argument("gain mode: expected single_ray or frustum, got '" +
+                              std::string(name) + "'");
+}
 namespace {
 
 // Parameter of the first intersection of origin + t (end - origin), t in [0, 1], with the

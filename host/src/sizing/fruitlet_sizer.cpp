@@ -51,6 +51,13 @@ const char* toString(SizingEstimator estimator) {
   return estimator == SizingEstimator::kOurs ? "ours" : "paper";
 }
 
+SizingEstimator parseSizingEstimator(std::string_view name) {
+  if (name == "ours") return SizingEstimator::kOurs;
+  if (name == "paper") return SizingEstimator::kPaper;
+  throw std::invalid_argument("sizing estimator: expected ours or paper, got '" +
+                              std::string(name) + "'");
+}
+
 const char* toString(SizeSource source) {
   switch (source) {
     case SizeSource::kWellSeenImages:

@@ -387,7 +387,7 @@ RenderedView StereoRenderer::renderWithGroundTruth(const Eigen::Isometry3d& T_wo
     for (int v = 0; v < depth.rows; ++v)
       for (int u = 0; u < depth.cols; ++u)
         if (const float z = depth.at<float>(v, u); z > 0.0f)
-          view.frame.disparity_px.at<float>(v, u) = static_cast<float>(K.fx_px * K.baseline_m / z);
+          view.frame.disparity_px.at<float>(v, u) = static_cast<float>(K.disparityFromDepth(z));
   }
   return view;
 }

@@ -36,6 +36,8 @@ struct StereoIntrinsics {
   }
   /// Depth of a disparity (rectified pair): z = fx * b / d.
   double depthFromDisparity(double disparity_px) const { return fx_px * baseline_m / disparity_px; }
+  /// Its inverse: d = fx * b / z.
+  double disparityFromDepth(double depth_m) const { return fx_px * baseline_m / depth_m; }
 };
 
 }  // namespace fvp::host

@@ -44,5 +44,9 @@ class MapEngineRegistry : public NamedRegistry<MapEngineEntry> {
 
 /// Whether the named engine needs a compute backend (throws for an unknown name).
 bool mapEngineNeedsBackend(std::string_view engine);
+/// The backend a run on this engine uses: backend_name ("cpu", "opencl", "vulkan", "auto")
+/// when the engine needs one or a backend is named (not "auto"), else none (null).
+std::unique_ptr<accel::Backend> createBackendFor(std::string_view engine,
+                                                 std::string_view backend_name);
 
 }  // namespace fvp::host::map

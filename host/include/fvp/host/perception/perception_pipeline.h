@@ -43,6 +43,12 @@ struct PerceptionResult {
   std::optional<ClusterRegion> region;  ///< the one used (given or from the tag)
 };
 
+/// What PerceptionPipeline::process requires of a frame (any source: a robot's driver, the
+/// Python module, the simulator): a valid camera model and pose, a left image of the
+/// intrinsics' size, and a right image, mask and disparity of that size where present (the
+/// mask CV_8U, the disparity CV_32F). Throws std::invalid_argument "SOURCE: FIELD: ...".
+void checkStereoFrame(const StereoFrame& frame, const std::string& source);
+
 class PerceptionPipeline {
  public:
   explicit PerceptionPipeline(PerceptionConfig config = {});

@@ -31,6 +31,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include "fvp/accel/kernel_types.h"
@@ -49,6 +50,8 @@ class OccupiedVoxelScene;
 namespace fvp::host::planner {
 
 enum class GainMode { kSingleRay, kFrustum };
+/// "single_ray" or "frustum" (planner configs' gain_mode); throws std::invalid_argument.
+GainMode parseGainMode(std::string_view name);
 
 // The simulated camera: 1440 x 1080 px at fx = fy = 1100 px.
 inline constexpr double kDefaultFovXRad = 1.1632;  // 2 atan(720 / 1100)

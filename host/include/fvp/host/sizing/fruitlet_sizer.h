@@ -22,6 +22,7 @@
 #include <functional>
 #include <opencv2/core.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "fvp/host/core/stereo_intrinsics.h"
@@ -31,6 +32,8 @@ namespace fvp::host::sizing {
 
 enum class SizingEstimator { kOurs, kPaper };
 const char* toString(SizingEstimator estimator);
+/// "ours" or "paper"; throws std::invalid_argument otherwise.
+SizingEstimator parseSizingEstimator(std::string_view name);
 
 /// One captured image as sizing needs it.
 struct SizingView {
