@@ -45,6 +45,12 @@ void addExperimentCommands(CLI::App& app) {
   cmd->add_option("--engine", opt->experiment.trial.engine,
                   "map engine for every planner (default: each planner's own)")
       ->check(CLI::IsMember(host::map::MapEngineRegistry::instance().names()));
+  cmd->add_option(
+         "--stop", opt->experiment.trial.stop,
+         "budget: run the whole budget (the paper) | auto: stop once the cluster's sizes have "
+         "settled, the budget being the cap")
+      ->check(CLI::IsMember({"budget", "auto"}))
+      ->capture_default_str();
   cmd->add_option("--clock", opt->experiment.trial.clock, "wall | fixed")
       ->check(CLI::IsMember({"wall", "fixed"}))
       ->capture_default_str();

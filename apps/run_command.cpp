@@ -45,6 +45,12 @@ void addRunCommand(CLI::App& app) {
       ->check(CLI::IsMember(host::map::MapEngineRegistry::instance().names()));
   cmd->add_option("--max-views", opt->max_views, "stop after this many views (0: no limit)")
       ->check(decimalUnsigned());
+  cmd->add_option(
+         "--stop", opt->trial.stop,
+         "budget: run the whole budget (the paper) | auto: stop once the cluster's sizes have "
+         "settled, the budget being the cap")
+      ->check(CLI::IsMember({"budget", "auto"}))
+      ->capture_default_str();
   cmd->add_option("--clock", opt->trial.clock,
                   "simulated clock: wall (charge measured compute time) | fixed (a constant)")
       ->check(CLI::IsMember({"wall", "fixed"}))

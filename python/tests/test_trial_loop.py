@@ -98,6 +98,25 @@ def test_run_trial_is_fvp_run_as_a_function():
     assert "fruitlets" in result and "metrics" in result
 
 
+def test_run_trial_with_the_automatic_stop_records_each_sizing():
+    result = fvp.run_trial(seed=SEED, clock="fixed", stop="auto", max_views=3, backend="cpu")
+    assert result["stop"]["rule"] == "auto"
+    assert result["stop"]["size_tolerance_mm"] > 0
+    history = result["size_history"]
+    # One sizing per view once the tag placed the region; the last is the trial's own sizing.
+    assert 1 <= len(history) <= result["views"]
+    assert [h["view"] for h in history] == sorted(h["view"] for h in history)
+    last = sorted(f["size_mm"] for f in history[-1]["fruitlets"])
+    final = sorted(f["size_mm"] for f in result["sized_fruitlets"])
+    assert np.allclose(last, final)
+    try:
+        fvp.run_trial(seed=SEED, clock="fixed", stop="never", max_views=1, backend="cpu")
+    except ValueError as e:
+        assert "stop" in str(e)
+    else:
+        raise AssertionError("an unknown stop rule must be refused")
+
+
 def test_a_trial_runs_once():
     trial = fvp.sim.Trial(seed=SEED, clock="fixed", max_views=1, backend="cpu")
     trial.run()

@@ -327,6 +327,9 @@ TEST(Experiment, ResumeWithAChangedSettingIsRefusedNamingIt) {
   const std::string clock = refused([](auto& r) { r.trial.clock = "fixed"; });
   EXPECT_NE(clock.find("clock wall, this run asks for fixed"), std::string::npos) << clock;
   EXPECT_NE(refused([](auto& r) { r.trial.max_views = 3; }).find("max_views"), std::string::npos);
+  const std::string stop = refused([](auto& r) { r.trial.stop = "auto"; });
+  EXPECT_NE(stop.find("stop budget, this run asks for auto"), std::string::npos) << stop;
+  EXPECT_EQ(manifest["stop"], "budget");
   EXPECT_NE(refused([](auto& r) {
               r.trial.engine = "octomap";
             }).find("engine (each planner's own), this run asks for octomap"),
@@ -497,8 +500,18 @@ TEST(Experiment, SchemaErrorsNameTheFileTheLineAndTheField) {
   }
   // The unmatched fruitlet's est_size_mm is null in a real trial: fine.
   EXPECT_EQ(errorFor(with("/fruitlets/1/est_size_mm", nullptr)), "");
-  // A run's manifest is read as strictly.
+  // A run's manifest is read as strictly; one written before --stop existed ran on the budget.
   nlohmann::json manifest = nlohmann::json::parse(slurp(out / "manifest.json"));
+  manifest.erase("stop");
+  writeText(out / "manifest.json", manifest.dump());
+  EXPECT_EQ(readManifest(out / "manifest.json").stop, "budget");
+  manifest["stop"] = "never";
+  writeText(out / "manifest.json", manifest.dump());
+  EXPECT_NE(errorOf([&] {
+              readManifest(out / "manifest.json");
+            }).find("manifest.json: field 'stop': expected \"budget\" or \"auto\""),
+            std::string::npos);
+  manifest["stop"] = "budget";
   manifest["budget_s"] = "x";
   writeText(out / "manifest.json", manifest.dump());
   EXPECT_NE(errorOf([&] {

@@ -195,6 +195,49 @@ TEST(Sizing, Eq4OnAnIdealSphereViewPaperShortOursClose) {
   EXPECT_EQ(f.per_image.size(), 2u);
 }
 
+// The support rule (docs/sizing.md): a fragment split off a fruitlet's surface (here a
+// small patch behind it, where mask pixels bled onto a leaf) falls on the fruitlet's segment
+// and would be sized as large as the fruitlet, but shows a few percent of the surface that
+// size implies; the fruitlet's own TSDF surface, from a single view, more than the quarter
+// asked.
+TEST(Sizing, SupportRuleDropsAFragmentAndKeepsTheFruitlet) {
+  const Eigen::Vector3d c(0.0, 0.0, 0.3);
+  const double r = 0.005;
+  const SphereView v = renderSphere(c, r);
+  tsdf::TsdfVolume volume({}, Eigen::AlignedBox3d(c.array() - 0.03, c.array() + 0.03));
+  volume.integrate(v.depth, v.mask, v.in, Eigen::Isometry3d::Identity());
+  std::vector<Eigen::Vector3f> pts = volume.extractSurfacePoints();
+  const std::size_t sphere_points = pts.size();
+  // 81 points on a 2.4 mm square 15 mm behind the centre, on the optical axis: DBSCAN's
+  // 2 mm cannot join it to the sphere.
+  for (int i = 0; i < 9; ++i)
+    for (int j = 0; j < 9; ++j)
+      pts.emplace_back(float(0.0003 * (i - 4)), float(0.0003 * (j - 4)), 0.315f);
+  const sizing::SizingView view{v.mask, v.disparity, v.in, Eigen::Isometry3d::Identity()};
+  sizing::SizingConfig config;
+  const auto kept = sizing::sizeFruitlets({view, view}, pts, nullptr, config);
+  ASSERT_EQ(kept.fruitlets.size(), 1u);
+  ASSERT_EQ(kept.unsupported.size(), 1u);
+  EXPECT_EQ(kept.events.unsupported_detections, 1u);
+  const auto& fruitlet = kept.fruitlets[0];
+  EXPECT_LT((fruitlet.sphere_center_m - c).norm(), 3e-4);
+  // One view of an unoccluded sphere shows 0.7 of its near hemisphere (the grazing rim gives
+  // no depth): 0.35 of the sphere against the quarter asked.
+  EXPECT_GT(double(fruitlet.points), 1.3 * fruitlet.support.required_points);
+  EXPECT_GE(fruitlet.points, sphere_points * 9 / 10);
+  const auto& fragment = kept.unsupported[0];
+  EXPECT_EQ(fragment.points, 81u);
+  // Sized off the fruitlet's segment in both images, which it shares.
+  EXPECT_NEAR(fragment.size_ours_mm, fruitlet.size_ours_mm, 0.5);
+  EXPECT_EQ(fragment.support.own_segment_images, 0);
+  EXPECT_LT(double(fragment.points), 0.25 * fragment.support.required_points);
+  // Without the rule the fragment is a second fruitlet: the rule is what drops it.
+  config.min_support_area_fraction = 0.0;
+  const auto all = sizing::sizeFruitlets({view, view}, pts, nullptr, config);
+  EXPECT_EQ(all.fruitlets.size(), 2u);
+  EXPECT_TRUE(all.unsupported.empty());
+}
+
 TEST(Sizing, EmptyInputsAreCountedNotErrors) {
   sizing::SizingConfig config;
   const auto empty = sizing::sizeFruitlets({}, {}, nullptr, config);

@@ -229,6 +229,7 @@ nlohmann::ordered_json ExperimentManifest::toJson() const {
   j["kind"] = kind;
   j["budget_s"] = budget_s;
   j["clock"] = clock;
+  j["stop"] = stop;
   j["max_views"] = max_views;
   j["world_config"] = configJson(world_config);
   j["planner_config"] = configJson(planner_config);
@@ -277,6 +278,12 @@ ExperimentManifest readManifest(const std::filesystem::path& path) {
     fieldError(where, "budget_s", "a finite positive number", &budget);
   m.budget_s = budget.get<double>();
   m.clock = readString(j, "clock", where);
+  // Manifests written before the automatic stop existed ran on the budget alone.
+  if (member(j, "stop")) {
+    m.stop = readString(j, "stop", where);
+    if (m.stop != "budget" && m.stop != "auto")
+      fieldError(where, "stop", "\"budget\" or \"auto\"", &j["stop"]);
+  }
   m.max_views =
       int(readUnsigned(j, "max_views", where, INT_MAX, "a non-negative integer (0: no limit)"));
   m.world_config = readConfig(j, "world_config", where);
@@ -326,6 +333,7 @@ std::optional<ManifestDifference> mergeDifference(const ExperimentManifest& a,
     return ManifestDifference{"budget_s", nlohmann::json(a.budget_s).dump(),
                               nlohmann::json(b.budget_s).dump()};
   if (a.clock != b.clock) return ManifestDifference{"clock", a.clock, b.clock};
+  if (a.stop != b.stop) return ManifestDifference{"stop", a.stop, b.stop};
   if (a.max_views != b.max_views)
     return ManifestDifference{"max_views", shownMaxViews(a.max_views), shownMaxViews(b.max_views)};
   if (a.world_config.fnv1a64 != b.world_config.fnv1a64)

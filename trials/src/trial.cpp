@@ -9,6 +9,7 @@
 #include <memory>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -16,7 +17,10 @@
 #include "fvp/accel/backend.h"
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/host/core/output_directory.h"
+#include "fvp/host/eval/fruitlet_matching.h"
 #include "fvp/host/map/map_engine_registry.h"
+#include "fvp/host/nbv/cluster_completion.h"
+#include "fvp/host/nbv/loop_observers.h"
 #include "fvp/host/nbv/nbv_loop.h"
 #include "fvp/host/planner/planner_registry.h"
 #include "fvp/host/planner/view_planner.h"
@@ -60,6 +64,9 @@ void validate(const TrialOptions& o) {
     throw std::invalid_argument("trial option 'engine': expected one of " +
                                 host::map::MapEngineRegistry::instance().knownNames() + ", got '" +
                                 o.engine + "'");
+  if (o.stop != "budget" && o.stop != "auto")
+    throw std::invalid_argument("trial option 'stop': expected budget or auto, got '" + o.stop +
+                                "'");
   if (o.max_views && *o.max_views < 1)
     throw std::invalid_argument("trial option 'max_views': expected at least 1");
 }
@@ -115,6 +122,46 @@ class TrialLog : public host::nbv::LoopObserver {
   Clock::time_point wall_start_;
   nlohmann::json views_ = nlohmann::json::array(), plans_ = nlohmann::json::array();
 };
+
+/// The cluster as the automatic stop sized it after each view, each sizing scored against
+/// the world's ground truth: what a shorter budget would have reported.
+nlohmann::json sizeHistoryJson(const std::vector<host::nbv::SizingSnapshot>& history,
+                               const World& world) {
+  std::vector<Eigen::Vector3d> truth_m;
+  std::vector<double> truth_mm;
+  for (const auto& f : world.fruitlets()) {
+    truth_m.push_back(f.center_m);
+    truth_mm.push_back(f.gtSizeMm());
+  }
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& snapshot : history) {
+    std::vector<Eigen::Vector3d> centres;
+    std::vector<double> sizes;
+    nlohmann::json fruitlets = nlohmann::json::array();
+    for (const auto& f : snapshot.fruitlets) {
+      centres.push_back(f.center_m);
+      sizes.push_back(f.size_mm);
+      fruitlets.push_back({{"center_m", vec3(f.center_m)},
+                           {"size_mm", f.size_mm},
+                           {"well_seen_images", f.well_seen_images},
+                           {"view_span_deg", f.view_span_deg},
+                           {"size_source", host::sizing::toString(f.size_source)}});
+    }
+    const auto m = host::eval::sizeMetrics(
+        truth_mm, sizes, host::eval::matchFruitlets(centres, truth_m), centres.size());
+    const auto opt = [](const std::optional<double>& v) {
+      return v ? nlohmann::json(*v) : nlohmann::json();
+    };
+    out.push_back({{"view", snapshot.view},
+                   {"sim_time_s", snapshot.now_s},
+                   {"sizing_wall_s", snapshot.sizing_s},
+                   {"fruitlets", fruitlets},
+                   {"match_percent", m.match_percent},
+                   {"mae_mm", opt(m.mae_mm)},
+                   {"precision_percent", opt(m.precision_percent)}});
+  }
+  return out;
+}
 
 }  // namespace
 
@@ -192,8 +239,16 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
   host::nbv::StopCondition stop = host::nbv::StopCondition::budget(options.budget_s);
   if (options.max_views) stop = stop || host::nbv::StopCondition::views(*options.max_views);
   TrialLog log(*parts, *camera, options, wall_start);
+  host::nbv::LoopObservers observers;
+  observers.add(&log);
+  std::optional<host::nbv::ClusterCompletion> completion;
+  if (options.stop == "auto") {
+    completion.emplace(parts->session(), loop_clock, parts->sizingConfig());
+    observers.add(&*completion);
+    stop = stop || completion->stopCondition();
+  }
   host::nbv::NbvLoop loop(parts->session(), parts->planner(), loop_camera, loop_arm, loop_clock);
-  const host::nbv::NbvResult run = loop.run(stop, &log);
+  const host::nbv::NbvResult run = loop.run(stop, &observers);
   const host::nbv::NbvEvents& events = run.events;
   std::vector<Eigen::Vector3d> camera_path;
   for (const auto& T : run.camera_poses) camera_path.push_back(T.translation());
@@ -231,13 +286,28 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
                             {"dropped_frames", events.dropped_frames},
                             {"motion_status", events.motion_status}};
   result["events"] = counted;
+  double loop_sizing_s = 0.0;
+  if (completion)
+    for (const auto& snapshot : completion->history()) loop_sizing_s += snapshot.sizing_s;
   result["wall_breakdown_s"] = {{"rendering", camera->totalRenderSeconds()},
                                 {"perception", run.wall_s.perception},
                                 {"mapping", run.wall_s.mapping},
                                 {"tsdf", run.wall_s.tsdf},
                                 {"planning", run.wall_s.planning},
                                 {"motion_planning", run.wall_s.motion_planning},
-                                {"sizing", sizing_wall_s}};
+                                {"sizing", sizing_wall_s},
+                                {"sizing_during_loop", loop_sizing_s}};
+  if (completion) {
+    result["stop"] = {{"rule", "auto"},
+                      {"stable_views", completion->config().stable_views},
+                      {"size_tolerance_mm", completion->config().size_tolerance_mm},
+                      {"same_fruitlet_m", completion->config().same_fruitlet_m},
+                      {"min_well_seen_images", completion->config().min_well_seen_images},
+                      {"min_view_span_deg", completion->config().min_view_span_deg}};
+    result["size_history"] = sizeHistoryJson(completion->history(), *world);
+  } else {
+    result["stop"] = {{"rule", "budget"}};
+  }
   result["clock"] = nlohmann::json::parse(clock->toJson());
   result["view_log"] = log.views();
   result["plan_log"] = log.plans();
@@ -286,7 +356,7 @@ std::string trialSummary(const nlohmann::json& result) {
     << "\n"
     << "views " << result.value("views", 0) << ", simulated " << result.value("sim_time_s", 0.0)
     << " s of " << result.value("budget_s", 0.0) << " s, wall " << result.value("wall_time_s", 0.0)
-    << " s\n";
+    << " s, stop: " << result.value("stop_reason", "?") << "\n";
   if (result.contains("fruitlets")) {
     s << "\n fruitlet  true (mm)  estimated (mm)  error (mm)\n";
     int i = 0;

@@ -97,6 +97,10 @@ host::MappingSession& TrialParts::session() {
   return impl_->session;
 }
 
+const host::sizing::SizingConfig& TrialParts::sizingConfig() const {
+  return impl_->sizing_config;
+}
+
 host::planner::ViewPlanner& TrialParts::planner() {
   return *impl_->planner;
 }

@@ -55,6 +55,7 @@ class TrialParts {
   host::map::MapEngine* map();
   host::planner::ViewPlanner& planner();
   host::MappingSession& session();
+  const host::sizing::SizingConfig& sizingConfig() const;
   /// The trial-level configuration (engine, map, perception, sizing) as JSON.
   nlohmann::json configJson() const;
   /// Writes a small PNG of the view's left image for the report.

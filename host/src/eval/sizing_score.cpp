@@ -67,32 +67,48 @@ nlohmann::json scoreBothEstimators(const sizing::SizingResult& sz,
   return out;
 }
 
+namespace {
+
+nlohmann::json detectionJson(const sizing::FruitletEstimate& f) {
+  nlohmann::json per_image = nlohmann::json::array();
+  for (const auto& s : f.per_image)
+    per_image.push_back({{"view", s.view},
+                         {"size_paper_mm", s.size_paper_mm},
+                         {"size_ours_mm", s.size_ours_mm},
+                         {"minor_axis_px", s.minor_axis_px},
+                         {"max_disparity_px", s.max_disparity_px},
+                         {"visible_fraction", s.visible_fraction},
+                         {"touches_border", s.touches_border},
+                         {"shared_segment", s.shared_segment},
+                         {"well_seen", s.well_seen},
+                         {"axis_ratio", s.axis_ratio}});
+  return {{"center_m", vec3(f.center_m)},
+          {"size_mm", f.size_mm},
+          {"centroid_m", vec3(f.centroid_m)},
+          {"sphere_center_m", vec3(f.sphere_center_m)},
+          {"sphere_radius_m", f.sphere_radius_m},
+          {"size_source", sizing::toString(f.size_source)},
+          {"size_paper_mm", f.size_paper_mm},
+          {"size_ours_mm", f.size_ours_mm},
+          {"points", f.points},
+          {"support",
+           {{"sized_images", f.support.sized_images},
+            {"own_segment_images", f.support.own_segment_images},
+            {"well_seen_images", f.support.well_seen_images},
+            {"sphere_rms_mm", f.support.sphere_rms_mm},
+            {"required_points", f.support.required_points},
+            {"size_stderr_mm", f.support.size_stderr_mm}}},
+          {"per_image", per_image}};
+}
+
+}  // namespace
+
 nlohmann::json sizingDetails(const sizing::SizingResult& sz) {
-  nlohmann::json detections = nlohmann::json::array();
-  for (const auto& f : sz.fruitlets) {
-    nlohmann::json per_image = nlohmann::json::array();
-    for (const auto& s : f.per_image)
-      per_image.push_back({{"view", s.view},
-                           {"size_paper_mm", s.size_paper_mm},
-                           {"size_ours_mm", s.size_ours_mm},
-                           {"minor_axis_px", s.minor_axis_px},
-                           {"max_disparity_px", s.max_disparity_px},
-                           {"visible_fraction", s.visible_fraction},
-                           {"touches_border", s.touches_border},
-                           {"shared_segment", s.shared_segment},
-                           {"axis_ratio", s.axis_ratio}});
-    detections.push_back({{"center_m", vec3(f.center_m)},
-                          {"size_mm", f.size_mm},
-                          {"centroid_m", vec3(f.centroid_m)},
-                          {"sphere_center_m", vec3(f.sphere_center_m)},
-                          {"sphere_radius_m", f.sphere_radius_m},
-                          {"size_source", sizing::toString(f.size_source)},
-                          {"size_paper_mm", f.size_paper_mm},
-                          {"size_ours_mm", f.size_ours_mm},
-                          {"points", f.points},
-                          {"per_image", per_image}});
-  }
+  nlohmann::json detections = nlohmann::json::array(), unsupported = nlohmann::json::array();
+  for (const auto& f : sz.fruitlets) detections.push_back(detectionJson(f));
+  for (const auto& f : sz.unsupported) unsupported.push_back(detectionJson(f));
   return {{"sized_fruitlets", detections},
+          {"unsupported_detections", unsupported},
           {"sizing_stats",
            {{"surface_points", sz.surface_points},
             {"in_roi_points", sz.in_roi_points},
@@ -105,7 +121,8 @@ nlohmann::json sizingDetails(const sizing::SizingResult& sz) {
               {"single_image_fruitlets", sz.events.single_image_fruitlets},
               {"unsized_clusters", sz.events.unsized_clusters},
               {"failed_sphere_fits", sz.events.failed_sphere_fits},
-              {"clusters_split_off", sz.events.clusters_split_off}}}}}};
+              {"clusters_split_off", sz.events.clusters_split_off},
+              {"unsupported_detections", sz.events.unsupported_detections}}}}}};
 }
 
 }  // namespace fvp::host::eval

@@ -87,7 +87,9 @@ sizing::SizingResult MappingSession::sizeFruitlets(const sizing::SizingConfig& c
     const map::VoxelState s = map->fineState(p.cast<double>());
     return s.roi && s.occupancy == map::VoxelClass::kOccupied;
   };
-  return sizing::sizeFruitlets(sizing_views_, surfacePoints(), in_roi_voxel, config);
+  sizing::SizingConfig own = config;
+  own.surface_voxel_size_m = tsdf_config_->voxel_size_m;
+  return sizing::sizeFruitlets(sizing_views_, surfacePoints(), in_roi_voxel, own);
 }
 
 void MappingSession::integrate(std::size_t index, const LabeledClouds& clouds) {

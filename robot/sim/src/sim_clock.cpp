@@ -19,6 +19,8 @@ const char* toString(ClockStage stage) {
       return "motion_planning";
     case ClockStage::kMotion:
       return "motion";
+    case ClockStage::kSizing:
+      return "sizing";
   }
   return "unknown";
 }

@@ -13,6 +13,9 @@ void SimulatedLoopClock::chargeCompute(host::nbv::LoopStage stage, double wall_s
     case host::nbv::LoopStage::kPlanning:
       clock_.chargeCompute(ClockStage::kPlanning, wall_s);
       return;
+    case host::nbv::LoopStage::kSizing:
+      clock_.chargeCompute(ClockStage::kSizing, wall_s);
+      return;
   }
 }
 

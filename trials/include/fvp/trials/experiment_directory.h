@@ -63,7 +63,8 @@ struct ExperimentManifest {
   // Row-defining: resume and merge refuse a difference.
   double budget_s = 0;
   std::string clock;
-  int max_views = 0;  ///< 0: no limit
+  std::string stop = "budget";  ///< budget | auto (absent in a manifest: budget)
+  int max_views = 0;            ///< 0: no limit
   ConfigFileStamp world_config, planner_config;
   // The run's own plan (kind "run" only). Resume refuses a difference; merge does not
   // compare them (shards differ in them by design; the engine is in the row key).
@@ -95,7 +96,7 @@ std::optional<ManifestDifference> resumeDifference(const ExperimentManifest& old
                                                    const ExperimentManifest& now);
 
 /// The first row-defining setting in which two experiments differ (what merge refuses):
-/// budget_s, clock, max_views, world_config, planner_config (configs by content hash).
+/// budget_s, clock, stop, max_views, world_config, planner_config (configs by content hash).
 std::optional<ManifestDifference> mergeDifference(const ExperimentManifest& a,
                                                   const ExperimentManifest& b);
 

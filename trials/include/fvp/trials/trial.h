@@ -38,6 +38,9 @@ struct TrialOptions {
   std::string engine;                    ///< grid | octomap; empty: the planner's default
   std::optional<int> max_views;          ///< stop after this many views (tests)
   std::string clock = "wall";            ///< wall | fixed
+  /// budget: the paper's protocol (budget_s, max_views); auto: also stop once the cluster's
+  /// sizes have settled (host/nbv/cluster_completion.h), budget_s being the cap.
+  std::string stop = "budget";
   /// Where result.json, the maps, the TSDF surface, the clusters and report.md go; empty:
   /// nothing is written (the result is only returned).
   std::filesystem::path out_dir;

@@ -8,7 +8,8 @@
 namespace fvp::host::nbv {
 
 /// The loop's own compute, which a simulated clock charges (measured or fixed).
-enum class LoopStage { kMapping, kTsdf, kPlanning };
+/// kSizing: sizing the cluster during the loop (the automatic stop's, cluster_completion.h).
+enum class LoopStage { kMapping, kTsdf, kPlanning, kSizing };
 
 class LoopClock {
  public:

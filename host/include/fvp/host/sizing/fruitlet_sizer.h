@@ -66,6 +66,17 @@ struct SizingConfig {
   /// segment cut by an occluder or two fruitlets merged in 2-D does not).
   double min_axis_ratio = 0.8;
   int min_segment_pixels = 12;
+  /// The support rule (docs/sizing.md, "Which detections are fruitlets"): a detection of
+  /// radius r must show surface over at least this fraction of its sphere, 4 pi r^2. A
+  /// quarter is pi r^2, the area of its own silhouette disc: half the hemisphere one
+  /// unoccluded view sees. Phantoms (mask pixels that bled onto the leaf behind a fruitlet,
+  /// small clusters of stereo points at depth edges) show a few percent of the sphere their
+  /// size implies. 0 keeps every detection.
+  double min_support_area_fraction = 0.25;
+  /// The surface points' spacing: the TSDF voxel (MappingSession sets its own). Zero
+  /// crossings between face neighbours number (|n_x| + |n_y| + |n_z|) per voxel face on a
+  /// surface of normal n: 1.5 on average over a sphere.
+  double surface_voxel_size_m = 0.0005;
   void validate() const;
 };
 
@@ -78,6 +89,8 @@ struct ImageSize {
   bool touches_border = false;
   bool shared_segment = false;  ///< another cluster falls on the same segment
   double axis_ratio = 0.0;      ///< minor / major axis of the fitted ellipse
+  /// Mostly visible, off the border, its own segment, round: one of ours' median's images.
+  bool well_seen = false;
 };
 
 /// Where our estimator's size came from.
@@ -88,6 +101,19 @@ enum class SizeSource {
 };
 const char* toString(SizeSource source);
 
+/// What a detection rests on (every detection reports it).
+struct DetectionSupport {
+  int sized_images = 0;         ///< images that gave a size
+  int own_segment_images = 0;   ///< of which no other detection fell on its segment
+  int well_seen_images = 0;     ///< of which well seen (ours: the median's images)
+  double sphere_rms_mm = -1.0;  ///< RMS distance of its points to its sphere; -1 without one
+  /// The surface points the support rule asks of a fruitlet of its size (points must reach it).
+  double required_points = 0.0;
+  /// Ours' confidence: the standard error of the median of its well-seen images' sizes
+  /// (1.2533 x 1.4826 MAD / sqrt(n)); -1 with fewer than two.
+  double size_stderr_mm = -1.0;
+};
+
 struct FruitletEstimate {
   Eigen::Vector3d center_m = Eigen::Vector3d::Zero();  ///< the chosen estimator's
   double size_mm = 0.0;                                ///< the chosen estimator's
@@ -96,6 +122,7 @@ struct FruitletEstimate {
   double size_paper_mm = 0.0, size_ours_mm = 0.0;
   SizeSource size_source = SizeSource::kWellSeenImages;
   std::size_t points = 0;
+  DetectionSupport support;
   std::vector<ImageSize> per_image;
 };
 
@@ -109,10 +136,13 @@ struct SizingEvents {
   std::size_t unsized_clusters = 0;    ///< no image gave a size (dropped)
   std::size_t failed_sphere_fits = 0;  ///< centre fell back to the centroid
   std::size_t clusters_split_off = 0;  ///< parts of DBSCAN clusters split off (one per fruitlet)
+  std::size_t unsupported_detections = 0;  ///< too little surface for their size (dropped)
 };
 
 struct SizingResult {
   std::vector<FruitletEstimate> fruitlets;
+  /// Sized detections the support rule dropped, with their support (for reports).
+  std::vector<FruitletEstimate> unsupported;
   SizingEvents events;
   std::size_t surface_points = 0, in_roi_points = 0, inlier_points = 0;
   std::vector<Eigen::Vector3f> points;  ///< after the ROI and outlier filters

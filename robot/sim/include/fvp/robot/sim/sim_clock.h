@@ -11,8 +11,8 @@
 
 namespace fvp::robot::sim {
 
-enum class ClockStage { kCapture, kMapping, kTsdf, kPlanning, kMotionPlanning, kMotion };
-inline constexpr int kClockStages = 6;
+enum class ClockStage { kCapture, kMapping, kTsdf, kPlanning, kMotionPlanning, kMotion, kSizing };
+inline constexpr int kClockStages = 7;
 const char* toString(ClockStage stage);
 
 struct IterationCharges {
@@ -38,7 +38,8 @@ class SimClock {
   /// Opens the next iteration's record (charges before the first call open one).
   void beginIteration();
   void chargeCapture();
-  /// A compute stage (mapping, TSDF, planning, motion planning) that took measured_wall_s.
+  /// A compute stage (mapping, TSDF, planning, motion planning, sizing for an automatic stop)
+  /// that took measured_wall_s.
   void chargeCompute(ClockStage stage, double measured_wall_s);
   void chargeMotion(double duration_s);
   void recordUncharged(double rendering_wall_s, double sgbm_wall_s);

@@ -1,0 +1,96 @@
+// When a cluster is done (docs/nbv-loop.md, "Automatic stop"): the loop sizes the cluster after
+// every view and stops once another view no longer changes what it would report: the same
+// fruitlets, each measured in enough well-seen images, none of whose sizes moved by more
+// than a tolerance over the last few views. The paper's budget stays the cap.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "fvp/host/nbv/loop_clock.h"
+#include "fvp/host/nbv/nbv_loop.h"
+#include "fvp/host/nbv/stop_condition.h"
+#include "fvp/host/session/mapping_session.h"
+#include "fvp/host/sizing/fruitlet_sizer.h"
+
+namespace fvp::host::nbv {
+
+struct ClusterCompletionConfig {
+  /// Views over which nothing may change: a new view adds a few well-seen images to each
+  /// fruitlet's median, so one quiet view says little; three say the median has settled.
+  int stable_views = 3;
+  /// The most a fruitlet's size may move over those views. One pixel at the planner's
+  /// farthest view (0.40 m, fx 1100 px) spans 0.36 mm; 0.1 mm is a quarter of that and a
+  /// third of the 0.3 mm error the sizing reaches with the paper's whole budget, so views
+  /// that move estimates less than this cannot buy a better size.
+  double size_tolerance_mm = 0.1;
+  /// Detections of two sizings closer than this are one fruitlet: the smallest fruitlet's
+  /// radius (3 mm; sizing keeps spheres of 1.5-12 mm radius).
+  double same_fruitlet_m = 0.003;
+  /// Each fruitlet's size must come from at least this many well-seen images (one image is
+  /// one sample of the per-image error; two agree or reveal it). Fruitlets sized by their
+  /// sphere fit (merged with a neighbour in every image) count once their size is stable.
+  int min_well_seen_images = 2;
+  /// ...and from directions at least this far apart (the largest angle between two of its
+  /// well-seen views, seen from the fruitlet). Images from one direction share their errors:
+  /// the same leaf in Eq. 4's disparity window, the same cut of the silhouette. A leaf d in
+  /// front of a fruitlet moves across its line of sight by d tan(angle); at 30 degrees and
+  /// d >= 2 cm that is 12 mm, more than a fruitlet's diameter, so no one occluder spoils
+  /// both ends of the span.
+  double min_view_span_deg = 30.0;
+  /// Throws std::invalid_argument naming the bad field.
+  void validate() const;
+};
+
+/// One fruitlet of one sizing, as the stop rule compares them.
+struct FruitletSnapshot {
+  Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
+  double size_mm = 0.0;
+  int well_seen_images = 0;
+  double view_span_deg = 0.0;  ///< largest angle between two well-seen views' directions
+  sizing::SizeSource size_source = sizing::SizeSource::kWellSeenImages;
+};
+
+/// The cluster sized after one view.
+struct SizingSnapshot {
+  int view = 0;        ///< 0-based index of the view it followed
+  double now_s = 0.0;  ///< the loop clock when the view was mapped
+  double sizing_s = 0.0;
+  std::vector<FruitletSnapshot> fruitlets;
+};
+
+/// A loop observer that sizes the session's cluster after every view and a stop condition
+/// that holds once the sizes have settled. The sizing's wall time is charged to the loop
+/// clock as LoopStage::kSizing: a robot would spend it too.
+class ClusterCompletion : public LoopObserver {
+ public:
+  /// session and clock must outlive this; the session needs enableTsdf().
+  ClusterCompletion(const MappingSession& session, LoopClock& clock,
+                    sizing::SizingConfig sizing_config, ClusterCompletionConfig config = {});
+
+  void onView(const ViewEvent& event) override;
+
+  /// Whether the sizes have settled (see ClusterCompletionConfig).
+  bool done() const;
+  /// Holds when done(); its reason is "cluster_done".
+  StopCondition stopCondition() const;
+
+  /// One snapshot per view mapped after the Cluster Region was known.
+  const std::vector<SizingSnapshot>& history() const { return history_; }
+  const ClusterCompletionConfig& config() const { return config_; }
+
+ private:
+  const MappingSession& session_;
+  LoopClock& clock_;
+  sizing::SizingConfig sizing_config_;
+  ClusterCompletionConfig config_;
+  std::vector<SizingSnapshot> history_;
+};
+
+/// Whether the last config.stable_views + 1 snapshots of history agree (the rule of done()).
+bool sizesSettled(const std::vector<SizingSnapshot>& history,
+                  const ClusterCompletionConfig& config);
+
+}  // namespace fvp::host::nbv

@@ -1,0 +1,98 @@
+#include "fvp/host/nbv/cluster_completion.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+namespace fvp::host::nbv {
+
+void ClusterCompletionConfig::validate() const {
+  if (stable_views < 1)
+    throw std::invalid_argument("cluster completion 'stable_views': expected at least 1");
+  if (!(size_tolerance_mm > 0.0) || !std::isfinite(size_tolerance_mm))
+    throw std::invalid_argument("cluster completion 'size_tolerance_mm': expected > 0");
+  if (!(same_fruitlet_m > 0.0) || !std::isfinite(same_fruitlet_m))
+    throw std::invalid_argument("cluster completion 'same_fruitlet_m': expected > 0");
+  if (min_well_seen_images < 1)
+    throw std::invalid_argument("cluster completion 'min_well_seen_images': expected at least 1");
+  if (!(min_view_span_deg >= 0.0) || !(min_view_span_deg <= 180.0))
+    throw std::invalid_argument("cluster completion 'min_view_span_deg': expected 0 to 180");
+}
+
+ClusterCompletion::ClusterCompletion(const MappingSession& session, LoopClock& clock,
+                                     sizing::SizingConfig sizing_config,
+                                     ClusterCompletionConfig config)
+    : session_(session), clock_(clock), sizing_config_(sizing_config), config_(config) {
+  config_.validate();
+  sizing_config_.validate();
+}
+
+void ClusterCompletion::onView(const ViewEvent& event) {
+  if (!session_.tsdf()) return;  // no Cluster Region yet: nothing to size
+  const auto start = std::chrono::steady_clock::now();
+  const sizing::SizingResult sized = session_.sizeFruitlets(sizing_config_);
+  const double sizing_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  clock_.chargeCompute(LoopStage::kSizing, sizing_s);
+  SizingSnapshot snapshot;
+  snapshot.view = event.index;
+  snapshot.now_s = clock_.now_s();
+  snapshot.sizing_s = sizing_s;
+  const auto& views = session_.sizingViews();
+  for (const auto& f : sized.fruitlets) {
+    std::vector<Eigen::Vector3d> directions;
+    for (const auto& image : f.per_image)
+      if (image.well_seen)
+        directions.push_back(
+            (views[std::size_t(image.view)].T_world_camera.translation() - f.center_m)
+                .normalized());
+    double span_rad = 0.0;
+    for (std::size_t i = 0; i < directions.size(); ++i)
+      for (std::size_t j = i + 1; j < directions.size(); ++j)
+        span_rad =
+            std::max(span_rad, std::acos(std::clamp(directions[i].dot(directions[j]), -1.0, 1.0)));
+    snapshot.fruitlets.push_back({f.center_m, f.size_mm, f.support.well_seen_images,
+                                  span_rad * 180.0 / M_PI, f.size_source});
+  }
+  history_.push_back(std::move(snapshot));
+}
+
+bool ClusterCompletion::done() const {
+  return sizesSettled(history_, config_);
+}
+
+StopCondition ClusterCompletion::stopCondition() const {
+  return StopCondition([this](const LoopState&) { return done(); }, "cluster_done");
+}
+
+bool sizesSettled(const std::vector<SizingSnapshot>& history,
+                  const ClusterCompletionConfig& config) {
+  if (history.size() < std::size_t(config.stable_views) + 1) return false;
+  const SizingSnapshot& latest = history.back();
+  // A cluster with nothing sized is not done: its fruitlets are still to be found (the
+  // budget ends a cluster that has none).
+  if (latest.fruitlets.empty()) return false;
+  for (const auto& f : latest.fruitlets)
+    if (f.size_source != sizing::SizeSource::kSphereFit &&
+        (f.well_seen_images < config.min_well_seen_images ||
+         f.view_span_deg < config.min_view_span_deg))
+      return false;
+  for (int k = 1; k <= config.stable_views; ++k) {
+    const SizingSnapshot& earlier = history[history.size() - 1 - std::size_t(k)];
+    // A fruitlet found or lost: the cluster is still changing.
+    if (earlier.fruitlets.size() != latest.fruitlets.size()) return false;
+    for (const auto& f : latest.fruitlets) {
+      const FruitletSnapshot* nearest = nullptr;
+      double nearest_m = config.same_fruitlet_m;
+      for (const auto& g : earlier.fruitlets)
+        if (const double d = (g.center_m - f.center_m).norm(); d <= nearest_m)
+          nearest = &g, nearest_m = d;
+      if (!nearest || std::abs(nearest->size_mm - f.size_mm) > config.size_tolerance_mm)
+        return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace fvp::host::nbv

@@ -1,0 +1,164 @@
+// The automatic stop's rule on constructed sizing histories: settled sizes stop; a fruitlet
+// found late, one not yet well seen, one seen from a single direction, a size still moving
+// and an empty cluster do not. Then the observer on real frames: it sizes after each view and
+// charges the sizing to the loop clock.
+#include "fvp/host/nbv/cluster_completion.h"
+
+#include <gtest/gtest.h>
+
+#include "fvp/accel/backend.h"
+#include "seed2_orbit_frames.h"
+
+namespace fvp::host::nbv {
+namespace {
+
+FruitletSnapshot fruitlet(double x_m, double size_mm, int well_seen = 4, double span_deg = 60.0) {
+  FruitletSnapshot f;
+  f.center_m = Eigen::Vector3d(x_m, 0.0, 0.3);
+  f.size_mm = size_mm;
+  f.well_seen_images = well_seen;
+  f.view_span_deg = span_deg;
+  return f;
+}
+
+/// views snapshots of two fruitlets whose sizes move by step_mm per view.
+std::vector<SizingSnapshot> history(int views, double step_mm = 0.02) {
+  std::vector<SizingSnapshot> h;
+  for (int v = 0; v < views; ++v) {
+    SizingSnapshot s;
+    s.view = v;
+    s.now_s = 5.0 * v;
+    s.fruitlets = {fruitlet(0.0, 8.0 + step_mm * v), fruitlet(0.02, 11.0 - step_mm * v)};
+    h.push_back(s);
+  }
+  return h;
+}
+
+TEST(ClusterCompletion, SettledSizesStopOnceEnoughViewsAgree) {
+  const ClusterCompletionConfig config;  // 3 views, 0.1 mm
+  EXPECT_FALSE(sizesSettled(history(3), config)) << "3 snapshots cannot show 3 quiet views";
+  EXPECT_TRUE(sizesSettled(history(4), config));
+  EXPECT_TRUE(sizesSettled(history(10), config));
+  // Detections wander by less than a fruitlet's radius between sizings: still the same.
+  auto h = history(4);
+  h.back().fruitlets[0].center_m.x() += 0.002;
+  EXPECT_TRUE(sizesSettled(h, config));
+}
+
+TEST(ClusterCompletion, ASizeStillMovingDoesNotStop) {
+  const ClusterCompletionConfig config;
+  // 0.04 mm per view: 0.12 mm over the last three views, past the 0.1 mm tolerance.
+  EXPECT_FALSE(sizesSettled(history(6, 0.04), config));
+  auto h = history(6);
+  h.back().fruitlets[1].size_mm += 0.15;
+  EXPECT_FALSE(sizesSettled(h, config));
+}
+
+TEST(ClusterCompletion, AFruitletFoundLateOrNotYetWellSeenDoesNotStop) {
+  const ClusterCompletionConfig config;
+  // A third fruitlet appears in the newest sizing (a view revealed it).
+  auto found = history(6);
+  found.back().fruitlets.push_back(fruitlet(0.04, 9.0));
+  EXPECT_FALSE(sizesSettled(found, config));
+  // Seen in every sizing, but never in a well-seen image (only cut or shared segments).
+  auto unseen = history(6);
+  for (auto& s : unseen) s.fruitlets.push_back(fruitlet(0.04, 9.0, /*well_seen=*/0, 0.0));
+  EXPECT_FALSE(sizesSettled(unseen, config));
+  // One that moved farther than a fruitlet's radius is another fruitlet.
+  auto moved = history(6);
+  moved.back().fruitlets[0].center_m.x() += 0.004;
+  EXPECT_FALSE(sizesSettled(moved, config));
+  // Once the newcomer is well seen and quiet for three views, the cluster is done.
+  for (int v = 0; v < 4; ++v) {
+    SizingSnapshot s = found.back();
+    s.view += 1;
+    found.push_back(s);
+  }
+  EXPECT_TRUE(sizesSettled(found, config));
+}
+
+TEST(ClusterCompletion, ImagesFromOneDirectionDoNotStopButSphereFitsDo) {
+  const ClusterCompletionConfig config;
+  auto narrow = history(6);
+  for (auto& s : narrow) s.fruitlets[0].view_span_deg = 12.0;
+  EXPECT_FALSE(sizesSettled(narrow, config));
+  // A fruitlet merged with a neighbour in every image has no well-seen image: its sphere
+  // fit is its size, and it counts once that is stable.
+  auto merged = history(6);
+  for (auto& s : merged) {
+    s.fruitlets[0].well_seen_images = 0;
+    s.fruitlets[0].view_span_deg = 0.0;
+    s.fruitlets[0].size_source = sizing::SizeSource::kSphereFit;
+  }
+  EXPECT_TRUE(sizesSettled(merged, config));
+}
+
+TEST(ClusterCompletion, AnEmptyClusterIsNeverDone) {
+  std::vector<SizingSnapshot> empty(8);
+  EXPECT_FALSE(sizesSettled(empty, {}));
+  EXPECT_FALSE(sizesSettled({}, {}));
+}
+
+TEST(ClusterCompletion, BadConfigIsRefusedNamingTheField) {
+  const auto refused = [](ClusterCompletionConfig c, const std::string& field) {
+    try {
+      c.validate();
+      ADD_FAILURE() << field << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+  };
+  ClusterCompletionConfig c;
+  c.stable_views = 0;
+  refused(c, "stable_views");
+  c = {};
+  c.size_tolerance_mm = -1.0;
+  refused(c, "size_tolerance_mm");
+  c = {};
+  c.same_fruitlet_m = 0.0;
+  refused(c, "same_fruitlet_m");
+  c = {};
+  c.min_well_seen_images = 0;
+  refused(c, "min_well_seen_images");
+  c = {};
+  c.min_view_span_deg = 200.0;
+  refused(c, "min_view_span_deg");
+}
+
+class CountingClock : public LoopClock {
+ public:
+  double now_s() const override { return 0.0; }
+  void chargeCompute(LoopStage stage, double wall_s) override {
+    if (stage == LoopStage::kSizing) sizing_s += wall_s, ++sizing_charges;
+  }
+  double sizing_s = 0.0;
+  int sizing_charges = 0;
+};
+
+TEST(ClusterCompletion, SizesTheSessionAfterEveryMappedViewAndChargesTheClock) {
+  auto backend = accel::createBackend("cpu");
+  MappingSession session({}, "grid", {}, backend.get());
+  session.enableTsdf();
+  CountingClock clock;
+  ClusterCompletion completion(session, clock, {});
+  // View 0 shows no tag; view 1 does (and is captured twice).
+  const std::size_t frames[] = {0, 1, 1};
+  for (int i = 0; i < 3; ++i) {
+    session.addView(test::seed2OrbitFrame(frames[i]));
+    ViewEvent event;
+    event.index = i;
+    completion.onView(event);
+  }
+  // The view before the tag was seen had nothing to size; every later one was sized.
+  ASSERT_EQ(completion.history().size(), 2u);
+  EXPECT_EQ(int(completion.history().size()), clock.sizing_charges);
+  EXPECT_EQ(completion.history().back().view, 2);
+  EXPECT_FALSE(completion.history().back().fruitlets.empty());
+  EXPECT_GT(clock.sizing_s, 0.0);
+  // Three views cannot show three quiet ones after the first sizing.
+  EXPECT_FALSE(completion.done());
+  EXPECT_EQ(completion.stopCondition().check({}), std::nullopt);
+}
+
+}  // namespace
+}  // namespace fvp::host::nbv
