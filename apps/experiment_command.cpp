@@ -51,6 +51,9 @@ void addExperimentCommands(CLI::App& app) {
          "settled, the budget being the cap")
       ->check(CLI::IsMember({"budget", "auto"}))
       ->capture_default_str();
+  cmd->add_flag("--size-history", opt->experiment.trial.record_size_history,
+                "size after every view and keep each sizing in result.json (size_history; always "
+                "with --stop auto; not charged to the clock)");
   cmd->add_option("--clock", opt->experiment.trial.clock, "wall | fixed")
       ->check(CLI::IsMember({"wall", "fixed"}))
       ->capture_default_str();

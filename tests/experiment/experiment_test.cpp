@@ -115,6 +115,47 @@ TEST(Experiment, PooledMetricsByHand) {
   EXPECT_EQ(slurp(out / "sizes.png").substr(1, 3), "PNG");
 }
 
+// Trials that kept their sizings: time per cluster, fruitlets per minute, and accuracy
+// against time pooled by hand. fvp's trials stop (cluster_done) at 40 s: at 10 s nothing is
+// sized, at 20 s one of two fruitlets (error 1 mm), from 30 s both (0.5 and 0.25 mm).
+TEST(Experiment, TimePerClusterAndAccuracyAgainstTimeByHand) {
+  const fs::path out = freshDir("against_time");
+  const TrialRunner with_history = [](const TrialOptions& o) {
+    nlohmann::json r = fakeTrial(o);
+    r["sim_time_s"] = o.planner == "fvp" ? 40.0 : 180.0;
+    r["stop_reason"] = o.planner == "fvp" ? "cluster_done" : "budget";
+    if (o.planner == "fvp")
+      r["size_history"] = {
+          {{"view", 0}, {"sim_time_s", 12.0}, {"match_percent", 50.0}, {"mae_mm", 1.0}},
+          {{"view", 1}, {"sim_time_s", 25.0}, {"match_percent", 100.0}, {"mae_mm", 0.375}},
+          {{"view", 2}, {"sim_time_s", 40.0}, {"match_percent", 100.0}, {"mae_mm", 0.75}}};
+    return r;
+  };
+  runExperiment(options(out, 2), with_history, nullptr);
+  const nlohmann::json s = nlohmann::json::parse(slurp(out / "summary.json"));
+  EXPECT_DOUBLE_EQ(s["fvp"]["median_sim_s_per_trial"].get<double>(), 40.0);
+  // 4 matched fruitlets in 80 simulated seconds.
+  EXPECT_DOUBLE_EQ(s["fvp"]["matched_per_sim_min"].get<double>(), 3.0);
+  EXPECT_DOUBLE_EQ(s["rvp"]["matched_per_sim_min"].get<double>(), 60.0 * 2 / 360.0);
+  const std::string table = slurp(out / "table1.md");
+  EXPECT_NE(table.find("| 100.0 | 40.0 | 3.00 |"), std::string::npos) << table;
+  const nlohmann::json curve = nlohmann::json::parse(slurp(out / "accuracy_vs_time.json"));
+  ASSERT_TRUE(curve.contains("fvp"));
+  EXPECT_FALSE(curve.contains("rvp"));  // no sizings kept
+  const auto at = [&](double t) {
+    for (const auto& p : curve["fvp"])
+      if (p["sim_time_s"] == t) return p;
+    return nlohmann::json();
+  };
+  EXPECT_DOUBLE_EQ(at(10.0)["match_percent"].get<double>(), 0.0);
+  EXPECT_TRUE(at(10.0)["mae_mm"].is_null());
+  EXPECT_DOUBLE_EQ(at(20.0)["match_percent"].get<double>(), 50.0);
+  EXPECT_DOUBLE_EQ(at(20.0)["mae_mm"].get<double>(), 1.0);
+  EXPECT_DOUBLE_EQ(at(30.0)["mae_mm"].get<double>(), 0.375);
+  EXPECT_DOUBLE_EQ(at(40.0)["mae_mm"].get<double>(), 0.75);
+  EXPECT_EQ(slurp(out / "accuracy_vs_time.png").substr(1, 3), "PNG");
+}
+
 TEST(Experiment, ResumeAfterAnInterruptionGivesTheUninterruptedResult) {
   const fs::path whole = freshDir("whole"), cut = freshDir("cut");
   runExperiment(options(whole, 3), fakeTrial, nullptr);

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iomanip>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -228,6 +229,83 @@ std::string sizesFigureScript(const std::vector<nlohmann::json>& trials) {
   return gp.str();
 }
 
+/// Accuracy against the time spent on a cluster (pooled over the trials of a row that kept a
+/// size_history): at each time, every trial as its latest sizing up to then reported it (none
+/// yet: nothing matched). Empty when no trial kept one.
+struct AccuracyAtTime {
+  double t_s = 0.0, match_percent = 0.0;
+  std::optional<double> mae_mm;
+};
+std::map<std::string, std::vector<AccuracyAtTime>> accuracyAgainstTime(
+    const std::vector<nlohmann::json>& trials, double step_s) {
+  std::map<std::string, std::vector<const nlohmann::json*>> rows;
+  double end_s = 0.0;
+  for (const auto& t : trials)
+    if (t.contains("size_history") && t.at("size_history").is_array() &&
+        !t.at("size_history").empty()) {
+      rows[trialRowKey(t)].push_back(&t);
+      end_s = std::max(end_s, t.value("sim_time_s", 0.0));
+    }
+  std::map<std::string, std::vector<AccuracyAtTime>> out;
+  for (const auto& [key, list] : rows)
+    for (double t_s = step_s; t_s <= end_s + step_s; t_s += step_s) {
+      double gt = 0, matched = 0, abs_sum = 0;
+      for (const nlohmann::json* trial : list) {
+        const double trial_gt = double(trial->at("fruitlets").size());
+        gt += trial_gt;
+        const nlohmann::json* latest = nullptr;
+        for (const auto& h : trial->at("size_history"))
+          if (h.value("sim_time_s", 0.0) <= t_s) latest = &h;
+        if (!latest) continue;
+        const double m = std::round(latest->value("match_percent", 0.0) * trial_gt / 100.0);
+        matched += m;
+        if (m > 0 && latest->at("mae_mm").is_number())
+          abs_sum += m * latest->at("mae_mm").get<double>();
+      }
+      AccuracyAtTime a;
+      a.t_s = t_s;
+      a.match_percent = gt > 0 ? 100.0 * matched / gt : 0.0;
+      if (matched > 0) a.mae_mm = abs_sum / matched;
+      out[key].push_back(a);
+    }
+  return out;
+}
+
+std::string accuracyTimeFigureScript(const std::map<std::string, std::vector<AccuracyAtTime>>& rows,
+                                     const std::vector<nlohmann::json>& trials) {
+  std::ostringstream gp;
+  gp << "set terminal pngcairo size 900,600 font 'DejaVu Sans,12'\n"
+     << "set title 'Accuracy against simulated time spent on a cluster (pooled over trials)'\n"
+     << "set xlabel 'simulated time on the cluster (s)'\nset ylabel 'MAE (mm)'\n"
+     << "set y2label 'MP (%)'\nset y2range [0:105]\nset yrange [0:*]\nset ytics nomirror\n"
+     << "set y2tics\nset grid\nset key bottom right\n";
+  // Where automatic stops ended their trials (median per row), as vertical lines.
+  std::map<std::string, std::vector<double>> stops;
+  for (const auto& t : trials)
+    if (t.value("stop_reason", "") == "cluster_done")
+      stops[trialRowKey(t)].push_back(t.value("sim_time_s", 0.0));
+  int arrow = 1;
+  for (const auto& [key, times] : stops)
+    gp << "set arrow " << arrow++ << " from " << median(times) << ", graph 0 to " << median(times)
+       << ", graph 1 nohead dt 2 lc rgb 'black'\nset label " << arrow << " '" << key
+       << ": median automatic stop' at " << median(times) << ", graph 0.95 offset 0.5,0\n";
+  std::string plot = "plot ";
+  int i = 0;
+  for (const auto& [key, points] : rows) {
+    gp << "$r" << i << " << EOD\n";
+    for (const auto& a : points)
+      gp << a.t_s << " " << (a.mae_mm ? std::to_string(*a.mae_mm) : "NaN") << " " << a.match_percent
+         << "\n";
+    gp << "EOD\n";
+    plot += (i ? ", " : "") + std::string("$r") + std::to_string(i) +
+            " using 1:2 with lines lw 2 title '" + key + " MAE', $r" + std::to_string(i) +
+            " using 1:3 axes x1y2 with lines dt 3 lw 2 title '" + key + " MP'";
+    ++i;
+  }
+  gp << plot << "\n";
+  return gp.str();
+}
+
 }  // namespace
 
 std::pair<int, int> parseShard(const std::string& text) {
@@ -300,6 +378,30 @@ bool writeReports(const fs::path& dir, const std::vector<nlohmann::json>& unsort
   // The tables first: the figure is an extra that must not cost them.
   host::writeFileAtomically(dir / "table1.md", "Table 1",
                             table + "\nSize distributions: sizes.png.\n");
+
+  // Accuracy against time, when trials kept their sizings (--size-history or --stop auto):
+  // an extra like sizes.png, its data in accuracy_vs_time.json.
+  const auto against_time = accuracyAgainstTime(trials, 5.0);
+  std::error_code stale;
+  fs::remove(dir / "accuracy_vs_time.png", stale);
+  fs::remove(dir / "accuracy_vs_time.json", stale);
+  if (!against_time.empty()) {
+    nlohmann::json data = nlohmann::json::object();
+    for (const auto& [key, points] : against_time)
+      for (const auto& a : points)
+        data[key].push_back({{"sim_time_s", a.t_s},
+                             {"match_percent", a.match_percent},
+                             {"mae_mm", a.mae_mm ? nlohmann::json(*a.mae_mm) : nlohmann::json()}});
+    host::writeFileAtomically(dir / "accuracy_vs_time.json", "accuracy against time",
+                              data.dump(1) + "\n");
+    try {
+      host::plotWithGnuplot(accuracyTimeFigureScript(against_time, trials),
+                            dir / "accuracy_vs_time.png", "accuracy against time figure");
+    } catch (const std::exception& e) {
+      if (warning)
+        warning((dir / "accuracy_vs_time.png").string() + " not drawn: " + oneLine(e.what()));
+    }
+  }
 
   std::string why_not;
   if (trials.empty()) {

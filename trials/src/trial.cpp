@@ -123,6 +123,17 @@ class TrialLog : public host::nbv::LoopObserver {
   nlohmann::json views_ = nlohmann::json::array(), plans_ = nlohmann::json::array();
 };
 
+/// The loop clock as an observer sees it: the time, with nothing charged (sizing for a
+/// figure is not part of the loop).
+class UnchargedClock : public host::nbv::LoopClock {
+ public:
+  explicit UnchargedClock(const host::nbv::LoopClock& clock) : clock_(clock) {}
+  double now_s() const override { return clock_.now_s(); }
+
+ private:
+  const host::nbv::LoopClock& clock_;
+};
+
 /// The cluster as the automatic stop sized it after each view, each sizing scored against
 /// the world's ground truth: what a shorter budget would have reported.
 nlohmann::json sizeHistoryJson(const std::vector<host::nbv::SizingSnapshot>& history,
@@ -242,10 +253,14 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
   host::nbv::LoopObservers observers;
   observers.add(&log);
   std::optional<host::nbv::ClusterCompletion> completion;
+  UnchargedClock observing_clock(loop_clock);
   if (options.stop == "auto") {
     completion.emplace(parts->session(), loop_clock, parts->sizingConfig());
     observers.add(&*completion);
     stop = stop || completion->stopCondition();
+  } else if (options.record_size_history) {
+    completion.emplace(parts->session(), observing_clock, parts->sizingConfig());
+    observers.add(&*completion);
   }
   host::nbv::NbvLoop loop(parts->session(), parts->planner(), loop_camera, loop_arm, loop_clock);
   const host::nbv::NbvResult run = loop.run(stop, &observers);
@@ -297,14 +312,14 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
                                 {"motion_planning", run.wall_s.motion_planning},
                                 {"sizing", sizing_wall_s},
                                 {"sizing_during_loop", loop_sizing_s}};
-  if (completion) {
+  if (completion) result["size_history"] = sizeHistoryJson(completion->history(), *world);
+  if (options.stop == "auto") {
     result["stop"] = {{"rule", "auto"},
                       {"stable_views", completion->config().stable_views},
                       {"size_tolerance_mm", completion->config().size_tolerance_mm},
                       {"same_fruitlet_m", completion->config().same_fruitlet_m},
                       {"min_well_seen_images", completion->config().min_well_seen_images},
                       {"min_view_span_deg", completion->config().min_view_span_deg}};
-    result["size_history"] = sizeHistoryJson(completion->history(), *world);
   } else {
     result["stop"] = {{"rule", "budget"}};
   }

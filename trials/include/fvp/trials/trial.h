@@ -41,6 +41,10 @@ struct TrialOptions {
   /// budget: the paper's protocol (budget_s, max_views); auto: also stop once the cluster's
   /// sizes have settled (host/nbv/cluster_completion.h), budget_s being the cap.
   std::string stop = "budget";
+  /// Size the cluster after every view and keep each sizing, scored, in result.json's
+  /// size_history (always with stop auto). Under stop budget it is an observation for the
+  /// accuracy-against-time figure, not part of the loop: not charged to the clock.
+  bool record_size_history = false;
   /// Where result.json, the maps, the TSDF surface, the clusters and report.md go; empty:
   /// nothing is written (the result is only returned).
   std::filesystem::path out_dir;
