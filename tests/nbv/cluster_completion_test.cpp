@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "fvp/accel/backend.h"
 #include "seed2_orbit_frames.h"
 
@@ -93,6 +95,18 @@ TEST(ClusterCompletion, ImagesFromOneDirectionDoNotStopButSphereFitsDo) {
   EXPECT_TRUE(sizesSettled(merged, config));
 }
 
+TEST(ClusterCompletion, NaNSizesAndTwoDetectionsOnOneEarlierFruitletNeverSettle) {
+  const ClusterCompletionConfig config;
+  auto nan = history(6);
+  for (auto& s : nan) s.fruitlets[1].size_mm = std::nan("");
+  EXPECT_FALSE(sizesSettled(nan, config));
+  // The newest sizing lost the fruitlet at 2 cm and split the one at 0 into two: as many
+  // detections as before, but both near one earlier fruitlet.
+  auto split = history(6);
+  split.back().fruitlets[1] = fruitlet(0.001, 8.1);
+  EXPECT_FALSE(sizesSettled(split, config));
+}
+
 TEST(ClusterCompletion, AnEmptyClusterIsNeverDone) {
   std::vector<SizingSnapshot> empty(8);
   EXPECT_FALSE(sizesSettled(empty, {}));
@@ -137,6 +151,11 @@ class CountingClock : public LoopClock {
 
 TEST(ClusterCompletion, SizesTheSessionAfterEveryMappedViewAndChargesTheClock) {
   auto backend = accel::createBackend("cpu");
+  {
+    const MappingSession without_tsdf({}, "grid", {}, backend.get());
+    CountingClock clock;
+    EXPECT_THROW(ClusterCompletion(without_tsdf, clock, {}), std::invalid_argument);
+  }
   MappingSession session({}, "grid", {}, backend.get());
   session.enableTsdf();
   CountingClock clock;

@@ -231,11 +231,21 @@ TEST(Sizing, SupportRuleDropsAFragmentAndKeepsTheFruitlet) {
   EXPECT_NEAR(fragment.size_ours_mm, fruitlet.size_ours_mm, 0.5);
   EXPECT_EQ(fragment.support.own_segment_images, 0);
   EXPECT_LT(double(fragment.points), 0.25 * fragment.support.required_points);
-  // Without the rule the fragment is a second fruitlet: the rule is what drops it.
+  // With the fragment gone the fruitlet's segment is its own again: sized from its two
+  // well-seen images, not from its sphere fit.
+  EXPECT_EQ(fruitlet.support.own_segment_images, 2);
+  EXPECT_EQ(fruitlet.support.well_seen_images, 2);
+  EXPECT_EQ(fruitlet.size_source, sizing::SizeSource::kWellSeenImages);
+  EXPECT_NEAR(fruitlet.size_ours_mm, 10.0, 0.15);
+  // Without the rule the fragment is a second fruitlet, and it makes the fruitlet's
+  // segment shared in every image: the rule is what drops it and restores the sizing.
   config.min_support_area_fraction = 0.0;
   const auto all = sizing::sizeFruitlets({view, view}, pts, nullptr, config);
-  EXPECT_EQ(all.fruitlets.size(), 2u);
+  ASSERT_EQ(all.fruitlets.size(), 2u);
   EXPECT_TRUE(all.unsupported.empty());
+  for (const auto& f : all.fruitlets) EXPECT_EQ(f.support.own_segment_images, 0);
+  EXPECT_EQ(all.events.not_visible, kept.events.not_visible);
+  EXPECT_EQ(all.events.unsized_clusters, kept.events.unsized_clusters);
 }
 
 TEST(Sizing, EmptyInputsAreCountedNotErrors) {

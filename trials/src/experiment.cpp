@@ -139,6 +139,14 @@ std::string fmt(const nlohmann::json& v, int precision) {
   return s.str();
 }
 
+/// A member that is a number, or null (absent, null or another type: an older or partial line).
+std::optional<double> numberAt(const nlohmann::json& object, const char* key) {
+  if (!object.is_object()) return std::nullopt;
+  const auto it = object.find(key);
+  if (it == object.end() || !it->is_number()) return std::nullopt;
+  return it->get<double>();
+}
+
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -150,13 +158,15 @@ double median(std::vector<double> v) {
 nlohmann::json pool(const std::vector<const nlohmann::json*>& trials, const char* fruitlets_key) {
   std::size_t gt = 0, matched = 0;
   std::uint64_t detections = 0;
-  double abs_sum = 0, pct_sum = 0, views = 0, wall = 0, sim = 0;
+  double abs_sum = 0, pct_sum = 0, views = 0, wall = 0, sim = 0, matched_in_sim = 0;
   std::vector<double> sim_per_trial;
   for (const nlohmann::json* t : trials) {
     views += t->contains("views") ? t->at("views").get<double>() : 0.0;
-    if (t->contains("sim_time_s") && t->at("sim_time_s").is_number()) {
-      sim += t->at("sim_time_s").get<double>();
-      sim_per_trial.push_back(t->at("sim_time_s").get<double>());
+    const std::optional<double> sim_s = numberAt(*t, "sim_time_s");
+    if (sim_s) {
+      sim += *sim_s;
+      sim_per_trial.push_back(*sim_s);
+      for (const auto& f : t->at(fruitlets_key)) matched_in_sim += f.at("matched").get<bool>();
     }
     wall += t->contains("wall_time_s") ? t->at("wall_time_s").get<double>() : 0.0;
     detections += t->contains("detections") ? t->at("detections").get<std::uint64_t>() : 0;
@@ -183,7 +193,7 @@ nlohmann::json pool(const std::vector<const nlohmann::json*>& trials, const char
           {"mean_views", opt(n > 0, n ? views / double(n) : 0.0)},
           // The time a cluster took (the budget, or less with --stop auto) and what it bought.
           {"median_sim_s_per_trial", opt(!sim_per_trial.empty(), median(sim_per_trial))},
-          {"matched_per_sim_min", opt(sim > 0, sim > 0 ? 60.0 * double(matched) / sim : 0.0)},
+          {"matched_per_sim_min", opt(sim > 0, sim > 0 ? 60.0 * matched_in_sim / sim : 0.0)},
           {"wall_s_per_trial", opt(n > 0, n ? wall / double(n) : 0.0)}};
 }
 
@@ -244,7 +254,11 @@ std::map<std::string, std::vector<AccuracyAtTime>> accuracyAgainstTime(
     if (t.contains("size_history") && t.at("size_history").is_array() &&
         !t.at("size_history").empty()) {
       rows[trialRowKey(t)].push_back(&t);
-      end_s = std::max(end_s, t.value("sim_time_s", 0.0));
+      if (const std::optional<double> sim_s = numberAt(t, "sim_time_s"))
+        end_s = std::max(end_s, *sim_s);
+      for (const auto& h : t.at("size_history"))
+        if (const std::optional<double> h_s = numberAt(h, "sim_time_s"))
+          end_s = std::max(end_s, *h_s);
     }
   std::map<std::string, std::vector<AccuracyAtTime>> out;
   for (const auto& [key, list] : rows)
@@ -255,12 +269,14 @@ std::map<std::string, std::vector<AccuracyAtTime>> accuracyAgainstTime(
         gt += trial_gt;
         const nlohmann::json* latest = nullptr;
         for (const auto& h : trial->at("size_history"))
-          if (h.value("sim_time_s", 0.0) <= t_s) latest = &h;
+          if (const std::optional<double> h_s = numberAt(h, "sim_time_s"); h_s && *h_s <= t_s)
+            latest = &h;
         if (!latest) continue;
-        const double m = std::round(latest->value("match_percent", 0.0) * trial_gt / 100.0);
+        const std::optional<double> mp = numberAt(*latest, "match_percent");
+        const std::optional<double> mae = numberAt(*latest, "mae_mm");
+        const double m = mp ? std::round(*mp * trial_gt / 100.0) : 0.0;
         matched += m;
-        if (m > 0 && latest->at("mae_mm").is_number())
-          abs_sum += m * latest->at("mae_mm").get<double>();
+        if (m > 0 && mae) abs_sum += m * *mae;
       }
       AccuracyAtTime a;
       a.t_s = t_s;
@@ -281,9 +297,12 @@ std::string accuracyTimeFigureScript(const std::map<std::string, std::vector<Acc
      << "set y2tics\nset grid\nset key bottom right\n";
   // Where automatic stops ended their trials (median per row), as vertical lines.
   std::map<std::string, std::vector<double>> stops;
-  for (const auto& t : trials)
-    if (t.value("stop_reason", "") == "cluster_done")
-      stops[trialRowKey(t)].push_back(t.value("sim_time_s", 0.0));
+  for (const auto& t : trials) {
+    const auto reason = t.find("stop_reason");
+    const std::optional<double> sim_s = numberAt(t, "sim_time_s");
+    if (reason != t.end() && *reason == "cluster_done" && sim_s)
+      stops[trialRowKey(t)].push_back(*sim_s);
+  }
   int arrow = 1;
   for (const auto& [key, times] : stops)
     gp << "set arrow " << arrow++ << " from " << median(times) << ", graph 0 to " << median(times)

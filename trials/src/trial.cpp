@@ -252,8 +252,8 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
   TrialLog log(*parts, *camera, options, wall_start);
   host::nbv::LoopObservers observers;
   observers.add(&log);
+  UnchargedClock observing_clock(loop_clock);  // before completion: it outlives it
   std::optional<host::nbv::ClusterCompletion> completion;
-  UnchargedClock observing_clock(loop_clock);
   if (options.stop == "auto") {
     completion.emplace(parts->session(), loop_clock, parts->sizingConfig());
     observers.add(&*completion);

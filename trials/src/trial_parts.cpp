@@ -108,7 +108,11 @@ host::planner::ViewPlanner& TrialParts::planner() {
 nlohmann::json TrialParts::configJson() const {
   return {{"engine", impl_->engine},
           {"clock", impl_->options.clock},
-          {"fine_map_extent", host::map::toString(impl_->map_config.fine_map_extent)}};
+          {"fine_map_extent", host::map::toString(impl_->map_config.fine_map_extent)},
+          {"stop", impl_->options.stop},
+          {"sizing",
+           {{"estimator", host::sizing::toString(impl_->sizing_config.estimator)},
+            {"min_support_area_fraction", impl_->sizing_config.min_support_area_fraction}}}};
 }
 
 void TrialParts::keepViewImage(int index, const host::StereoFrame& frame) const {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 namespace fvp::host::nbv {
@@ -26,6 +27,9 @@ ClusterCompletion::ClusterCompletion(const MappingSession& session, LoopClock& c
     : session_(session), clock_(clock), sizing_config_(sizing_config), config_(config) {
   config_.validate();
   sizing_config_.validate();
+  if (!session_.tsdfEnabled())
+    throw std::invalid_argument(
+        "ClusterCompletion: the session sizes nothing without enableTsdf()");
 }
 
 void ClusterCompletion::onView(const ViewEvent& event) {
@@ -82,14 +86,19 @@ bool sizesSettled(const std::vector<SizingSnapshot>& history,
     const SizingSnapshot& earlier = history[history.size() - 1 - std::size_t(k)];
     // A fruitlet found or lost: the cluster is still changing.
     if (earlier.fruitlets.size() != latest.fruitlets.size()) return false;
+    std::vector<bool> taken(earlier.fruitlets.size(), false);  // one-to-one
     for (const auto& f : latest.fruitlets) {
-      const FruitletSnapshot* nearest = nullptr;
+      std::optional<std::size_t> nearest;
       double nearest_m = config.same_fruitlet_m;
-      for (const auto& g : earlier.fruitlets)
-        if (const double d = (g.center_m - f.center_m).norm(); d <= nearest_m)
-          nearest = &g, nearest_m = d;
-      if (!nearest || std::abs(nearest->size_mm - f.size_mm) > config.size_tolerance_mm)
+      for (std::size_t g = 0; g < earlier.fruitlets.size(); ++g)
+        if (const double d = (earlier.fruitlets[g].center_m - f.center_m).norm();
+            !taken[g] && d <= nearest_m)
+          nearest = g, nearest_m = d;
+      // A NaN size never agrees.
+      if (!nearest ||
+          !(std::abs(earlier.fruitlets[*nearest].size_mm - f.size_mm) <= config.size_tolerance_mm))
         return false;
+      taken[*nearest] = true;
     }
   }
   return true;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <stdexcept>
 
 #include "fvp/host/sizing/point_filters.h"
@@ -45,6 +46,117 @@ double windowMaxDisparity(const cv::Mat& disparity, int u, int v, int h) {
       if (std::isfinite(d[x]) && d[x] > best) best = d[x];
   }
   return best;
+}
+
+/// Eq. 4 in one image on the segment a cluster falls on (view and shared flag left to the
+/// caller); nothing when the cluster is not visible there or the disparity window is
+/// invalid or saturated (counted).
+std::optional<ImageSize> measureImage(const SizingView& view, const Segments& segments, int best,
+                                      double visible, const SizingConfig& config,
+                                      SizingEvents& events) {
+  const StereoIntrinsics& in = view.intrinsics;
+  const cv::Mat& labels = segments.labels;
+  if (best == 0 || visible < config.min_visible_fraction) {
+    ++events.not_visible;
+    return std::nullopt;
+  }
+  const cv::Mat& stats = segments.stats;
+  const int x0 = stats.at<int>(best, cv::CC_STAT_LEFT), y0 = stats.at<int>(best, cv::CC_STAT_TOP);
+  const int w = stats.at<int>(best, cv::CC_STAT_WIDTH), h = stats.at<int>(best, cv::CC_STAT_HEIGHT);
+  if (stats.at<int>(best, cv::CC_STAT_AREA) < config.min_segment_pixels) {
+    ++events.not_visible;
+    return std::nullopt;
+  }
+  // Hull of the segment's pixel centres (as cv2.fitEllipse on the hull in the authors' code).
+  std::vector<cv::Point> pixels;
+  for (int y = y0; y < y0 + h; ++y)
+    for (int x = x0; x < x0 + w; ++x)
+      if (labels.at<int>(y, x) == best) pixels.emplace_back(x, y);
+  std::vector<cv::Point> hull;
+  cv::convexHull(pixels, hull);
+  if (hull.size() < 5) {
+    ++events.not_visible;
+    return std::nullopt;
+  }
+  const cv::RotatedRect ellipse = cv::fitEllipse(hull);
+  const double minor_px = std::min(ellipse.size.width, ellipse.size.height);
+  const double major_px = std::max(ellipse.size.width, ellipse.size.height);
+  const cv::Point2d c(segments.centroids.at<double>(best, 0),
+                      segments.centroids.at<double>(best, 1));
+  const double d_max = windowMaxDisparity(view.disparity_px, int(std::lround(c.x)),
+                                          int(std::lround(c.y)), config.disparity_window_half_px);
+  if (!(d_max > 0.0) || in.fx_px * in.baseline_m / d_max > config.max_depth_m) {
+    ++events.invalid_disparity_windows;
+    return std::nullopt;
+  }
+  if (d_max >= config.saturated_disparity_px) {
+    ++events.saturated_windows;
+    return std::nullopt;
+  }
+  ImageSize s;
+  s.minor_axis_px = minor_px;
+  s.max_disparity_px = d_max;
+  s.visible_fraction = visible;
+  s.axis_ratio = major_px > 0 ? minor_px / major_px : 0.0;
+  s.touches_border = x0 <= 0 || y0 <= 0 || x0 + w >= labels.cols || y0 + h >= labels.rows;
+  s.size_paper_mm = 1000.0 * minor_px * in.baseline_m / d_max;
+  const double m = minor_px + kHullShortfallPx;
+  const double z_near = in.fx_px * in.baseline_m / d_max;
+  s.size_ours_mm = 1000.0 * m * z_near / (in.fx_px - 0.5 * m);
+  return s;
+}
+
+/// Both estimators, the support and the support rule's requirement from a cluster's
+/// measured images (their shared flags set); nothing for a cluster no image sized.
+void aggregate(FruitletEstimate& f, bool sphere_ok, const SizingConfig& config) {
+  if (f.per_image.empty()) return;
+  std::vector<double> all, good;
+  f.size_paper_mm = 0.0;
+  f.support.own_segment_images = 0;
+  for (auto& s : f.per_image) {
+    f.size_paper_mm = std::max(f.size_paper_mm, s.size_paper_mm);
+    all.push_back(s.size_ours_mm);
+    s.well_seen = s.visible_fraction >= config.well_seen_fraction && !s.touches_border &&
+                  !s.shared_segment && s.axis_ratio >= config.min_axis_ratio;
+    if (s.well_seen) good.push_back(s.size_ours_mm);
+    if (!s.shared_segment) ++f.support.own_segment_images;
+  }
+  f.support.sized_images = int(f.per_image.size());
+  f.support.well_seen_images = int(good.size());
+  const bool every_segment_shared = f.support.own_segment_images == 0;
+  if (!good.empty()) {
+    f.size_ours_mm = median(good);
+    f.size_source = SizeSource::kWellSeenImages;
+  } else if (every_segment_shared && sphere_ok) {
+    // In every image the fruitlet's segment is merged with another's: each hull measures
+    // both; its 3-D surface measures it alone. (Cut or border segments measure less of it,
+    // and their median stays the estimate.)
+    f.size_ours_mm = 2000.0 * f.sphere_radius_m;
+    f.size_source = SizeSource::kSphereFit;
+  } else {
+    f.size_ours_mm = median(all);
+    f.size_source = SizeSource::kAllImages;
+  }
+  f.support.size_stderr_mm = -1.0;
+  if (good.size() >= 2) {
+    std::vector<double> deviations;
+    for (double v : good) deviations.push_back(std::abs(v - f.size_ours_mm));
+    f.support.size_stderr_mm =
+        1.2533 * 1.4826 * median(deviations) / std::sqrt(double(good.size()));
+  }
+  if (config.estimator == SizingEstimator::kPaper) {
+    f.center_m = f.centroid_m;
+    f.size_mm = f.size_paper_mm;
+  } else {
+    f.center_m = f.sphere_center_m;
+    f.size_mm = f.size_ours_mm;
+  }
+  // The support rule's requirement, on our size for either estimator (the paper's maximum
+  // would ask more of the same points).
+  const double radius_m = 0.0005 * f.size_ours_mm;
+  f.support.required_points = kSurfaceCrossingsPerVoxelFace * config.min_support_area_fraction *
+                              4.0 * M_PI * radius_m * radius_m /
+                              (config.surface_voxel_size_m * config.surface_voxel_size_m);
 }
 
 }  // namespace
@@ -169,171 +281,96 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
       if (in_image > 0) falls[ci][vi] = {true, best, double(best_votes) / in_image};
     }
 
-  // The support rule drops detections; one dropped no longer shares a segment with the
-  // fruitlet it fell on, whose images are then sized again without it, until no detection is
-  // dropped (each pass drops at least one, or is the last).
-  std::vector<bool> dropped(sized.size(), false);
-  const SizingEvents events_before_sizing = result.events;
+  // Each cluster's own measurements, once: its centroid and sphere, and Eq. 4 in every image
+  // it is visible in. Only whether an image's segment is shared depends on which other
+  // detections are kept (below).
+  struct Measured {
+    FruitletEstimate base;  ///< centroid, sphere, points; per_image without shared flags
+    bool sphere_ok = false;
+  };
+  std::vector<Measured> measured(sized.size());
+  for (std::size_t ci = 0; ci < sized.size(); ++ci) {
+    const std::vector<Eigen::Vector3f>& pts = *sized[ci].second;
+    FruitletEstimate& f = measured[ci].base;
+    f.points = pts.size();
+    for (const auto& p : pts) f.centroid_m += p.cast<double>();
+    f.centroid_m /= double(pts.size());
+    for (std::size_t vi = 0; vi < views.size(); ++vi) {
+      if (!falls[ci][vi].in_image) continue;
+      if (auto s = measureImage(views[vi], segments[vi], falls[ci][vi].segment,
+                                falls[ci][vi].visible, config, result.events)) {
+        s->view = int(vi);
+        f.per_image.push_back(*s);
+      }
+    }
+    f.sphere_center_m = f.centroid_m;
+    Eigen::Vector3d sphere;
+    double radius = 0.0;
+    // Accept a sphere only of a fruitlet's size near the points (3-8 mm radius and margin).
+    if (fitSphere(pts, sphere, radius) && radius > kDefaultMinFruitletRadius_m &&
+        radius < kDefaultMaxFruitletRadius_m && (sphere - f.centroid_m).norm() < 0.010) {
+      f.sphere_center_m = sphere;
+      f.sphere_radius_m = radius;
+      double sum_sq = 0.0;
+      for (const auto& p : pts) {
+        const double d = (p.cast<double>() - sphere).norm() - radius;
+        sum_sq += d * d;
+      }
+      f.support.sphere_rms_mm = 1000.0 * std::sqrt(sum_sq / double(pts.size()));
+      measured[ci].sphere_ok = true;
+    }
+  }
+
+  // Sizes every kept cluster from its images, an image's segment shared when another
+  // cluster that still marks segments falls on it.
+  std::vector<bool> dropped(sized.size(), false), marks_segments(sized.size(), true);
+  const auto sizeKept = [&](std::size_t ci) {
+    FruitletEstimate f = measured[ci].base;
+    for (auto& s : f.per_image) {
+      const auto vi = std::size_t(s.view);
+      const int segment_label = falls[ci][vi].segment;
+      s.shared_segment = false;
+      for (std::size_t other = 0; other < sized.size(); ++other)
+        s.shared_segment |= other != ci && marks_segments[other] &&
+                            falls[other][vi].segment == segment_label &&
+                            falls[other][vi].visible >= config.min_visible_fraction;
+    }
+    aggregate(f, measured[ci].sphere_ok, config);
+    return f;
+  };
+  // The support rule, one detection at a time: the worst-supported one that fails is dropped
+  // and the rest are sized again, since a dropped phantom (no segment of its own: it lay on
+  // a fruitlet's) no longer makes that fruitlet's images shared. A dropped detection that
+  // had a segment of its own keeps marking segments: it may be a real fruitlet merged in
+  // 2-D with a neighbour, whose merged outline must not size the neighbour.
+  std::vector<FruitletEstimate> estimates(sized.size());
   for (;;) {
-    result.events = events_before_sizing;
-    result.fruitlets.clear();
-    std::vector<std::size_t> newly_dropped;
+    std::optional<std::size_t> worst;
+    double worst_ratio = 1.0;
     for (std::size_t ci = 0; ci < sized.size(); ++ci) {
       if (dropped[ci]) continue;
-      const std::vector<Eigen::Vector3f>& pts = *sized[ci].second;
-      FruitletEstimate f;
-      f.points = pts.size();
-      for (const auto& p : pts) f.centroid_m += p.cast<double>();
-      f.centroid_m /= double(pts.size());
-
-      for (std::size_t vi = 0; vi < views.size(); ++vi) {
-        const SizingView& view = views[vi];
-        const StereoIntrinsics& in = view.intrinsics;
-        const cv::Mat& labels = segments[vi].labels;
-        const int best = falls[ci][vi].segment;
-        const double visible = falls[ci][vi].visible;
-        if (!falls[ci][vi].in_image) continue;
-        bool shared = false;
-        for (std::size_t other = 0; other < sized.size(); ++other)
-          shared |= other != ci && !dropped[other] && falls[other][vi].segment == best &&
-                    falls[other][vi].visible >= config.min_visible_fraction;
-        if (best == 0 || visible < config.min_visible_fraction) {
-          ++result.events.not_visible;
-          continue;
-        }
-        const cv::Mat& stats = segments[vi].stats;
-        const int x0 = stats.at<int>(best, cv::CC_STAT_LEFT),
-                  y0 = stats.at<int>(best, cv::CC_STAT_TOP);
-        const int w = stats.at<int>(best, cv::CC_STAT_WIDTH),
-                  h = stats.at<int>(best, cv::CC_STAT_HEIGHT);
-        if (stats.at<int>(best, cv::CC_STAT_AREA) < config.min_segment_pixels) {
-          ++result.events.not_visible;
-          continue;
-        }
-        // Hull of the segment's pixel centres (as cv2.fitEllipse on the hull in the authors' code).
-        std::vector<cv::Point> pixels;
-        for (int y = y0; y < y0 + h; ++y)
-          for (int x = x0; x < x0 + w; ++x)
-            if (labels.at<int>(y, x) == best) pixels.emplace_back(x, y);
-        std::vector<cv::Point> hull;
-        cv::convexHull(pixels, hull);
-        if (hull.size() < 5) {
-          ++result.events.not_visible;
-          continue;
-        }
-        const cv::RotatedRect ellipse = cv::fitEllipse(hull);
-        const double minor_px = std::min(ellipse.size.width, ellipse.size.height);
-        const cv::Point2d c(segments[vi].centroids.at<double>(best, 0),
-                            segments[vi].centroids.at<double>(best, 1));
-        const double d_max =
-            windowMaxDisparity(view.disparity_px, int(std::lround(c.x)), int(std::lround(c.y)),
-                               config.disparity_window_half_px);
-        if (!(d_max > 0.0) || in.fx_px * in.baseline_m / d_max > config.max_depth_m) {
-          ++result.events.invalid_disparity_windows;
-          continue;
-        }
-        if (d_max >= config.saturated_disparity_px) {
-          ++result.events.saturated_windows;
-          continue;
-        }
-        ImageSize s;
-        s.view = int(vi);
-        s.minor_axis_px = minor_px;
-        s.max_disparity_px = d_max;
-        s.visible_fraction = visible;
-        s.shared_segment = shared;
-        s.axis_ratio = std::max(ellipse.size.width, ellipse.size.height) > 0
-                           ? minor_px / std::max(ellipse.size.width, ellipse.size.height)
-                           : 0.0;
-        s.touches_border = x0 <= 0 || y0 <= 0 || x0 + w >= labels.cols || y0 + h >= labels.rows;
-        s.size_paper_mm = 1000.0 * minor_px * in.baseline_m / d_max;
-        const double m = minor_px + kHullShortfallPx;
-        const double z_near = in.fx_px * in.baseline_m / d_max;
-        s.size_ours_mm = 1000.0 * m * z_near / (in.fx_px - 0.5 * m);
-        f.per_image.push_back(s);
-      }
-      if (f.per_image.empty()) {
-        ++result.events.unsized_clusters;
-        continue;
-      }
-      if (f.per_image.size() == 1) ++result.events.single_image_fruitlets;
-
-      std::vector<double> all, good;
-      f.size_paper_mm = 0.0;
-      for (auto& s : f.per_image) {
-        f.size_paper_mm = std::max(f.size_paper_mm, s.size_paper_mm);
-        all.push_back(s.size_ours_mm);
-        s.well_seen = s.visible_fraction >= config.well_seen_fraction && !s.touches_border &&
-                      !s.shared_segment && s.axis_ratio >= config.min_axis_ratio;
-        if (s.well_seen) good.push_back(s.size_ours_mm);
-        if (!s.shared_segment) ++f.support.own_segment_images;
-      }
-      f.support.sized_images = int(f.per_image.size());
-      f.support.well_seen_images = int(good.size());
-      double radius = 0.0;
-      f.sphere_center_m = f.centroid_m;
-      Eigen::Vector3d sphere;
-      // Accept a sphere only of a fruitlet's size near the points (3-8 mm radius and margin).
-      if (fitSphere(pts, sphere, radius) && radius > kDefaultMinFruitletRadius_m &&
-          radius < kDefaultMaxFruitletRadius_m && (sphere - f.centroid_m).norm() < 0.010) {
-        f.sphere_center_m = sphere;
-        f.sphere_radius_m = radius;
-        double sum_sq = 0.0;
-        for (const auto& p : pts) {
-          const double d = (p.cast<double>() - sphere).norm() - radius;
-          sum_sq += d * d;
-        }
-        f.support.sphere_rms_mm = 1000.0 * std::sqrt(sum_sq / double(pts.size()));
-      } else {
-        ++result.events.failed_sphere_fits;
-      }
-
-      const bool every_segment_shared =
-          std::all_of(f.per_image.begin(), f.per_image.end(),
-                      [](const ImageSize& s) { return s.shared_segment; });
-      if (!good.empty()) {
-        f.size_ours_mm = median(good);
-        f.size_source = SizeSource::kWellSeenImages;
-      } else if (every_segment_shared && f.sphere_radius_m > 0.0) {
-        // In every image the fruitlet's segment is merged with another's: each hull measures
-        // both; its 3-D surface measures it alone. (Cut or border segments measure less of it,
-        // and their median stays the estimate.)
-        f.size_ours_mm = 2000.0 * f.sphere_radius_m;
-        f.size_source = SizeSource::kSphereFit;
-      } else {
-        f.size_ours_mm = median(all);
-        f.size_source = SizeSource::kAllImages;
-      }
-
-      if (good.size() >= 2) {
-        std::vector<double> deviations;
-        for (double v : good) deviations.push_back(std::abs(v - f.size_ours_mm));
-        f.support.size_stderr_mm =
-            1.2533 * 1.4826 * median(deviations) / std::sqrt(double(good.size()));
-      }
-
-      if (config.estimator == SizingEstimator::kPaper) {
-        f.center_m = f.centroid_m;
-        f.size_mm = f.size_paper_mm;
-      } else {
-        f.center_m = f.sphere_center_m;
-        f.size_mm = f.size_ours_mm;
-      }
-      // The support rule, on our size for either estimator (the paper's maximum would ask
-      // more of the same points).
-      const double radius_m = 0.0005 * f.size_ours_mm;
-      f.support.required_points = kSurfaceCrossingsPerVoxelFace * config.min_support_area_fraction *
-                                  4.0 * M_PI * radius_m * radius_m /
-                                  (config.surface_voxel_size_m * config.surface_voxel_size_m);
-      if (double(f.points) < f.support.required_points) {
-        newly_dropped.push_back(ci);
-        result.unsupported.push_back(std::move(f));
-        continue;
-      }
-      result.fruitlets.push_back(std::move(f));
+      estimates[ci] = sizeKept(ci);
+      const FruitletEstimate& f = estimates[ci];
+      if (f.per_image.empty()) continue;  // unsized: dropped below, not by the rule
+      const double ratio =
+          f.support.required_points > 0.0 ? double(f.points) / f.support.required_points : INFINITY;
+      if (ratio < worst_ratio) worst = ci, worst_ratio = ratio;
     }
-    if (newly_dropped.empty()) break;
-    for (std::size_t ci : newly_dropped) dropped[ci] = true;
+    if (!worst) break;
+    dropped[*worst] = true;
+    marks_segments[*worst] = estimates[*worst].support.own_segment_images > 0;
+    result.unsupported.push_back(std::move(estimates[*worst]));
+  }
+  for (std::size_t ci = 0; ci < sized.size(); ++ci) {
+    if (dropped[ci]) continue;
+    FruitletEstimate& f = estimates[ci];
+    if (f.per_image.empty()) {
+      ++result.events.unsized_clusters;
+      continue;
+    }
+    if (f.per_image.size() == 1) ++result.events.single_image_fruitlets;
+    if (!measured[ci].sphere_ok) ++result.events.failed_sphere_fits;
+    result.fruitlets.push_back(std::move(f));
   }
   result.events.unsupported_detections = result.unsupported.size();
   return result;

@@ -21,9 +21,9 @@ struct ClusterCompletionConfig {
   /// Views over which nothing may change: a new view adds a few well-seen images to each
   /// fruitlet's median, so one quiet view says little; three say the median has settled.
   int stable_views = 3;
-  /// The most a fruitlet's size may move over those views. One pixel at the planner's
-  /// farthest view (0.40 m, fx 1100 px) spans 0.36 mm; 0.1 mm is a quarter of that and a
-  /// third of the 0.3 mm error the sizing reaches with the paper's whole budget, so views
+  /// The most a fruitlet's size may differ, in any of those views, from its latest size. One pixel
+  /// at the planner's farthest view (0.40 m, fx 1100 px) spans 0.36 mm; 0.1 mm is a quarter of that
+  /// and a third of the 0.3 mm error the sizing reaches with the paper's whole budget, so views
   /// that move estimates less than this cannot buy a better size.
   double size_tolerance_mm = 0.1;
   /// Detections of two sizings closer than this are one fruitlet: the smallest fruitlet's
@@ -66,9 +66,13 @@ struct SizingSnapshot {
 /// clock as LoopStage::kSizing: a robot would spend it too.
 class ClusterCompletion : public LoopObserver {
  public:
-  /// session and clock must outlive this; the session needs enableTsdf().
+  /// session and clock must outlive this. Throws std::invalid_argument for a bad config or
+  /// a session without enableTsdf() (nothing could be sized).
   ClusterCompletion(const MappingSession& session, LoopClock& clock,
                     sizing::SizingConfig sizing_config, ClusterCompletionConfig config = {});
+  // stopCondition() refers to this object.
+  ClusterCompletion(const ClusterCompletion&) = delete;
+  ClusterCompletion& operator=(const ClusterCompletion&) = delete;
 
   void onView(const ViewEvent& event) override;
 

@@ -69,6 +69,7 @@ class MappingSession {
   /// session's backend; a cpu backend of its own without one), from the view whose tag
   /// places the region on, earlier views included.
   void enableTsdf(const tsdf::TsdfConfig& config = {});
+  bool tsdfEnabled() const { return tsdf_config_.has_value(); }
   /// Null until enableTsdf() was called and the region is known.
   const tsdf::TsdfVolume* tsdf() const { return tsdf_.get(); }
   /// The TSDF's surface points; empty while there is no TSDF.
