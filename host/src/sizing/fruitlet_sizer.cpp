@@ -108,7 +108,7 @@ std::optional<ImageSize> measureImage(const SizingView& view, const Segments& se
 
 /// Both estimators, the support and the support rule's requirement from a cluster's
 /// measured images (their shared flags set); nothing for a cluster no image sized.
-void aggregate(FruitletEstimate& f, bool sphere_ok, const SizingConfig& config) {
+void aggregate(FruitletEstimate& f, const SizingConfig& config) {
   if (f.per_image.empty()) return;
   std::vector<double> all, good;
   f.size_paper_mm = 0.0;
@@ -127,7 +127,7 @@ void aggregate(FruitletEstimate& f, bool sphere_ok, const SizingConfig& config) 
   if (!good.empty()) {
     f.size_ours_mm = median(good);
     f.size_source = SizeSource::kWellSeenImages;
-  } else if (every_segment_shared && sphere_ok) {
+  } else if (every_segment_shared && f.sphere_radius_m > 0.0) {  // the sphere was accepted
     // In every image the fruitlet's segment is merged with another's: each hull measures
     // both; its 3-D surface measures it alone. (Cut or border segments measure less of it,
     // and their median stays the estimate.)
@@ -284,14 +284,11 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
   // Each cluster's own measurements, once: its centroid and sphere, and Eq. 4 in every image
   // it is visible in. Only whether an image's segment is shared depends on which other
   // detections are kept (below).
-  struct Measured {
-    FruitletEstimate base;  ///< centroid, sphere, points; per_image without shared flags
-    bool sphere_ok = false;
-  };
-  std::vector<Measured> measured(sized.size());
+  // (centroid, sphere, points; per_image without shared flags)
+  std::vector<FruitletEstimate> measured(sized.size());
   for (std::size_t ci = 0; ci < sized.size(); ++ci) {
     const std::vector<Eigen::Vector3f>& pts = *sized[ci].second;
-    FruitletEstimate& f = measured[ci].base;
+    FruitletEstimate& f = measured[ci];
     f.points = pts.size();
     for (const auto& p : pts) f.centroid_m += p.cast<double>();
     f.centroid_m /= double(pts.size());
@@ -317,7 +314,6 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
         sum_sq += d * d;
       }
       f.support.sphere_rms_mm = 1000.0 * std::sqrt(sum_sq / double(pts.size()));
-      measured[ci].sphere_ok = true;
     }
   }
 
@@ -325,7 +321,7 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
   // cluster that still marks segments falls on it.
   std::vector<bool> dropped(sized.size(), false), marks_segments(sized.size(), true);
   const auto sizeKept = [&](std::size_t ci) {
-    FruitletEstimate f = measured[ci].base;
+    FruitletEstimate f = measured[ci];
     for (auto& s : f.per_image) {
       const auto vi = std::size_t(s.view);
       const int segment_label = falls[ci][vi].segment;
@@ -335,7 +331,7 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
                             falls[other][vi].segment == segment_label &&
                             falls[other][vi].visible >= config.min_visible_fraction;
     }
-    aggregate(f, measured[ci].sphere_ok, config);
+    aggregate(f, config);
     return f;
   };
   // The support rule, one detection at a time: the worst-supported one that fails is dropped
@@ -369,7 +365,7 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
       continue;
     }
     if (f.per_image.size() == 1) ++result.events.single_image_fruitlets;
-    if (!measured[ci].sphere_ok) ++result.events.failed_sphere_fits;
+    if (!(f.sphere_radius_m > 0.0)) ++result.events.failed_sphere_fits;
     result.fruitlets.push_back(std::move(f));
   }
   result.events.unsupported_detections = result.unsupported.size();
