@@ -28,25 +28,35 @@ const MapConfig& validated(const MapConfig& config) {
 
 }  // namespace
 
+GridMapEngine::FineLevel::FineLevel(accel::Backend& backend, const MapConfig& config,
+                                    const ClusterRegion& region)
+    : layer(backend, fineGridGeometry(config, region), /*with_roi=*/true,
+            regionInGrid(fineGridGeometry(config, region), region),
+            allocationFor(fineGridGeometry(config, region))),
+      integrator(layer),
+      distance(layer),
+      frontiers(layer) {}
+
 GridMapEngine::GridMapEngine(const MapConfig& config, const ClusterRegion& region,
                              accel::Backend& backend)
     : MapEngine(validated(config), region),
       backend_(backend),
       coarse_(backend, coarseGridGeometry(config), /*with_roi=*/false, std::nullopt,
               allocationFor(coarseGridGeometry(config))),
-      fine_(backend, fineGridGeometry(config, region), /*with_roi=*/true,
-            regionInGrid(fineGridGeometry(config, region), region),
-            allocationFor(fineGridGeometry(config, region))),
       coarse_integrator_(coarse_),
-      fine_integrator_(fine_),
-      fine_distance_(fine_),
-      fine_frontiers_(fine_) {}
+      fine_(std::make_unique<FineLevel>(backend, config, region)) {}
+
+void GridMapEngine::placeFineMap() {
+  fine_ = std::make_unique<FineLevel>(backend_, config(), region());
+  distance_max_d_m_ = -1.0;
+  scene_change_[1] = 0;
+}
 
 void GridMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
                                   const std::vector<accel::ScanPoint>& points, ScanStats& stats) {
   // Every end point lies within max range of the sensor; the exact walk needs it within
   // 8192 voxels of each grid's corner (fvp_dda.h), else its rays would be dropped.
-  for (const OccupancyLayer* layer : {&coarse_, &fine_}) {
+  for (const OccupancyLayer* layer : {&coarse_, &fine_->layer}) {
     const GridGeometry& g = layer->geometry();
     for (int a = 0; a < 3; ++a) {
       const double from_corner_vox =
@@ -66,7 +76,7 @@ void GridMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
     const Eigen::Vector3f sensor = sensor_origin_m.cast<float>();
     const auto n = static_cast<std::uint32_t>(points.size());
     stats.coarse_voxels_updated = coarse_integrator_.integrate(*buffer, n, sensor, config().model);
-    stats.fine_voxels_updated = fine_integrator_.integrate(*buffer, n, sensor, config().model);
+    stats.fine_voxels_updated = fine_->integrator.integrate(*buffer, n, sensor, config().model);
   }
 }
 
@@ -78,10 +88,10 @@ VoxelClass GridMapEngine::coarseClass(const Eigen::Vector3d& p_m) const {
 
 VoxelState GridMapEngine::fineState(const Eigen::Vector3d& p_m) const {
   std::array<int, 3> index;
-  if (!fine_.geometry().gridIndex(p_m, index)) return {};
+  if (!fine_->layer.geometry().gridIndex(p_m, index)) return {};
   VoxelState s;
-  s.occupancy = classifyLogOdds(fine_.occupancyAt(index), config().model.occupiedLogOdds());
-  s.roi = s.occupancy != VoxelClass::kUnknown && fine_.roiAt(index) > 0.0f;
+  s.occupancy = classifyLogOdds(fine_->layer.occupancyAt(index), config().model.occupiedLogOdds());
+  s.roi = s.occupancy != VoxelClass::kUnknown && fine_->layer.roiAt(index) > 0.0f;
   return s;
 }
 
@@ -97,9 +107,9 @@ void GridMapEngine::exportCoarse(const std::filesystem::path& bt_path) const {
 void GridMapEngine::exportFine(const std::filesystem::path& ot_path) const {
   RoiOcTree tree(config().fine_voxel_size_m);
   tree.setOccupancyThres(config().model.occupied_prob);
-  fine_.forEachVoxel([&](const std::array<int, 3>& index, float occupancy, float roi) {
+  fine_->layer.forEachVoxel([&](const std::array<int, 3>& index, float occupancy, float roi) {
     if (std::isnan(occupancy)) return;
-    const Eigen::Vector3d c = fine_.geometry().voxelCenter_m(index);
+    const Eigen::Vector3d c = fine_->layer.geometry().voxelCenter_m(index);
     RoiOcTreeNode* node =
         tree.setNodeValue(octomap::point3d(c.x(), c.y(), c.z()), occupancy, /*lazy_eval=*/true);
     node->setRoiLogOdds(std::isnan(roi) ? 0.0f : roi);
@@ -109,11 +119,11 @@ void GridMapEngine::exportFine(const std::filesystem::path& ot_path) const {
 }
 
 const GridGeometry& GridMapEngine::gridGeometry(MapLevel level) const {
-  return level == MapLevel::kCoarse ? coarse_.geometry() : fine_.geometry();
+  return level == MapLevel::kCoarse ? coarse_.geometry() : fine_->layer.geometry();
 }
 
 std::vector<std::array<int, 3>> GridMapEngine::occupiedVoxels(MapLevel level) const {
-  const OccupancyLayer& grid = level == MapLevel::kCoarse ? coarse_ : fine_;
+  const OccupancyLayer& grid = level == MapLevel::kCoarse ? coarse_ : fine_->layer;
   const float occupied = config().model.occupiedLogOdds();
   std::vector<std::array<int, 3>> voxels;
   grid.forEachVoxel([&](const std::array<int, 3>& index, float occupancy, float) {
@@ -124,10 +134,10 @@ std::vector<std::array<int, 3>> GridMapEngine::occupiedVoxels(MapLevel level) co
 
 void GridMapEngine::updateRoiDistance(double max_d_m) {
   if (!(max_d_m > 0.0)) throw std::invalid_argument("updateRoiDistance: max_d_m must be positive");
-  if (distance_max_d_m_ == max_d_m && fine_distance_.current()) return;
-  const double voxel = fine_.geometry().voxel_size_m;
+  if (distance_max_d_m_ == max_d_m && fine_->distance.current()) return;
+  const double voxel = fine_->layer.geometry().voxel_size_m;
   const int radius_vox = std::max(1, static_cast<int>(std::ceil(max_d_m / voxel)));
-  fine_distance_.compute(radius_vox);
+  fine_->distance.compute(radius_vox);
   distance_max_d_m_ = max_d_m;
 }
 
@@ -135,12 +145,12 @@ double GridMapEngine::roiDistance_m(const std::array<int, 3>& fine_index) const 
   if (distance_max_d_m_ < 0.0)
     throw std::logic_error("roiDistance_m: call updateRoiDistance() first");
   // Outside the grid distanceVoxAt gives the cap radius, ceil(max_d / voxel): max_d here.
-  return std::min(fine_distance_.distanceVoxAt(fine_index) * fine_.geometry().voxel_size_m,
+  return std::min(fine_->distance.distanceVoxAt(fine_index) * fine_->layer.geometry().voxel_size_m,
                   distance_max_d_m_);
 }
 
 std::vector<FrontierVoxel> GridMapEngine::frontiers() {
-  return fine_frontiers_.extract(config().model.occupiedLogOdds());
+  return fine_->frontiers.extract(config().model.occupiedLogOdds());
 }
 
 void GridMapEngine::writeCoarseBricks(octomap::OcTree& tree, std::uint64_t since) const {
@@ -171,7 +181,7 @@ const octomap::OcTree& GridMapEngine::coarseOcTree() {
 }
 
 void GridMapEngine::refreshScene(MapLevel level, OccupiedVoxelScene& scene, bool fresh) {
-  const OccupancyLayer& layer = level == MapLevel::kCoarse ? coarse_ : fine_;
+  const OccupancyLayer& layer = level == MapLevel::kCoarse ? coarse_ : fine_->layer;
   std::uint64_t& synced = scene_change_[level == MapLevel::kCoarse ? 0 : 1];
   if (fresh) synced = 0;
   const float occupied = config().model.occupiedLogOdds();

@@ -20,6 +20,15 @@ ScanStats MapEngine::integrate(const LabeledClouds& clouds) {
   return stats;
 }
 
+void MapEngine::moveToRegion(const ClusterRegion& region) {
+  if (!(region.radius_m() > 0.0) || !region.center_m().allFinite())
+    throw std::invalid_argument(
+        "moveToRegion: the Cluster Region needs a finite centre and a positive radius");
+  region_ = region;
+  scenes_[1] = SceneState{};  // the fine scene described the old region's voxels
+  placeFineMap();
+}
+
 const OccupiedVoxelScene& MapEngine::occupiedScene(MapLevel level) {
   SceneState& state = scenes_[level == MapLevel::kCoarse ? 0 : 1];
   const bool fresh = !state.scene;

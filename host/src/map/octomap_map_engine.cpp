@@ -169,6 +169,29 @@ std::vector<std::uint64_t> sortedUnion(std::vector<std::vector<std::uint64_t>> p
   return std::move(parts.front());
 }
 
+// Keys are 16 bit: every lattice index the engine turns into a key must lie within
+// OctoMap's +-32768 voxels.
+void checkKeyRange(const char* name, const std::array<std::int64_t, 3>& lo_index,
+                   const std::array<std::int64_t, 3>& end_index, int key_offset) {
+  for (int a = 0; a < 3; ++a) {
+    if (lo_index[a] + key_offset < 0 ||
+        end_index[a] - 1 + key_offset > std::numeric_limits<octomap::key_type>::max()) {
+      throw std::invalid_argument(std::string("octomap engine: the ") + name +
+                                  " lies outside OctoMap's key range (+-32768 voxels around "
+                                  "the origin)");
+    }
+  }
+}
+
+void checkKeyRange(const char* name, const GridGeometry& g, int key_offset) {
+  std::array<std::int64_t, 3> lo, end;
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = g.first_voxel[a];
+    end[a] = std::int64_t{g.first_voxel[a]} + g.dims[a];
+  }
+  checkKeyRange(name, lo, end, key_offset);
+}
+
 }  // namespace
 
 OctomapMapEngine::OctomapMapEngine(const MapConfig& config, const ClusterRegion& region)
@@ -180,13 +203,8 @@ OctomapMapEngine::OctomapMapEngine(const MapConfig& config, const ClusterRegion&
         "positive radius");
   }
   coarse_grid_ = coarseGridGeometry(config);
-  fine_grid_ = fineGridGeometry(config, region);
-  fine_region_ = regionInGrid(fine_grid_, region);
-
   coarse_ = std::make_unique<octomap::OcTree>(config.coarse_voxel_size_m);
-  fine_ = std::make_unique<RoiOcTree>(config.fine_voxel_size_m);
   setSensorModel(*coarse_, config.model);
-  setSensorModel(*fine_, config.model);
   key_offset_ = coarse_->coordToKey(0.0);  // tree_max_val: the key of lattice index 0
 
   // The observation box as the coarse grid holds it (snapped outward to whole 8-voxel
@@ -196,34 +214,23 @@ OctomapMapEngine::OctomapMapEngine(const MapConfig& config, const ClusterRegion&
     fine_box_lo_[a] = std::llround(coarse_grid_.first_voxel[a] * ratio);
     fine_box_hi_[a] = std::llround((coarse_grid_.first_voxel[a] + coarse_grid_.dims[a]) * ratio);
   }
-
-  // Keys are 16 bit: every lattice index the engine turns into a key must lie within
-  // OctoMap's +-32768 voxels.
-  auto checkKeyRange = [&](const char* name, const std::array<std::int64_t, 3>& lo_index,
-                           const std::array<std::int64_t, 3>& end_index) {
-    for (int a = 0; a < 3; ++a) {
-      if (lo_index[a] + key_offset_ < 0 ||
-          end_index[a] - 1 + key_offset_ > std::numeric_limits<octomap::key_type>::max()) {
-        throw std::invalid_argument(std::string("octomap engine: the ") + name +
-                                    " lies outside OctoMap's key range (+-32768 voxels around "
-                                    "the origin)");
-      }
-    }
-  };
-  const auto range = [](const GridGeometry& g, std::array<std::int64_t, 3>& lo,
-                        std::array<std::int64_t, 3>& end) {
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = g.first_voxel[a];
-      end[a] = std::int64_t{g.first_voxel[a]} + g.dims[a];
-    }
-  };
-  std::array<std::int64_t, 3> lo, end;
-  range(coarse_grid_, lo, end);
-  checkKeyRange("coarse grid", lo, end);
-  range(fine_grid_, lo, end);
-  checkKeyRange("fine grid", lo, end);
+  checkKeyRange("coarse grid", coarse_grid_, key_offset_);
   if (config.fine_map_extent == FineMapExtent::kObservationBox)
-    checkKeyRange("observation box at the fine voxel size", fine_box_lo_, fine_box_hi_);
+    checkKeyRange("observation box at the fine voxel size", fine_box_lo_, fine_box_hi_,
+                  key_offset_);
+  placeFineMap();
+}
+
+void OctomapMapEngine::placeFineMap() {
+  GridGeometry grid = fineGridGeometry(config(), region());
+  checkKeyRange("fine grid", grid, key_offset_);
+  fine_grid_ = grid;
+  fine_region_ = regionInGrid(fine_grid_, region());
+  fine_ = std::make_unique<RoiOcTree>(config().fine_voxel_size_m);
+  setSensorModel(*fine_, config().model);
+  distance_vox_.clear();
+  distance_max_d_m_ = -1.0;
+  distance_scans_ = 0;
 }
 
 OctomapMapEngine::~OctomapMapEngine() = default;

@@ -17,6 +17,17 @@ MappingSession::MappingSession(PerceptionConfig perception, std::string engine,
   map_config_.validate();
 }
 
+void MappingSession::carryOnWith(std::unique_ptr<map::MapEngine> map) {
+  if (!map) throw std::invalid_argument("MappingSession::carryOnWith: no map");
+  if (map_ || carried_map_)
+    throw std::logic_error("MappingSession::carryOnWith: the session already has a map");
+  if (map->engineName() != engine_)
+    throw std::invalid_argument("MappingSession::carryOnWith: the map is a '" +
+                                std::string(map->engineName()) + "' engine, the session's is '" +
+                                engine_ + "'");
+  carried_map_ = std::move(map);
+}
+
 ViewResult MappingSession::addView(const StereoFrame& frame, PerceptionResult* perceived_out) {
   ViewResult view;
   view.index = views_.size();
@@ -31,7 +42,12 @@ ViewResult MappingSession::addView(const StereoFrame& frame, PerceptionResult* p
 
   if (!region_ && perceived.region) {
     region_ = perceived.region;
-    map_ = map::createMapEngine(engine_, map_config_, *region_, backend_);
+    if (carried_map_) {
+      map_ = std::move(carried_map_);
+      map_->moveToRegion(*region_);
+    } else {
+      map_ = map::createMapEngine(engine_, map_config_, *region_, backend_);
+    }
     for (const auto& [index, clouds] : pending_) integrate(index, clouds);
     views_.back().earlier_views_integrated = pending_.size();
     pending_.clear();

@@ -35,11 +35,11 @@ class GridMapEngine final : public MapEngine {
 
   accel::Backend& backend() const { return backend_; }
   OccupancyLayer& coarse() { return coarse_; }
-  OccupancyLayer& fine() { return fine_; }
+  OccupancyLayer& fine() { return fine_->layer; }
   const OccupancyLayer& coarse() const { return coarse_; }
-  const OccupancyLayer& fine() const { return fine_; }
+  const OccupancyLayer& fine() const { return fine_->layer; }
   /// The fine map's ROI distance field (device-resident per slot; see updateRoiDistance).
-  RoiDistanceField& fineRoiDistance() { return fine_distance_; }
+  RoiDistanceField& fineRoiDistance() { return fine_->distance; }
 
   void updateRoiDistance(double max_d_m) override;
   double roiDistance_m(const std::array<int, 3>& fine_index) const override;
@@ -50,16 +50,26 @@ class GridMapEngine final : public MapEngine {
   void integrateScan(const Eigen::Vector3d& sensor_origin_m,
                      const std::vector<accel::ScanPoint>& points, ScanStats& stats) override;
   void refreshScene(MapLevel level, OccupiedVoxelScene& scene, bool fresh) override;
+  void placeFineMap() override;
 
  private:
   /// Writes the coarse voxels of bricks changed after change count `since` into tree.
   void writeCoarseBricks(octomap::OcTree& tree, std::uint64_t since) const;
 
+  /// The fine map over one Cluster Region's cube, with what reads and writes it; replaced
+  /// whole when the map moves to another region.
+  struct FineLevel {
+    FineLevel(accel::Backend& backend, const MapConfig& config, const ClusterRegion& region);
+    OccupancyLayer layer;
+    ScanIntegrator integrator;
+    RoiDistanceField distance;
+    FrontierExtractor frontiers;
+  };
+
   accel::Backend& backend_;
-  OccupancyLayer coarse_, fine_;
-  ScanIntegrator coarse_integrator_, fine_integrator_;
-  RoiDistanceField fine_distance_;
-  FrontierExtractor fine_frontiers_;
+  OccupancyLayer coarse_;
+  ScanIntegrator coarse_integrator_;
+  std::unique_ptr<FineLevel> fine_;
   double distance_max_d_m_ = -1.0;  ///< the cap of the last updateRoiDistance()
   std::unique_ptr<octomap::OcTree> coarse_tree_;
   std::uint64_t coarse_tree_change_ = 0;    ///< coarse change count the tree reflects

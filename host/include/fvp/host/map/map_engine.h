@@ -50,6 +50,12 @@ class MapEngine {
   /// Scans integrated so far.
   std::size_t scanCount() const { return scans_; }
 
+  /// Moves the fine map to another Cluster Region (the next cluster of a run over a tree):
+  /// the fine map starts empty over the new region, the coarse map keeps everything seen,
+  /// so the arm's collision world and the planners' coarse reads carry over. Throws
+  /// std::invalid_argument for a region without a finite centre and a positive radius.
+  void moveToRegion(const ClusterRegion& region);
+
   /// Integrates one view: rays from clouds.sensor_origin_m to every point (world frame),
   /// cut and counted by prepareScanPoints (scan_points.h), the same for both engines.
   ScanStats integrate(const LabeledClouds& clouds);
@@ -104,6 +110,8 @@ class MapEngine {
   /// empty). The default sets every occupied voxel (occupiedVoxels()); engines that know
   /// which parts changed update only those.
   virtual void refreshScene(MapLevel level, OccupiedVoxelScene& scene, bool fresh);
+  /// Builds an empty fine map (and what derives from it) over region().
+  virtual void placeFineMap() = 0;
 
  private:
   struct SceneState {

@@ -62,6 +62,7 @@ class OctomapMapEngine : public MapEngine {
  protected:
   void integrateScan(const Eigen::Vector3d& sensor_origin_m,
                      const std::vector<accel::ScanPoint>& points, ScanStats& stats) override;
+  void placeFineMap() override;
 
  public:
   VoxelClass coarseClass(const Eigen::Vector3d& p_m) const override;

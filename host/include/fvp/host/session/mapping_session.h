@@ -83,6 +83,12 @@ class MappingSession {
 
   /// Hands the map over; the session is done with it.
   std::unique_ptr<map::MapEngine> releaseMap() && { return std::move(map_); }
+  /// The map of an earlier session (the previous cluster of a run over a tree) to carry on
+  /// with: when this session's region becomes known, the map's fine map moves to it and
+  /// its coarse map keeps what was seen (MapEngine::moveToRegion). The map's config is
+  /// used as it is. Call before the region is known; throws std::invalid_argument for
+  /// another engine than the session's, std::logic_error when the session has a map.
+  void carryOnWith(std::unique_ptr<map::MapEngine> map);
 
  private:
   void integrate(std::size_t index, const LabeledClouds& clouds);
@@ -95,6 +101,7 @@ class MappingSession {
   accel::Backend* backend_;
   std::optional<ClusterRegion> region_;
   std::unique_ptr<map::MapEngine> map_;
+  std::unique_ptr<map::MapEngine> carried_map_;  ///< until the region is known
   std::vector<ViewResult> views_;
   // Clouds of views seen before the region was known, with the index of their view.
   std::vector<std::pair<std::size_t, LabeledClouds>> pending_;
