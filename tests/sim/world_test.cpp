@@ -120,6 +120,97 @@ TEST(World, StartViewLooksAtClusterAndSeesTagFace) {
   }
 }
 
+// A tree of several clusters: each on its own branch, apart from the others, with its own
+// tag beside it and its own start view; nothing of one touches a fruitlet of another.
+TEST(World, ClustersOfATreeAreApartEachWithItsOwnTagAndStartView) {
+  WorldConfig config;
+  config.cluster_count = 4;
+  const host::StereoIntrinsics intrinsics;
+  for (std::uint64_t seed = 0; seed < 10; ++seed) {
+    const World world = World::generate(config, seed);
+    ASSERT_EQ(world.clusters().size(), 4u) << seed;
+    EXPECT_EQ(world.leaves().size(), 4u * config.leaf_count);
+    std::vector<int> indices;
+    for (const FruitletCluster& c : world.clusters()) {
+      EXPECT_EQ(c.tag.tag_id, config.tag_id + c.index);
+      ASSERT_GE(static_cast<int>(c.fruitlet_indices.size()), config.min_fruitlets);
+      ASSERT_LE(static_cast<int>(c.fruitlet_indices.size()), config.max_fruitlets);
+      Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+      for (int i : c.fruitlet_indices) {
+        indices.push_back(i);
+        centroid += world.fruitlets()[static_cast<std::size_t>(i)].center_m;
+        EXPECT_LE((world.fruitlets()[static_cast<std::size_t>(i)].center_m - c.center_m).norm(),
+                  config.cluster_spread_m + 1e-12);
+      }
+      EXPECT_LT((centroid / double(c.fruitlet_indices.size()) - c.center_m).norm(), 1e-9);
+      const double tag_distance = (c.tag.T_world_tag.translation() - c.center_m).norm();
+      EXPECT_GE(tag_distance, config.min_tag_distance_m);
+      EXPECT_LE(tag_distance, config.max_tag_distance_m);
+      // The start view looks at the cluster with its tag in the image.
+      const Eigen::Isometry3d T_camera_world = c.T_world_start_camera.inverse();
+      EXPECT_NEAR((T_camera_world * c.center_m).norm(), config.start_view_distance_m, 1e-9);
+      const auto tag_pixel = intrinsics.project(T_camera_world * c.tag.T_world_tag.translation());
+      ASSERT_TRUE(tag_pixel.has_value());
+      EXPECT_GT(tag_pixel->x(), 0.0);
+      EXPECT_LT(tag_pixel->x(), intrinsics.width_px - 1.0);
+      for (const FruitletCluster& other : world.clusters()) {
+        if (other.index == c.index) continue;
+        EXPECT_GE((other.center_m - c.center_m).norm(), config.min_cluster_spacing_m);
+        // Another cluster's tag stays out of this cluster's region (tag distance + spread).
+        EXPECT_GT((other.tag.T_world_tag.translation() - c.center_m).norm(),
+                  config.max_tag_distance_m + config.cluster_spread_m);
+      }
+    }
+    std::vector<int> expected(world.fruitlets().size());
+    for (std::size_t i = 0; i < expected.size(); ++i) expected[i] = static_cast<int>(i);
+    EXPECT_EQ(indices, expected) << "the clusters partition the fruitlets, in order";
+    // No leaf, plate or fruiting branch touches any fruitlet.
+    for (const Fruitlet& f : world.fruitlets()) {
+      for (const Leaf& leaf : world.leaves()) {
+        for (double sx = -1.0; sx <= 1.0; sx += 0.1) {
+          for (double sy = -1.0; sy <= 1.0; sy += 0.1) {
+            if (sx * sx + sy * sy > 1.0) continue;
+            const double x = sx * leaf.half_length_m;
+            const Eigen::Vector3d p = leaf.T_world_leaf * Eigen::Vector3d(x, sy * leaf.half_width_m,
+                                                                          leaf.curl_per_m * x * x);
+            ASSERT_GT(grownEllipsoidValue(f, p, config.min_gap_m), 1.0) << "seed " << seed;
+          }
+        }
+      }
+      for (const FruitletCluster& c : world.clusters()) {
+        for (double sx = -0.5; sx <= 0.5; sx += 0.05) {
+          for (double sy = -0.5; sy <= 0.5; sy += 0.05) {
+            const Eigen::Vector3d p =
+                c.tag.T_world_tag *
+                Eigen::Vector3d(sx * c.tag.plate_size_m, sy * c.tag.plate_size_m, 0.0);
+            ASSERT_GT(grownEllipsoidValue(f, p, config.min_gap_m), 1.0) << "seed " << seed;
+          }
+        }
+      }
+    }
+  }
+}
+
+TEST(World, OneClusterByDefaultHoldingEveryFruitlet) {
+  const World world = World::generate(WorldConfig{}, 3);
+  ASSERT_EQ(world.clusters().size(), 1u);
+  EXPECT_EQ(world.clusters()[0].fruitlet_indices.size(), world.fruitlets().size());
+  EXPECT_LT((world.clusters()[0].center_m - world.clusterCenter_m()).norm(), 1e-9);
+  EXPECT_TRUE(world.startCameraPose().isApprox(world.clusters()[0].T_world_start_camera));
+}
+
+TEST(World, TooManyClustersForTheTagFamilyOrTheObjectIdsAreRejected) {
+  WorldConfig config;
+  config.cluster_count = 8;
+  config.max_fruitlets = 9;
+  EXPECT_THROW(config.validate(), std::invalid_argument);
+  config.max_fruitlets = 6;
+  config.tag_id = 580;
+  EXPECT_THROW(config.validate(), std::invalid_argument);
+  config.tag_id = 579;
+  EXPECT_NO_THROW(config.validate());
+}
+
 TEST(World, SameSeedSameWorldDifferentSeedDifferentWorld) {
   const WorldConfig config;
   const World a = World::generate(config, 1234);

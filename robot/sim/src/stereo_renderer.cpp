@@ -82,8 +82,9 @@ struct StereoRenderer::Impl {
   World world;
   RenderConfig config;
   std::vector<Primitive> primitives;
-  cv::Mat tag_cells;        ///< CV_8U tag image (total_width^2 cells), empty without a tag
-  double tag_cell_m = 0.0;  ///< edge of one tag cell
+  /// CV_8U tag image (total_width^2 cells) of each cluster's tag; empty without a tag.
+  std::vector<cv::Mat> tag_cells;
+  double tag_cell_m = 0.0;  ///< edge of one tag cell (every tag has the same size)
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   mutable std::atomic<double> last_seconds{0.0};
@@ -123,8 +124,11 @@ void StereoRenderer::Impl::build() {
     primitives.push_back(detail::makeLeaf(leaf, kFirstLeafId + leaf.index));
   }
   if (world.hasTag()) {
-    primitives.push_back(detail::makePlate(world.tag(), kTagId));
-    tag_cells = tag36h11Image(world.tag().tag_id);
+    for (const FruitletCluster& cluster : world.clusters()) {
+      primitives.push_back(detail::makePlate(cluster.tag, kTagId));
+      primitives.back().source_index = static_cast<int>(tag_cells.size());
+      tag_cells.push_back(tag36h11Image(cluster.tag.tag_id));
+    }
     tag_cell_m = world.tag().tag_size_m / tag36h11WidthAtBorder();
   }
 
@@ -283,11 +287,12 @@ Eigen::Vector3d StereoRenderer::Impl::albedo(const Primitive& prim,
       // The printed face looks along +z of the tag frame (into the plate).
       const double facing = prim.T_local_world.linear().row(2).dot(dir);
       if (facing <= 0.0) return paper * kPlateBackRgb;
-      const int cells = tag_cells.cols;
+      const cv::Mat& tag = tag_cells[static_cast<std::size_t>(prim.source_index)];
+      const int cells = tag.cols;
       const int col = static_cast<int>(std::floor(p.x() / tag_cell_m + 0.5 * cells));
       const int row = static_cast<int>(std::floor(p.y() / tag_cell_m + 0.5 * cells));
-      const bool white = col < 0 || row < 0 || col >= cells || row >= cells ||
-                         tag_cells.at<std::uint8_t>(row, col) != 0;
+      const bool white =
+          col < 0 || row < 0 || col >= cells || row >= cells || tag.at<std::uint8_t>(row, col) != 0;
       subregion = white ? 1u : 2u;
       return Eigen::Vector3d::Constant(paper * (white ? kTagWhite : kTagBlack));
     }

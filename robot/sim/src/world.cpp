@@ -35,6 +35,8 @@ constexpr double kTagSightMarginM = 0.01;
 // Rejection-sampling budgets.
 constexpr int kClusterAttempts = 2000;
 constexpr int kPlacementAttempts = 500;
+// Layouts drawn for one cluster of several before the generation gives up.
+constexpr int kLayoutAttempts = 2000;
 
 // The fruitlet palette, in sRGB (what the camera outputs). Six saturated hues chosen so an
 // HSV threshold separates them from everything else in the scene: leaves are green (hue
@@ -180,10 +182,12 @@ World World::fromParts(std::vector<Fruitlet> fruitlets, std::vector<Leaf> leaves
   world.leaves_ = std::move(leaves);
   world.branches_ = std::move(branches);
   world.has_tag_ = tag.has_value();
-  if (tag) world.tag_ = *tag;
-  const Eigen::Vector3d c = world.clusterCenter_m();
-  world.T_world_start_camera_ =
-      lookAt(c - config.start_view_distance_m * Eigen::Vector3d::UnitY(), c);
+  FruitletCluster& cluster = world.clusters_.front();
+  if (tag) cluster.tag = *tag;
+  for (const Fruitlet& f : world.fruitlets_) cluster.fruitlet_indices.push_back(f.index);
+  cluster.center_m = world.clusterCenter_m();
+  cluster.T_world_start_camera = lookAt(
+      cluster.center_m - config.start_view_distance_m * Eigen::Vector3d::UnitY(), cluster.center_m);
   return world;
 }
 
@@ -193,133 +197,202 @@ World World::generate(const WorldConfig& config, std::uint64_t seed) {
   World world;
   world.config_ = config;
   world.seed_ = seed;
+  world.clusters_.clear();
   const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  const int cluster_count = config.cluster_count;
+  const bool several = cluster_count > 1;
 
-  // Trunk and the fruiting branch, heading along +x or -x with some yaw, sloping up.
   world.branches_.push_back(
       {Eigen::Vector3d::Zero(), config.trunk_height_m * up, config.trunk_radius_m});
-  const double side = rng.coin() ? 1.0 : -1.0;
-  const double yaw = rng.uniform(-kMaxBranchYawDeg, kMaxBranchYawDeg) * kDegToRad;
-  const double elevation = rng.uniform(kMinBranchElevationDeg, kMaxBranchElevationDeg) * kDegToRad;
-  const Eigen::Vector3d heading(side * std::cos(yaw), std::sin(yaw), 0.0);
-  const Eigen::Vector3d branch_dir = std::cos(elevation) * heading + std::sin(elevation) * up;
-  const Eigen::Vector3d branch_start = config.cluster_height_m * up;
-  const Eigen::Vector3d branch_end = branch_start + kFruitingBranchLengthM * branch_dir;
-  world.branches_.push_back({branch_start, branch_end, config.branch_radius_m});
-  const double along_m = rng.uniform(kMinClusterAlongBranchM, kMaxClusterAlongBranchM);
-  const Eigen::Vector3d branch_point = branch_start + along_m * branch_dir;
-  // Horizontal normal of the branch towards -y: where the start view and the tag face.
-  const Eigen::Vector3d toward_view =
-      (-Eigen::Vector3d::UnitY() + heading.y() * heading).normalized();
-
-  // The cluster hangs under the branch; its centroid is exactly the anchor below.
   const double max_bound_m = config.max_radius_m * std::max(1.0, config.max_elongation);
-  const Eigen::Vector3d anchor =
-      branch_point - (config.branch_radius_m + 0.5 * config.cluster_spread_m + max_bound_m) * up;
-  const auto clearOfBranch = [&](const Fruitlet& f) {
-    return pointSegmentDistance(f.center_m, branch_start, branch_end) >=
-           config.branch_radius_m + f.boundingRadius_m() + config.min_gap_m;
-  };
-  const int count = rng.uniformInt(config.min_fruitlets, config.max_fruitlets);
-  std::array<int, kPaletteSrgb.size()> palette_order = {0, 1, 2, 3, 4, 5};
-  for (std::size_t i = palette_order.size() - 1; i > 0; --i) {
-    std::swap(palette_order[i], palette_order[rng.uniformInt(0, static_cast<int>(i))]);
-  }
-  bool placed = false;
-  for (int attempt = 0; attempt < kClusterAttempts && !placed; ++attempt) {
-    std::vector<Fruitlet> fruitlets;
-    for (int i = 0; i < count; ++i) {
-      Fruitlet f;
-      f.index = i;
-      f.radius_m = rng.uniform(config.min_radius_m, config.max_radius_m);
-      f.elongation = rng.uniform(config.min_elongation, config.max_elongation);
-      f.R_world_fruitlet = rng.rotation();
-      const auto& srgb = kPaletteSrgb[palette_order[i % palette_order.size()]];
-      f.rgb = {srgbToLinear(srgb[0]), srgbToLinear(srgb[1]), srgbToLinear(srgb[2])};
-      bool clear = false;
-      for (int tries = 0; tries < kPlacementAttempts && !clear; ++tries) {
-        f.center_m = anchor + rng.inBall(config.cluster_spread_m);
-        // Conservative: bounding spheres (largest semi-axis) at least min_gap_m apart.
-        clear = true;
-        for (const Fruitlet& other : fruitlets) {
-          clear = clear && (f.center_m - other.center_m).norm() >=
+  const double plate_half_m = 0.5 * kTagPlateScale * config.tag_size_m;
+  std::vector<BranchSegment> fruiting;  // each cluster's fruiting branch
+  std::vector<Eigen::Vector3d> cameras_m;
+
+  for (int k = 0; k < cluster_count; ++k) {
+    bool cluster_placed = false;
+    // One cluster: its layout is drawn once (the paper's world). Several: a layout that
+    // crowds an earlier cluster, its branch or its tag is drawn again.
+    for (int layout = 0; layout < (several ? kLayoutAttempts : 1) && !cluster_placed; ++layout) {
+      // The fruiting branch, heading along +x or -x with some yaw, sloping up.
+      const double side = rng.coin() ? 1.0 : -1.0;
+      const double yaw = rng.uniform(-kMaxBranchYawDeg, kMaxBranchYawDeg) * kDegToRad;
+      const double elevation =
+          rng.uniform(kMinBranchElevationDeg, kMaxBranchElevationDeg) * kDegToRad;
+      const double height = several ? config.cluster_height_m +
+                                          config.cluster_height_spread_m * rng.uniform(-0.5, 0.5)
+                                    : config.cluster_height_m;
+      const Eigen::Vector3d heading(side * std::cos(yaw), std::sin(yaw), 0.0);
+      const Eigen::Vector3d branch_dir = std::cos(elevation) * heading + std::sin(elevation) * up;
+      const Eigen::Vector3d branch_start = height * up;
+      const Eigen::Vector3d branch_end = branch_start + kFruitingBranchLengthM * branch_dir;
+      const double along_m = rng.uniform(kMinClusterAlongBranchM, kMaxClusterAlongBranchM);
+      const Eigen::Vector3d branch_point = branch_start + along_m * branch_dir;
+      // Horizontal normal of the branch towards -y: where the start view and the tag face.
+      const Eigen::Vector3d toward_view =
+          (-Eigen::Vector3d::UnitY() + heading.y() * heading).normalized();
+      // The cluster hangs under the branch; its centroid is exactly the anchor below.
+      const Eigen::Vector3d anchor =
+          branch_point -
+          (config.branch_radius_m + 0.5 * config.cluster_spread_m + max_bound_m) * up;
+      if (several) {
+        // Apart from every earlier cluster; the new branch clear of their fruitlets and tags,
+        // their branches clear of the new cluster.
+        bool apart = true;
+        for (const FruitletCluster& c : world.clusters_) {
+          apart = apart && (anchor - c.center_m).norm() >= config.min_cluster_spacing_m &&
+                  pointSegmentDistance(c.tag.T_world_tag.translation(), branch_start, branch_end) >=
+                      config.branch_radius_m + std::sqrt(2.0) * plate_half_m + config.min_gap_m;
+        }
+        for (const Fruitlet& f : world.fruitlets_) {
+          apart = apart && pointSegmentDistance(f.center_m, branch_start, branch_end) >=
+                               config.branch_radius_m + f.boundingRadius_m() + config.min_gap_m;
+        }
+        for (const BranchSegment& b : fruiting) {
+          apart =
+              apart && pointSegmentDistance(anchor, b.start_m, b.end_m) >=
+                           b.radius_m + config.cluster_spread_m + max_bound_m + config.min_gap_m;
+        }
+        if (!apart) continue;
+      }
+      const auto clearOfBranch = [&](const Fruitlet& f) {
+        return pointSegmentDistance(f.center_m, branch_start, branch_end) >=
+               config.branch_radius_m + f.boundingRadius_m() + config.min_gap_m;
+      };
+      const int first_index = static_cast<int>(world.fruitlets_.size());
+      const int count = rng.uniformInt(config.min_fruitlets, config.max_fruitlets);
+      std::array<int, kPaletteSrgb.size()> palette_order = {0, 1, 2, 3, 4, 5};
+      for (std::size_t i = palette_order.size() - 1; i > 0; --i) {
+        std::swap(palette_order[i], palette_order[rng.uniformInt(0, static_cast<int>(i))]);
+      }
+      std::vector<Fruitlet> cluster_fruitlets;
+      bool placed = false;
+      for (int attempt = 0; attempt < kClusterAttempts && !placed; ++attempt) {
+        std::vector<Fruitlet> fruitlets;
+        for (int i = 0; i < count; ++i) {
+          Fruitlet f;
+          f.index = first_index + i;
+          f.radius_m = rng.uniform(config.min_radius_m, config.max_radius_m);
+          f.elongation = rng.uniform(config.min_elongation, config.max_elongation);
+          f.R_world_fruitlet = rng.rotation();
+          const auto& srgb = kPaletteSrgb[palette_order[i % palette_order.size()]];
+          f.rgb = {srgbToLinear(srgb[0]), srgbToLinear(srgb[1]), srgbToLinear(srgb[2])};
+          bool clear = false;
+          for (int tries = 0; tries < kPlacementAttempts && !clear; ++tries) {
+            f.center_m = anchor + rng.inBall(config.cluster_spread_m);
+            // Conservative: bounding spheres (largest semi-axis) at least min_gap_m apart.
+            clear = true;
+            for (const Fruitlet& other : fruitlets) {
+              clear =
+                  clear && (f.center_m - other.center_m).norm() >=
                                f.boundingRadius_m() + other.boundingRadius_m() + config.min_gap_m;
+            }
+          }
+          if (!clear) break;
+          fruitlets.push_back(f);
+        }
+        if (static_cast<int>(fruitlets.size()) != count) continue;
+        Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+        for (const Fruitlet& f : fruitlets) centroid += f.center_m;
+        centroid /= count;
+        placed = true;
+        for (Fruitlet& f : fruitlets) {
+          f.center_m += anchor - centroid;  // pairwise gaps are unchanged by the shift
+          placed =
+              placed && (f.center_m - anchor).norm() <= config.cluster_spread_m && clearOfBranch(f);
+        }
+        if (placed) cluster_fruitlets = std::move(fruitlets);
+      }
+      if (!placed) {
+        throw std::runtime_error(
+            "world generation (seed " + std::to_string(seed) + "): cannot fit " +
+            std::to_string(count) +
+            " fruitlets within cluster_spread_m = " + std::to_string(config.cluster_spread_m) +
+            " m; increase cluster_spread_m or reduce max_radius_m");
+      }
+      const Eigen::Vector3d cluster = anchor;
+
+      // Start view: straight out from the branch, at the requested distance.
+      const Eigen::Vector3d camera_m = cluster + config.start_view_distance_m * toward_view;
+      const Eigen::Isometry3d T_world_start_camera = lookAt(camera_m, cluster);
+
+      // The tag plate, beside the cluster on the branch, facing the start view up to a tilt.
+      AprilTagPlacement tag;
+      tag.tag_id = config.tag_id + k;
+      tag.tag_size_m = config.tag_size_m;
+      tag.plate_size_m = kTagPlateScale * config.tag_size_m;
+      bool tag_placed = false;
+      for (int tries = 0; tries < kPlacementAttempts && !tag_placed; ++tries) {
+        // tag_side is right (+1) or left (-1) of the cluster as the start view sees it.
+        const double rightward =
+            branch_dir.dot(T_world_start_camera.linear().col(0)) >= 0.0 ? 1.0 : -1.0;
+        const double sign =
+            config.tag_side != 0 ? config.tag_side * rightward : (rng.coin() ? 1.0 : -1.0);
+        const double t = rng.uniform(0.0, config.max_tag_distance_m + config.cluster_spread_m);
+        const double tilt = config.max_tag_tilt_deg * kDegToRad;
+        const double yaw_t = rng.uniform(-tilt, tilt), pitch_t = rng.uniform(-tilt, tilt);
+        const double roll_t = rng.uniform(-tilt, tilt);
+        // Yaw and pitch swing the plate's edges back towards the branch: stand off that much
+        // more.
+        const double swing_m =
+            0.5 * tag.plate_size_m * (std::abs(std::sin(yaw_t)) + std::abs(std::sin(pitch_t)));
+        const Eigen::Vector3d centre =
+            branch_point + sign * t * branch_dir +
+            (config.branch_radius_m + kTagStandoffM + swing_m) * toward_view;
+        const double distance = (centre - cluster).norm();
+        if (distance < config.min_tag_distance_m || distance > config.max_tag_distance_m) continue;
+        const Eigen::Isometry3d upright = lookAt(centre + toward_view, centre);
+        Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+        T.linear() = Eigen::AngleAxisd(yaw_t, up).toRotationMatrix() *
+                     Eigen::AngleAxisd(pitch_t, upright.linear().col(0)).toRotationMatrix() *
+                     upright.linear() * Eigen::AngleAxisd(roll_t, Eigen::Vector3d::UnitZ());
+        T.translation() = centre;
+        tag.T_world_tag = T;
+        tag_placed = true;
+        for (const auto* fruitlets : {&cluster_fruitlets, &world.fruitlets_}) {
+          for (const Fruitlet& f : *fruitlets) {
+            tag_placed = tag_placed && pointPlateDistance(f.center_m, tag) >=
+                                           f.boundingRadius_m() + config.min_gap_m;
+          }
+        }
+        for (const FruitletCluster& c : world.clusters_) {
+          tag_placed = tag_placed && (c.tag.T_world_tag.translation() - centre).norm() >=
+                                         2.0 * std::sqrt(2.0) * plate_half_m + config.min_gap_m;
         }
       }
-      if (!clear) break;
-      fruitlets.push_back(f);
+      if (!tag_placed) {
+        if (several) continue;  // another layout
+        throw std::runtime_error("world generation (seed " + std::to_string(seed) +
+                                 "): cannot place the tag between min_tag_distance_m and "
+                                 "max_tag_distance_m without touching a fruitlet");
+      }
+      FruitletCluster placed_cluster;
+      placed_cluster.index = k;
+      for (const Fruitlet& f : cluster_fruitlets)
+        placed_cluster.fruitlet_indices.push_back(f.index);
+      placed_cluster.center_m = cluster;
+      placed_cluster.tag = tag;
+      placed_cluster.T_world_start_camera = T_world_start_camera;
+      world.clusters_.push_back(placed_cluster);
+      world.fruitlets_.insert(world.fruitlets_.end(), cluster_fruitlets.begin(),
+                              cluster_fruitlets.end());
+      fruiting.push_back({branch_start, branch_end, config.branch_radius_m});
+      world.branches_.push_back(fruiting.back());
+      cameras_m.push_back(camera_m);
+      cluster_placed = true;
     }
-    if (static_cast<int>(fruitlets.size()) != count) continue;
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (const Fruitlet& f : fruitlets) centroid += f.center_m;
-    centroid /= count;
-    placed = true;
-    for (Fruitlet& f : fruitlets) {
-      f.center_m += anchor - centroid;  // pairwise gaps are unchanged by the shift
-      placed =
-          placed && (f.center_m - anchor).norm() <= config.cluster_spread_m && clearOfBranch(f);
-    }
-    if (placed) world.fruitlets_ = std::move(fruitlets);
-  }
-  if (!placed) {
-    throw std::runtime_error("world generation (seed " + std::to_string(seed) + "): cannot fit " +
-                             std::to_string(count) + " fruitlets within cluster_spread_m = " +
-                             std::to_string(config.cluster_spread_m) +
-                             " m; increase cluster_spread_m or reduce max_radius_m");
-  }
-  const Eigen::Vector3d cluster = anchor;
-
-  // Start view: straight out from the branch, at the requested distance.
-  const Eigen::Vector3d camera_m = cluster + config.start_view_distance_m * toward_view;
-  world.T_world_start_camera_ = lookAt(camera_m, cluster);
-
-  // The tag plate, beside the cluster on the branch, facing the start view up to a tilt.
-  AprilTagPlacement tag;
-  tag.tag_id = config.tag_id;
-  tag.tag_size_m = config.tag_size_m;
-  tag.plate_size_m = kTagPlateScale * config.tag_size_m;
-  bool tag_placed = false;
-  for (int tries = 0; tries < kPlacementAttempts && !tag_placed; ++tries) {
-    // tag_side is right (+1) or left (-1) of the cluster as the start view sees it.
-    const double rightward =
-        branch_dir.dot(world.T_world_start_camera_.linear().col(0)) >= 0.0 ? 1.0 : -1.0;
-    const double sign =
-        config.tag_side != 0 ? config.tag_side * rightward : (rng.coin() ? 1.0 : -1.0);
-    const double t = rng.uniform(0.0, config.max_tag_distance_m + config.cluster_spread_m);
-    const double tilt = config.max_tag_tilt_deg * kDegToRad;
-    const double yaw_t = rng.uniform(-tilt, tilt), pitch_t = rng.uniform(-tilt, tilt);
-    const double roll_t = rng.uniform(-tilt, tilt);
-    // Yaw and pitch swing the plate's edges back towards the branch: stand off that much more.
-    const double swing_m =
-        0.5 * tag.plate_size_m * (std::abs(std::sin(yaw_t)) + std::abs(std::sin(pitch_t)));
-    const Eigen::Vector3d centre = branch_point + sign * t * branch_dir +
-                                   (config.branch_radius_m + kTagStandoffM + swing_m) * toward_view;
-    const double distance = (centre - cluster).norm();
-    if (distance < config.min_tag_distance_m || distance > config.max_tag_distance_m) continue;
-    const Eigen::Isometry3d upright = lookAt(centre + toward_view, centre);
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.linear() = Eigen::AngleAxisd(yaw_t, up).toRotationMatrix() *
-                 Eigen::AngleAxisd(pitch_t, upright.linear().col(0)).toRotationMatrix() *
-                 upright.linear() * Eigen::AngleAxisd(roll_t, Eigen::Vector3d::UnitZ());
-    T.translation() = centre;
-    tag.T_world_tag = T;
-    tag_placed = true;
-    for (const Fruitlet& f : world.fruitlets_) {
-      tag_placed = tag_placed &&
-                   pointPlateDistance(f.center_m, tag) >= f.boundingRadius_m() + config.min_gap_m;
+    if (!cluster_placed) {
+      throw std::runtime_error(
+          "world generation (seed " + std::to_string(seed) + "): cannot place cluster " +
+          std::to_string(k) +
+          " at least min_cluster_spacing_m = " + std::to_string(config.min_cluster_spacing_m) +
+          " m from the others with its branch and tag clear of theirs; reduce cluster_count or "
+          "min_cluster_spacing_m, or raise cluster_height_spread_m");
     }
   }
-  if (!tag_placed) {
-    throw std::runtime_error("world generation (seed " + std::to_string(seed) +
-                             "): cannot place the tag between min_tag_distance_m and "
-                             "max_tag_distance_m without touching a fruitlet");
-  }
-  world.tag_ = tag;
   world.has_tag_ = true;
 
-  // Extra branches: clutter that keeps off the cluster and the start view's lines of sight.
-  const double plate_half_m = 0.5 * tag.plate_size_m;
-  const Eigen::Vector3d tag_centre = tag.T_world_tag.translation();
+  // Extra branches: clutter that keeps off every cluster and its start view's lines of sight.
   for (int b = 0; b < config.extra_branch_count; ++b) {
     for (int tries = 0; tries < kPlacementAttempts; ++tries) {
       const double height = config.cluster_height_m + rng.uniform(-0.4, 0.4);
@@ -332,57 +405,72 @@ World World::generate(const WorldConfig& config, std::uint64_t seed) {
           start + length * Eigen::Vector3d(std::cos(slope) * std::cos(azimuth),
                                            std::cos(slope) * std::sin(azimuth), std::sin(slope));
       const double clearance = radius + std::max(0.01, config.min_gap_m);
-      if (segmentSegmentDistance(start, end, camera_m, cluster) <
-              clearance + config.cluster_spread_m + max_bound_m ||
-          segmentSegmentDistance(start, end, camera_m, tag_centre) <
-              clearance + plate_half_m * std::sqrt(2.0)) {
-        continue;
+      bool clear = true;
+      for (std::size_t k = 0; k < world.clusters_.size(); ++k) {
+        const FruitletCluster& c = world.clusters_[k];
+        clear = clear &&
+                segmentSegmentDistance(start, end, cameras_m[k], c.center_m) >=
+                    clearance + config.cluster_spread_m + max_bound_m &&
+                segmentSegmentDistance(start, end, cameras_m[k], c.tag.T_world_tag.translation()) >=
+                    clearance + plate_half_m * std::sqrt(2.0);
       }
+      if (!clear) continue;
       world.branches_.push_back({start, end, radius});
       break;
     }
   }
 
-  // Leaves: a share in front of the cluster (towards the start view), the rest anywhere in
-  // the leaf region; never touching a fruitlet, never hiding the tag from the start view.
+  // Leaves, leaf_count around each cluster: a share in front of it (towards its start view),
+  // the rest anywhere in its leaf region; never touching a fruitlet, never hiding a tag from
+  // its start view.
   const int front_leaves =
       static_cast<int>(std::lround(config.front_leaf_fraction * config.leaf_count));
   const double front_reach_m =
       std::max(0.02, std::min(config.leaf_region_m, 0.5 * config.start_view_distance_m));
-  const Eigen::Matrix3d R_view = world.T_world_start_camera_.linear();
-  for (int k = 0; k < config.leaf_count; ++k) {
-    bool leaf_placed = false;
-    for (int tries = 0; tries < kPlacementAttempts && !leaf_placed; ++tries) {
-      Leaf leaf;
-      leaf.index = k;
-      leaf.half_length_m = 0.5 * rng.uniform(config.min_leaf_length_m, config.max_leaf_length_m);
-      leaf.half_width_m = 0.5 * rng.uniform(config.min_leaf_width_m, config.max_leaf_width_m);
-      leaf.curl_per_m = rng.coin() ? 0.0 : rng.uniform(-1.0, 1.0) * config.max_leaf_curl_per_m;
-      leaf.T_world_leaf.linear() = rng.rotation();
-      Eigen::Vector3d centre;
-      if (k < front_leaves) {
-        const double ahead = rng.uniform(0.02, front_reach_m);
-        const double lateral = (config.cluster_spread_m + 0.02) * std::sqrt(rng.uniform());
-        const double phi = rng.uniform(0.0, 2.0 * kPi);
-        centre = cluster +
-                 R_view * Eigen::Vector3d(lateral * std::cos(phi), lateral * std::sin(phi), -ahead);
-      } else {
-        centre = cluster + rng.inBall(config.leaf_region_m);
+  for (std::size_t k = 0; k < world.clusters_.size(); ++k) {
+    const Eigen::Vector3d& cluster = world.clusters_[k].center_m;
+    const Eigen::Matrix3d R_view = world.clusters_[k].T_world_start_camera.linear();
+    for (int j = 0; j < config.leaf_count; ++j) {
+      const int leaf_index = static_cast<int>(world.leaves_.size());
+      bool leaf_placed = false;
+      for (int tries = 0; tries < kPlacementAttempts && !leaf_placed; ++tries) {
+        Leaf leaf;
+        leaf.index = leaf_index;
+        leaf.half_length_m = 0.5 * rng.uniform(config.min_leaf_length_m, config.max_leaf_length_m);
+        leaf.half_width_m = 0.5 * rng.uniform(config.min_leaf_width_m, config.max_leaf_width_m);
+        leaf.curl_per_m = rng.coin() ? 0.0 : rng.uniform(-1.0, 1.0) * config.max_leaf_curl_per_m;
+        leaf.T_world_leaf.linear() = rng.rotation();
+        Eigen::Vector3d centre;
+        if (j < front_leaves) {
+          const double ahead = rng.uniform(0.02, front_reach_m);
+          const double lateral = (config.cluster_spread_m + 0.02) * std::sqrt(rng.uniform());
+          const double phi = rng.uniform(0.0, 2.0 * kPi);
+          centre = cluster + R_view * Eigen::Vector3d(lateral * std::cos(phi),
+                                                      lateral * std::sin(phi), -ahead);
+        } else {
+          centre = cluster + rng.inBall(config.leaf_region_m);
+        }
+        if ((centre - cluster).norm() > config.leaf_region_m) continue;
+        leaf.T_world_leaf.translation() = centre;
+        bool clear = true;
+        for (std::size_t c = 0; c < world.clusters_.size(); ++c) {
+          clear = clear &&
+                  (centre - cameras_m[c]).norm() >= kLeafCameraClearanceM + leaf.half_length_m &&
+                  !leafHidesTag(leaf, world.clusters_[c].tag, cameras_m[c]);
+        }
+        if (!clear) continue;
+        leaf_placed = true;
+        for (const Fruitlet& f : world.fruitlets_) {
+          leaf_placed = leaf_placed && pointLeafDistanceLowerBound(f.center_m, leaf) >=
+                                           f.boundingRadius_m() + config.min_gap_m;
+        }
+        if (leaf_placed) world.leaves_.push_back(leaf);
       }
-      if ((centre - cluster).norm() > config.leaf_region_m) continue;
-      leaf.T_world_leaf.translation() = centre;
-      if ((centre - camera_m).norm() < kLeafCameraClearanceM + leaf.half_length_m) continue;
-      leaf_placed = !leafHidesTag(leaf, tag, camera_m);
-      for (const Fruitlet& f : world.fruitlets_) {
-        leaf_placed = leaf_placed && pointLeafDistanceLowerBound(f.center_m, leaf) >=
-                                         f.boundingRadius_m() + config.min_gap_m;
+      if (!leaf_placed) {
+        throw std::runtime_error("world generation (seed " + std::to_string(seed) +
+                                 "): cannot place leaf " + std::to_string(leaf_index) +
+                                 "; reduce leaf_count or enlarge leaf_region_m");
       }
-      if (leaf_placed) world.leaves_.push_back(leaf);
-    }
-    if (!leaf_placed) {
-      throw std::runtime_error("world generation (seed " + std::to_string(seed) +
-                               "): cannot place leaf " + std::to_string(k) +
-                               "; reduce leaf_count or enlarge leaf_region_m");
     }
   }
   return world;
@@ -405,16 +493,25 @@ std::string World::groundTruthJson() const {
                                  {"R_world_fruitlet", toJson(f.R_world_fruitlet)},
                                  {"rgb_linear", toJson(f.rgb)}});
   }
-  if (has_tag_) {
-    json["tag"] = {{"family", "tag36h11"},
-                   {"id", tag_.tag_id},
-                   {"size_m", tag_.tag_size_m},
-                   {"plate_size_m", tag_.plate_size_m},
-                   {"T_world_tag", toJson(tag_.T_world_tag.matrix())}};
-  } else {
-    json["tag"] = nullptr;
+  const auto tagJson = [&](const AprilTagPlacement& tag) -> nlohmann::ordered_json {
+    if (!has_tag_) return nullptr;
+    return {{"family", "tag36h11"},
+            {"id", tag.tag_id},
+            {"size_m", tag.tag_size_m},
+            {"plate_size_m", tag.plate_size_m},
+            {"T_world_tag", toJson(tag.T_world_tag.matrix())}};
+  };
+  json["tag"] = tagJson(tag());
+  json["start_camera"] = {{"T_world_camera", toJson(startCameraPose().matrix())}};
+  json["clusters"] = nlohmann::ordered_json::array();
+  for (const FruitletCluster& c : clusters_) {
+    json["clusters"].push_back(
+        {{"index", c.index},
+         {"fruitlet_indices", c.fruitlet_indices},
+         {"center_m", toJson(c.center_m)},
+         {"tag", tagJson(c.tag)},
+         {"start_camera", {{"T_world_camera", toJson(c.T_world_start_camera.matrix())}}}});
   }
-  json["start_camera"] = {{"T_world_camera", toJson(T_world_start_camera_.matrix())}};
   json["branches"] = nlohmann::ordered_json::array();
   for (const BranchSegment& b : branches_) {
     json["branches"].push_back(

@@ -59,6 +59,9 @@ const std::vector<KeySpec>& keySpecs() {
       {"cluster_height_m", &WorldConfig::cluster_height_m, 0.05, 10.0},
       {"branch_radius_m", &WorldConfig::branch_radius_m, 0.001, 0.1},
       {"extra_branch_count", &WorldConfig::extra_branch_count, 0, 20},
+      {"cluster_count", &WorldConfig::cluster_count, 1, 8},
+      {"min_cluster_spacing_m", &WorldConfig::min_cluster_spacing_m, 0.01, 2.0},
+      {"cluster_height_spread_m", &WorldConfig::cluster_height_spread_m, 0.0, 2.0},
       {"start_view_distance_m", &WorldConfig::start_view_distance_m, 0.05, 5.0},
   };
   return specs;
@@ -116,6 +119,18 @@ void WorldConfig::validate(const std::string& source) const {
                                   " is out of range; expected " + lo_text + " <= " + spec.name +
                                   " <= " + formatNumber(spec.hi));
     }
+  }
+  if (cluster_count * max_fruitlets > kMaxFruitlets) {
+    throw std::invalid_argument(source + ": cluster_count (" + formatNumber(cluster_count) +
+                                ") x max_fruitlets (" + formatNumber(max_fruitlets) +
+                                "): expected at most " + formatNumber(kMaxFruitlets) +
+                                " fruitlets in a world (the renderer's object ids)");
+  }
+  if (tag_id + cluster_count > kTagFamilyCodes) {
+    throw std::invalid_argument(source + ": tag_id (" + formatNumber(tag_id) +
+                                ") + cluster_count (" + formatNumber(cluster_count) +
+                                "): cluster k carries tag id tag_id + k, "
+                                "expected at most 586 (tag36h11)");
   }
   if (cluster_height_m > trunk_height_m) {
     throw std::invalid_argument(source + ": cluster_height_m = " + formatNumber(cluster_height_m) +

@@ -65,6 +65,19 @@ struct AprilTagPlacement {
   double plate_size_m = 0.0;  ///< edge of the white backing plate (>= 1.25 tag_size_m)
 };
 
+/// One fruitlet cluster of a world: its fruitlets, its tag and its start view. A world has
+/// config.cluster_count of them (one by default: the paper's protocol); cluster k carries
+/// tag id config.tag_id + k.
+struct FruitletCluster {
+  int index = 0;
+  std::vector<int> fruitlet_indices;                   ///< into World::fruitlets()
+  Eigen::Vector3d center_m = Eigen::Vector3d::Zero();  ///< centroid of its fruitlets
+  AprilTagPlacement tag;  ///< all zero for a fromParts world without a tag
+  /// Left-camera pose (OpenCV optical frame) at start_view_distance_m from center_m on the
+  /// tag's side, looking at it, image "down" as close to world -z as possible.
+  Eigen::Isometry3d T_world_start_camera = Eigen::Isometry3d::Identity();
+};
+
 /// Plate edge / tag size of generated tags: the tag's 10x10-cell image (8 cells = tag_size_m)
 /// plus one more white cell on each side as a quiet zone.
 inline constexpr double kTagPlateScale = 1.5;
@@ -75,9 +88,9 @@ class World {
   /// std::runtime_error if the config leaves no room to place the cluster or the tag.
   static World generate(const WorldConfig& config, std::uint64_t seed);
 
-  /// A world from explicit primitives, for tests and tools (no placement checks). Fruitlet
-  /// and leaf indices must be 0..n-1 in order. The start view looks at the fruitlets'
-  /// centroid from config.start_view_distance_m along -y (camera y = world -z).
+  /// A world of one cluster from explicit primitives, for tests and tools (no placement
+  /// checks). Fruitlet and leaf indices must be 0..n-1 in order. The start view looks at the
+  /// fruitlets' centroid from config.start_view_distance_m along -y (camera y = world -z).
   static World fromParts(std::vector<Fruitlet> fruitlets, std::vector<Leaf> leaves,
                          std::vector<BranchSegment> branches, std::optional<AprilTagPlacement> tag,
                          const WorldConfig& config = {});
@@ -87,15 +100,16 @@ class World {
   const std::vector<Fruitlet>& fruitlets() const { return fruitlets_; }
   const std::vector<Leaf>& leaves() const { return leaves_; }
   const std::vector<BranchSegment>& branches() const { return branches_; }
+  /// The clusters, at least one; their fruitlets partition fruitlets().
+  const std::vector<FruitletCluster>& clusters() const { return clusters_; }
   /// False only for fromParts worlds built without a tag; tag() is then all zero.
   bool hasTag() const { return has_tag_; }
-  const AprilTagPlacement& tag() const { return tag_; }
-  /// Centroid of the fruitlet centres.
+  /// The first cluster's tag (the only one in a one-cluster world).
+  const AprilTagPlacement& tag() const { return clusters_.front().tag; }
+  /// Centroid of all fruitlet centres (the cluster's centre in a one-cluster world).
   Eigen::Vector3d clusterCenter_m() const;
-  /// The start view: left-camera pose (OpenCV optical frame) at start_view_distance_m from
-  /// the cluster centre on the tag's side, looking at the cluster centre, image "down" as
-  /// close to world -z as possible.
-  Eigen::Isometry3d startCameraPose() const { return T_world_start_camera_; }
+  /// The first cluster's start view (the run's start pose).
+  Eigen::Isometry3d startCameraPose() const { return clusters_.front().T_world_start_camera; }
 
   /// Ground truth as JSON text (seed, config, fruitlets with centre / size, tag pose).
   std::string groundTruthJson() const;
@@ -106,9 +120,8 @@ class World {
   std::vector<Fruitlet> fruitlets_;
   std::vector<Leaf> leaves_;
   std::vector<BranchSegment> branches_;
+  std::vector<FruitletCluster> clusters_{1};
   bool has_tag_ = false;
-  AprilTagPlacement tag_;
-  Eigen::Isometry3d T_world_start_camera_ = Eigen::Isometry3d::Identity();
 };
 
 }  // namespace fvp::robot::sim

@@ -48,6 +48,15 @@ struct WorldConfig {
   double cluster_height_m = 1.0;  ///< height of the fruiting branch above the trunk base
   double branch_radius_m = 0.01;  ///< the fruiting branch
   int extra_branch_count = 3;     ///< further branches (background clutter)
+  // Clusters (a tree rather than one cluster; docs/simulation.md "Worlds of several clusters")
+  /// Clusters on the tree, each on its own fruiting branch with its own tag (tag_id + k)
+  /// and leaf_count leaves; 1 is the paper's world.
+  int cluster_count = 1;
+  /// Cluster centres at least this far apart (several clusters only).
+  double min_cluster_spacing_m = 0.2;
+  /// Fruiting branches leave the trunk within cluster_height_m +- half this (several
+  /// clusters only; one cluster's branch leaves at cluster_height_m).
+  double cluster_height_spread_m = 0.3;
   // Start view
   double start_view_distance_m = 0.3;
 
