@@ -133,7 +133,7 @@ TEST(Experiment, TimePerClusterAndAccuracyAgainstTimeByHand) {
   };
   runExperiment(options(out, 2), with_history, nullptr);
   const nlohmann::json s = nlohmann::json::parse(slurp(out / "summary.json"));
-  EXPECT_DOUBLE_EQ(s["fvp"]["median_sim_s_per_trial"].get<double>(), 40.0);
+  EXPECT_DOUBLE_EQ(s["fvp"]["median_sim_s_per_cluster"].get<double>(), 40.0);
   // 4 matched fruitlets in 80 simulated seconds.
   EXPECT_DOUBLE_EQ(s["fvp"]["matched_per_sim_min"].get<double>(), 3.0);
   EXPECT_DOUBLE_EQ(s["rvp"]["matched_per_sim_min"].get<double>(), 60.0 * 2 / 360.0);

@@ -7,6 +7,7 @@
 #include "fvp/robot/arm_model.h"
 #include "fvp/robot/sim/arm_controller.h"
 #include "fvp/robot/sim/camera_views.h"
+#include "fvp/robot/sim/sim_clock.h"
 #include "fvp/robot/sim/world.h"
 #include "fvp/robot/ur5_kinematics.h"
 
@@ -191,6 +192,34 @@ TEST(ArmModel, StartViewsOfGeneratedWorldsAreWellInsideReach) {
     }
   }
   EXPECT_EQ(orbit_reached, orbit_total);
+}
+
+}  // namespace
+}  // namespace fvp::robot
+
+namespace fvp::robot {
+namespace {
+
+// Trees: every cluster's start view is reachable, and in an empty world the arm moves from
+// the first cluster's start view to every other's.
+TEST(ArmModel, EveryClusterOfATreeIsReachedFromTheFirst) {
+  const ArmModel arm{ArmConfig{}};
+  sim::WorldConfig config;
+  config.cluster_count = 4;
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    const auto world = sim::World::generate(config, seed);
+    for (const auto& cluster : world.clusters()) {
+      const auto start = ArmController::startConfiguration(arm, cluster.T_world_start_camera);
+      ASSERT_TRUE(start.has_value()) << "seed " << seed << " cluster " << cluster.index;
+      sim::SimClock clock(sim::SimClock::Mode::kFixed);
+      ArmController controller(arm, clock,
+                               *ArmController::startConfiguration(arm, world.startCameraPose()));
+      controller.setReproducibleMotionPlanning(seed);
+      const MotionPlan plan = controller.moveToPose(cluster.T_world_start_camera);
+      EXPECT_EQ(plan.status, MotionStatus::kSuccess)
+          << "seed " << seed << " cluster " << cluster.index;
+    }
+  }
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/host/core/output_directory.h"
 #include "fvp/host/eval/fruitlet_matching.h"
+#include "fvp/host/eval/sizing_score.h"
 #include "fvp/host/map/map_engine_registry.h"
 #include "fvp/host/nbv/cluster_completion.h"
 #include "fvp/host/nbv/loop_observers.h"
@@ -75,13 +76,19 @@ void validate(const TrialOptions& o) {
 /// loop's observer hooks.
 class TrialLog : public host::nbv::LoopObserver {
  public:
-  TrialLog(const TrialParts& parts, const SimulatedCamera& camera, const TrialOptions& options,
-           Clock::time_point wall_start)
-      : parts_(parts), camera_(camera), options_(options), wall_start_(wall_start) {}
+  TrialLog(const SimulatedCamera& camera, const TrialOptions& options, Clock::time_point wall_start)
+      : camera_(camera), options_(options), wall_start_(wall_start) {}
+
+  /// The views that follow are of this cluster of a tree (their log entries say which).
+  void startCluster(int cluster) {
+    cluster_ = cluster;
+    first_view_ = static_cast<int>(views_.size());
+  }
 
   void onView(const host::nbv::ViewEvent& e) override {
     const host::ViewResult& v = *e.result;
-    views_.push_back({{"index", e.index},
+    const int index = first_view_ + e.index;  // over the whole run
+    views_.push_back({{"index", index},
                       {"position_m", vec3(e.T_world_camera.translation())},
                       {"tag_detected", v.tag_detected},
                       {"roi_points", v.roi_points},
@@ -91,9 +98,10 @@ class TrialLog : public host::nbv::LoopObserver {
                       {"mapping_s", v.scan.seconds},
                       {"tsdf_s", v.tsdf_s},
                       {"sim_time_s", e.now_s}});
-    if (!options_.out_dir.empty()) parts_.keepViewImage(e.index, *e.frame);
+    if (cluster_ >= 0) views_.back()["cluster"] = cluster_;
+    if (!options_.out_dir.empty()) keepViewImage(options_.out_dir, index, *e.frame);
     if (options_.on_progress)
-      options_.on_progress({e.index + 1, e.now_s, options_.budget_s, secondsSince(wall_start_)});
+      options_.on_progress({index + 1, e.now_s, options_.budget_s, secondsSince(wall_start_)});
   }
 
   void onPlan(const host::nbv::PlanEvent& e) override {
@@ -110,16 +118,17 @@ class TrialLog : public host::nbv::LoopObserver {
           step.chosen ? nlohmann::json(step.candidates[*step.chosen].utility) : nlohmann::json()},
          {"planning_s", e.planning_s},
          {"timings_s", timings}});
+    if (cluster_ >= 0) plans_.back()["cluster"] = cluster_;
   }
 
   const nlohmann::json& views() const { return views_; }
   const nlohmann::json& plans() const { return plans_; }
 
  private:
-  const TrialParts& parts_;
   const SimulatedCamera& camera_;
   const TrialOptions& options_;
   Clock::time_point wall_start_;
+  int cluster_ = -1, first_view_ = 0;  ///< -1: a one-cluster world
   nlohmann::json views_ = nlohmann::json::array(), plans_ = nlohmann::json::array();
 };
 
@@ -136,11 +145,14 @@ class UnchargedClock : public host::nbv::LoopClock {
 
 /// The cluster as the automatic stop sized it after each view, each sizing scored against
 /// the world's ground truth: what a shorter budget would have reported.
+/// Times are from the start of the cluster (t0_s on the run's clock).
 nlohmann::json sizeHistoryJson(const std::vector<host::nbv::SizingSnapshot>& history,
-                               const World& world) {
+                               const World& world, const std::vector<int>& fruitlet_indices,
+                               double t0_s) {
   std::vector<Eigen::Vector3d> truth_m;
   std::vector<double> truth_mm;
-  for (const auto& f : world.fruitlets()) {
+  for (const int i : fruitlet_indices) {
+    const Fruitlet& f = world.fruitlets().at(static_cast<std::size_t>(i));
     truth_m.push_back(f.center_m);
     truth_mm.push_back(f.gtSizeMm());
   }
@@ -164,7 +176,7 @@ nlohmann::json sizeHistoryJson(const std::vector<host::nbv::SizingSnapshot>& his
       return v ? nlohmann::json(*v) : nlohmann::json();
     };
     out.push_back({{"view", snapshot.view},
-                   {"sim_time_s", snapshot.now_s},
+                   {"sim_time_s", snapshot.now_s - t0_s},
                    {"sizing_wall_s", snapshot.sizing_s},
                    {"fruitlets", fruitlets},
                    {"match_percent", m.match_percent},
@@ -174,27 +186,96 @@ nlohmann::json sizeHistoryJson(const std::vector<host::nbv::SizingSnapshot>& his
   return out;
 }
 
+// A cluster's start view and the same view from farther out: its camera body (3 cm) with
+// the collision padding (1 cm) and a coarse voxel (1 cm) needs about 5 cm around it, and
+// leaves may hang that close to the start view (the generator keeps them 5 cm off the
+// camera centre), so each step backs off by that much; 0.45 m is the farthest, where the
+// 3 cm tag still spans about 70 px.
+constexpr double kApproachStepM = 0.05;
+constexpr int kApproachSteps = 3;
+
+std::vector<Eigen::Isometry3d> approachPoses(const FruitletCluster& cluster) {
+  std::vector<Eigen::Isometry3d> poses;
+  const Eigen::Vector3d back = -cluster.T_world_start_camera.linear().col(2);
+  for (int step = 0; step <= kApproachSteps; ++step) {
+    Eigen::Isometry3d T = cluster.T_world_start_camera;
+    T.translation() += step * kApproachStepM * back;
+    poses.push_back(T);
+  }
+  return poses;
+}
+
+/// The perception of cluster k: in a world of several clusters only its own tag places a
+/// Cluster Region (one cluster: any tag, as a grower's single tag).
+host::PerceptionConfig perceptionFor(const World& world, std::size_t k) {
+  host::PerceptionConfig perception;
+  if (world.clusters().size() > 1) perception.tag.tag_id = world.clusters()[k].tag.tag_id;
+  return perception;
+}
+
+nlohmann::json eventsJson(const host::nbv::NbvEvents& events) {
+  return {{"planning_iterations", events.planning_iterations},
+          {"iterations_without_move", events.iterations_without_move},
+          {"move_attempts", events.move_attempts},
+          {"failed_moves", events.failed_moves},
+          {"candidates_rejected_clearance", events.rejected_clearance},
+          {"gain_rays_culled", events.culled_rays},
+          {"views_without_tag", events.views_without_tag},
+          {"dropped_disparities", events.dropped_disparities},
+          {"saturated_disparities", events.saturated_disparities},
+          {"collision_voxels_freed_at_arm", events.obstacle_update_count},
+          {"dropped_frames", events.dropped_frames},
+          {"motion_status", events.motion_status}};
+}
+
+/// Adds every number of `part` into `total` (objects member by member, recursively).
+void addNumbers(nlohmann::json& total, const nlohmann::json& part) {
+  for (const auto& [key, value] : part.items()) {
+    if (value.is_object()) {
+      if (!total.contains(key)) total[key] = nlohmann::json::object();
+      addNumbers(total[key], value);
+    } else if (value.is_number_integer()) {
+      total[key] = total.value(key, std::int64_t{0}) + value.get<std::int64_t>();
+    } else if (value.is_number()) {
+      total[key] = total.value(key, 0.0) + value.get<double>();
+    }
+  }
+}
+
 }  // namespace
+
+/// What running the loop on one cluster gave.
+struct ClusterOutcome {
+  host::nbv::NbvResult run;
+  nlohmann::json sizing;        ///< sizeAndScore's object
+  nlohmann::json size_history;  ///< null unless sizes were kept after every view
+  double sizing_wall_s = 0.0, sizing_during_loop_s = 0.0;
+  std::optional<host::nbv::ClusterCompletionConfig> stop_config;  ///< with --stop auto
+};
 
 struct Trial::Impl {
   explicit Impl(TrialOptions opts) : options(std::move(opts)) {
     validate(options);
     if (!options.out_dir.empty()) {
       host::prepareOutputDirectory(options.out_dir, "trial output directory");
-      host::removeStaleOutputs(options.out_dir, TrialParts::outputFiles(), {"views"});
+      std::vector<std::string> stale = TrialParts::outputFiles();
+      for (int k = 0; k < kMaxClusterDirs; ++k)
+        for (const std::string& file : TrialParts::clusterFiles())
+          stale.push_back(clusterDirName(k) + "/" + file);
+      host::removeStaleOutputs(options.out_dir, stale, {"views"});
     }
     engine = options.engine.empty() ? defaultEngine(options.planner) : options.engine;
 
-    // Maps (and TSDF) fed view by view, the planner, and the sizing at the end. First: a
-    // missing backend or a bad planner config fails before the world and the arm are built.
+    // First: a missing backend or a bad planner config fails before the arm is built.
     backend = host::map::createBackendFor(engine, options.backend);
-    parts = std::make_unique<TrialParts>(options, engine, backend.get());
-
-    // The world and the simulated camera.
     const WorldConfig world_config = options.world_config.empty()
                                          ? WorldConfig{}
                                          : WorldConfig::fromYamlFile(options.world_config);
     world = std::make_unique<World>(World::generate(world_config, options.seed));
+    // The first cluster's session and planner (maps + TSDF fed view by view, then sizing).
+    parts = makeParts(0);
+
+    // The simulated camera.
     RenderConfig render_config;
     render_config.noise_seed = options.seed;
     renderer = std::make_unique<StereoRenderer>(*world, render_config);
@@ -217,20 +298,41 @@ struct Trial::Impl {
     sim_arm = std::make_unique<SimulatedArm>(*controller, *workspace);
   }
 
+  // Cluster k's files go to out_dir/cluster_K (a world has at most 8 clusters).
+  static constexpr int kMaxClusterDirs = 8;
+  static std::string clusterDirName(std::size_t k) { return "cluster_" + std::to_string(k); }
+
+  std::unique_ptr<TrialParts> makeParts(std::size_t k) const {
+    // One cluster: the planner's seed is the trial's, as it always was.
+    return std::make_unique<TrialParts>(options, engine, backend.get(), perceptionFor(*world, k),
+                                        options.seed + k);
+  }
+
   void warn(const std::string& text) {
     warnings.push_back(text);
     if (options.on_warning) options.on_warning(text);
   }
 
+  /// The loop on one cluster from where the camera is, until the cluster's stop (its cap
+  /// counted from t0_s), then its sizing scored against its fruitlets.
+  ClusterOutcome runCluster(TrialParts& cluster_parts, const FruitletCluster& cluster,
+                            host::nbv::Camera& loop_camera, host::nbv::Arm& loop_arm,
+                            host::nbv::LoopClock& loop_clock, TrialLog& log);
+
   nlohmann::json run(host::nbv::Camera& loop_camera, host::nbv::Arm& loop_arm);
+  nlohmann::json runTree(host::nbv::Camera& loop_camera, host::nbv::Arm& loop_arm);
+  /// The fields every result has: options, config, clock, logs, warnings.
+  void describeRun(nlohmann::json& result, const TrialLog& log,
+                   const std::vector<Eigen::Vector3d>& camera_path) const;
+  nlohmann::json stopJson(const ClusterOutcome& outcome) const;
 
   TrialOptions options;
   Clock::time_point wall_start = Clock::now();
   std::vector<std::string> warnings;
   std::string engine;
   std::unique_ptr<accel::Backend> backend;
-  std::unique_ptr<TrialParts> parts;
   std::unique_ptr<World> world;
+  std::unique_ptr<TrialParts> parts;
   std::unique_ptr<StereoRenderer> renderer;
   ArmConfig arm_config;
   std::unique_ptr<ArmModel> arm;
@@ -242,36 +344,83 @@ struct Trial::Impl {
   bool ran = false;
 };
 
-nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& loop_arm) {
-  if (ran) throw std::logic_error("Trial::run: a trial runs once (its world and clock are spent)");
-  ran = true;
-  // The loop, driven through the camera, arm and clock like a robot's.
-  SimulatedLoopClock loop_clock(*clock);
-  host::nbv::StopCondition stop = host::nbv::StopCondition::budget(options.budget_s);
+ClusterOutcome Trial::Impl::runCluster(TrialParts& cluster_parts, const FruitletCluster& cluster,
+                                       host::nbv::Camera& loop_camera, host::nbv::Arm& loop_arm,
+                                       host::nbv::LoopClock& loop_clock, TrialLog& log) {
+  const double t0_s = loop_clock.now_s();
+  host::nbv::StopCondition stop =
+      t0_s == 0.0 ? host::nbv::StopCondition::budget(options.budget_s)
+                  : host::nbv::StopCondition(
+                        [deadline_s = t0_s + options.budget_s](const host::nbv::LoopState& s) {
+                          return s.now_s >= deadline_s;
+                        },
+                        "budget");
   if (options.max_views) stop = stop || host::nbv::StopCondition::views(*options.max_views);
-  TrialLog log(*parts, *camera, options, wall_start);
   host::nbv::LoopObservers observers;
   observers.add(&log);
   UnchargedClock observing_clock(loop_clock);  // before completion: it outlives it
   std::optional<host::nbv::ClusterCompletion> completion;
   if (options.stop == "auto") {
-    completion.emplace(parts->session(), loop_clock, parts->sizingConfig());
+    completion.emplace(cluster_parts.session(), loop_clock, cluster_parts.sizingConfig());
     observers.add(&*completion);
     stop = stop || completion->stopCondition();
   } else if (options.record_size_history) {
-    completion.emplace(parts->session(), observing_clock, parts->sizingConfig());
+    completion.emplace(cluster_parts.session(), observing_clock, cluster_parts.sizingConfig());
     observers.add(&*completion);
   }
-  host::nbv::NbvLoop loop(parts->session(), parts->planner(), loop_camera, loop_arm, loop_clock);
-  const host::nbv::NbvResult run = loop.run(stop, &observers);
-  const host::nbv::NbvEvents& events = run.events;
+  host::nbv::NbvLoop loop(cluster_parts.session(), cluster_parts.planner(), loop_camera, loop_arm,
+                          loop_clock);
+  ClusterOutcome out;
+  out.run = loop.run(stop, &observers);
+
+  const auto t_size = Clock::now();
+  out.sizing = cluster_parts.sizeAndScore(*world, cluster.fruitlet_indices);
+  out.sizing_wall_s = secondsSince(t_size);
+  if (completion) {
+    for (const auto& snapshot : completion->history())
+      out.sizing_during_loop_s += snapshot.sizing_s;
+    out.size_history =
+        sizeHistoryJson(completion->history(), *world, cluster.fruitlet_indices, t0_s);
+    if (options.stop == "auto") out.stop_config = completion->config();
+  }
+  return out;
+}
+
+nlohmann::json Trial::Impl::stopJson(const ClusterOutcome& outcome) const {
+  if (!outcome.stop_config) return {{"rule", "budget"}};
+  const host::nbv::ClusterCompletionConfig& c = *outcome.stop_config;
+  return {{"rule", "auto"},
+          {"stable_views", c.stable_views},
+          {"size_tolerance_mm", c.size_tolerance_mm},
+          {"same_fruitlet_m", c.same_fruitlet_m},
+          {"min_well_seen_images", c.min_well_seen_images},
+          {"min_view_span_deg", c.min_view_span_deg},
+          {"max_iterations_without_view", c.max_iterations_without_view}};
+}
+
+void Trial::Impl::describeRun(nlohmann::json& result, const TrialLog& log,
+                              const std::vector<Eigen::Vector3d>& camera_path) const {
+  result["clock"] = nlohmann::json::parse(clock->toJson());
+  result["view_log"] = log.views();
+  result["plan_log"] = log.plans();
+  nlohmann::json path = nlohmann::json::array();
+  for (const auto& p : camera_path) path.push_back(vec3(p));
+  result["camera_path_m"] = path;
+  result["warnings"] = warnings;
+}
+
+nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& loop_arm) {
+  if (ran) throw std::logic_error("Trial::run: a trial runs once (its world and clock are spent)");
+  ran = true;
+  if (world->clusters().size() > 1) return runTree(loop_camera, loop_arm);
+  // The loop, driven through the camera, arm and clock like a robot's.
+  SimulatedLoopClock loop_clock(*clock);
+  TrialLog log(*camera, options, wall_start);
+  const ClusterOutcome outcome =
+      runCluster(*parts, world->clusters().front(), loop_camera, loop_arm, loop_clock, log);
+  const host::nbv::NbvResult& run = outcome.run;
   std::vector<Eigen::Vector3d> camera_path;
   for (const auto& T : run.camera_poses) camera_path.push_back(T.translation());
-
-  // Size, score and write.
-  const auto t_size = Clock::now();
-  nlohmann::json sizing = parts->sizeAndScore(*world, options.out_dir);
-  const double sizing_wall_s = secondsSince(t_size);
 
   nlohmann::json result;
   result["planner"] = options.planner;
@@ -287,52 +436,190 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
   result["config"] = {{"planner", nlohmann::json::parse(parts->planner().configJson())},
                       {"arm", nlohmann::json::parse(arm_config.toJson())},
                       {"trial", parts->configJson()}};
-  for (auto& [key, value] : sizing.items()) result[key] = value;
-  nlohmann::json counted = {{"planning_iterations", events.planning_iterations},
-                            {"iterations_without_move", events.iterations_without_move},
-                            {"move_attempts", events.move_attempts},
-                            {"failed_moves", events.failed_moves},
-                            {"candidates_rejected_clearance", events.rejected_clearance},
-                            {"gain_rays_culled", events.culled_rays},
-                            {"views_without_tag", events.views_without_tag},
-                            {"dropped_disparities", events.dropped_disparities},
-                            {"saturated_disparities", events.saturated_disparities},
-                            {"collision_voxels_freed_at_arm", events.obstacle_update_count},
-                            {"dropped_frames", events.dropped_frames},
-                            {"motion_status", events.motion_status}};
-  result["events"] = counted;
-  double loop_sizing_s = 0.0;
-  if (completion)
-    for (const auto& snapshot : completion->history()) loop_sizing_s += snapshot.sizing_s;
+  for (auto& [key, value] : outcome.sizing.items()) result[key] = value;
+  result["events"] = eventsJson(run.events);
   result["wall_breakdown_s"] = {{"rendering", camera->totalRenderSeconds()},
                                 {"perception", run.wall_s.perception},
                                 {"mapping", run.wall_s.mapping},
                                 {"tsdf", run.wall_s.tsdf},
                                 {"planning", run.wall_s.planning},
                                 {"motion_planning", run.wall_s.motion_planning},
-                                {"sizing", sizing_wall_s},
-                                {"sizing_during_loop", loop_sizing_s}};
-  if (completion) result["size_history"] = sizeHistoryJson(completion->history(), *world);
-  if (options.stop == "auto") {
-    result["stop"] = {{"rule", "auto"},
-                      {"stable_views", completion->config().stable_views},
-                      {"size_tolerance_mm", completion->config().size_tolerance_mm},
-                      {"same_fruitlet_m", completion->config().same_fruitlet_m},
-                      {"min_well_seen_images", completion->config().min_well_seen_images},
-                      {"min_view_span_deg", completion->config().min_view_span_deg}};
-  } else {
-    result["stop"] = {{"rule", "budget"}};
-  }
-  result["clock"] = nlohmann::json::parse(clock->toJson());
-  result["view_log"] = log.views();
-  result["plan_log"] = log.plans();
-  nlohmann::json path = nlohmann::json::array();
-  for (const auto& p : camera_path) path.push_back(vec3(p));
-  result["camera_path_m"] = path;
-
-  result["warnings"] = warnings;
+                                {"sizing", outcome.sizing_wall_s},
+                                {"sizing_during_loop", outcome.sizing_during_loop_s}};
+  if (!outcome.size_history.is_null()) result["size_history"] = outcome.size_history;
+  result["stop"] = stopJson(outcome);
+  describeRun(result, log, camera_path);
   if (!options.out_dir.empty())
     parts->writeOutputs(result, *world, camera_path, options.out_dir, options.on_warning);
+  return result;
+}
+
+// A tree: the clusters one after another, nearest start view next, on one clock and one
+// coarse map (each cluster's session carries the map on to the next, which moves the fine
+// map to its own region). A cluster whose start view the arm cannot reach is skipped and
+// counted.
+nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::Arm& loop_arm) {
+  SimulatedLoopClock loop_clock(*clock);
+  TrialLog log(*camera, options, wall_start);
+  const std::vector<FruitletCluster>& clusters = world->clusters();
+  std::vector<bool> visited(clusters.size(), false);
+  std::unique_ptr<host::map::MapEngine> carried_map;
+  std::unique_ptr<TrialParts> cluster_parts = std::move(parts);
+  nlohmann::json cluster_entries = nlohmann::json::array(), tour = nlohmann::json::array();
+  nlohmann::json scored = nlohmann::json::object();  // "fruitlets..." arrays over the clusters
+  nlohmann::json events = nlohmann::json::object(), wall = nlohmann::json::object();
+  nlohmann::json transit_motion = nlohmann::json::object();
+  std::map<std::string, int> cluster_status;
+  std::vector<Eigen::Vector3d> camera_path;
+  std::uint64_t detections = 0;
+  int views = 0;
+  double transit_s = 0.0;
+  nlohmann::json stop_json, planner_config, trial_config;
+  for (std::size_t step = 0; step < clusters.size(); ++step) {
+    // The nearest unvisited start view from where the camera is now.
+    const Eigen::Vector3d here = loop_arm.cameraPose().translation();
+    std::size_t k = clusters.size();
+    for (std::size_t i = 0; i < clusters.size(); ++i)
+      if (!visited[i] && (k == clusters.size() ||
+                          (clusters[i].T_world_start_camera.translation() - here).norm() <
+                              (clusters[k].T_world_start_camera.translation() - here).norm()))
+        k = i;
+    visited[k] = true;
+    tour.push_back(k);
+    const FruitletCluster& cluster = clusters[k];
+    nlohmann::json entry = {{"index", k},
+                            {"tag_id", cluster.tag.tag_id},
+                            {"gt_fruitlets", cluster.fruitlet_indices.size()},
+                            {"start_sim_s", loop_clock.now_s()}};
+    const auto skip = [&](const std::string& status) {
+      entry["status"] = status;
+      ++cluster_status[status];
+      cluster_entries.push_back(entry);
+    };
+    // To its start view (the first cluster's is where the arm starts), or, where the arm
+    // cannot stand there, the same view from farther out along its axis.
+    if (!loop_arm.cameraPose().isApprox(cluster.T_world_start_camera, 1e-9)) {
+      std::string move_status = "unreachable";
+      bool arrived = false;
+      for (const Eigen::Isometry3d& T : approachPoses(cluster)) {
+        if (!loop_arm.reachable(T)) continue;
+        const double before_s = loop_clock.now_s();
+        const host::nbv::MoveResult move = loop_arm.moveTo(T);
+        transit_s += loop_clock.now_s() - before_s;
+        move_status = host::nbv::toString(move.status);
+        transit_motion[move_status] = transit_motion.value(move_status, 0) + 1;
+        if ((arrived = move.ok())) {
+          entry["approach_distance_m"] = (T.translation() - cluster.center_m).norm();
+          break;
+        }
+      }
+      if (!arrived) {
+        entry["move_status"] = move_status;
+        skip(move_status == "unreachable" ? "unreachable" : "move_failed");
+        continue;
+      }
+    }
+    if (!cluster_parts) cluster_parts = makeParts(k);
+    if (carried_map) cluster_parts->session().carryOnWith(std::move(carried_map));
+    const double t0_s = loop_clock.now_s();
+    log.startCluster(static_cast<int>(k));
+    const ClusterOutcome outcome =
+        runCluster(*cluster_parts, cluster, loop_camera, loop_arm, loop_clock, log);
+    const bool mapped = cluster_parts->map() != nullptr;
+    entry["status"] = mapped ? "sized" : "no_tag";
+    ++cluster_status[entry["status"].get<std::string>()];
+    entry["views"] = outcome.run.views;
+    entry["stop_reason"] = outcome.run.stop_reason;
+    entry["sim_time_s"] = loop_clock.now_s() - t0_s;
+    for (auto& [key, value] : outcome.sizing.items()) {
+      if (key.rfind("fruitlets", 0) == 0) {
+        // Every scored fruitlet says which cluster it is in.
+        nlohmann::json tagged = value;
+        for (auto& f : tagged) f["cluster"] = k;
+        for (const auto& f : tagged) scored[key].push_back(f);
+        entry[key] = std::move(tagged);
+      } else if (key == "detections" || key.rfind("metrics", 0) == 0 || key == "sizing_estimator" ||
+                 key == "unsupported_detections" || key == "sized_fruitlets" ||
+                 key == "sizing_stats") {
+        entry[key] = value;
+      }
+    }
+    detections += outcome.sizing.value("detections", std::uint64_t{0});
+    views += outcome.run.views;
+    entry["events"] = eventsJson(outcome.run.events);
+    addNumbers(events, entry["events"]);
+    addNumbers(wall, {{"perception", outcome.run.wall_s.perception},
+                      {"mapping", outcome.run.wall_s.mapping},
+                      {"tsdf", outcome.run.wall_s.tsdf},
+                      {"planning", outcome.run.wall_s.planning},
+                      {"motion_planning", outcome.run.wall_s.motion_planning},
+                      {"sizing", outcome.sizing_wall_s},
+                      {"sizing_during_loop", outcome.sizing_during_loop_s}});
+    if (!outcome.size_history.is_null()) entry["size_history"] = outcome.size_history;
+    for (const auto& T : outcome.run.camera_poses) camera_path.push_back(T.translation());
+    stop_json = stopJson(outcome);
+    planner_config = nlohmann::json::parse(cluster_parts->planner().configJson());
+    trial_config = cluster_parts->configJson();
+    if (!options.out_dir.empty())
+      cluster_parts->writeClusterFiles(options.out_dir / clusterDirName(k));
+    cluster_entries.push_back(entry);
+    carried_map = std::move(cluster_parts->session()).releaseMap();
+    cluster_parts.reset();
+  }
+
+  nlohmann::json result;
+  result["planner"] = options.planner;
+  result["seed"] = options.seed;
+  result["engine"] = engine;
+  result["backend"] = backend ? std::string(accel::toString(backend->kind())) : "none";
+  result["views"] = views;
+  result["stop_reason"] = "tour_done";
+  result["sim_time_s"] = clock->now_s();
+  result["budget_s"] = options.budget_s;
+  result["wall_time_s"] = secondsSince(wall_start);
+  result["status"] = cluster_status["sized"] > 0 ? "ok" : "no_tag";
+  result["config"] = {{"planner", planner_config},
+                      {"arm", nlohmann::json::parse(arm_config.toJson())},
+                      {"trial", trial_config}};
+  // Every cluster's fruitlets, scored against its own ground truth, and the pooled metrics
+  // (a skipped cluster's fruitlets are in them, not matched).
+  for (const auto& c : cluster_entries) {
+    if (c.contains("fruitlets")) continue;
+    for (const int i : clusters[c.at("index").get<std::size_t>()].fruitlet_indices) {
+      const Fruitlet& f = world->fruitlets()[static_cast<std::size_t>(i)];
+      const nlohmann::json missed = {{"gt_center_m", vec3(f.center_m)},
+                                     {"gt_size_mm", f.gtSizeMm()},
+                                     {"matched", false},
+                                     {"est_center_m", nullptr},
+                                     {"est_size_mm", nullptr},
+                                     {"cluster", c.at("index")}};
+      scored["fruitlets"].push_back(missed);
+      for (const char* other : {"fruitlets_paper_sizing", "fruitlets_ours_sizing"})
+        if (scored.contains(other)) scored[other].push_back(missed);
+    }
+  }
+  if (!scored.contains("fruitlets")) scored["fruitlets"] = nlohmann::json::array();
+  for (const auto& [key, fruitlets] : scored.items()) {
+    result[key] = fruitlets;
+    result["metrics" + key.substr(std::string("fruitlets").size())] =
+        host::eval::pooledMetricsJson(fruitlets, detections);
+  }
+  result["detections"] = detections;
+  if (!cluster_entries.empty() && cluster_entries.back().contains("sizing_estimator"))
+    result["sizing_estimator"] = cluster_entries.back()["sizing_estimator"];
+  result["clusters"] = cluster_entries;
+  result["tour"] = {{"order", tour},
+                    {"cluster_status", cluster_status},
+                    {"transit_sim_s", transit_s},
+                    {"transit_motion_status", transit_motion}};
+  result["events"] = events.empty() ? eventsJson({}) : events;
+  wall["rendering"] = camera->totalRenderSeconds();
+  result["wall_breakdown_s"] = wall;
+  result["stop"] = stop_json.is_null() ? nlohmann::json{{"rule", options.stop}} : stop_json;
+  describeRun(result, log, camera_path);
+  if (!options.out_dir.empty())
+    writeTreeOutputs(result, *world, carried_map.get(), camera_path, options.out_dir,
+                     options.on_warning);
   return result;
 }
 

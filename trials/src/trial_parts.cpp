@@ -54,14 +54,15 @@ WorkspaceTree loadWorkspaceTree(const ArmModel& arm,
 }
 
 struct TrialParts::Impl {
-  Impl(const TrialOptions& options, const std::string& engine, accel::Backend* backend)
+  Impl(const TrialOptions& options, const std::string& engine, accel::Backend* backend,
+       const host::PerceptionConfig& perception, std::uint64_t planner_seed)
       : options(options),
         engine(engine),
         backend(backend),
         map_config(host::planner::plannerMapConfig(options.planner, engine)),
-        session(host::PerceptionConfig{}, engine, map_config, backend) {
+        session(perception, engine, map_config, backend) {
     session.enableTsdf();
-    planner = host::planner::createPlanner(options.planner, options.planner_config, options.seed,
+    planner = host::planner::createPlanner(options.planner, options.planner_config, planner_seed,
                                            backend);
   }
 
@@ -76,8 +77,9 @@ struct TrialParts::Impl {
 };
 
 TrialParts::TrialParts(const TrialOptions& options, const std::string& engine,
-                       accel::Backend* backend)
-    : impl_(std::make_unique<Impl>(options, engine, backend)) {}
+                       accel::Backend* backend, const host::PerceptionConfig& perception,
+                       std::uint64_t planner_seed)
+    : impl_(std::make_unique<Impl>(options, engine, backend, perception, planner_seed)) {}
 
 TrialParts::~TrialParts() = default;
 
@@ -115,9 +117,10 @@ nlohmann::json TrialParts::configJson() const {
             {"min_support_area_fraction", impl_->sizing_config.min_support_area_fraction}}}};
 }
 
-void TrialParts::keepViewImage(int index, const host::StereoFrame& frame) const {
+void keepViewImage(const std::filesystem::path& out_dir, int index,
+                   const host::StereoFrame& frame) {
   if (frame.left_bgr.empty()) return;
-  const std::filesystem::path dir = impl_->options.out_dir / "views";
+  const std::filesystem::path dir = out_dir / "views";
   std::filesystem::create_directories(dir);
   cv::Mat small;
   const double scale = double(kReportImageWidthPx) / frame.left_bgr.cols;
@@ -179,6 +182,25 @@ void plotCameraPath(const World& world, const std::vector<Eigen::Vector3d>& path
 
 }  // namespace
 
+const std::vector<std::string>& TrialParts::clusterFiles() {
+  static const std::vector<std::string> files = {"fine.ot", "surface.ply", "mesh.ply",
+                                                 "clusters.ply"};
+  return files;
+}
+
+void TrialParts::writeClusterFiles(const std::filesystem::path& dir) const {
+  std::filesystem::create_directories(dir);
+  if (const host::map::MapEngine* map = impl_->session.map()) map->exportFine(dir / "fine.ot");
+  const auto& sz = impl_->sizing;
+  host::writePlyPoints(dir / "surface.ply", impl_->session.surfacePoints());
+  const host::tsdf::TriangleMesh mesh = impl_->session.surfaceMesh();
+  host::writePlyMesh(dir / "mesh.ply", mesh.vertices_m, mesh.triangles,
+                     "fvp TSDF mesh (marching cubes), world frame, metres");
+  host::writePlyColoredPoints(dir / "clusters.ply", sz.points,
+                              host::sizing::clusterColours(sz.labels),
+                              "fvp clusters, world frame, metres; grey = noise");
+}
+
 const std::vector<std::string>& TrialParts::outputFiles() {
   static const std::vector<std::string> files = {"result.json",  "report.md",   "coarse.bt",
                                                  "fine.ot",      "surface.ply", "mesh.ply",
@@ -196,10 +218,9 @@ void TrialParts::writeOutputs(nlohmann::json& result, const World& world,
     host::writeFileAtomically(out_dir / "result.json", "trial result", result.dump(2) + "\n");
   };
   write_result();
-  if (const host::map::MapEngine* map = impl_->session.map()) {
+  if (const host::map::MapEngine* map = impl_->session.map())
     map->exportCoarse(out_dir / "coarse.bt");
-    map->exportFine(out_dir / "fine.ot");
-  }
+  writeClusterFiles(out_dir);
   bool path_drawn = false;
   if (!camera_path.empty()) {
     try {
@@ -212,14 +233,6 @@ void TrialParts::writeOutputs(nlohmann::json& result, const World& world,
       write_result();
     }
   }
-  const auto& sz = impl_->sizing;
-  host::writePlyPoints(out_dir / "surface.ply", impl_->session.surfacePoints());
-  const host::tsdf::TriangleMesh mesh = impl_->session.surfaceMesh();
-  host::writePlyMesh(out_dir / "mesh.ply", mesh.vertices_m, mesh.triangles,
-                     "fvp TSDF mesh (marching cubes), world frame, metres");
-  host::writePlyColoredPoints(out_dir / "clusters.ply", sz.points,
-                              host::sizing::clusterColours(sz.labels),
-                              "fvp clusters, world frame, metres; grey = noise");
 
   std::ostringstream md;
   md << "# Trial: " << result["planner"].get<std::string>() << ", world seed " << result["seed"]
@@ -271,14 +284,94 @@ void TrialParts::writeOutputs(nlohmann::json& result, const World& world,
   host::writeFileAtomically(out_dir / "report.md", "trial report", md.str());
 }
 
+void writeTreeOutputs(nlohmann::json& result, const World& world, const host::map::MapEngine* map,
+                      const std::vector<Eigen::Vector3d>& camera_path,
+                      const std::filesystem::path& out_dir,
+                      const std::function<void(const std::string&)>& warn) {
+  std::filesystem::create_directories(out_dir);
+  const auto write_result = [&] {
+    host::writeFileAtomically(out_dir / "result.json", "trial result", result.dump(2) + "\n");
+  };
+  write_result();
+  if (map) map->exportCoarse(out_dir / "coarse.bt");
+  bool path_drawn = false;
+  if (!camera_path.empty()) {
+    try {
+      plotCameraPath(world, camera_path, out_dir / "path.png");
+      path_drawn = true;
+    } catch (const std::exception& e) {
+      const std::string text = std::string("path.png not drawn: ") + e.what();
+      result["warnings"].push_back(text);
+      if (warn) warn(text);
+      write_result();
+    }
+  }
+  const nlohmann::json& m = result["metrics"];
+  const double minutes = result.value("sim_time_s", 0.0) / 60.0;
+  std::size_t matched = 0;
+  for (const auto& f : result["fruitlets"]) matched += f.value("matched", false);
+  std::ostringstream md;
+  md << "# Tree trial: " << result["planner"].get<std::string>() << ", world seed "
+     << result["seed"] << "\n\n"
+     << "Engine `" << result["engine"].get<std::string>() << "`, backend `"
+     << result["backend"].get<std::string>() << "`, " << result["clusters"].size()
+     << " clusters, stop rule `" << result["stop"].value("rule", "?") << "` (cap "
+     << fmt(result["budget_s"], 0) << " s a cluster).\n\n"
+     << "| views | simulated time | fruitlets sized / min | detections | match % | MAE (mm) | "
+        "MAPE (%) | precision % |\n|---|---|---|---|---|---|---|---|\n"
+     << "| " << result["views"] << " | " << fmt(result["sim_time_s"], 1) << " s | "
+     << (minutes > 0 ? fmt(matched / minutes, 2) : "-") << " | " << result.value("detections", 0)
+     << " | " << fmtOrDash(m["match_percent"], 1) << " | " << fmtOrDash(m["mae_mm"], 2) << " | "
+     << fmtOrDash(m["mape_percent"], 1) << " | " << fmtOrDash(m["precision_percent"], 1)
+     << " |\n\n## Clusters, in the order visited\n\n"
+     << "| cluster | tag | status | views | simulated s | stop | fruitlets | matched | "
+        "detections | MAE (mm) |\n|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& c : result["clusters"]) {
+    std::size_t c_matched = 0;
+    if (c.contains("fruitlets"))
+      for (const auto& f : c["fruitlets"]) c_matched += f.value("matched", false);
+    const bool ran = c.contains("views");
+    md << "| " << c["index"] << " | " << c["tag_id"] << " | " << c.value("status", "?") << " | "
+       << (ran ? std::to_string(c["views"].get<int>()) : "-") << " | "
+       << (ran ? fmt(c["sim_time_s"], 1) : "-") << " | " << c.value("stop_reason", "-") << " | "
+       << c["gt_fruitlets"] << " | " << c_matched << " | " << c.value("detections", 0) << " | "
+       << (c.contains("metrics") ? fmtOrDash(c["metrics"]["mae_mm"], 2) : "-") << " |\n";
+  }
+  md << "\nBetween clusters the arm spent " << fmt(result["tour"]["transit_sim_s"], 1)
+     << " simulated s moving. Each cluster's fine map, TSDF surface and clusters are in "
+        "`cluster_K/`.\n\n## Sizes against ground truth\n\n"
+     << "| cluster | true size (mm) | estimated (mm) | error (mm) |\n|---|---|---|---|\n";
+  for (const auto& f : result["fruitlets"]) {
+    const bool hit = f.value("matched", false);
+    md << "| " << f["cluster"] << " | " << fmt(f["gt_size_mm"], 2) << " | "
+       << (hit ? fmt(f["est_size_mm"], 2) : "not matched") << " | "
+       << (hit ? fmt(f["est_size_mm"].get<double>() - f["gt_size_mm"].get<double>(), 2) : "-")
+       << " |\n";
+  }
+  md << "\n## Where the wall time went\n\n| part | wall s |\n|---|---|\n";
+  for (const auto& [part, sec] : result["wall_breakdown_s"].items())
+    md << "| " << part << " | " << fmt(sec, 2) << " |\n";
+  md << "\n## Counted events (all clusters)\n\n```json\n" << result["events"].dump(2) << "\n```\n";
+  if (path_drawn) md << "\n## Camera path\n\n![camera path](path.png)\n";
+  if (!result["warnings"].empty()) {
+    md << "\n## Warnings\n\n";
+    for (const auto& w : result["warnings"]) md << "- " << w.get<std::string>() << "\n";
+  }
+  host::writeFileAtomically(out_dir / "report.md", "trial report", md.str());
+}
+
 }  // namespace fvp::trials
 
 namespace fvp::trials {
 
-nlohmann::json TrialParts::sizeAndScore(const World& world, const std::filesystem::path&) {
+nlohmann::json TrialParts::sizeAndScore(const World& world,
+                                        const std::vector<int>& fruitlet_indices) {
   impl_->sizing = impl_->session.sizeFruitlets(impl_->sizing_config);
   std::vector<host::eval::GroundTruthFruitlet> truth;
-  for (const auto& f : world.fruitlets()) truth.push_back({f.center_m, f.gtSizeMm()});
+  for (const int i : fruitlet_indices) {
+    const Fruitlet& f = world.fruitlets().at(static_cast<std::size_t>(i));
+    truth.push_back({f.center_m, f.gtSizeMm()});
+  }
   nlohmann::json out =
       host::eval::scoreBothEstimators(impl_->sizing, truth, impl_->sizing_config.estimator);
   // The details object must outlive the loop (items() of a temporary would dangle).

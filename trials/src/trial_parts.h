@@ -38,6 +38,18 @@ std::string defaultCacheDir();
 robot::WorkspaceTree loadWorkspaceTree(const robot::ArmModel& arm,
                                        const std::function<void(const std::string&)>& warn);
 
+/// A tree trial's files into out_dir, each atomically: result.json first, then the shared
+/// coarse map (coarse.bt, when a cluster was mapped), the camera path over the tree and
+/// report.md. The clusters' own files were written as each was finished (cluster_K/).
+void writeTreeOutputs(nlohmann::json& result, const robot::sim::World& world,
+                      const host::map::MapEngine* map,
+                      const std::vector<Eigen::Vector3d>& camera_path,
+                      const std::filesystem::path& out_dir,
+                      const std::function<void(const std::string&)>& warn);
+
+/// Writes a small PNG of the view's left image for the report: out_dir/views/NNN.png.
+void keepViewImage(const std::filesystem::path& out_dir, int index, const host::StereoFrame& frame);
+
 /// What one view did, with the wall times the clock charges.
 struct ViewOutcome {
   host::ViewResult result;
@@ -47,7 +59,10 @@ struct ViewOutcome {
 
 class TrialParts {
  public:
-  TrialParts(const TrialOptions& options, const std::string& engine, accel::Backend* backend);
+  /// perception: the tag (and so the cluster) this part's session maps; planner_seed seeds
+  /// its planner (the trial's seed for one cluster).
+  TrialParts(const TrialOptions& options, const std::string& engine, accel::Backend* backend,
+             const host::PerceptionConfig& perception, std::uint64_t planner_seed);
   ~TrialParts();
 
   ViewOutcome addView(const host::StereoFrame& frame);
@@ -58,11 +73,16 @@ class TrialParts {
   const host::sizing::SizingConfig& sizingConfig() const;
   /// The trial-level configuration (engine, map, perception, sizing) as JSON.
   nlohmann::json configJson() const;
-  /// Writes a small PNG of the view's left image for the report.
-  void keepViewImage(int index, const host::StereoFrame& frame) const;
-  /// Sizes the fruitlets from the views so far and scores them against the world's ground
-  /// truth: {"fruitlets", "detections", "metrics", ...} of result.json.
-  nlohmann::json sizeAndScore(const robot::sim::World& world, const std::filesystem::path& out_dir);
+  /// Sizes the fruitlets from the views so far and scores them against the ground truth of
+  /// the fruitlets with these indices in the world (the cluster's): {"fruitlets",
+  /// "detections", "metrics", ...} of result.json.
+  nlohmann::json sizeAndScore(const robot::sim::World& world,
+                              const std::vector<int>& fruitlet_indices);
+  /// The cluster's files from the last sizeAndScore, each atomically, into dir: fine.ot (while
+  /// the session holds its map), surface.ply, mesh.ply and clusters.ply.
+  void writeClusterFiles(const std::filesystem::path& dir) const;
+  /// Those files' names.
+  static const std::vector<std::string>& clusterFiles();
   /// result.json first, then the maps, surface, clusters, the camera-path figure and
   /// report.md, each atomically, into out_dir. A figure that cannot be drawn is passed to
   /// warn and added to result["warnings"] (result.json is written again then).

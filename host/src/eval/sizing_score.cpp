@@ -42,16 +42,29 @@ nlohmann::json scoreSizing(const sizing::SizingResult& sz,
     }
     fruitlets.push_back(f);
   }
+  return {{"fruitlets", fruitlets}, {"detections", detections.size()}, {"metrics", metricsJson(m)}};
+}
+
+nlohmann::json metricsJson(const SizeMetrics& m) {
   const auto opt = [](const std::optional<double>& v) {
     return v ? nlohmann::json(*v) : nlohmann::json();
   };
-  return {{"fruitlets", fruitlets},
-          {"detections", detections.size()},
-          {"metrics",
-           {{"match_percent", m.match_percent},
-            {"mae_mm", opt(m.mae_mm)},
-            {"mape_percent", opt(m.mape_percent)},
-            {"precision_percent", opt(m.precision_percent)}}}};
+  return {{"match_percent", m.match_percent},
+          {"mae_mm", opt(m.mae_mm)},
+          {"mape_percent", opt(m.mape_percent)},
+          {"precision_percent", opt(m.precision_percent)}};
+}
+
+nlohmann::json pooledMetricsJson(const nlohmann::json& fruitlets, std::size_t detections) {
+  std::vector<double> gt_mm, est_mm;
+  std::vector<int> detection_of_gt;
+  for (const auto& f : fruitlets) {
+    gt_mm.push_back(f.at("gt_size_mm").get<double>());
+    const bool matched = f.at("matched").get<bool>();
+    detection_of_gt.push_back(matched ? static_cast<int>(est_mm.size()) : -1);
+    if (matched) est_mm.push_back(f.at("est_size_mm").get<double>());
+  }
+  return metricsJson(sizeMetrics(gt_mm, est_mm, detection_of_gt, detections));
 }
 
 nlohmann::json scoreBothEstimators(const sizing::SizingResult& sz,

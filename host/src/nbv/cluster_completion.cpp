@@ -19,6 +19,9 @@ void ClusterCompletionConfig::validate() const {
     throw std::invalid_argument("cluster completion 'min_well_seen_images': expected at least 1");
   if (!(min_view_span_deg >= 0.0) || !(min_view_span_deg <= 180.0))
     throw std::invalid_argument("cluster completion 'min_view_span_deg': expected 0 to 180");
+  if (max_iterations_without_view < 1)
+    throw std::invalid_argument(
+        "cluster completion 'max_iterations_without_view': expected at least 1");
 }
 
 ClusterCompletion::ClusterCompletion(const MappingSession& session, LoopClock& clock,
@@ -67,7 +70,8 @@ bool ClusterCompletion::done() const {
 }
 
 StopCondition ClusterCompletion::stopCondition() const {
-  return StopCondition([this](const LoopState&) { return done(); }, "cluster_done");
+  return StopCondition([this](const LoopState&) { return done(); }, "cluster_done") ||
+         StopCondition::stalled(static_cast<std::size_t>(config_.max_iterations_without_view));
 }
 
 bool sizesSettled(const std::vector<SizingSnapshot>& history,

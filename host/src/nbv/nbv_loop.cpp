@@ -47,11 +47,13 @@ NbvResult NbvLoop::run(const StopCondition& stop, LoopObserver* observer) {
   NbvResult out;
   NbvEvents& events = out.events;
   LoopState state;
+  std::size_t iterations_without_view = 0;
   const auto update = [&] {
     state.views = out.views;
     state.iterations = events.planning_iterations;
     state.now_s = clock_.now_s();
     state.dropped_frames = events.dropped_frames;
+    state.iterations_without_view = iterations_without_view;
   };
   const auto stopped = [&] {
     update();
@@ -145,7 +147,12 @@ NbvResult NbvLoop::run(const StopCondition& stop, LoopObserver* observer) {
     // Without a move a new capture would see the same view: plan again (the planner's
     // threshold has decayed) until a move succeeds or the loop stops.
     capture_next = step.moved();
-    if (!step.moved()) ++events.iterations_without_move;
+    if (step.moved()) {
+      iterations_without_view = 0;
+    } else {
+      ++events.iterations_without_move;
+      ++iterations_without_view;
+    }
   }
   return out;
 }

@@ -21,6 +21,15 @@ StopCondition StopCondition::views(int max_views) {
   return {[max_views](const LoopState& s) { return s.views >= max_views; }, "max_views"};
 }
 
+StopCondition StopCondition::stalled(std::size_t iterations_without_view) {
+  if (iterations_without_view < 1)
+    throw std::invalid_argument("StopCondition::stalled: expected at least 1 iteration");
+  return {[iterations_without_view](const LoopState& s) {
+            return s.iterations_without_view >= iterations_without_view;
+          },
+          "no_reachable_view"};
+}
+
 std::optional<std::string> StopCondition::check(const LoopState& state) const {
   for (const auto& [predicate, reason] : terms_)
     if (predicate(state)) return reason;

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "fvp/host/eval/fruitlet_matching.h"
 #include "fvp/host/eval/ground_truth.h"
 #include "fvp/host/sizing/fruitlet_sizer.h"
 
@@ -19,6 +20,13 @@ namespace fvp::host::eval {
 nlohmann::json scoreSizing(const sizing::SizingResult& sizing,
                            const std::vector<GroundTruthFruitlet>& truth,
                            sizing::SizingEstimator estimator);
+
+/// {"match_percent", "mae_mm", "mape_percent", "precision_percent"} (null where undefined).
+nlohmann::json metricsJson(const SizeMetrics& metrics);
+
+/// The metrics of scored fruitlets pooled from several scorings (the clusters of a tree):
+/// scoreSizing's "fruitlets" entries, concatenated, and the detections of all of them.
+nlohmann::json pooledMetricsJson(const nlohmann::json& fruitlets, std::size_t detections);
 
 /// The scored default estimator plus "fruitlets_<other>_sizing", "metrics_<other>_sizing",
 /// "sizing_estimator" (truth may be empty: then only detections).

@@ -40,6 +40,13 @@ struct ClusterCompletionConfig {
   /// d >= 2 cm that is 12 mm, more than a fruitlet's diameter, so no one occluder spoils
   /// both ends of the span.
   double min_view_span_deg = 30.0;
+  /// A cluster is also done when the planner finds no view to move to for this many
+  /// iterations in a row ("no_reachable_view"): its threshold decays by threshold_decay
+  /// (0.8) in each of max_sampling_rounds (8) rounds, so after 3 iterations it is 0.8^24 =
+  /// 0.5 % of where it started and no longer filters anything. Every one of the 4800
+  /// candidates those iterations sampled with a gain above its travel cost was then tried
+  /// and none could be reached: more planning here only spends the clock.
+  int max_iterations_without_view = 3;
   /// Throws std::invalid_argument naming the bad field.
   void validate() const;
 };
@@ -79,6 +86,8 @@ class ClusterCompletion : public LoopObserver {
   /// Whether the sizes have settled (see ClusterCompletionConfig).
   bool done() const;
   /// Holds when done(); its reason is "cluster_done".
+  /// "cluster_done" once the sizes have settled, "no_reachable_view" once the planner is
+  /// stuck (max_iterations_without_view).
   StopCondition stopCondition() const;
 
   /// One snapshot per view mapped after the Cluster Region was known.

@@ -16,6 +16,8 @@ struct LoopState {
   std::size_t iterations = 0;      ///< planning iterations run
   double now_s = 0.0;              ///< the loop clock
   std::size_t dropped_frames = 0;  ///< frames the camera dropped so far
+  /// Planning iterations since the last view: the planner found no view it could move to.
+  std::size_t iterations_without_view = 0;
 };
 
 class StopCondition {
@@ -29,6 +31,9 @@ class StopCondition {
   static StopCondition budget(double budget_s);
   /// max_views frames have been added.
   static StopCondition views(int max_views);
+  /// The planner went this many iterations in a row without moving to a new view
+  /// ("no_reachable_view").
+  static StopCondition stalled(std::size_t iterations_without_view);
 
   /// The reason of the first condition that holds, or nothing.
   std::optional<std::string> check(const LoopState& state) const;

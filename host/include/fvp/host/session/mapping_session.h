@@ -81,8 +81,11 @@ class MappingSession {
   /// ROI-occupied fine voxels. Needs enableTsdf(); without a map no point is kept.
   sizing::SizingResult sizeFruitlets(const sizing::SizingConfig& config) const;
 
-  /// Hands the map over; the session is done with it.
-  std::unique_ptr<map::MapEngine> releaseMap() && { return std::move(map_); }
+  /// Hands the map over (or the carried one it never needed: no view showed its tag); the
+  /// session is done with it.
+  std::unique_ptr<map::MapEngine> releaseMap() && {
+    return map_ ? std::move(map_) : std::move(carried_map_);
+  }
   /// The map of an earlier session (the previous cluster of a run over a tree) to carry on
   /// with: when this session's region becomes known, the map's fine map moves to it and
   /// its coarse map keeps what was seen (MapEngine::moveToRegion). The map's config is
