@@ -198,7 +198,26 @@ TEST(NbvLoop, NoTagInTheFirstViewStopsWithoutPlanning) {
   EXPECT_EQ(rig.planner.calls, 0);
 }
 
+TEST(NbvLoop, APlannerThatCannotMoveStopsTheLoopOnceStalled) {
+  Rig rig;
+  rig.arm.refuse_every = 1;  // every move refused: no second view
+  const NbvResult r = rig.run(StopCondition::stalled(3) || StopCondition::views(5));
+  EXPECT_EQ(r.stop_reason, "no_reachable_view");
+  EXPECT_EQ(r.views, 1);
+  EXPECT_EQ(r.events.planning_iterations, 3u);
+  EXPECT_EQ(r.events.iterations_without_move, 3u);
+}
+
+TEST(NbvLoop, AMoveStartsTheStallCountAfresh) {
+  Rig rig;
+  rig.arm.refuse_every = 2;  // one iteration without a view between views
+  const NbvResult r = rig.run(StopCondition::stalled(2) || StopCondition::views(4));
+  EXPECT_EQ(r.stop_reason, "max_views");
+  EXPECT_EQ(r.events.iterations_without_move, 2u);
+}
+
 TEST(StopCondition, RefusesNonsenseAndReportsTheFirstThatHolds) {
+  EXPECT_THROW(StopCondition::stalled(0), std::invalid_argument);
   EXPECT_THROW(StopCondition::budget(0.0), std::invalid_argument);
   EXPECT_THROW(StopCondition::budget(INFINITY), std::invalid_argument);
   EXPECT_THROW(StopCondition::views(0), std::invalid_argument);
