@@ -659,6 +659,20 @@ std::string trialSummary(const nlohmann::json& result) {
     << "views " << result.value("views", 0) << ", simulated " << result.value("sim_time_s", 0.0)
     << " s of " << result.value("budget_s", 0.0) << " s, wall " << result.value("wall_time_s", 0.0)
     << " s, stop: " << result.value("stop_reason", "?") << "\n";
+  if (result.contains("clusters")) {
+    s << "\n cluster  tag  status        views  simulated (s)  stop               matched\n";
+    for (const auto& c : result["clusters"]) {
+      std::size_t matched = 0;
+      if (c.contains("fruitlets"))
+        for (const auto& f : c["fruitlets"]) matched += f.value("matched", false);
+      s << std::setw(8) << c.value("index", 0) << std::setw(5) << c.value("tag_id", 0) << "  "
+        << std::left << std::setw(12) << c.value("status", "?") << std::right << std::setw(7)
+        << c.value("views", 0) << std::setw(15) << std::setprecision(1)
+        << c.value("sim_time_s", 0.0) << "  " << std::left << std::setw(19)
+        << c.value("stop_reason", "-") << std::right << matched << " of "
+        << c.value("gt_fruitlets", 0) << "\n";
+    }
+  }
   if (result.contains("fruitlets")) {
     s << "\n fruitlet  true (mm)  estimated (mm)  error (mm)\n";
     int i = 0;
