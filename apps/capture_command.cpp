@@ -225,9 +225,9 @@ void addCaptureCommand(CLI::App& app) {
               << "disparities    " << st.fine_samples << " full-res + " << st.coarse_samples
               << " coarse samples; dropped " << st.droppedDisparities() << ": SGBM invalid "
               << st.sgbm_invalid << ", saturated (too near) " << st.saturated
-              << ", blind left band " << st.blind_band << ", non-finite " << st.nonfinite
-              << ", zero/negative " << st.nonpositive << ", out of range " << st.out_of_range
-              << "\n";
+              << ", blind left band " << st.blind_band << ", dark (no signal) " << st.no_signal
+              << ", non-finite " << st.nonfinite << ", zero/negative " << st.nonpositive
+              << ", out of range " << st.out_of_range << "\n";
     std::cout << std::setprecision(3)
               << "occlusion      visible fraction of each fruitlet's "
                  "silhouette vs a render without leaves:\n";

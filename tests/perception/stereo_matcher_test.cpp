@@ -46,6 +46,44 @@ TEST(StereoMatcher, DefaultsAreTheReferenceConfiguration) {
   EXPECT_THROW(bad.validate(), std::invalid_argument);
 }
 
+// A dark band (black sky: sensor noise only, 2 grey levels) above a textured scene. SGBM
+// alone fills it with disparities from its neighbours; the matcher keeps none of them and
+// counts them, and keeps the lit scene's.
+TEST(StereoMatcher, DarkWindowsGetNoDisparity) {
+  const StereoIntrinsics K = smallCamera();
+  auto pair = test::makeStereoPair(K, K.fx_px * K.baseline_m / 0.5, {}, 2.0, 11);
+  const int dark_rows = 80;
+  cv::RNG rng(3);
+  for (cv::Mat* image : {&pair.left, &pair.right}) {
+    cv::Mat band = (*image)(cv::Rect(0, 0, K.width_px, dark_rows));
+    rng.fill(band, cv::RNG::NORMAL, 2.0, 2.0);  // black plus the noise, clipped at 0
+  }
+  const auto validIn = [&](const cv::Mat& d, int v0, int v1) {
+    int n = 0;
+    for (int v = v0; v < v1; ++v)
+      for (int u = 400; u < K.width_px; ++u) n += d.at<float>(v, u) > 0.0f;
+    return n;
+  };
+  StereoMatcherConfig blind_to_dark;
+  blind_to_dark.sgbm.min_signal = 0;
+  const DisparityResult guessed =
+      StereoMatcher(blind_to_dark).compute(pair.left, pair.right, cv::Rect());
+  const DisparityResult r = StereoMatcher().compute(pair.left, pair.right, cv::Rect());
+  // Rows clear of the band's edge by the coarse window (3 coarse px = 6 full-resolution px).
+  std::cout << "dark band: " << validIn(guessed.disparity_px, 0, dark_rows - 8)
+            << " disparities without the guard, " << validIn(r.disparity_px, 0, dark_rows - 8)
+            << " with it; no_signal " << r.stats.no_signal << "\n";
+  EXPECT_GT(validIn(guessed.disparity_px, 0, dark_rows - 8), 1000);
+  EXPECT_EQ(validIn(r.disparity_px, 0, dark_rows - 8), 0);
+  EXPECT_GT(r.stats.no_signal, 0);
+  // The lit part keeps what it had.
+  EXPECT_EQ(validIn(r.disparity_px, dark_rows + 8, K.height_px),
+            validIn(guessed.disparity_px, dark_rows + 8, K.height_px));
+  SgbmConfig bad;
+  bad.min_signal = 256;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+}
+
 // A textured patch at 0.3 m over a background at 0.5 m: the fine band recovers its depth.
 TEST(StereoMatcher, FineBandDepthErrorAtPointThreeMetres) {
   const StereoIntrinsics K = smallCamera();

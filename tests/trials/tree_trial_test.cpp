@@ -104,8 +104,11 @@ TEST_F(TreeTrial, VisitsEveryClusterOnceAndSkipsOneItCannotReach) {
   EXPECT_EQ(r["views"], views);
   // Every fruitlet of the tree is scored once, the blocked cluster's as missed.
   ASSERT_EQ(r["fruitlets"].size(), world.fruitlets().size());
-  for (const auto& f : r["fruitlets"])
-    if (f["cluster"] == blocked) EXPECT_FALSE(f["matched"].get<bool>());
+  for (const auto& f : r["fruitlets"]) {
+    if (f["cluster"] == blocked) {
+      EXPECT_FALSE(f["matched"].get<bool>());
+    }
+  }
   EXPECT_EQ(r["stop_reason"], "tour_done");
 
   // The coarse map written at the end still holds the first cluster's surroundings: the map

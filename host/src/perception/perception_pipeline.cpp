@@ -117,6 +117,7 @@ PerceptionResult PerceptionPipeline::process(
   st.sgbm_invalid = ds.sgbm_invalid;
   st.saturated = ds.saturated;
   st.blind_band = ds.blind_band;
+  st.no_signal = ds.no_signal;
   st.sgbm_s = ds.sgbm_s;
   st.segmentation_s = timing.segmentation_s;
   st.tag_s = timing.tag_s;

@@ -16,6 +16,7 @@ namespace {
 constexpr float kCodeInvalid = -1.0f;
 constexpr float kCodeSaturated = -2.0f;
 constexpr float kCodeBlind = -3.0f;
+constexpr float kCodeNoSignal = -4.0f;
 
 void fail(const std::string& where, const std::string& field, const std::string& expected) {
   throw std::invalid_argument(where + ": " + field + ": expected " + expected);
@@ -29,6 +30,20 @@ cv::Mat sgbmCodes(const cv::Mat& left, const cv::Mat& right, const SgbmConfig& c
                                      c.speckle_window_size, c.speckle_range, c.mode);
   cv::Mat raw;
   sgbm->compute(left, right, raw);
+  // The brightest value in each pixel's matching window, over the channels.
+  cv::Mat brightest;
+  if (c.min_signal > 0) {
+    cv::Mat channels_max = left;
+    if (left.channels() > 1) {
+      std::vector<cv::Mat> planes;
+      cv::split(left, planes);
+      channels_max = planes[0].clone();
+      for (std::size_t i = 1; i < planes.size(); ++i)
+        cv::max(channels_max, planes[i], channels_max);
+    }
+    cv::dilate(channels_max, brightest,
+               cv::getStructuringElement(cv::MORPH_RECT, cv::Size(c.block_size, c.block_size)));
+  }
   cv::Mat codes(raw.size(), CV_32F);
   const int invalid_below = c.min_disparity * 16;
   const float saturated_from =
@@ -36,10 +51,13 @@ cv::Mat sgbmCodes(const cv::Mat& left, const cv::Mat& right, const SgbmConfig& c
   const int blind_cols = c.min_disparity + c.num_disparities;
   for (int v = 0; v < raw.rows; ++v) {
     const auto* r = raw.ptr<short>(v);
+    const std::uint8_t* lit = brightest.empty() ? nullptr : brightest.ptr<std::uint8_t>(v);
     auto* out = codes.ptr<float>(v);
     for (int u = 0; u < raw.cols; ++u) {
       if (x0 + u < blind_cols && r[u] < invalid_below) {
         out[u] = kCodeBlind;
+      } else if (lit && lit[u] <= c.min_signal) {
+        out[u] = kCodeNoSignal;
       } else if (r[u] < invalid_below) {
         out[u] = kCodeInvalid;
       } else {
@@ -78,6 +96,10 @@ inline float classify(float code, float scale, PerceptionStats& s) {
     ++s.blind_band;
     return 0.0f;
   }
+  if (code == kCodeNoSignal) {
+    ++s.no_signal;
+    return 0.0f;
+  }
   return code * scale;
 }
 
@@ -106,6 +128,7 @@ void SgbmConfig::validate() const {
   if (speckle_range < 0) fail(w, "speckle_range", ">= 0");
   if (saturation_margin_px < 0 || saturation_margin_px >= num_disparities)
     fail(w, "saturation_margin_px", "[0, num_disparities)");
+  if (min_signal < 0 || min_signal > 255) fail(w, "min_signal", "[0, 255]");
   if (mode != cv::StereoSGBM::MODE_SGBM && mode != cv::StereoSGBM::MODE_HH &&
       mode != cv::StereoSGBM::MODE_SGBM_3WAY && mode != cv::StereoSGBM::MODE_HH4)
     fail(w, "mode", "one of cv::StereoSGBM's modes");

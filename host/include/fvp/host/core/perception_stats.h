@@ -10,12 +10,15 @@ namespace fvp::host {
 struct PerceptionStats {
   // Disparity stage (StereoMatcher): one count per disparity sample (full-resolution pixel
   // inside the fine band, coarse pixel elsewhere). The matcher writes 0 for every rejected
-  // sample, so these three are a breakdown of `nonpositive` below, not additional drops.
+  // sample, so these four are a breakdown of `nonpositive` below, not additional drops.
   std::int64_t fine_samples = 0;    ///< samples computed at full resolution
   std::int64_t coarse_samples = 0;  ///< samples of the coarse (reduced resolution) pass
   std::int64_t sgbm_invalid = 0;    ///< SGBM marked invalid (uniqueness, L-R check, speckle)
   std::int64_t saturated = 0;       ///< at the top of the search range: object too near
   std::int64_t blind_band = 0;      ///< in the left band where SGBM cannot match
+  /// The left image's matching window is dark: nothing the flash lit, only sensor noise,
+  /// so any disparity SGBM put there is a guess (it fills black sky from its neighbours).
+  std::int64_t no_signal = 0;
 
   // Projection stage (CloudProjector): one count per sample considered.
   std::int64_t nonfinite = 0;     ///< NaN / inf disparities

@@ -27,6 +27,11 @@ inline constexpr int kDefaultSpeckleRange = 2;
 inline constexpr int kDefaultSgbmMode = cv::StereoSGBM::MODE_SGBM;
 /// Disparities >= num_disparities - margin are saturated (SGBM clamps near objects there).
 inline constexpr int kDefaultSaturationMarginPx = 2;
+/// The brightest value (any channel, 8-bit) a matching window must exceed to be matched:
+/// five sigmas of the sensor's dark noise (2 grey levels) above black. A window darker than
+/// that holds nothing the flash lit, and SGBM fills it from its neighbours' disparities:
+/// over the black sky above a tree that put points in mid-air 0.2-0.4 m from the camera.
+inline constexpr int kDefaultMinSignal = 10;
 inline constexpr int kDefaultCoarseScale = 2;  ///< coarse pass at 1/2 resolution
 inline constexpr int kDefaultStripOverlapPx =
     24;  ///< rows above and below each strip for SGBM's paths to settle
@@ -45,6 +50,7 @@ struct SgbmConfig {
   int speckle_range = kDefaultSpeckleRange;
   int mode = kDefaultSgbmMode;
   int saturation_margin_px = kDefaultSaturationMarginPx;
+  int min_signal = kDefaultMinSignal;  ///< 0..255; 0: match dark windows too
 
   /// The same matcher for images downscaled by `scale`: the disparity range shrinks (rounded
   /// up to a multiple of 16), the speckle window by scale^2.
