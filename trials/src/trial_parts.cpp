@@ -180,6 +180,46 @@ void plotCameraPath(const World& world, const std::vector<Eigen::Vector3d>& path
   host::plotWithGnuplot(s.str(), png, "camera path figure");
 }
 
+/// result.json first (nothing after it, a full disk or a missing gnuplot, can lose it), then
+/// the coarse map and the camera-path figure; a figure that cannot be drawn becomes a
+/// warning in result (written again). Returns whether path.png was drawn.
+bool writeResultMapAndPath(nlohmann::json& result, const World& world,
+                           const host::map::MapEngine* map,
+                           const std::vector<Eigen::Vector3d>& camera_path,
+                           const std::filesystem::path& out_dir,
+                           const std::function<void(const std::string&)>& warn) {
+  std::filesystem::create_directories(out_dir);
+  const auto write_result = [&] {
+    host::writeFileAtomically(out_dir / "result.json", "trial result", result.dump(2) + "\n");
+  };
+  write_result();
+  if (map) map->exportCoarse(out_dir / "coarse.bt");
+  if (camera_path.empty()) return false;
+  try {
+    plotCameraPath(world, camera_path, out_dir / "path.png");
+    return true;
+  } catch (const std::exception& e) {
+    const std::string text = std::string("path.png not drawn: ") + e.what();
+    result["warnings"].push_back(text);
+    if (warn) warn(text);
+    write_result();
+    return false;
+  }
+}
+
+/// The report's wall times, counted events, camera path and warnings.
+void appendReportTail(std::ostringstream& md, const nlohmann::json& result, bool path_drawn) {
+  md << "\n## Where the wall time went\n\n| part | wall s |\n|---|---|\n";
+  for (const auto& [part, s] : result["wall_breakdown_s"].items())
+    md << "| " << part << " | " << fmt(s, 2) << " |\n";
+  md << "\n## Counted events\n\n```json\n" << result["events"].dump(2) << "\n```\n";
+  if (path_drawn) md << "\n## Camera path\n\n![camera path](path.png)\n";
+  if (!result["warnings"].empty()) {
+    md << "\n## Warnings\n\n";
+    for (const auto& w : result["warnings"]) md << "- " << w.get<std::string>() << "\n";
+  }
+}
+
 }  // namespace
 
 const std::vector<std::string>& TrialParts::clusterFiles() {
@@ -212,28 +252,9 @@ void TrialParts::writeOutputs(nlohmann::json& result, const World& world,
                               const std::vector<Eigen::Vector3d>& camera_path,
                               const std::filesystem::path& out_dir,
                               const std::function<void(const std::string&)>& warn) const {
-  std::filesystem::create_directories(out_dir);
-  // The result first: nothing after it (a full disk, a missing gnuplot) can lose it.
-  const auto write_result = [&] {
-    host::writeFileAtomically(out_dir / "result.json", "trial result", result.dump(2) + "\n");
-  };
-  write_result();
-  if (const host::map::MapEngine* map = impl_->session.map())
-    map->exportCoarse(out_dir / "coarse.bt");
+  const bool path_drawn =
+      writeResultMapAndPath(result, world, impl_->session.map(), camera_path, out_dir, warn);
   writeClusterFiles(out_dir);
-  bool path_drawn = false;
-  if (!camera_path.empty()) {
-    try {
-      plotCameraPath(world, camera_path, out_dir / "path.png");
-      path_drawn = true;
-    } catch (const std::exception& e) {
-      const std::string text = std::string("path.png not drawn: ") + e.what();
-      result["warnings"].push_back(text);
-      if (warn) warn(text);
-      write_result();
-    }
-  }
-
   std::ostringstream md;
   md << "# Trial: " << result["planner"].get<std::string>() << ", world seed " << result["seed"]
      << "\n\n"
@@ -265,15 +286,7 @@ void TrialParts::writeOutputs(nlohmann::json& result, const World& world,
     for (const auto& [key, value] : it.items())
       if (value.is_number()) charged[key] += value.get<double>();
   for (const auto& [stage, s] : charged) md << "| " << stage << " | " << fmt(s, 2) << " |\n";
-  md << "\n## Where the wall time went\n\n| part | wall s |\n|---|---|\n";
-  for (const auto& [part, s] : result["wall_breakdown_s"].items())
-    md << "| " << part << " | " << fmt(s, 2) << " |\n";
-  md << "\n## Counted events\n\n```json\n" << result["events"].dump(2) << "\n```\n";
-  if (path_drawn) md << "\n## Camera path\n\n![camera path](path.png)\n";
-  if (!result["warnings"].empty()) {
-    md << "\n## Warnings\n\n";
-    for (const auto& w : result["warnings"]) md << "- " << w.get<std::string>() << "\n";
-  }
+  appendReportTail(md, result, path_drawn);
   md << "\n## Captured views\n\n";
   for (std::size_t v = 0; v < camera_path.size(); ++v) {
     std::ostringstream name;
@@ -288,24 +301,7 @@ void writeTreeOutputs(nlohmann::json& result, const World& world, const host::ma
                       const std::vector<Eigen::Vector3d>& camera_path,
                       const std::filesystem::path& out_dir,
                       const std::function<void(const std::string&)>& warn) {
-  std::filesystem::create_directories(out_dir);
-  const auto write_result = [&] {
-    host::writeFileAtomically(out_dir / "result.json", "trial result", result.dump(2) + "\n");
-  };
-  write_result();
-  if (map) map->exportCoarse(out_dir / "coarse.bt");
-  bool path_drawn = false;
-  if (!camera_path.empty()) {
-    try {
-      plotCameraPath(world, camera_path, out_dir / "path.png");
-      path_drawn = true;
-    } catch (const std::exception& e) {
-      const std::string text = std::string("path.png not drawn: ") + e.what();
-      result["warnings"].push_back(text);
-      if (warn) warn(text);
-      write_result();
-    }
-  }
+  const bool path_drawn = writeResultMapAndPath(result, world, map, camera_path, out_dir, warn);
   const nlohmann::json& m = result["metrics"];
   const double minutes = result.value("sim_time_s", 0.0) / 60.0;
   std::size_t matched = 0;
@@ -348,15 +344,7 @@ void writeTreeOutputs(nlohmann::json& result, const World& world, const host::ma
        << (hit ? fmt(f["est_size_mm"].get<double>() - f["gt_size_mm"].get<double>(), 2) : "-")
        << " |\n";
   }
-  md << "\n## Where the wall time went\n\n| part | wall s |\n|---|---|\n";
-  for (const auto& [part, sec] : result["wall_breakdown_s"].items())
-    md << "| " << part << " | " << fmt(sec, 2) << " |\n";
-  md << "\n## Counted events (all clusters)\n\n```json\n" << result["events"].dump(2) << "\n```\n";
-  if (path_drawn) md << "\n## Camera path\n\n![camera path](path.png)\n";
-  if (!result["warnings"].empty()) {
-    md << "\n## Warnings\n\n";
-    for (const auto& w : result["warnings"]) md << "- " << w.get<std::string>() << "\n";
-  }
+  appendReportTail(md, result, path_drawn);
   host::writeFileAtomically(out_dir / "report.md", "trial report", md.str());
 }
 
