@@ -20,6 +20,30 @@ double grownEllipsoidValue(const Fruitlet& f, const Eigen::Vector3d& p, double g
   return q.cwiseQuotient(f.semiAxes_m() + Eigen::Vector3d::Constant(gap)).squaredNorm();
 }
 
+// Points on a (curled) leaf: a grid of `step` in the unit disc, mapped onto the ellipse.
+std::vector<Eigen::Vector3d> leafSamples(const Leaf& leaf, double step) {
+  std::vector<Eigen::Vector3d> points;
+  for (double sx = -1.0; sx <= 1.0; sx += step) {
+    for (double sy = -1.0; sy <= 1.0; sy += step) {
+      if (sx * sx + sy * sy > 1.0) continue;
+      const double x = sx * leaf.half_length_m;
+      points.push_back(leaf.T_world_leaf *
+                       Eigen::Vector3d(x, sy * leaf.half_width_m, leaf.curl_per_m * x * x));
+    }
+  }
+  return points;
+}
+
+// Points on a tag's plate: a grid of `step` plate widths.
+std::vector<Eigen::Vector3d> plateSamples(const AprilTagPlacement& tag, double step) {
+  std::vector<Eigen::Vector3d> points;
+  for (double sx = -0.5; sx <= 0.5; sx += step)
+    for (double sy = -0.5; sy <= 0.5; sy += step)
+      points.push_back(tag.T_world_tag *
+                       Eigen::Vector3d(sx * tag.plate_size_m, sy * tag.plate_size_m, 0.0));
+  return points;
+}
+
 TEST(World, FruitletCountsSizesAndSpreadInRange) {
   const WorldConfig config;
   for (std::uint64_t seed = 0; seed < kSeeds; ++seed) {
@@ -58,28 +82,18 @@ TEST(World, FruitletsLeavesAndTagDoNotIntersect) {
     }
     // Dense samples of every leaf and of the tag plate stay outside every fruitlet.
     for (const Leaf& leaf : world.leaves()) {
-      for (double sx = -1.0; sx <= 1.0; sx += 0.05) {
-        for (double sy = -1.0; sy <= 1.0; sy += 0.05) {
-          if (sx * sx + sy * sy > 1.0) continue;
-          const double x = sx * leaf.half_length_m;
-          const Eigen::Vector3d p = leaf.T_world_leaf * Eigen::Vector3d(x, sy * leaf.half_width_m,
-                                                                        leaf.curl_per_m * x * x);
-          for (const Fruitlet& f : fruitlets) {
-            ASSERT_GT(grownEllipsoidValue(f, p, config.min_gap_m), 1.0)
-                << "seed " << seed << " leaf " << leaf.index << " fruitlet " << f.index;
-          }
+      for (const Eigen::Vector3d& p : leafSamples(leaf, 0.05)) {
+        for (const Fruitlet& f : fruitlets) {
+          ASSERT_GT(grownEllipsoidValue(f, p, config.min_gap_m), 1.0)
+              << "seed " << seed << " leaf " << leaf.index << " fruitlet " << f.index;
         }
       }
     }
     const AprilTagPlacement& tag = world.tag();
     ASSERT_TRUE(world.hasTag());
-    for (double sx = -0.5; sx <= 0.5; sx += 0.025) {
-      for (double sy = -0.5; sy <= 0.5; sy += 0.025) {
-        const Eigen::Vector3d p =
-            tag.T_world_tag * Eigen::Vector3d(sx * tag.plate_size_m, sy * tag.plate_size_m, 0.0);
-        for (const Fruitlet& f : fruitlets) {
-          ASSERT_GT(grownEllipsoidValue(f, p, config.min_gap_m), 1.0) << "seed " << seed;
-        }
+    for (const Eigen::Vector3d& p : plateSamples(tag, 0.025)) {
+      for (const Fruitlet& f : fruitlets) {
+        ASSERT_GT(grownEllipsoidValue(f, p, config.min_gap_m), 1.0) << "seed " << seed;
       }
     }
     const double tag_distance = (tag.T_world_tag.translation() - world.clusterCenter_m()).norm();
@@ -167,24 +181,13 @@ TEST(World, ClustersOfATreeAreApartEachWithItsOwnTagAndStartView) {
     // No leaf, plate or fruiting branch touches any fruitlet.
     for (const Fruitlet& f : world.fruitlets()) {
       for (const Leaf& leaf : world.leaves()) {
-        for (double sx = -1.0; sx <= 1.0; sx += 0.1) {
-          for (double sy = -1.0; sy <= 1.0; sy += 0.1) {
-            if (sx * sx + sy * sy > 1.0) continue;
-            const double x = sx * leaf.half_length_m;
-            const Eigen::Vector3d p = leaf.T_world_leaf * Eigen::Vector3d(x, sy * leaf.half_width_m,
-                                                                          leaf.curl_per_m * x * x);
-            ASSERT_GT(grownEllipsoidValue(f, p, config.min_gap_m), 1.0) << "seed " << seed;
-          }
+        for (const Eigen::Vector3d& p : leafSamples(leaf, 0.1)) {
+          ASSERT_GT(grownEllipsoidValue(f, p, config.min_gap_m), 1.0) << "seed " << seed;
         }
       }
       for (const FruitletCluster& c : world.clusters()) {
-        for (double sx = -0.5; sx <= 0.5; sx += 0.05) {
-          for (double sy = -0.5; sy <= 0.5; sy += 0.05) {
-            const Eigen::Vector3d p =
-                c.tag.T_world_tag *
-                Eigen::Vector3d(sx * c.tag.plate_size_m, sy * c.tag.plate_size_m, 0.0);
-            ASSERT_GT(grownEllipsoidValue(f, p, config.min_gap_m), 1.0) << "seed " << seed;
-          }
+        for (const Eigen::Vector3d& p : plateSamples(c.tag, 0.05)) {
+          ASSERT_GT(grownEllipsoidValue(f, p, config.min_gap_m), 1.0) << "seed " << seed;
         }
       }
     }

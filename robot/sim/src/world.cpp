@@ -235,6 +235,10 @@ World World::generate(const WorldConfig& config, std::uint64_t seed) {
       const Eigen::Vector3d anchor =
           branch_point -
           (config.branch_radius_m + 0.5 * config.cluster_spread_m + max_bound_m) * up;
+      const auto clearOfBranch = [&](const Fruitlet& f) {
+        return pointSegmentDistance(f.center_m, branch_start, branch_end) >=
+               config.branch_radius_m + f.boundingRadius_m() + config.min_gap_m;
+      };
       if (several) {
         // Apart from every earlier cluster; the new branch clear of their fruitlets and tags,
         // their branches clear of the new cluster.
@@ -244,10 +248,7 @@ World World::generate(const WorldConfig& config, std::uint64_t seed) {
                   pointSegmentDistance(c.tag.T_world_tag.translation(), branch_start, branch_end) >=
                       config.branch_radius_m + std::sqrt(2.0) * plate_half_m + config.min_gap_m;
         }
-        for (const Fruitlet& f : world.fruitlets_) {
-          apart = apart && pointSegmentDistance(f.center_m, branch_start, branch_end) >=
-                               config.branch_radius_m + f.boundingRadius_m() + config.min_gap_m;
-        }
+        for (const Fruitlet& f : world.fruitlets_) apart = apart && clearOfBranch(f);
         for (const BranchSegment& b : fruiting) {
           apart =
               apart && pointSegmentDistance(anchor, b.start_m, b.end_m) >=
@@ -255,10 +256,6 @@ World World::generate(const WorldConfig& config, std::uint64_t seed) {
         }
         if (!apart) continue;
       }
-      const auto clearOfBranch = [&](const Fruitlet& f) {
-        return pointSegmentDistance(f.center_m, branch_start, branch_end) >=
-               config.branch_radius_m + f.boundingRadius_m() + config.min_gap_m;
-      };
       const int first_index = static_cast<int>(world.fruitlets_.size());
       const int count = rng.uniformInt(config.min_fruitlets, config.max_fruitlets);
       std::array<int, kPaletteSrgb.size()> palette_order = {0, 1, 2, 3, 4, 5};
