@@ -151,10 +151,9 @@ nlohmann::json sizeHistoryJson(const std::vector<host::nbv::SizingSnapshot>& his
                                double t0_s) {
   std::vector<Eigen::Vector3d> truth_m;
   std::vector<double> truth_mm;
-  for (const int i : fruitlet_indices) {
-    const Fruitlet& f = world.fruitlets().at(static_cast<std::size_t>(i));
-    truth_m.push_back(f.center_m);
-    truth_mm.push_back(f.gtSizeMm());
+  for (const auto& g : groundTruthOf(world, fruitlet_indices)) {
+    truth_m.push_back(g.center_m);
+    truth_mm.push_back(g.size_mm);
   }
   nlohmann::json out = nlohmann::json::array();
   for (const auto& snapshot : history) {
@@ -250,7 +249,6 @@ struct ClusterOutcome {
   nlohmann::json sizing;        ///< sizeAndScore's object
   nlohmann::json size_history;  ///< null unless sizes were kept after every view
   double sizing_wall_s = 0.0, sizing_during_loop_s = 0.0;
-  std::optional<host::nbv::ClusterCompletionConfig> stop_config;  ///< with --stop auto
 };
 
 struct Trial::Impl {
@@ -324,9 +322,12 @@ struct Trial::Impl {
   /// The fields every result has: options, config, clock, logs, warnings.
   void describeRun(nlohmann::json& result, const TrialLog& log,
                    const std::vector<Eigen::Vector3d>& camera_path) const;
-  nlohmann::json stopJson(const ClusterOutcome& outcome) const;
+  /// result.json's "stop": the rule and, with --stop auto, its parameters.
+  nlohmann::json stopJson() const;
 
   TrialOptions options;
+  /// The automatic stop's parameters, for every cluster (and the record of them).
+  host::nbv::ClusterCompletionConfig completion_config;
   Clock::time_point wall_start = Clock::now();
   std::vector<std::string> warnings;
   std::string engine;
@@ -348,24 +349,21 @@ ClusterOutcome Trial::Impl::runCluster(TrialParts& cluster_parts, const Fruitlet
                                        host::nbv::Camera& loop_camera, host::nbv::Arm& loop_arm,
                                        host::nbv::LoopClock& loop_clock, TrialLog& log) {
   const double t0_s = loop_clock.now_s();
-  host::nbv::StopCondition stop =
-      t0_s == 0.0 ? host::nbv::StopCondition::budget(options.budget_s)
-                  : host::nbv::StopCondition(
-                        [deadline_s = t0_s + options.budget_s](const host::nbv::LoopState& s) {
-                          return s.now_s >= deadline_s;
-                        },
-                        "budget");
+  // The budget is a time on the run's clock: this cluster's cap from its arrival.
+  host::nbv::StopCondition stop = host::nbv::StopCondition::budget(t0_s + options.budget_s);
   if (options.max_views) stop = stop || host::nbv::StopCondition::views(*options.max_views);
   host::nbv::LoopObservers observers;
   observers.add(&log);
   UnchargedClock observing_clock(loop_clock);  // before completion: it outlives it
   std::optional<host::nbv::ClusterCompletion> completion;
   if (options.stop == "auto") {
-    completion.emplace(cluster_parts.session(), loop_clock, cluster_parts.sizingConfig());
+    completion.emplace(cluster_parts.session(), loop_clock, cluster_parts.sizingConfig(),
+                       completion_config);
     observers.add(&*completion);
     stop = stop || completion->stopCondition();
   } else if (options.record_size_history) {
-    completion.emplace(cluster_parts.session(), observing_clock, cluster_parts.sizingConfig());
+    completion.emplace(cluster_parts.session(), observing_clock, cluster_parts.sizingConfig(),
+                       completion_config);
     observers.add(&*completion);
   }
   host::nbv::NbvLoop loop(cluster_parts.session(), cluster_parts.planner(), loop_camera, loop_arm,
@@ -381,14 +379,13 @@ ClusterOutcome Trial::Impl::runCluster(TrialParts& cluster_parts, const Fruitlet
       out.sizing_during_loop_s += snapshot.sizing_s;
     out.size_history =
         sizeHistoryJson(completion->history(), *world, cluster.fruitlet_indices, t0_s);
-    if (options.stop == "auto") out.stop_config = completion->config();
   }
   return out;
 }
 
-nlohmann::json Trial::Impl::stopJson(const ClusterOutcome& outcome) const {
-  if (!outcome.stop_config) return {{"rule", "budget"}};
-  const host::nbv::ClusterCompletionConfig& c = *outcome.stop_config;
+nlohmann::json Trial::Impl::stopJson() const {
+  if (options.stop != "auto") return {{"rule", "budget"}};
+  const host::nbv::ClusterCompletionConfig& c = completion_config;
   return {{"rule", "auto"},
           {"stable_views", c.stable_views},
           {"size_tolerance_mm", c.size_tolerance_mm},
@@ -447,7 +444,7 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
                                 {"sizing", outcome.sizing_wall_s},
                                 {"sizing_during_loop", outcome.sizing_during_loop_s}};
   if (!outcome.size_history.is_null()) result["size_history"] = outcome.size_history;
-  result["stop"] = stopJson(outcome);
+  result["stop"] = stopJson();
   describeRun(result, log, camera_path);
   if (!options.out_dir.empty())
     parts->writeOutputs(result, *world, camera_path, options.out_dir, options.on_warning);
@@ -474,7 +471,7 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
   std::uint64_t detections = 0;
   int views = 0;
   double transit_s = 0.0;
-  nlohmann::json stop_json, planner_config, trial_config;
+  nlohmann::json planner_config, trial_config;
   for (std::size_t step = 0; step < clusters.size(); ++step) {
     // The nearest unvisited start view from where the camera is now.
     const Eigen::Vector3d here = loop_arm.cameraPose().translation();
@@ -557,7 +554,6 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
                       {"sizing_during_loop", outcome.sizing_during_loop_s}});
     if (!outcome.size_history.is_null()) entry["size_history"] = outcome.size_history;
     for (const auto& T : outcome.run.camera_poses) camera_path.push_back(T.translation());
-    stop_json = stopJson(outcome);
     planner_config = nlohmann::json::parse(cluster_parts->planner().configJson());
     trial_config = cluster_parts->configJson();
     if (!options.out_dir.empty())
@@ -585,14 +581,11 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
   // (a skipped cluster's fruitlets are in them, not matched).
   for (const auto& c : cluster_entries) {
     if (c.contains("fruitlets")) continue;
-    for (const int i : clusters[c.at("index").get<std::size_t>()].fruitlet_indices) {
-      const Fruitlet& f = world->fruitlets()[static_cast<std::size_t>(i)];
-      const nlohmann::json missed = {{"gt_center_m", vec3(f.center_m)},
-                                     {"gt_size_mm", f.gtSizeMm()},
-                                     {"matched", false},
-                                     {"est_center_m", nullptr},
-                                     {"est_size_mm", nullptr},
-                                     {"cluster", c.at("index")}};
+    const auto& indices = clusters[c.at("index").get<std::size_t>()].fruitlet_indices;
+    for (const auto& g : groundTruthOf(*world, indices)) {
+      const nlohmann::json missed = {
+          {"gt_center_m", vec3(g.center_m)}, {"gt_size_mm", g.size_mm}, {"matched", false},
+          {"est_center_m", nullptr},         {"est_size_mm", nullptr},  {"cluster", c.at("index")}};
       scored["fruitlets"].push_back(missed);
       for (const char* other : {"fruitlets_paper_sizing", "fruitlets_ours_sizing"})
         if (scored.contains(other)) scored[other].push_back(missed);
@@ -615,7 +608,7 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
   result["events"] = events.empty() ? eventsJson({}) : events;
   wall["rendering"] = camera->totalRenderSeconds();
   result["wall_breakdown_s"] = wall;
-  result["stop"] = stop_json.is_null() ? nlohmann::json{{"rule", options.stop}} : stop_json;
+  result["stop"] = stopJson();
   describeRun(result, log, camera_path);
   if (!options.out_dir.empty())
     writeTreeOutputs(result, *world, carried_map.get(), camera_path, options.out_dir,

@@ -117,6 +117,16 @@ nlohmann::json TrialParts::configJson() const {
             {"min_support_area_fraction", impl_->sizing_config.min_support_area_fraction}}}};
 }
 
+std::vector<host::eval::GroundTruthFruitlet> groundTruthOf(const World& world,
+                                                           const std::vector<int>& indices) {
+  std::vector<host::eval::GroundTruthFruitlet> truth;
+  for (const int i : indices) {
+    const Fruitlet& f = world.fruitlets().at(static_cast<std::size_t>(i));
+    truth.push_back({f.center_m, f.gtSizeMm()});
+  }
+  return truth;
+}
+
 void keepViewImage(const std::filesystem::path& out_dir, int index,
                    const host::StereoFrame& frame) {
   if (frame.left_bgr.empty()) return;
@@ -355,11 +365,7 @@ namespace fvp::trials {
 nlohmann::json TrialParts::sizeAndScore(const World& world,
                                         const std::vector<int>& fruitlet_indices) {
   impl_->sizing = impl_->session.sizeFruitlets(impl_->sizing_config);
-  std::vector<host::eval::GroundTruthFruitlet> truth;
-  for (const int i : fruitlet_indices) {
-    const Fruitlet& f = world.fruitlets().at(static_cast<std::size_t>(i));
-    truth.push_back({f.center_m, f.gtSizeMm()});
-  }
+  const std::vector<host::eval::GroundTruthFruitlet> truth = groundTruthOf(world, fruitlet_indices);
   nlohmann::json out =
       host::eval::scoreBothEstimators(impl_->sizing, truth, impl_->sizing_config.estimator);
   // The details object must outlive the loop (items() of a temporary would dangle).

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "fvp/host/eval/ground_truth.h"
 #include "fvp/host/map/map_config.h"
 #include "fvp/host/perception/stereo_frame.h"
 #include "fvp/host/planner/view_planner.h"
@@ -49,6 +50,10 @@ void writeTreeOutputs(nlohmann::json& result, const robot::sim::World& world,
 
 /// Writes a small PNG of the view's left image for the report: out_dir/views/NNN.png.
 void keepViewImage(const std::filesystem::path& out_dir, int index, const host::StereoFrame& frame);
+
+/// The ground truth of the world's fruitlets with these indices (a cluster's).
+std::vector<host::eval::GroundTruthFruitlet> groundTruthOf(const robot::sim::World& world,
+                                                           const std::vector<int>& indices);
 
 /// What one view did, with the wall times the clock charges.
 struct ViewOutcome {
