@@ -24,7 +24,7 @@ void addExperimentCommands(CLI::App& app) {
   auto* cmd =
       app.add_subcommand("experiment",
                          "Run every planner on the same simulated worlds; write trials.jsonl, "
-                         "summary.json, table1.md and sizes.png to --out");
+                         "summary.json, table1.md, sizes.png and index.html to --out");
   cmd->add_option("--planners", opt->planners, "comma-separated planners (fvp, rvp)")
       ->capture_default_str();
   cmd->add_option("--trials", opt->experiment.trials, "worlds (seeds) per planner")
@@ -92,7 +92,10 @@ void addExperimentCommands(CLI::App& app) {
     trials::runExperiment(o, trials::runTrial, progress, warning);
     if (tty) std::cerr << "\n";
     std::cout << "wrote " << opt->out << "/{manifest.json, trials.jsonl, summary.json, table1.md"
-              << (std::filesystem::exists(o.out_dir / "sizes.png") ? ", sizes.png" : "") << "}\n";
+              << (std::filesystem::exists(o.out_dir / "sizes.png") ? ", sizes.png" : "")
+              << ", index.html}\n"
+              << "open " << (o.out_dir / "index.html").string()
+              << " for Table 1, the figures and every trial's 3-D viewer\n";
   });
 
   auto merge_out = std::make_shared<std::string>();
@@ -105,7 +108,8 @@ void addExperimentCommands(CLI::App& app) {
     trials::mergeExperiments(dirs, *merge_out, [](const std::string& line) {
       std::cerr << "fvp: warning: " << line << "\n";
     });
-    std::cout << "merged " << dirs.size() << " shards into " << *merge_out << "\n";
+    std::cout << "merged " << dirs.size() << " shards into " << *merge_out << " (index.html: "
+              << "Table 1, the figures and every trial's viewer)\n";
   });
 }
 

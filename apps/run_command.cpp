@@ -22,8 +22,8 @@ void addRunCommand(CLI::App& app) {
   };
   auto opt = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("run",
-                                 "Run one simulated trial; write result.json and report.md "
-                                 "to --out");
+                                 "Run one simulated trial; write result.json, report.md and "
+                                 "viewer.html (the trial in 3-D) to --out");
   cmd->add_option("--planner", opt->trial.planner, "viewpoint planner: fvp | rvp")
       ->check(CLI::IsMember(host::planner::PlannerRegistry::instance().names()))
       ->capture_default_str();
@@ -77,7 +77,9 @@ void addRunCommand(CLI::App& app) {
     const nlohmann::json result = trials::runTrial(trial);
     if (tty) std::cerr << "\n";
     std::cout << trials::trialSummary(result)
-              << "report: " << (std::filesystem::path(opt->out) / "report.md").string() << "\n";
+              << "report: " << (std::filesystem::path(opt->out) / "report.md").string() << "\n"
+              << "3-D viewer: " << (std::filesystem::path(opt->out) / "viewer.html").string()
+              << " (open it in a browser)\n";
   });
 }
 

@@ -69,7 +69,8 @@ void addSizeCommand(CLI::App& app) {
                                                   : "-")
                 << " %\n";
     }
-    std::cout << "wrote " << opt->out << "/{fruitlets.json, surface.ply, mesh.ply, clusters.ply}\n";
+    std::cout << "wrote " << opt->out
+              << "/{fruitlets.json, surface.ply, mesh.ply, clusters.ply, viewer.html, overlays/}\n";
   });
 }
 

@@ -2,6 +2,29 @@
 # disk at run time and a broken shader fails the build.
 
 set(FVP_EMBED_SCRIPT ${CMAKE_CURRENT_LIST_DIR}/EmbedOpenClSource.cmake)
+set(FVP_EMBED_TEXT_SCRIPT ${CMAKE_CURRENT_LIST_DIR}/EmbedTextFile.cmake)
+
+# fvp_embed_text(<out_var> NAME <name> FILE <path> [NAME ... FILE ...]): each file becomes a
+# C++ source defining  extern const std::string_view kText_<name>;
+function(fvp_embed_text out_var)
+  set(generated)
+  set(args ${ARGN})
+  while(args)
+    list(POP_FRONT args name_kw name file_kw file)
+    if(NOT name_kw STREQUAL "NAME" OR NOT file_kw STREQUAL "FILE")
+      message(FATAL_ERROR "fvp_embed_text: expected NAME <name> FILE <path> pairs")
+    endif()
+    set(out ${CMAKE_CURRENT_BINARY_DIR}/embedded/text_${name}.cpp)
+    add_custom_command(
+      OUTPUT ${out}
+      COMMAND ${CMAKE_COMMAND} -DINPUT=${file} -DOUTPUT=${out} -DNAME=${name}
+              -P ${FVP_EMBED_TEXT_SCRIPT}
+      DEPENDS ${file} ${FVP_EMBED_TEXT_SCRIPT}
+      COMMENT "Embedding ${name}")
+    list(APPEND generated ${out})
+  endwhile()
+  set(${out_var} ${generated} PARENT_SCOPE)
+endfunction()
 
 # fvp_embed_opencl(<out_var> <kernel.cl>...): each kernel becomes a C++ source defining
 #   extern const char kOpenClSource_<name>[];

@@ -198,6 +198,49 @@ TEST(Experiment, ShardsMergedEqualOneRun) {
   EXPECT_THROW(mergeExperiments({a, a}, freshDir("dup")), std::runtime_error);
 }
 
+// index.html: Table 1's rows, and each trial's viewer and report linked where they are, in
+// a run and, through the shards' directories, in a merge; "-" where a trial has none.
+TEST(Experiment, TheIndexLinksEveryTrialsViewerWhereItIs) {
+  const auto trial_with_files = [](const TrialOptions& o) {
+    if (o.planner == "fvp") {
+      fs::create_directories(o.out_dir);
+      writeText(o.out_dir / "viewer.html", "<html></html>");
+      writeText(o.out_dir / "report.md", "# report");
+    }
+    return fakeTrial(o);
+  };
+  const fs::path a = freshDir("index0"), b = freshDir("index1"), merged = freshDir("index_merged");
+  ExperimentOptions s0 = options(a, 3), s1 = options(b, 3);
+  s0.shard_count = s1.shard_count = 2;
+  s1.shard_index = 1;
+  runExperiment(s0, trial_with_files, nullptr);
+  runExperiment(s1, trial_with_files, nullptr);
+  mergeExperiments({a, b}, merged);
+  for (const fs::path& dir : {a, merged}) {
+    const std::string html = slurp(dir / "index.html");
+    EXPECT_NE(html.find("<td>FVP (ours)</td>"), std::string::npos) << dir;
+    std::size_t links = 0;
+    for (std::size_t at = 0; (at = html.find("href=\"", at)) != std::string::npos; ++links) {
+      at += 6;
+      const std::string target = html.substr(at, html.find('"', at) - at);
+      EXPECT_TRUE(fs::exists(dir / target)) << dir << ": " << target;
+    }
+    // fvp's trials have a viewer and a report each, rvp's none.
+    std::size_t fvp_trials = 0;
+    for (const auto& t : readTrials(dir / "trials.jsonl", nullptr))
+      fvp_trials += t.at("planner") == "fvp";
+    ASSERT_GT(fvp_trials, 0u);
+    EXPECT_EQ(links, 2 * fvp_trials) << dir;
+    if (dir == merged) {  // rvp's rows (shard 1's) say it has no viewer and no report
+      const std::size_t row = html.find("<tr><td>rvp</td>");
+      ASSERT_NE(row, std::string::npos);
+      EXPECT_EQ(html.substr(row, html.find("</tr>", row) - row).find("<td>-</td><td>-</td>") ==
+                    std::string::npos,
+                false);
+    }
+  }
+}
+
 // The "FVP on the octomap engine" ablation runs on its own and merges with the main run
 // into its own row: same planner and seeds, a different engine, not a conflict.
 TEST(Experiment, AnEngineAblationMergesWithTheMainRunAsItsOwnRow) {

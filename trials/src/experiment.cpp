@@ -16,6 +16,7 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "experiment_index.h"
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/host/core/gnuplot.h"
 #include "fvp/host/core/output_directory.h"
@@ -381,7 +382,7 @@ nlohmann::json summarize(const std::vector<nlohmann::json>& trials) {
 }
 
 bool writeReports(const fs::path& dir, const std::vector<nlohmann::json>& unsorted,
-                  const MessageSink& warning) {
+                  const MessageSink& warning, const TrialDirFn& trial_dir) {
   // A canonical order: sums (and so every figure) do not depend on how trials were run.
   std::vector<nlohmann::json> trials = unsorted;
   std::sort(trials.begin(), trials.end(), bySeedThenRow);
@@ -419,6 +420,13 @@ bool writeReports(const fs::path& dir, const std::vector<nlohmann::json>& unsort
   // The tables first: the figure is an extra that must not cost them.
   host::writeFileAtomically(dir / "table1.md", "Table 1",
                             table + "\nSize distributions: sizes.png.\n");
+  // The index links the figures that exist when it is written: written again after them.
+  const TrialDirFn dir_of_trial =
+      trial_dir ? TrialDirFn(trial_dir) : TrialDirFn([&dir](const nlohmann::json& t) {
+        return dir / "trials" /
+               trialKey(t.at("planner").get<std::string>(), t.at("seed").get<std::uint64_t>());
+      });
+  const auto write_index = [&] { writeIndexPage(dir, table, trials, dir_of_trial); };
 
   // Accuracy against time, when trials kept their sizings (--size-history or --stop auto):
   // an extra like sizes.png, its data in accuracy_vs_time.json.
@@ -451,6 +459,7 @@ bool writeReports(const fs::path& dir, const std::vector<nlohmann::json>& unsort
     try {
       host::plotWithGnuplot(sizesFigureScript(trials), dir / "sizes.png",
                             "size distribution figure");
+      write_index();
       return true;
     } catch (const std::exception& e) {
       why_not = oneLine(e.what());
@@ -461,6 +470,7 @@ bool writeReports(const fs::path& dir, const std::vector<nlohmann::json>& unsort
   fs::remove(dir / "sizes.png", ignored);  // an older figure would not match these tables
   host::writeFileAtomically(dir / "table1.md", "Table 1",
                             table + "\nsizes.png: not drawn: " + why_not + "\n");
+  write_index();
   return false;
 }
 
@@ -642,7 +652,11 @@ void mergeExperiments(const std::vector<fs::path>& shard_dirs, const fs::path& o
   std::ostringstream whole;
   for (const auto& t : all) whole << t.dump() << "\n";
   host::writeFileAtomically(out_dir / "trials.jsonl", "merged trials", whole.str());
-  writeReports(out_dir, all, warning);
+  writeReports(out_dir, all, warning, [&dir_of](const nlohmann::json& t) {
+    const std::uint64_t seed = t.at("seed").get<std::uint64_t>();
+    return dir_of.at(trialKey(trialRowKey(t), seed)) / "trials" /
+           trialKey(t.at("planner").get<std::string>(), seed);
+  });
 }
 
 }  // namespace fvp::trials

@@ -26,6 +26,7 @@
 #include "fvp/host/planner/planner_registry.h"
 #include "fvp/host/planner/view_planner.h"
 #include "fvp/host/session/mapping_session.h"
+#include "fvp/host/session/session_report.h"
 #include "fvp/robot/arm_model.h"
 #include "fvp/robot/sim/arm_controller.h"
 #include "fvp/robot/sim/simulated_arm.h"
@@ -35,6 +36,7 @@
 #include "fvp/robot/sim/world.h"
 #include "fvp/robot/workspace_tree.h"
 #include "trial_parts.h"
+#include "trial_viewer.h"
 
 namespace fvp::trials {
 // The simulator's parts and the arm, by their short names.
@@ -49,6 +51,12 @@ double secondsSince(Clock::time_point start) {
 
 nlohmann::json vec3(const Eigen::Vector3d& v) {
   return {v.x(), v.y(), v.z()};
+}
+
+/// R_world_camera as [w, x, y, z]; the camera looks along its z axis (OpenCV frame).
+nlohmann::json quaternionWxyz(const Eigen::Isometry3d& T) {
+  const Eigen::Quaterniond q(T.rotation());
+  return {q.w(), q.x(), q.y(), q.z()};
 }
 
 void validate(const TrialOptions& o) {
@@ -90,6 +98,8 @@ class TrialLog : public host::nbv::LoopObserver {
     const int index = first_view_ + e.index;  // over the whole run
     views_.push_back({{"index", index},
                       {"position_m", vec3(e.T_world_camera.translation())},
+                      {"quaternion_wxyz", quaternionWxyz(e.T_world_camera)},
+                      {"viewing_direction", vec3(e.T_world_camera.linear().col(2))},
                       {"tag_detected", v.tag_detected},
                       {"roi_points", v.roi_points},
                       {"other_points", v.other_points},
@@ -99,7 +109,11 @@ class TrialLog : public host::nbv::LoopObserver {
                       {"tsdf_s", v.tsdf_s},
                       {"sim_time_s", e.now_s}});
     if (cluster_ >= 0) views_.back()["cluster"] = cluster_;
-    if (!options_.out_dir.empty()) keepViewImage(options_.out_dir, index, *e.frame);
+    if (!options_.out_dir.empty()) {
+      keepViewImage(options_.out_dir, index, *e.frame);
+      images_.add(index, e.frame->left_bgr);
+      if (!intrinsics_) intrinsics_ = e.frame->intrinsics;
+    }
     if (options_.on_progress)
       options_.on_progress({index + 1, e.now_s, options_.budget_s, secondsSince(wall_start_)});
   }
@@ -116,6 +130,11 @@ class TrialLog : public host::nbv::LoopObserver {
          {"sampling_rounds", step.sampling_rounds},
          {"chosen_utility",
           step.chosen ? nlohmann::json(step.candidates[*step.chosen].utility) : nlohmann::json()},
+         {"chosen_position_m",
+          step.chosen ? vec3(step.candidates[*step.chosen].position_m()) : nlohmann::json()},
+         {"chosen_quaternion_wxyz",
+          step.chosen ? quaternionWxyz(step.candidates[*step.chosen].T_world_camera)
+                      : nlohmann::json()},
          {"planning_s", e.planning_s},
          {"timings_s", timings}});
     if (cluster_ >= 0) plans_.back()["cluster"] = cluster_;
@@ -123,14 +142,26 @@ class TrialLog : public host::nbv::LoopObserver {
 
   const nlohmann::json& views() const { return views_; }
   const nlohmann::json& plans() const { return plans_; }
+  /// The views' images for the overlays (kept only with an output directory).
+  const ViewImages& images() const { return images_; }
+  const std::optional<host::StereoIntrinsics>& intrinsics() const { return intrinsics_; }
+  /// The run's number of this cluster's first view.
+  int firstView() const { return first_view_; }
 
  private:
   const SimulatedCamera& camera_;
   const TrialOptions& options_;
+  ViewImages images_;
+  std::optional<host::StereoIntrinsics> intrinsics_;
   Clock::time_point wall_start_;
   int cluster_ = -1, first_view_ = 0;  ///< -1: a one-cluster world
   nlohmann::json views_ = nlohmann::json::array(), plans_ = nlohmann::json::array();
 };
+
+/// The log's view images, as the overlays ask for them.
+std::function<cv::Mat(int)> imageSource(const TrialLog& log) {
+  return [&log](int view) { return log.images().image(view); };
+}
 
 /// The loop clock as an observer sees it: the time, with nothing charged (sizing for a
 /// figure is not part of the loop).
@@ -260,7 +291,8 @@ struct Trial::Impl {
       for (int k = 0; k < kMaxClusterDirs; ++k)
         for (const std::string& file : TrialParts::clusterFiles())
           stale.push_back(clusterDirName(k) + "/" + file);
-      host::removeStaleOutputs(options.out_dir, stale, {"views"});
+      stale.push_back("viewer.html");
+      host::removeStaleOutputs(options.out_dir, stale, {"views", "overlays"});
     }
     engine = options.engine.empty() ? defaultEngine(options.planner) : options.engine;
 
@@ -324,6 +356,9 @@ struct Trial::Impl {
                    const std::vector<Eigen::Vector3d>& camera_path) const;
   /// result.json's "stop": the rule and, with --stop auto, its parameters.
   nlohmann::json stopJson() const;
+  std::string viewerTitle() const {
+    return "Trial: " + options.planner + ", world seed " + std::to_string(options.seed);
+  }
 
   TrialOptions options;
   /// The automatic stop's parameters, for every cluster (and the record of them).
@@ -446,8 +481,14 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
   if (!outcome.size_history.is_null()) result["size_history"] = outcome.size_history;
   result["stop"] = stopJson();
   describeRun(result, log, camera_path);
-  if (!options.out_dir.empty())
+  if (!options.out_dir.empty()) {
+    host::report::ViewerScene scene(viewerTitle(), "");
+    host::addSessionToScene(scene, parts->session(), outcome.sizing, 0, std::nullopt);
+    result["overlays"] = host::writeSessionOverlays(
+        parts->session(), outcome.sizing, 0, std::nullopt, imageSource(log), options.out_dir);
     parts->writeOutputs(result, *world, camera_path, options.out_dir, options.on_warning);
+    writeTrialViewer(scene, result, log.intrinsics(), options.out_dir);
+  }
   return result;
 }
 
@@ -472,6 +513,8 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
   int views = 0;
   double transit_s = 0.0;
   nlohmann::json planner_config, trial_config;
+  host::report::ViewerScene scene(viewerTitle(), "");
+  nlohmann::json overlays = nlohmann::json::array();
   for (std::size_t step = 0; step < clusters.size(); ++step) {
     // The nearest unvisited start view from where the camera is now.
     const Eigen::Vector3d here = loop_arm.cameraPose().translation();
@@ -556,8 +599,16 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
     for (const auto& T : outcome.run.camera_poses) camera_path.push_back(T.translation());
     planner_config = nlohmann::json::parse(cluster_parts->planner().configJson());
     trial_config = cluster_parts->configJson();
-    if (!options.out_dir.empty())
+    if (!options.out_dir.empty()) {
       cluster_parts->writeClusterFiles(options.out_dir / clusterDirName(k));
+      const int cluster = static_cast<int>(k);
+      host::addSessionToScene(scene, cluster_parts->session(), outcome.sizing, log.firstView(),
+                              cluster);
+      for (auto& o :
+           host::writeSessionOverlays(cluster_parts->session(), outcome.sizing, log.firstView(),
+                                      cluster, imageSource(log), options.out_dir))
+        overlays.push_back(std::move(o));
+    }
     cluster_entries.push_back(entry);
     carried_map = std::move(cluster_parts->session()).releaseMap();
     cluster_parts.reset();
@@ -610,9 +661,12 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
   result["wall_breakdown_s"] = wall;
   result["stop"] = stopJson();
   describeRun(result, log, camera_path);
-  if (!options.out_dir.empty())
+  if (!options.out_dir.empty()) {
+    result["overlays"] = overlays;
     writeTreeOutputs(result, *world, carried_map.get(), camera_path, options.out_dir,
                      options.on_warning);
+    writeTrialViewer(scene, result, log.intrinsics(), options.out_dir);
+  }
   return result;
 }
 

@@ -103,4 +103,31 @@ class TrialParts {
   std::unique_ptr<Impl> impl_;
 };
 
+/// Which figures a trial's report shows (drawn into its directory beside report.md).
+struct ReportFigures {
+  bool path = false;   ///< path.png: the camera path
+  bool sizes = false;  ///< sizes.png: estimated against true sizes
+};
+/// report.md of a one-cluster trial, from its result.json (what writeOutputs writes).
+std::string trialReportMarkdown(const nlohmann::json& result, const ReportFigures& figures);
+/// report.md of a tree trial, from its result.json (what writeTreeOutputs writes).
+std::string treeReportMarkdown(const nlohmann::json& result, const ReportFigures& figures);
+
+/// A Cluster Region drawn on the camera-path figure.
+struct PathRegion {
+  Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
+  double radius_m = 0.0;
+};
+/// The gnuplot script of path.png: top and side views of the camera positions (path, in
+/// capture order, coloured by it), each view's viewing direction from result["view_log"]
+/// as a 3 cm arrow, the start and last views marked, the fruitlets and the regions.
+std::string cameraPathScript(const std::vector<Eigen::Vector3d>& fruitlets,
+                             const std::vector<Eigen::Vector3d>& path, const nlohmann::json& result,
+                             const std::vector<PathRegion>& regions,
+                             const std::string& region_title);
+/// sizes.png: our estimator's size against the true size of each matched fruitlet (one
+/// colour a cluster in a tree), with y = x and a +-0.5 mm band. False, and no file, when
+/// no fruitlet matched; std::runtime_error when gnuplot cannot draw it.
+bool plotSizeScatter(const nlohmann::json& result, const std::filesystem::path& png);
+
 }  // namespace fvp::trials

@@ -43,7 +43,8 @@ void removeStaleOutputs(const fs::path& dir, const std::vector<std::string>& out
     std::vector<fs::path> stale;
     for (const auto& entry : fs::directory_iterator(dir / sub, ec)) {
       const std::string stem = entry.path().stem().string();
-      if (entry.path().extension() == ".png" && !stem.empty() &&
+      if ((entry.path().extension() == ".png" || entry.path().extension() == ".jpg") &&
+          !stem.empty() &&
           std::all_of(stem.begin(), stem.end(), [](unsigned char c) { return std::isdigit(c); }))
         stale.push_back(entry.path());
     }

@@ -94,7 +94,11 @@ nlohmann::json detectionJson(const sizing::FruitletEstimate& f) {
                          {"touches_border", s.touches_border},
                          {"shared_segment", s.shared_segment},
                          {"well_seen", s.well_seen},
-                         {"axis_ratio", s.axis_ratio}});
+                         {"axis_ratio", s.axis_ratio},
+                         {"ellipse",
+                          {{"center_px", s.ellipse_center_px},
+                           {"axes_px", s.ellipse_axes_px},
+                           {"angle_deg", s.ellipse_angle_deg}}}});
   return {{"center_m", vec3(f.center_m)},
           {"size_mm", f.size_mm},
           {"centroid_m", vec3(f.centroid_m)},

@@ -1,16 +1,20 @@
 #include "fvp/host/session/capture_sizing.h"
 
 #include <algorithm>
+#include <map>
 #include <stdexcept>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/host/core/output_directory.h"
 #include "fvp/host/eval/sizing_score.h"
 #include "fvp/host/perception/capture.h"
 #include "fvp/host/perception/ply_io.h"
+#include "fvp/host/report/viewer_page.h"
 #include "fvp/host/session/mapping_session.h"
+#include "fvp/host/session/session_report.h"
 
 namespace fvp::host {
 
@@ -62,6 +66,40 @@ std::vector<std::filesystem::path> listCaptures(const std::filesystem::path& dir
   return captures;
 }
 
+namespace {
+
+/// The overlays of the views that sized fruitlets (their left.png read again) and
+/// viewer.html: the set's maps, mesh and detections, and a camera per capture.
+void writeSetViewer(const MappingSession& session, nlohmann::json& out,
+                    const std::vector<std::filesystem::path>& dirs,
+                    const std::filesystem::path& out_dir) {
+  const auto left_image = [&](int view) {
+    return cv::imread((dirs.at(static_cast<std::size_t>(view)) / "left.png").string(),
+                      cv::IMREAD_COLOR);
+  };
+  out["overlays"] = writeSessionOverlays(session, out, 0, std::nullopt, left_image, out_dir);
+  writeFileAtomically(out_dir / "fruitlets.json", "fruitlets", out.dump(2) + "\n");
+  std::map<int, std::string> overlay_of;
+  for (const auto& o : out["overlays"]) overlay_of[o["view"].get<int>()] = o["file"];
+  report::ViewerScene scene("Capture set: " + dirs.front().parent_path().filename().string(),
+                            std::to_string(dirs.size()) + " captures, " +
+                                std::to_string(out["sized_fruitlets"].size()) + " fruitlets sized");
+  addSessionToScene(scene, session, out, 0, std::nullopt);
+  const auto& views = session.sizingViews();
+  for (std::size_t v = 0; v < views.size(); ++v) {
+    nlohmann::json extra = {{"capture", dirs[v].filename().string()},
+                            {"tag_detected", session.views()[v].tag_detected},
+                            {"roi_points", session.views()[v].roi_points},
+                            {"other_points", session.views()[v].other_points}};
+    if (overlay_of.count(int(v))) extra["image"] = overlay_of[int(v)];
+    scene.addCamera(int(v), views[v].T_world_camera, std::move(extra));
+  }
+  if (!views.empty()) scene.setIntrinsics(views.front().intrinsics);
+  report::writeViewerPage(scene.toJson(), out_dir / "viewer.html");
+}
+
+}  // namespace
+
 nlohmann::json sizeCaptureSet(const std::filesystem::path& captures_dir,
                               const CaptureSizingOptions& options, accel::Backend* backend) {
   std::vector<std::string> warnings;
@@ -73,10 +111,10 @@ nlohmann::json sizeCaptureSet(const std::filesystem::path& captures_dir,
   const std::vector<std::filesystem::path> dirs = listCaptures(captures_dir, &skipped);
   for (const std::string& s : skipped) warn(s);
   static const std::vector<std::string> kOutputs = {"fruitlets.json", "surface.ply", "mesh.ply",
-                                                    "clusters.ply"};
+                                                    "clusters.ply", "viewer.html"};
   if (!options.out_dir.empty()) {
     prepareOutputDirectory(options.out_dir, "sizing output directory");
-    removeStaleOutputs(options.out_dir, kOutputs);
+    removeStaleOutputs(options.out_dir, kOutputs, {"overlays"});
   }
   MappingSession session(options.perception, options.engine, map::MapConfig{}, backend);
   session.enableTsdf();
@@ -146,6 +184,7 @@ nlohmann::json sizeCaptureSet(const std::filesystem::path& captures_dir,
     writePlyColoredPoints(options.out_dir / "clusters.ply", sized.points,
                           sizing::clusterColours(sized.labels),
                           "fvp clusters, world frame, metres; grey = noise");
+    writeSetViewer(session, out, dirs, options.out_dir);
   }
   return out;
 }

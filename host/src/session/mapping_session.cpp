@@ -35,6 +35,7 @@ ViewResult MappingSession::addView(const StereoFrame& frame, PerceptionResult* p
   PerceptionResult perceived = perception_.process(frame, region_);
   view.perceive_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   view.tag_detected = perceived.tag.has_value();
+  view.tag = perceived.tag;
   view.roi_points = perceived.clouds.roi_points_m.size();
   view.other_points = perceived.clouds.other_points_m.size();
   view.perception = perceived.clouds.stats;
@@ -42,6 +43,7 @@ ViewResult MappingSession::addView(const StereoFrame& frame, PerceptionResult* p
 
   if (!region_ && perceived.region) {
     region_ = perceived.region;
+    if (perceived.tag) T_world_tag_ = perceived.tag->T_world_tag;
     if (carried_map_) {
       map_ = std::move(carried_map_);
       map_->moveToRegion(*region_);

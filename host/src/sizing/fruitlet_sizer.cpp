@@ -98,6 +98,9 @@ std::optional<ImageSize> measureImage(const SizingView& view, const Segments& se
   s.max_disparity_px = d_max;
   s.visible_fraction = visible;
   s.axis_ratio = major_px > 0 ? minor_px / major_px : 0.0;
+  s.ellipse_center_px = {ellipse.center.x, ellipse.center.y};
+  s.ellipse_axes_px = {ellipse.size.width, ellipse.size.height};
+  s.ellipse_angle_deg = ellipse.angle;
   s.touches_border = x0 <= 0 || y0 <= 0 || x0 + w >= labels.cols || y0 + h >= labels.rows;
   s.size_paper_mm = 1000.0 * minor_px * in.baseline_m / d_max;
   const double m = minor_px + kHullShortfallPx;

@@ -58,9 +58,13 @@ nlohmann::json summarize(const std::vector<nlohmann::json>& trials);
 
 /// summary.json and table1.md from checked trials, then sizes.png: a figure gnuplot cannot
 /// draw is reported through warning and noted in table1.md, and returns false (no stale
-/// sizes.png is left); the reports stand. Returns whether sizes.png was drawn.
-bool writeReports(const std::filesystem::path& dir, const std::vector<nlohmann::json>& trials,
-                  const MessageSink& warning = {});
+/// sizes.png is left); the reports stand. Returns whether sizes.png was drawn. Last,
+/// index.html links the tables, figures and each trial's viewer.html and report.md, found
+/// by trial_dir (default: dir/trials/<planner>-<seed>, where runExperiment puts them).
+bool writeReports(
+    const std::filesystem::path& dir, const std::vector<nlohmann::json>& trials,
+    const MessageSink& warning = {},
+    const std::function<std::filesystem::path(const nlohmann::json& trial)>& trial_dir = {});
 
 /// `fvp merge`: combines the trials.jsonl of experiment directories into out_dir and writes
 /// manifest.json (kind "merged") and the reports. Refused: a directory without a manifest,

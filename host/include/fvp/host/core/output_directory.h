@@ -15,7 +15,7 @@ namespace fvp::host {
 void prepareOutputDirectory(const std::filesystem::path& dir, const std::string& what);
 
 /// Removes, where present, the files named in `outputs` (paths relative to dir) and, for
-/// each directory in `numbered_dirs`, the files in it named like NNN.png (digits only):
+/// each directory in `numbered_dirs`, the files in it named like NNN.png or NNN.jpg (digits only):
 /// what an earlier run into the same directory wrote. Nothing else is touched.
 void removeStaleOutputs(const std::filesystem::path& dir, const std::vector<std::string>& outputs,
                         const std::vector<std::string>& numbered_dirs = {});

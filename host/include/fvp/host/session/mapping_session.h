@@ -31,6 +31,7 @@ namespace fvp::host {
 struct ViewResult {
   std::size_t index = 0;  ///< position of the view in the session
   bool tag_detected = false;
+  std::optional<TagDetection> tag;  ///< the cluster's tag as this view saw it
   std::size_t roi_points = 0, other_points = 0;
   double perceive_s = 0.0;  ///< wall time of the perception pipeline alone
   PerceptionStats perception;
@@ -56,6 +57,8 @@ class MappingSession {
 
   /// Null / empty until a view's tag was detected.
   const std::optional<ClusterRegion>& region() const { return region_; }
+  /// The tag pose seen when the region was placed; empty until then, or when no tag was seen.
+  const std::optional<Eigen::Isometry3d>& T_world_tag() const { return T_world_tag_; }
   map::MapEngine* map() { return map_.get(); }
   const map::MapEngine* map() const { return map_.get(); }
   /// Every view so far, with the scans of views integrated after they were added.
@@ -103,6 +106,7 @@ class MappingSession {
   map::MapConfig map_config_;
   accel::Backend* backend_;
   std::optional<ClusterRegion> region_;
+  std::optional<Eigen::Isometry3d> T_world_tag_;
   std::unique_ptr<map::MapEngine> map_;
   std::unique_ptr<map::MapEngine> carried_map_;  ///< until the region is known
   std::vector<ViewResult> views_;

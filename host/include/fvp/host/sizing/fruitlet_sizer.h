@@ -89,6 +89,10 @@ struct ImageSize {
   bool touches_border = false;
   bool shared_segment = false;  ///< another cluster falls on the same segment
   double axis_ratio = 0.0;      ///< minor / major axis of the fitted ellipse
+  /// The fitted ellipse (cv::fitEllipse on the segment's hull), in the image's pixels: its
+  /// centre, full axis lengths (width, height before rotation) and rotation in degrees.
+  std::array<double, 2> ellipse_center_px{}, ellipse_axes_px{};
+  double ellipse_angle_deg = 0.0;
   /// Mostly visible, off the border, its own segment, round: one of ours' median's images.
   bool well_seen = false;
 };
