@@ -15,10 +15,11 @@ void addSizeCommand(CLI::App& app) {
     std::string captures, out, sizing = "ours", engine = "grid", backend = "auto", config;
   };
   auto opt = std::make_shared<Options>();
-  auto* cmd = app.add_subcommand(
-      "size",
-      "Size the fruitlets of a set of stored captures; write fruitlets.json, surface.ply, mesh.ply "
-      "and clusters.ply to --out");
+  auto* cmd =
+      app.add_subcommand("size",
+                         "Size the fruitlets of a set of stored captures; write fruitlets.json, "
+                         "surface.ply, mesh.ply, "
+                         "clusters.ply, viewer.html (the set in 3-D) and overlays/ to --out");
   cmd->add_option("--captures", opt->captures,
                   "a capture directory, or a directory of them (used in name order)")
       ->required();

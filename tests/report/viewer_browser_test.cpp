@@ -79,6 +79,10 @@ class ViewerInBrowser : public ::testing::Test {
     return nlohmann::json::parse(text);
   }
 
+  void checkPage();
+  void checkLayers();
+  void checkOverlays();
+
   static inline fs::path* dir_ = nullptr;
   static inline nlohmann::json* result_ = nullptr;
 };
@@ -110,7 +114,25 @@ std::size_t plyFaces(const fs::path& ply) {
   return 0;
 }
 
-TEST_F(ViewerInBrowser, LoadsWithoutErrorsOrRequestsAndDrawsWhatTheTrialHolds) {
+// One test: CTest runs each case in a process of its own, and each would run the trial.
+TEST_F(ViewerInBrowser, ShowsTheTrialAndItsOverlays) {
+  ASSERT_EQ(host::runProgram({"sh", "-c", "command -v chromium-headless-shell"}, "").exit_code, 0)
+      << "chromium-headless-shell is not installed: scripts/install-deps --tests installs it";
+  {
+    SCOPED_TRACE("the page loads and draws what the trial holds");
+    checkPage();
+  }
+  {
+    SCOPED_TRACE("each layer alone puts its pixels on the screen");
+    checkLayers();
+  }
+  {
+    SCOPED_TRACE("overlays: the start view and the views that sized a fruitlet");
+    checkOverlays();
+  }
+}
+
+void ViewerInBrowser::checkPage() {
   const host::SubprocessResult run = browse("");
   ASSERT_EQ(run.exit_code, 0) << run.stderr_text;
   const nlohmann::json h = hook(run.stdout_text);
@@ -145,7 +167,7 @@ TEST_F(ViewerInBrowser, LoadsWithoutErrorsOrRequestsAndDrawsWhatTheTrialHolds) {
   EXPECT_EQ(c.at("mesh_triangles").get<std::size_t>(), faces);
 }
 
-TEST_F(ViewerInBrowser, EachLayerAlonePutsItsPixelsOnTheScreen) {
+void ViewerInBrowser::checkLayers() {
   const fs::path empty_png = *dir_ / "empty.png";
   ASSERT_EQ(browse("?layers=", empty_png).exit_code, 0);
   const cv::Mat empty = cv::imread(empty_png.string(), cv::IMREAD_COLOR);
@@ -165,7 +187,7 @@ TEST_F(ViewerInBrowser, EachLayerAlonePutsItsPixelsOnTheScreen) {
   }
 }
 
-TEST_F(ViewerInBrowser, OverlaysAreTheStartViewAndTheViewsThatSizedAFruitlet) {
+void ViewerInBrowser::checkOverlays() {
   const nlohmann::json& r = *result_;
   std::set<int> expected = {0};
   for (const auto& d : r.at("sized_fruitlets"))

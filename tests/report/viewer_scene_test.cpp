@@ -156,6 +156,8 @@ TEST(ViewerScene, DetectionsKeepTheirMatchAndViewsAcrossClusters) {
   EXPECT_EQ(truth[0]["detection"], 0);
   EXPECT_TRUE(truth[1]["detection"].is_null());
   EXPECT_EQ(truth[2]["detection"], 3);
+  EXPECT_EQ(truth[0]["label"], "C0.F0");
+  EXPECT_EQ(truth[2]["label"], "C1.F0");  // numbered within its cluster, as the report does
 }
 
 TEST(ViewerPage, InlinesTheSceneSoThatNoTextEndsItsScript) {

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <set>
 
 #include "fvp/host/nbv/arm.h"
@@ -122,6 +123,35 @@ TEST_F(TreeTrial, VisitsEveryClusterOnceAndSkipsOneItCannotReach) {
       ++occupied_near_first;
   EXPECT_GT(occupied_near_first, 10);
   EXPECT_NE(r["tour"]["order"].back(), 0);
+
+  // The viewer's scene holds every fruitlet of the tree, the skipped cluster's too, and its
+  // labels are the report's (C<k>.D<i>, C<k>.F<j>).
+  std::ifstream page_in(o.out_dir / "viewer.html");
+  const std::string page((std::istreambuf_iterator<char>(page_in)), {});
+  const std::string open_tag = "<script type=\"application/json\" id=\"fvp-scene\">";
+  const std::size_t begin = page.find(open_tag);
+  ASSERT_NE(begin, std::string::npos);
+  const std::size_t start = begin + open_tag.size();
+  const nlohmann::json scene =
+      nlohmann::json::parse(page.substr(start, page.find("</script>", start) - start));
+  EXPECT_EQ(scene.at("ground_truth").size(), r["fruitlets"].size());
+  std::ifstream report_in(o.out_dir / "report.md");
+  const std::string report((std::istreambuf_iterator<char>(report_in)), {});
+  std::size_t detections = 0;
+  for (const auto& d : scene.at("detections")) {
+    ++detections;
+    EXPECT_NE(report.find("| " + d.at("label").get<std::string>() + " |"), std::string::npos)
+        << d.at("label");
+  }
+  std::size_t expected_detections = 0;
+  for (const auto& c : r["clusters"])
+    if (c.contains("sized_fruitlets"))
+      expected_detections += c["sized_fruitlets"].size() + c["unsupported_detections"].size();
+  EXPECT_EQ(detections, expected_detections);
+  for (const auto& f : scene.at("ground_truth"))
+    EXPECT_NE(report.find("| " + f.at("label").get<std::string>() + " |"), std::string::npos)
+        << f.at("label");
+  EXPECT_EQ(scene.at("cluster_regions").size(), 2u);  // the sized clusters'
 }
 
 TEST_F(TreeTrial, RepeatsExactlyWithAFixedClock) {

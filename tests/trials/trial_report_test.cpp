@@ -230,14 +230,14 @@ TEST(TrialReport, KeepsWallAndSimulatedTimeInSeparateTables) {
 
 TEST(TrialReport, ShowsOverlaysOfTheViewsThatCountAndThumbnailsOfTheOthers) {
   nlohmann::json result = trialResult();
-  result["overlays"] = {{{"view", 0}, {"file", "overlays/000.png"}, {"why", "start view"}},
-                        {{"view", 3}, {"file", "overlays/003.png"}, {"why", "sized D0, D2"}}};
+  result["overlays"] = {{{"view", 0}, {"file", "overlays/000.jpg"}, {"why", "start view"}},
+                        {{"view", 3}, {"file", "overlays/003.jpg"}, {"why", "sized D0, D2"}}};
   const std::string md = trialReportMarkdown(result, {});
-  const std::string overlays = section(md, "Views that sized fruitlets");
+  const std::string overlays = section(md, "Views that count");
   ASSERT_FALSE(overlays.empty()) << md;
-  EXPECT_TRUE(contains(overlays, "\n![view 0: start view](overlays/000.png)\n")) << overlays;
+  EXPECT_TRUE(contains(overlays, "\n![view 0: start view](overlays/000.jpg)\n")) << overlays;
   EXPECT_TRUE(contains(overlays, "*View 3: sized D0, D2.*")) << overlays;
-  EXPECT_TRUE(contains(overlays, "\n![view 3: sized D0, D2](overlays/003.png)\n")) << overlays;
+  EXPECT_TRUE(contains(overlays, "\n![view 3: sized D0, D2](overlays/003.jpg)\n")) << overlays;
   const std::string others = section(md, "Other captured views");
   ASSERT_FALSE(others.empty()) << md;
   for (const char* shown : {"views/001.png", "views/002.png", "views/004.png"})
@@ -249,7 +249,7 @@ TEST(TrialReport, ShowsOverlaysOfTheViewsThatCountAndThumbnailsOfTheOthers) {
 
 TEST(TrialReport, WithoutOverlaysShowsEveryViewAsAThumbnail) {
   const std::string md = trialReportMarkdown(trialResult(), {});
-  EXPECT_TRUE(section(md, "Views that sized fruitlets").empty());
+  EXPECT_TRUE(section(md, "Views that count").empty());
   const std::string views = section(md, "Captured views");
   for (int v = 0; v < kViews; ++v)
     EXPECT_TRUE(contains(views, "](views/00" + std::to_string(v) + ".png)")) << views;
@@ -294,8 +294,8 @@ TEST(TreeReport, ListsEachClustersDetectionsAndOverlays) {
       f["cluster"] = c["index"];
       result["fruitlets"].push_back(f);
     }
-  result["overlays"] = {{{"view", 0}, {"file", "overlays/000.png"}, {"why", "start view"}},
-                        {{"view", 4}, {"file", "overlays/004.png"}, {"why", "sized D1"}}};
+  result["overlays"] = {{{"view", 0}, {"file", "overlays/000.jpg"}, {"why", "start view"}},
+                        {{"view", 4}, {"file", "overlays/004.jpg"}, {"why", "sized C1.D1"}}};
   const std::string md = treeReportMarkdown(result, {});
   const std::string detections = section(md, "Detections");
   ASSERT_FALSE(detections.empty()) << md;
@@ -320,7 +320,7 @@ TEST(TreeReport, ListsEachClustersDetectionsAndOverlays) {
   // The wall time is below, not in the top table.
   EXPECT_FALSE(contains(md.substr(0, md.find("\n## ")), "82.4"));
   EXPECT_TRUE(contains(section(md, "Where the wall time went"), "**82.40**"));
-  EXPECT_TRUE(contains(section(md, "Views that sized fruitlets"), "](overlays/004.png)"));
+  EXPECT_TRUE(contains(section(md, "Views that count"), "](overlays/004.jpg)"));
   const std::string others = section(md, "Other captured views");
   EXPECT_TRUE(contains(others, "views/001.png")) << others;
   EXPECT_FALSE(contains(md, "views/004.png"));

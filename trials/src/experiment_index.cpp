@@ -1,5 +1,6 @@
 #include "experiment_index.h"
 
+#include <cctype>
 #include <iomanip>
 #include <sstream>
 
@@ -78,6 +79,13 @@ std::string tableHtml(const std::string& markdown) {
   return html.str();
 }
 
+/// The directory's name, also when given as "runs/exp/" or ".".
+std::string experimentName(const fs::path& dir) {
+  const fs::path normal = fs::absolute(dir).lexically_normal();
+  const std::string name = normal.filename().string();
+  return name.empty() ? normal.parent_path().filename().string() : name;
+}
+
 std::string number(const nlohmann::json& v, int precision) {
   if (!v.is_number()) return "-";
   std::ostringstream s;
@@ -99,7 +107,7 @@ void writeIndexPage(const fs::path& dir, const std::string& table_markdown,
        << "td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}\n"
        << "th{background:#f2f2f2}td:first-child,th:first-child{text-align:left}\n"
        << "img{max-width:100%;border:1px solid #ddd}\n</style></head><body>\n"
-       << "<h1>Experiment: " << escapeHtml(dir.filename().string()) << "</h1>\n"
+       << "<h1>Experiment: " << escapeHtml(experimentName(dir)) << "</h1>\n"
        << "<h2>Table 1: sizing accuracy</h2>\n"
        << tableHtml(table_markdown);
   for (const auto& [file, caption] :

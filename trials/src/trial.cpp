@@ -25,6 +25,7 @@
 #include "fvp/host/nbv/nbv_loop.h"
 #include "fvp/host/planner/planner_registry.h"
 #include "fvp/host/planner/view_planner.h"
+#include "fvp/host/report/viewer_scene.h"
 #include "fvp/host/session/mapping_session.h"
 #include "fvp/host/session/session_report.h"
 #include "fvp/robot/arm_model.h"
@@ -49,14 +50,11 @@ double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-nlohmann::json vec3(const Eigen::Vector3d& v) {
-  return {v.x(), v.y(), v.z()};
-}
+using host::report::vec3Json;
 
 /// R_world_camera as [w, x, y, z]; the camera looks along its z axis (OpenCV frame).
 nlohmann::json quaternionWxyz(const Eigen::Isometry3d& T) {
-  const Eigen::Quaterniond q(T.rotation());
-  return {q.w(), q.x(), q.y(), q.z()};
+  return host::report::poseJson(T).at("quaternion_wxyz");
 }
 
 void validate(const TrialOptions& o) {
@@ -97,9 +95,9 @@ class TrialLog : public host::nbv::LoopObserver {
     const host::ViewResult& v = *e.result;
     const int index = first_view_ + e.index;  // over the whole run
     views_.push_back({{"index", index},
-                      {"position_m", vec3(e.T_world_camera.translation())},
+                      {"position_m", vec3Json(e.T_world_camera.translation())},
                       {"quaternion_wxyz", quaternionWxyz(e.T_world_camera)},
-                      {"viewing_direction", vec3(e.T_world_camera.linear().col(2))},
+                      {"viewing_direction", vec3Json(e.T_world_camera.linear().col(2))},
                       {"tag_detected", v.tag_detected},
                       {"roi_points", v.roi_points},
                       {"other_points", v.other_points},
@@ -131,7 +129,7 @@ class TrialLog : public host::nbv::LoopObserver {
          {"chosen_utility",
           step.chosen ? nlohmann::json(step.candidates[*step.chosen].utility) : nlohmann::json()},
          {"chosen_position_m",
-          step.chosen ? vec3(step.candidates[*step.chosen].position_m()) : nlohmann::json()},
+          step.chosen ? vec3Json(step.candidates[*step.chosen].position_m()) : nlohmann::json()},
          {"chosen_quaternion_wxyz",
           step.chosen ? quaternionWxyz(step.candidates[*step.chosen].T_world_camera)
                       : nlohmann::json()},
@@ -194,7 +192,7 @@ nlohmann::json sizeHistoryJson(const std::vector<host::nbv::SizingSnapshot>& his
     for (const auto& f : snapshot.fruitlets) {
       centres.push_back(f.center_m);
       sizes.push_back(f.size_mm);
-      fruitlets.push_back({{"center_m", vec3(f.center_m)},
+      fruitlets.push_back({{"center_m", vec3Json(f.center_m)},
                            {"size_mm", f.size_mm},
                            {"well_seen_images", f.well_seen_images},
                            {"view_span_deg", f.view_span_deg},
@@ -356,8 +354,32 @@ struct Trial::Impl {
                    const std::vector<Eigen::Vector3d>& camera_path) const;
   /// result.json's "stop": the rule and, with --stop auto, its parameters.
   nlohmann::json stopJson() const;
+  /// The overlays write() writes, or none and a warning when it fails: they are an extra that
+  /// must not cost the run its result.
+  nlohmann::json overlaysOrWarning(const std::function<nlohmann::json()>& write) {
+    try {
+      return write();
+    } catch (const std::exception& e) {
+      warn(std::string("overlays not drawn: ") + e.what());
+      return nlohmann::json::array();
+    }
+  }
+  /// viewer.html by write(), after result.json: a failure becomes a warning in result.json
+  /// (written again), as a figure's does.
+  void viewerOrWarning(nlohmann::json& result, const std::function<void()>& write) {
+    try {
+      write();
+    } catch (const std::exception& e) {
+      const std::string text = std::string("viewer.html not written: ") + e.what();
+      result["warnings"].push_back(text);
+      if (options.on_warning) options.on_warning(text);
+      host::writeFileAtomically(options.out_dir / "result.json", "trial result",
+                                result.dump(2) + "\n");
+    }
+  }
   std::string viewerTitle() const {
-    return "Trial: " + options.planner + ", world seed " + std::to_string(options.seed);
+    return (world->clusters().size() > 1 ? "Tree trial: " : "Trial: ") + options.planner +
+           ", world seed " + std::to_string(options.seed);
   }
 
   TrialOptions options;
@@ -436,7 +458,7 @@ void Trial::Impl::describeRun(nlohmann::json& result, const TrialLog& log,
   result["view_log"] = log.views();
   result["plan_log"] = log.plans();
   nlohmann::json path = nlohmann::json::array();
-  for (const auto& p : camera_path) path.push_back(vec3(p));
+  for (const auto& p : camera_path) path.push_back(vec3Json(p));
   result["camera_path_m"] = path;
   result["warnings"] = warnings;
 }
@@ -480,14 +502,19 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
                                 {"sizing_during_loop", outcome.sizing_during_loop_s}};
   if (!outcome.size_history.is_null()) result["size_history"] = outcome.size_history;
   result["stop"] = stopJson();
+  if (!options.out_dir.empty())
+    result["overlays"] = overlaysOrWarning([&] {
+      return host::writeSessionOverlays(parts->session(), outcome.sizing, 0, std::nullopt,
+                                        imageSource(log), options.out_dir, "start view");
+    });
   describeRun(result, log, camera_path);
   if (!options.out_dir.empty()) {
-    host::report::ViewerScene scene(viewerTitle(), "");
-    host::addSessionToScene(scene, parts->session(), outcome.sizing, 0, std::nullopt);
-    result["overlays"] = host::writeSessionOverlays(
-        parts->session(), outcome.sizing, 0, std::nullopt, imageSource(log), options.out_dir);
     parts->writeOutputs(result, *world, camera_path, options.out_dir, options.on_warning);
-    writeTrialViewer(scene, result, log.intrinsics(), options.out_dir);
+    viewerOrWarning(result, [&] {
+      host::report::ViewerScene scene(viewerTitle(), "");
+      host::addSessionToScene(scene, parts->session(), outcome.sizing, 0, std::nullopt);
+      writeTrialViewer(scene, result, log.intrinsics(), options.out_dir);
+    });
   }
   return result;
 }
@@ -514,6 +541,7 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
   double transit_s = 0.0;
   nlohmann::json planner_config, trial_config;
   host::report::ViewerScene scene(viewerTitle(), "");
+  std::string scene_error;  // why the scene could not be built (no viewer then)
   nlohmann::json overlays = nlohmann::json::array();
   for (std::size_t step = 0; step < clusters.size(); ++step) {
     // The nearest unvisited start view from where the camera is now.
@@ -602,11 +630,18 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
     if (!options.out_dir.empty()) {
       cluster_parts->writeClusterFiles(options.out_dir / clusterDirName(k));
       const int cluster = static_cast<int>(k);
-      host::addSessionToScene(scene, cluster_parts->session(), outcome.sizing, log.firstView(),
-                              cluster);
-      for (auto& o :
-           host::writeSessionOverlays(cluster_parts->session(), outcome.sizing, log.firstView(),
-                                      cluster, imageSource(log), options.out_dir))
+      // The scene's part of this cluster now: its map moves on to the next cluster.
+      try {
+        host::addSessionToScene(scene, cluster_parts->session(), outcome.sizing, log.firstView(),
+                                cluster);
+      } catch (const std::exception& e) {
+        scene_error = e.what();
+      }
+      for (auto& o : overlaysOrWarning([&] {
+             return host::writeSessionOverlays(cluster_parts->session(), outcome.sizing,
+                                               log.firstView(), cluster, imageSource(log),
+                                               options.out_dir, "start view");
+           }))
         overlays.push_back(std::move(o));
     }
     cluster_entries.push_back(entry);
@@ -633,14 +668,21 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
   for (const auto& c : cluster_entries) {
     if (c.contains("fruitlets")) continue;
     const auto& indices = clusters[c.at("index").get<std::size_t>()].fruitlet_indices;
+    nlohmann::json cluster_missed = nlohmann::json::array();
     for (const auto& g : groundTruthOf(*world, indices)) {
-      const nlohmann::json missed = {
-          {"gt_center_m", vec3(g.center_m)}, {"gt_size_mm", g.size_mm}, {"matched", false},
-          {"est_center_m", nullptr},         {"est_size_mm", nullptr},  {"cluster", c.at("index")}};
+      const nlohmann::json missed = {{"gt_center_m", vec3Json(g.center_m)},
+                                     {"gt_size_mm", g.size_mm},
+                                     {"matched", false},
+                                     {"est_center_m", nullptr},
+                                     {"est_size_mm", nullptr},
+                                     {"cluster", c.at("index")}};
       scored["fruitlets"].push_back(missed);
       for (const char* other : {"fruitlets_paper_sizing", "fruitlets_ours_sizing"})
         if (scored.contains(other)) scored[other].push_back(missed);
+      cluster_missed.push_back(missed);
     }
+    // The viewer shows a skipped cluster's fruitlets too, none matched.
+    scene.addSizing({{"fruitlets", cluster_missed}}, 0, c.at("index").get<int>());
   }
   if (!scored.contains("fruitlets")) scored["fruitlets"] = nlohmann::json::array();
   for (const auto& [key, fruitlets] : scored.items()) {
@@ -660,12 +702,15 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
   wall["rendering"] = camera->totalRenderSeconds();
   result["wall_breakdown_s"] = wall;
   result["stop"] = stopJson();
+  if (!options.out_dir.empty()) result["overlays"] = overlays;
   describeRun(result, log, camera_path);
   if (!options.out_dir.empty()) {
-    result["overlays"] = overlays;
     writeTreeOutputs(result, *world, carried_map.get(), camera_path, options.out_dir,
                      options.on_warning);
-    writeTrialViewer(scene, result, log.intrinsics(), options.out_dir);
+    viewerOrWarning(result, [&] {
+      if (!scene_error.empty()) throw std::runtime_error(scene_error);
+      writeTrialViewer(scene, result, log.intrinsics(), options.out_dir);
+    });
   }
   return result;
 }

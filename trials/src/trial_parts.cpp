@@ -18,10 +18,12 @@
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/host/core/cluster_region.h"
 #include "fvp/host/core/gnuplot.h"
+#include "fvp/host/core/output_directory.h"
 #include "fvp/host/eval/sizing_score.h"
 #include "fvp/host/map/map_config.h"
 #include "fvp/host/perception/ply_io.h"
 #include "fvp/host/planner/planner_registry.h"
+#include "fvp/host/report/viewer_scene.h"
 #include "fvp/host/sizing/fruitlet_sizer.h"
 #include "fvp/host/tsdf/tsdf_volume.h"
 
@@ -144,10 +146,8 @@ void keepViewImage(const std::filesystem::path& out_dir, int index,
   std::vector<unsigned char> png;
   if (!cv::imencode(".png", small, png))
     throw std::runtime_error("view image " + std::to_string(index) + ": PNG encoding failed");
-  std::ostringstream name;
-  name << std::setw(3) << std::setfill('0') << index << ".png";
   host::writeFileAtomically(
-      dir / name.str(), "view image",
+      out_dir / host::numberedFileName("views", index, "png"), "view image",
       std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
 }
 
@@ -176,9 +176,7 @@ const nlohmann::json& field(const nlohmann::json& j, const char* key) {
 
 /// A view's picture in the report: views/NNN.png.
 std::string viewImageFile(int view) {
-  std::ostringstream name;
-  name << "views/" << std::setw(3) << std::setfill('0') << view << ".png";
-  return name.str();
+  return host::numberedFileName("views", view, "png");
 }
 
 /// A JSON 3-vector as Eigen (zero when it is not one).
@@ -488,10 +486,10 @@ std::pair<double, nlohmann::json> scoredSizeAndCentre(const nlohmann::json& d,
   return {size, d.contains(centre_key) ? d[centre_key] : d.value("center_m", nlohmann::json())};
 }
 
-/// "nearest F2 at 14.3 mm" against the scope's ground truth ("" without one); prefix names
-/// a tree's cluster ("C3.").
+/// "nearest F2 at 14.3 mm" against the scope's ground truth ("" without one); cluster names
+/// a tree's cluster ("nearest C3.F2 ...").
 std::string nearestFruitletText(const nlohmann::json& centre, const nlohmann::json& fruitlets,
-                                const std::string& prefix) {
+                                std::optional<int> cluster) {
   if (!centre.is_array() || centre.size() != 3) return "";
   const Eigen::Vector3d c = vec3Of(centre);
   int best = -1;
@@ -502,7 +500,8 @@ std::string nearestFruitletText(const nlohmann::json& centre, const nlohmann::js
     if (best < 0 || mm < best_mm) best = static_cast<int>(j), best_mm = mm;
   }
   if (best < 0) return "";
-  return "nearest " + prefix + "F" + std::to_string(best) + " at " + fmt(best_mm, 1) + " mm";
+  return "nearest " + host::report::fruitletLabel(static_cast<std::size_t>(best), cluster) +
+         " at " + fmt(best_mm, 1) + " mm";
 }
 
 /// Where a detection's size came from (docs/sizing.md).
@@ -524,9 +523,9 @@ std::string sizeSourceText(const nlohmann::json& d) {
 /// One table of a scope's detections (a trial's or a cluster's): the kept ones (D0.., the
 /// order of sized_fruitlets) with the ground-truth fruitlet (F0.., the order of fruitlets)
 /// each matched or "spurious", and the ones the support rule dropped (X0..), each with the
-/// rule's numbers and why. prefix names a tree's cluster in the ids ("C3.": C3.D0).
+/// rule's numbers and why. cluster names a tree's cluster in the ids (C3.D0).
 void appendDetectionTable(std::ostringstream& md, const nlohmann::json& scope,
-                          const std::string& estimator, const std::string& prefix) {
+                          const std::string& estimator, std::optional<int> cluster) {
   static const nlohmann::json none = nlohmann::json::array();
   const nlohmann::json& kept = scope.contains("sized_fruitlets") ? scope["sized_fruitlets"] : none;
   const nlohmann::json& dropped =
@@ -554,11 +553,11 @@ void appendDetectionTable(std::ostringstream& md, const nlohmann::json& scope,
     if (!is_kept)
       match = "dropped";
     else if (fruitlet >= 0)
-      match = prefix + "F" + std::to_string(fruitlet) + " (true " +
+      match = host::report::fruitletLabel(static_cast<std::size_t>(fruitlet), cluster) + " (true " +
               fmtOrDash(field(truth[fruitlet], "gt_size_mm"), 2) + " mm)";
     else
       match = "**spurious**";
-    const std::string nearest = fruitlet < 0 ? nearestFruitletText(centre, truth, prefix) : "";
+    const std::string nearest = fruitlet < 0 ? nearestFruitletText(centre, truth, cluster) : "";
     if (!nearest.empty()) match += " (" + nearest + ")";
     std::string why;
     if (is_kept) {
@@ -581,15 +580,13 @@ void appendDetectionTable(std::ostringstream& md, const nlohmann::json& scope,
        << (stderr_mm >= 0.0 ? "±" + fmt(stderr_mm, 2) : "- (< 2 well seen)") << " | " << why
        << " |\n";
   };
-  // (Appended rather than "D" + ...: GCC 12 warns falsely on that, bug 105329.)
-  const auto id = [&](char kind, std::size_t i) {
-    return std::string(prefix).append(1, kind).append(std::to_string(i));
-  };
   for (std::size_t i = 0; i < kept.size(); ++i) {
     const auto it = fruitlet_of.find(static_cast<int>(i));
-    row(id('D', i), kept[i], true, it == fruitlet_of.end() ? -1 : it->second);
+    row(host::report::detectionLabel(true, i, cluster), kept[i], true,
+        it == fruitlet_of.end() ? -1 : it->second);
   }
-  for (std::size_t i = 0; i < dropped.size(); ++i) row(id('X', i), dropped[i], false, -1);
+  for (std::size_t i = 0; i < dropped.size(); ++i)
+    row(host::report::detectionLabel(false, i, cluster), dropped[i], false, -1);
 }
 
 /// The support rule in a sentence, with the trial's fraction.
@@ -618,8 +615,9 @@ void appendViews(std::ostringstream& md, const nlohmann::json& result) {
   const bool overlays =
       result.contains("overlays") && result["overlays"].is_array() && !result["overlays"].empty();
   if (overlays) {
-    md << "\n## Views that sized fruitlets\n\nThe start view and each view whose segments "
-          "sized a fruitlet, with the segments drawn over the image.\n";
+    md << "\n## Views that count\n\nThe start view and each view whose segments sized a "
+          "fruitlet, cropped to the Cluster Region, with the segments drawn over the image "
+          "(docs/viewer.md, \"The evidence report\").\n";
     for (const auto& o : result["overlays"]) {
       const int view = o.value("view", -1);
       const std::string why = o.value("why", "");
@@ -667,19 +665,23 @@ std::string trialReportMarkdown(const nlohmann::json& result, const ReportFigure
   md << "\n## Sizes against ground truth\n\n"
      << "| fruitlet | true size (mm) | estimated (mm) | error (mm) | centre error (mm) | "
         "detection |\n|---|---|---|---|---|---|\n";
-  int i = 0;
+  std::size_t i = 0;
   for (const auto& f : field(result, "fruitlets")) {
     const bool matched = f.value("matched", false) && field(f, "est_size_mm").is_number();
-    md << "| F" << i++ << " | " << fmtOrDash(field(f, "gt_size_mm"), 2) << " | "
+    md << "| " << host::report::fruitletLabel(i++, std::nullopt) << " | "
+       << fmtOrDash(field(f, "gt_size_mm"), 2) << " | "
        << (matched ? fmt(f["est_size_mm"], 2) : "not matched") << " | "
        << (matched ? fmt(f["est_size_mm"].get<double>() - f["gt_size_mm"].get<double>(), 2) : "-")
        << " | " << fmtOrDash(field(f, "center_error_mm"), 2) << " | "
-       << (matched && f.contains("detection") ? "D" + field(f, "detection").dump() : "-") << " |\n";
+       << (matched && f.contains("detection")
+               ? host::report::detectionLabel(true, f["detection"].get<std::size_t>(), std::nullopt)
+               : "-")
+       << " |\n";
   }
   if (figures.sizes) md << "\n![estimated against true size](sizes.png)\n";
   md << "\n## Detections\n\n";
   appendSupportRule(md, result);
-  appendDetectionTable(md, result, estimator, "");
+  appendDetectionTable(md, result, estimator, std::nullopt);
   appendSimulatedBudget(md, result);
   appendReportTail(md, result, figures);
   return md.str();
@@ -721,17 +723,19 @@ std::string treeReportMarkdown(const nlohmann::json& result, const ReportFigures
         "`cluster_K/`.\n\n## Sizes against ground truth\n\n"
      << "| cluster | fruitlet | true size (mm) | estimated (mm) | error (mm) | detection |\n"
         "|---|---|---|---|---|---|\n";
-  std::map<int, int> next_in_cluster;  // fruitlets are numbered C<k>.F0.. in each cluster
+  std::map<int, std::size_t> next_in_cluster;  // fruitlets are numbered C<k>.F0.. in each cluster
   for (const auto& f : field(result, "fruitlets")) {
     const int cluster = f.value("cluster", -1);
-    const std::string prefix = "C" + std::to_string(cluster) + ".";
     const bool hit = f.value("matched", false) && field(f, "est_size_mm").is_number();
-    md << "| " << cluster << " | " << prefix << "F" << next_in_cluster[cluster]++ << " | "
+    md << "| " << cluster << " | "
+       << host::report::fruitletLabel(next_in_cluster[cluster]++, cluster) << " | "
        << fmtOrDash(field(f, "gt_size_mm"), 2) << " | "
        << (hit ? fmt(f["est_size_mm"], 2) : "not matched") << " | "
        << (hit ? fmt(f["est_size_mm"].get<double>() - f["gt_size_mm"].get<double>(), 2) : "-")
        << " | "
-       << (hit && f.contains("detection") ? prefix + "D" + field(f, "detection").dump() : "-")
+       << (hit && f.contains("detection")
+               ? host::report::detectionLabel(true, f["detection"].get<std::size_t>(), cluster)
+               : "-")
        << " |\n";
   }
   if (figures.sizes) md << "\n![estimated against true size](sizes.png)\n";
@@ -744,7 +748,7 @@ std::string treeReportMarkdown(const nlohmann::json& result, const ReportFigures
        << field(c, "tag_id").dump() << ")\n\n";
     first = false;
     if (c.contains("sized_fruitlets") || c.contains("unsupported_detections"))
-      appendDetectionTable(md, c, estimator, "C" + field(c, "index").dump() + ".");
+      appendDetectionTable(md, c, estimator, c.value("index", -1));
     else
       md << "Not sized (" << c.value("status", "?") << ").\n";
   }

@@ -7,11 +7,11 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "fvp/host/core/stereo_intrinsics.h"
 #include "fvp/host/report/viewer_scene.h"
-#include "fvp/host/session/mapping_session.h"
 
 namespace fvp::trials {
 

@@ -52,4 +52,10 @@ void removeStaleOutputs(const fs::path& dir, const std::vector<std::string>& out
   }
 }
 
+std::string numberedFileName(const std::string& dir, int number, const std::string& extension) {
+  std::string digits = std::to_string(number);
+  if (digits.size() < 3) digits.insert(0, 3 - digits.size(), '0');
+  return dir + "/" + digits + "." + extension;
+}
+
 }  // namespace fvp::host

@@ -15,8 +15,9 @@ extern const std::string_view kText_orbit_controls_js;
 namespace fvp::host::report {
 namespace {
 
-/// Replaces the one line of the template that is exactly `placeholder` (spaces around it
-/// allowed) by `content`; a template without it is a build defect.
+/// Replaces the first occurrence of `placeholder` by `content` (the template holds each
+/// once, on a line of its own; the scene, which may hold any text, goes in last); a
+/// template without it is a build defect.
 void replaceLine(std::string& page, std::string_view placeholder, const std::string& content) {
   const std::size_t at = page.find(placeholder);
   if (at == std::string::npos)

@@ -1,6 +1,7 @@
 #include "fvp/host/report/viewer_scene.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -12,6 +13,12 @@ std::string detectionLabel(bool kept, std::size_t index, std::optional<int> clus
   std::string label;
   if (cluster) label.append("C").append(std::to_string(*cluster)).append(".");
   return label.append(kept ? "D" : "X").append(std::to_string(index));
+}
+
+std::string fruitletLabel(std::size_t index, std::optional<int> cluster) {
+  std::string label;
+  if (cluster) label.append("C").append(std::to_string(*cluster)).append(".");
+  return label.append("F").append(std::to_string(index));
 }
 
 nlohmann::json vec3Json(const Eigen::Vector3d& v) {
@@ -46,7 +53,9 @@ namespace {
 template <typename T>
 std::string base64Of(const std::vector<T>& values) {
   static_assert(std::is_arithmetic_v<T>);
-  return base64(values.data(), values.size() * sizeof(T));  // x86 and ARM: little-endian
+  // The scene's binary arrays are little-endian: the bytes as they lie in memory.
+  static_assert(std::endian::native == std::endian::little);
+  return base64(values.data(), values.size() * sizeof(T));
 }
 
 void setCluster(nlohmann::json& j, std::optional<int> cluster) {
@@ -101,9 +110,7 @@ void ViewerScene::addCamera(int view, const Eigen::Isometry3d& T_world_camera,
                             nlohmann::json extra) {
   if (!extra.is_object()) extra = nlohmann::json::object();
   extra["view"] = view;
-  const nlohmann::json pose = poseJson(T_world_camera);  // items() of a temporary would dangle
-  extra["position_m"] = pose["position_m"];
-  extra["quaternion_wxyz"] = pose["quaternion_wxyz"];
+  extra.update(poseJson(T_world_camera));
   cameras_.push_back(std::move(extra));
 }
 
@@ -129,7 +136,7 @@ void ViewerScene::addSizing(const nlohmann::json& sizing, int view_offset,
     int g = 0;
     for (const auto& f : sizing["fruitlets"]) {
       nlohmann::json t = {{"index", first_truth + g},
-                          {"label", std::string("F").append(std::to_string(first_truth + g))},
+                          {"label", fruitletLabel(static_cast<std::size_t>(g), cluster)},
                           {"center_m", f.at("gt_center_m")},
                           {"size_mm", f.at("gt_size_mm")},
                           {"detection", nullptr}};

@@ -71,6 +71,7 @@ namespace {
 /// The overlays of the views that sized fruitlets (their left.png read again) and
 /// viewer.html: the set's maps, mesh and detections, and a camera per capture.
 void writeSetViewer(const MappingSession& session, nlohmann::json& out,
+                    const std::filesystem::path& captures_dir,
                     const std::vector<std::filesystem::path>& dirs,
                     const std::filesystem::path& out_dir) {
   const auto left_image = [&](int view) {
@@ -81,7 +82,7 @@ void writeSetViewer(const MappingSession& session, nlohmann::json& out,
   writeFileAtomically(out_dir / "fruitlets.json", "fruitlets", out.dump(2) + "\n");
   std::map<int, std::string> overlay_of;
   for (const auto& o : out["overlays"]) overlay_of[o["view"].get<int>()] = o["file"];
-  report::ViewerScene scene("Capture set: " + dirs.front().parent_path().filename().string(),
+  report::ViewerScene scene("Capture set: " + captures_dir.lexically_normal().string(),
                             std::to_string(dirs.size()) + " captures, " +
                                 std::to_string(out["sized_fruitlets"].size()) + " fruitlets sized");
   addSessionToScene(scene, session, out, 0, std::nullopt);
@@ -184,7 +185,7 @@ nlohmann::json sizeCaptureSet(const std::filesystem::path& captures_dir,
     writePlyColoredPoints(options.out_dir / "clusters.ply", sized.points,
                           sizing::clusterColours(sized.labels),
                           "fvp clusters, world frame, metres; grey = noise");
-    writeSetViewer(session, out, dirs, options.out_dir);
+    writeSetViewer(session, out, captures_dir, dirs, options.out_dir);
   }
   return out;
 }

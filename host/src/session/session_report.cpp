@@ -7,23 +7,15 @@
 #include <stdexcept>
 
 #include "fvp/host/core/atomic_file.h"
+#include "fvp/host/core/output_directory.h"
 #include "fvp/host/report/view_overlay.h"
 
 namespace fvp::host {
-namespace {
-
-std::string overlayFileName(int view) {
-  std::ostringstream name;
-  name << "overlays/" << std::setw(3) << std::setfill('0') << view << ".jpg";
-  return name.str();
-}
-
-}  // namespace
-
 nlohmann::json writeSessionOverlays(const MappingSession& session, const nlohmann::json& sizing,
                                     int first_view, std::optional<int> cluster,
                                     const std::function<cv::Mat(int view)>& image_of,
-                                    const std::filesystem::path& out_dir) {
+                                    const std::filesystem::path& out_dir,
+                                    const std::optional<std::string>& first_view_reason) {
   // Session view -> the labels of the kept detections it sized.
   std::map<int, std::vector<std::string>> sized_in;
   if (sizing.contains("sized_fruitlets")) {
@@ -37,10 +29,11 @@ nlohmann::json writeSessionOverlays(const MappingSession& session, const nlohman
   const auto& views = session.sizingViews();
   nlohmann::json out = nlohmann::json::array();
   for (int v = 0; v < static_cast<int>(views.size()); ++v) {
-    if (v != 0 && !sized_in.count(v)) continue;
+    const bool first_counts = v == 0 && first_view_reason.has_value();
+    if (!first_counts && !sized_in.count(v)) continue;
     const cv::Mat image = image_of(first_view + v);
     if (image.empty()) continue;
-    std::string why = v == 0 ? "start view" : "";
+    std::string why = first_counts ? *first_view_reason : "";
     if (sized_in.count(v)) {
       why += (why.empty() ? "sized " : "; sized ");
       for (std::size_t i = 0; i < sized_in[v].size(); ++i) why += (i ? ", " : "") + sized_in[v][i];
@@ -59,7 +52,7 @@ nlohmann::json writeSessionOverlays(const MappingSession& session, const nlohman
     if (!cv::imencode(".jpg", overlay, jpeg, {cv::IMWRITE_JPEG_QUALITY, 90}))
       throw std::runtime_error("overlay of view " + std::to_string(first_view + v) +
                                ": JPEG encoding failed");
-    const std::string file = overlayFileName(first_view + v);
+    const std::string file = numberedFileName("overlays", first_view + v, "jpg");
     std::filesystem::create_directories(out_dir / "overlays");
     writeFileAtomically(out_dir / file, "view overlay",
                         std::string_view(reinterpret_cast<const char*>(jpeg.data()), jpeg.size()));

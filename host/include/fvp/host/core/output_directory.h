@@ -20,4 +20,8 @@ void prepareOutputDirectory(const std::filesystem::path& dir, const std::string&
 void removeStaleOutputs(const std::filesystem::path& dir, const std::vector<std::string>& outputs,
                         const std::vector<std::string>& numbered_dirs = {});
 
+/// A numbered file's name, as removeStaleOutputs recognises it: dir/NNN.extension (at least
+/// three digits, zero-padded; extension without its dot), e.g. "views/007.png".
+std::string numberedFileName(const std::string& dir, int number, const std::string& extension);
+
 }  // namespace fvp::host

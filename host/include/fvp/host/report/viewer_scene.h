@@ -26,6 +26,9 @@ nlohmann::json poseJson(const Eigen::Isometry3d& T_world_frame);
 /// detection of a sizing, "X<k>" for the k-th the support rule dropped, prefixed "C<c>." in
 /// cluster c of a tree.
 std::string detectionLabel(bool kept, std::size_t index, std::optional<int> cluster);
+/// A ground-truth fruitlet's label: "F<k>" for the k-th fruitlet of a scoring, "C<c>.F<k>"
+/// in cluster c of a tree.
+std::string fruitletLabel(std::size_t index, std::optional<int> cluster);
 /// Standard base64 (RFC 4648, padded) of a byte buffer.
 std::string base64(const void* data, std::size_t bytes);
 
