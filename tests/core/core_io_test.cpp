@@ -134,7 +134,7 @@ TEST(OutputDirectory, CreatesAMissingDirectoryAndRefusesAFile) {
 TEST(OutputDirectory, RemovesOnlyWhatAnEarlierRunWrote) {
   const fs::path dir = freshDir("fvp_stale_outputs");
   for (const char* name : {"result.json", "notes.txt", "views/007.png", "views/cover.png",
-                           "views/12.jpg", "views/0001.png"}) {
+                           "views/12.jpg", "views/0001.png", "views/013.txt"}) {
     fs::create_directories((dir / name).parent_path());
     std::ofstream(dir / name) << "x";
   }
@@ -145,8 +145,15 @@ TEST(OutputDirectory, RemovesOnlyWhatAnEarlierRunWrote) {
   EXPECT_FALSE(fs::exists(dir / "views/0001.png"));
   EXPECT_TRUE(fs::exists(dir / "notes.txt"));
   EXPECT_TRUE(fs::exists(dir / "views/cover.png"));
-  EXPECT_TRUE(fs::exists(dir / "views/12.jpg"));
+  EXPECT_FALSE(fs::exists(dir / "views/12.jpg"));  // overlays are numbered JPEGs
+  EXPECT_TRUE(fs::exists(dir / "views/013.txt"));
   EXPECT_TRUE(fs::is_directory(dir / "report.md"));
+}
+
+TEST(OutputDirectory, NumberedFileNamesArePaddedToThreeDigits) {
+  EXPECT_EQ(numberedFileName("views", 7, "png"), "views/007.png");
+  EXPECT_EQ(numberedFileName("overlays", 42, "jpg"), "overlays/042.jpg");
+  EXPECT_EQ(numberedFileName("views", 1234, "png"), "views/1234.png");
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <numbers>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
@@ -51,6 +52,14 @@ double secondsSince(Clock::time_point start) {
 }
 
 using host::report::vec3Json;
+
+/// How far the camera really was from where the robot was told it was: the translation
+/// (mm) and rotation (deg) of T_told^-1 T_true (zero without pose errors).
+nlohmann::json poseErrorJson(const Eigen::Isometry3d& T_told, const Eigen::Isometry3d& T_true) {
+  const Eigen::Isometry3d d = T_told.inverse() * T_true;
+  return {{"translation_mm", 1000.0 * d.translation().norm()},
+          {"rotation_deg", Eigen::AngleAxisd(d.rotation()).angle() * 180.0 / std::numbers::pi}};
+}
 
 /// R_world_camera as [w, x, y, z]; the camera looks along its z axis (OpenCV frame).
 nlohmann::json quaternionWxyz(const Eigen::Isometry3d& T) {
@@ -107,6 +116,8 @@ class TrialLog : public host::nbv::LoopObserver {
                       {"tsdf_s", v.tsdf_s},
                       {"sim_time_s", e.now_s}});
     if (cluster_ >= 0) views_.back()["cluster"] = cluster_;
+    if (camera_.hasPoseErrors())
+      views_.back()["pose_error"] = poseErrorJson(e.T_world_camera, camera_.lastTruePose());
     if (!options_.out_dir.empty()) {
       keepViewImage(options_.out_dir, index, *e.frame);
       images_.add(index, e.frame->left_bgr);
@@ -322,7 +333,9 @@ struct Trial::Impl {
     // A fixed clock is for runs that repeat: then the moves must repeat too.
     if (clock->mode() == SimClock::Mode::kFixed)
       controller->setReproducibleMotionPlanning(options.seed);
-    camera = std::make_unique<SimulatedCamera>(*renderer, *clock);
+    pose_errors = std::make_unique<PoseErrorModel>(world->config(), options.seed);
+    camera = std::make_unique<SimulatedCamera>(
+        *renderer, *clock, pose_errors->enabled() ? pose_errors.get() : nullptr);
     sim_arm = std::make_unique<SimulatedArm>(*controller, *workspace);
   }
 
@@ -397,6 +410,7 @@ struct Trial::Impl {
   std::unique_ptr<WorkspaceTree> workspace;
   std::unique_ptr<SimClock> clock;
   std::unique_ptr<ArmController> controller;
+  std::unique_ptr<PoseErrorModel> pose_errors;
   std::unique_ptr<SimulatedCamera> camera;
   std::unique_ptr<SimulatedArm> sim_arm;
   bool ran = false;

@@ -2,13 +2,18 @@
 
 namespace fvp::robot::sim {
 
-SimulatedCamera::SimulatedCamera(const StereoRenderer& renderer, SimClock& clock)
-    : renderer_(renderer), clock_(clock) {}
+SimulatedCamera::SimulatedCamera(const StereoRenderer& renderer, SimClock& clock,
+                                 const PoseErrorModel* pose_errors)
+    : renderer_(renderer), clock_(clock), pose_errors_(pose_errors) {}
 
 host::nbv::CaptureResult SimulatedCamera::capture(const Eigen::Isometry3d& T_world_camera) {
   RenderOptions options;
   host::nbv::CaptureResult out;
-  out.frame = renderer_.render(T_world_camera, options);
+  last_true_pose_ =
+      pose_errors_ ? pose_errors_->truePose(T_world_camera, captures_) : T_world_camera;
+  ++captures_;
+  out.frame = renderer_.render(last_true_pose_, options);
+  out.frame.T_world_camera = T_world_camera;  // what the robot believes
   out.status = host::nbv::CaptureStatus::kOk;
   last_render_s_ = renderer_.lastRenderSeconds();
   total_render_s_ += last_render_s_;

@@ -63,6 +63,12 @@ const std::vector<KeySpec>& keySpecs() {
       {"min_cluster_spacing_m", &WorldConfig::min_cluster_spacing_m, 0.01, 2.0},
       {"cluster_height_spread_m", &WorldConfig::cluster_height_spread_m, 0.0, 2.0},
       {"start_view_distance_m", &WorldConfig::start_view_distance_m, 0.05, 5.0},
+      // Errors of centimetres or degrees are a broken robot, not one to size fruitlets with.
+      {"hand_eye_translation_sigma_m", &WorldConfig::hand_eye_translation_sigma_m, 0.0, 0.02},
+      {"hand_eye_rotation_sigma_deg", &WorldConfig::hand_eye_rotation_sigma_deg, 0.0, 5.0},
+      {"arm_position_error_m", &WorldConfig::arm_position_error_m, 0.0, 0.02},
+      {"view_translation_sigma_m", &WorldConfig::view_translation_sigma_m, 0.0, 0.02},
+      {"view_rotation_sigma_deg", &WorldConfig::view_rotation_sigma_deg, 0.0, 5.0},
   };
   return specs;
 }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "fvp/host/nbv/camera.h"
+#include "fvp/robot/sim/pose_error_model.h"
 #include "fvp/robot/sim/sim_clock.h"
 #include "fvp/robot/sim/stereo_renderer.h"
 
@@ -10,20 +11,29 @@ namespace fvp::robot::sim {
 
 class SimulatedCamera : public host::nbv::Camera {
  public:
-  /// renderer and clock must outlive the camera.
-  SimulatedCamera(const StereoRenderer& renderer, SimClock& clock);
+  /// renderer, clock and pose_errors (null: none) must outlive the camera.
+  SimulatedCamera(const StereoRenderer& renderer, SimClock& clock,
+                  const PoseErrorModel* pose_errors = nullptr);
 
   /// Renders the images alone (no ground-truth depth or ids: the loop perceives from the
   /// images) and charges the capture; rendering itself is the simulator's cost, recorded,
-  /// not charged.
+  /// not charged. With pose errors the images are rendered from where the camera really is
+  /// (PoseErrorModel::truePose) and the frame carries T_world_camera, the pose the robot was
+  /// told.
   host::nbv::CaptureResult capture(const Eigen::Isometry3d& T_world_camera) override;
 
   double lastRenderSeconds() const { return last_render_s_; }
   double totalRenderSeconds() const { return total_render_s_; }
+  bool hasPoseErrors() const { return pose_errors_ != nullptr; }
+  /// The pose the last capture was rendered from (the told one without pose errors).
+  const Eigen::Isometry3d& lastTruePose() const { return last_true_pose_; }
 
  private:
   const StereoRenderer& renderer_;
   SimClock& clock_;
+  const PoseErrorModel* pose_errors_;
+  int captures_ = 0;
+  Eigen::Isometry3d last_true_pose_ = Eigen::Isometry3d::Identity();
   double last_render_s_ = 0.0, total_render_s_ = 0.0;
 };
 

@@ -59,6 +59,15 @@ struct WorldConfig {
   double cluster_height_spread_m = 0.3;
   // Start view
   double start_view_distance_m = 0.3;
+  // Pose errors (docs/simulation.md "Pose errors"): the camera renders from the true pose and
+  // the robot is told another. All 0: exact poses (the paper's simulation).
+  double hand_eye_translation_sigma_m = 0.0;  ///< per axis, fixed per trial
+  double hand_eye_rotation_sigma_deg = 0.0;   ///< per rotation-vector component, per trial
+  /// Per-axis RMS of the arm's smooth, position-dependent positioning error (the absolute
+  /// accuracy of an uncalibrated arm).
+  double arm_position_error_m = 0.0;
+  double view_translation_sigma_m = 0.0;  ///< per axis, each view (repeatability)
+  double view_rotation_sigma_deg = 0.0;   ///< per rotation-vector component, each view
 
   /// Reads a YAML file; missing keys keep their defaults; unknown keys, wrong types and
   /// out-of-range values throw std::invalid_argument naming the file and the key.
