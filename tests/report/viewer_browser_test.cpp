@@ -200,6 +200,19 @@ void ViewerInBrowser::checkOverlays() {
     EXPECT_EQ(image.cols, 960) << o.dump();
   }
   EXPECT_EQ(listed, expected);
+  // view_log says what each view contributed: the detections it sized are its overlay's.
+  for (const auto& v : r.at("view_log")) {
+    EXPECT_TRUE(v.contains("fine_voxels_updated")) << v.dump();
+    if (!v.contains("sized")) continue;
+    const int view = v.at("index").get<int>();
+    EXPECT_TRUE(listed.count(view)) << view;
+    for (const auto& o : r.at("overlays"))
+      if (o.at("view") == view)
+        for (const auto& label : v.at("sized"))
+          EXPECT_NE(o.at("why").get<std::string>().find(label.get<std::string>()),
+                    std::string::npos)
+              << o.dump();
+  }
 }
 
 }  // namespace

@@ -110,6 +110,8 @@ class TrialLog : public host::nbv::LoopObserver {
                       {"tag_detected", v.tag_detected},
                       {"roi_points", v.roi_points},
                       {"other_points", v.other_points},
+                      {"coarse_voxels_updated", v.scan.coarse_voxels_updated},
+                      {"fine_voxels_updated", v.scan.fine_voxels_updated},
                       {"render_s", camera_.lastRenderSeconds()},
                       {"perceive_s", v.perceive_s},
                       {"mapping_s", v.scan.seconds},
@@ -166,6 +168,22 @@ class TrialLog : public host::nbv::LoopObserver {
   int cluster_ = -1, first_view_ = 0;  ///< -1: a one-cluster world
   nlohmann::json views_ = nlohmann::json::array(), plans_ = nlohmann::json::array();
 };
+
+/// Each view's entry in view_log gets "sized": the kept detections of a cluster's sizing (its
+/// per_image views counted from first_view) that the view gave a size to.
+void markSizedViews(nlohmann::json& view_log, const nlohmann::json& sizing, int first_view,
+                    std::optional<int> cluster) {
+  if (!sizing.contains("sized_fruitlets")) return;
+  std::size_t k = 0;
+  for (const auto& d : sizing["sized_fruitlets"]) {
+    for (const auto& s : d.at("per_image")) {
+      const std::size_t view = static_cast<std::size_t>(first_view + s.at("view").get<int>());
+      if (view < view_log.size())
+        view_log[view]["sized"].push_back(host::report::detectionLabel(true, k, cluster));
+    }
+    ++k;
+  }
+}
 
 /// The log's view images, as the overlays ask for them.
 std::function<cv::Mat(int)> imageSource(const TrialLog& log) {
@@ -522,6 +540,7 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
                                         imageSource(log), options.out_dir, "start view");
     });
   describeRun(result, log, camera_path);
+  markSizedViews(result["view_log"], outcome.sizing, 0, std::nullopt);
   if (!options.out_dir.empty()) {
     parts->writeOutputs(result, *world, camera_path, options.out_dir, options.on_warning);
     viewerOrWarning(result, [&] {
@@ -611,6 +630,7 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
     entry["status"] = mapped ? "sized" : "no_tag";
     ++cluster_status[entry["status"].get<std::string>()];
     entry["views"] = outcome.run.views;
+    entry["first_view"] = log.firstView();  // the run's number of its first view
     entry["stop_reason"] = outcome.run.stop_reason;
     entry["sim_time_s"] = loop_clock.now_s() - t0_s;
     for (auto& [key, value] : outcome.sizing.items()) {
@@ -718,6 +738,9 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
   result["stop"] = stopJson();
   if (!options.out_dir.empty()) result["overlays"] = overlays;
   describeRun(result, log, camera_path);
+  for (const auto& c : result["clusters"])
+    if (c.contains("first_view"))
+      markSizedViews(result["view_log"], c, c["first_view"].get<int>(), c["index"].get<int>());
   if (!options.out_dir.empty()) {
     writeTreeOutputs(result, *world, carried_map.get(), camera_path, options.out_dir,
                      options.on_warning);
