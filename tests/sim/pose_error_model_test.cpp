@@ -154,3 +154,4 @@ TEST(PoseErrorModel, TheCameraRendersFromTheTruePoseAndTheCloudMovesByExactlyThe
 
 }  // namespace
 }  // namespace fvp::robot::sim
+

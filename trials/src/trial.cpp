@@ -333,7 +333,7 @@ struct Trial::Impl {
     parts = makeParts(0);
 
     // The simulated camera.
-    RenderConfig render_config;
+    RenderConfig render_config = renderConfigFor(world->config());
     render_config.noise_seed = options.seed;
     renderer = std::make_unique<StereoRenderer>(*world, render_config);
 

@@ -362,10 +362,22 @@ StereoRenderer::StereoRenderer(const World& world, const RenderConfig& config)
   if (!(config.noise_sigma >= 0.0) || !(config.flash_power >= 0.0)) {
     throw std::invalid_argument("StereoRenderer: noise_sigma and flash_power must be >= 0");
   }
+  if (!(config.right_baseline_scale > 0.5 && config.right_baseline_scale < 2.0) ||
+      !(std::abs(config.right_vertical_offset_px) <= 10.0)) {
+    throw std::invalid_argument(
+        "StereoRenderer: right_baseline_scale must be in (0.5, 2) and right_vertical_offset_px "
+        "within +-10 px");
+  }
   impl_->build();
 }
 
 StereoRenderer::~StereoRenderer() = default;
+
+RenderConfig renderConfigFor(const WorldConfig& world, RenderConfig base) {
+  base.right_baseline_scale = 1.0 + world.stereo_baseline_error;
+  base.right_vertical_offset_px = world.stereo_vertical_misalignment_px;
+  return base;
+}
 
 double StereoRenderer::lastRenderSeconds() const {
   return impl_->last_seconds.load();
@@ -392,7 +404,9 @@ RenderedView StereoRenderer::renderWithGroundTruth(const Eigen::Isometry3d& T_wo
     for (int v = 0; v < depth.rows; ++v)
       for (int u = 0; u < depth.cols; ++u)
         if (const float z = depth.at<float>(v, u); z > 0.0f)
-          view.frame.disparity_px.at<float>(v, u) = static_cast<float>(K.disparityFromDepth(z));
+          // What an ideal matcher measures on the rig as built (its true baseline).
+          view.frame.disparity_px.at<float>(v, u) = static_cast<float>(
+              K.disparityFromDepth(z) * impl_->config.right_baseline_scale);
   }
   return view;
 }
@@ -416,10 +430,11 @@ host::StereoFrame StereoRenderer::Impl::render(const Eigen::Isometry3d& T_world_
     truth->object_id = cv::Mat::zeros(height, width, CV_32S);
   }
   const Eigen::Matrix3d R = T_world_camera.linear();
-  const std::array<Eigen::Vector3d, 2> eyes = {
-      T_world_camera.translation(), T_world_camera.translation() + in.baseline_m * R.col(0)};
+  const double baseline_m = in.baseline_m * im.config.right_baseline_scale;  // the true one
+  const std::array<Eigen::Vector3d, 2> eyes = {T_world_camera.translation(),
+                                               T_world_camera.translation() + baseline_m * R.col(0)};
   // One flash for the simultaneous exposure of both cameras, at the rig's centre.
-  const Eigen::Vector3d flash = T_world_camera.translation() + 0.5 * in.baseline_m * R.col(0);
+  const Eigen::Vector3d flash = T_world_camera.translation() + 0.5 * baseline_m * R.col(0);
   // Noise differs per view: mix the seed with the pose's bits.
   std::uint64_t view_seed = detail::mix64(im.config.noise_seed);
   for (int i = 0; i < 16; ++i) {
@@ -431,9 +446,12 @@ host::StereoFrame StereoRenderer::Impl::render(const Eigen::Isometry3d& T_world_
   const int spp = im.config.samples_per_pixel;
   const int strata_x = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(spp))));
   const int strata_y = (spp + strata_x - 1) / strata_x;
-  const auto rayDir = [&](double u, double v) {
-    return Eigen::Vector3d(
-        R * Eigen::Vector3d((u - in.cx_px) / in.fx_px, (v - in.cy_px) / in.fy_px, 1.0));
+  // The right camera's rows are offset: its pixel row v sees what row v - offset would.
+  const std::array<double, 2> row_offset_px = {0.0, im.config.right_vertical_offset_px};
+  const auto rayDir = [&](int camera, double u, double v) {
+    return Eigen::Vector3d(R * Eigen::Vector3d((u - in.cx_px) / in.fx_px,
+                                               (v - row_offset_px[camera] - in.cy_px) / in.fy_px,
+                                               1.0));
   };
 
   // Adaptive anti-aliasing: shade every pixel corner once (shared by four pixels); a pixel
@@ -459,7 +477,8 @@ host::StereoFrame StereoRenderer::Impl::render(const Eigen::Isometry3d& T_world_
         for (int col = 0; col < corner_cols; ++col) {
           for (int camera = 0; camera < 2; ++camera) {
             const ShadedSample sample =
-                im.radiance(eyes[camera], rayDir(col - 0.5, row - 0.5), flash, options.with_leaves);
+                im.radiance(eyes[camera], rayDir(camera, col - 0.5, row - 0.5), flash,
+                            options.with_leaves);
             corners[camera][static_cast<std::size_t>(row) * corner_cols + col] = {
                 sample.rgb.cast<float>(), sample.region};
           }
@@ -479,7 +498,7 @@ host::StereoFrame StereoRenderer::Impl::render(const Eigen::Isometry3d& T_world_
         const std::uint64_t pixel_seed =
             detail::hashCombine(view_seed, static_cast<std::uint64_t>(row) * width + col);
         if (truth) {
-          const Hit hit = im.trace(eyes[0], rayDir(col, row), options.with_leaves);
+          const Hit hit = im.trace(eyes[0], rayDir(0, col, row), options.with_leaves);
           if (hit.primitive >= 0) {
             // The direction has unit z in the camera frame, so t is the z-depth.
             truth->depth_m.at<float>(row, col) = static_cast<float>(hit.t);
@@ -512,7 +531,7 @@ host::StereoFrame StereoRenderer::Impl::render(const Eigen::Isometry3d& T_world_
                 dv = ((s / strata_x) + jy) / strata_y - 0.5;
               }
               linear +=
-                  im.radiance(eyes[camera], rayDir(col + du, row + dv), flash, options.with_leaves)
+                  im.radiance(eyes[camera], rayDir(camera, col + du, row + dv), flash, options.with_leaves)
                       .rgb;
             }
             linear /= spp;

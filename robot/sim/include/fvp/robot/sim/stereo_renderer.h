@@ -21,6 +21,7 @@
 
 #include "fvp/host/perception/stereo_frame.h"
 #include "fvp/robot/sim/world.h"
+#include "fvp/robot/sim/world_config.h"
 
 namespace fvp::robot::sim {
 
@@ -39,7 +40,17 @@ struct RenderConfig {
   double noise_sigma = 2.0;      ///< Gaussian sensor noise, 8-bit grey levels
   std::uint64_t noise_seed = 0;  ///< mixed with the pose so each view's noise differs
   int threads = 0;               ///< 0: all cores
+  /// Stereo calibration errors (docs/simulation.md "Stereo calibration"): the rig's true
+  /// baseline is intrinsics.baseline_m times this, and a point appears this many pixels lower
+  /// in the right image than in the left (a residual vertical misalignment after
+  /// rectification). The frame's intrinsics stay the nominal ones, as a robot's calibration.
+  double right_baseline_scale = 1.0;
+  double right_vertical_offset_px = 0.0;
 };
+
+/// The render config of a world: its stereo calibration errors (stereo_baseline_error,
+/// stereo_vertical_misalignment_px) on top of base.
+RenderConfig renderConfigFor(const WorldConfig& world, RenderConfig base = {});
 
 struct RenderOptions {
   bool with_leaves = true;  ///< false: render without leaves (occlusion statistic)

@@ -68,6 +68,10 @@ struct WorldConfig {
   double arm_position_error_m = 0.0;
   double view_translation_sigma_m = 0.0;  ///< per axis, each view (repeatability)
   double view_rotation_sigma_deg = 0.0;   ///< per rotation-vector component, each view
+  // Stereo calibration (docs/simulation.md "Stereo calibration"); 0: a perfect rig.
+  double stereo_baseline_error = 0.0;  ///< true baseline / nominal - 1 (0.005: 0.5 % longer)
+  /// A point's row in the right image minus its row in the left, after rectification.
+  double stereo_vertical_misalignment_px = 0.0;
 
   /// Reads a YAML file; missing keys keep their defaults; unknown keys, wrong types and
   /// out-of-range values throw std::invalid_argument naming the file and the key.
