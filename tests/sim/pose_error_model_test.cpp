@@ -154,4 +154,3 @@ TEST(PoseErrorModel, TheCameraRendersFromTheTruePoseAndTheCloudMovesByExactlyThe
 
 }  // namespace
 }  // namespace fvp::robot::sim
-

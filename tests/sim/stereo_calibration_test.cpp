@@ -50,14 +50,14 @@ TEST(StereoCalibration, AVerticalMisalignmentMovesTheRightImageDownByItsRows) {
   const World world = World::generate(WorldConfig{}, 1);
   WorldConfig misaligned;
   misaligned.stereo_vertical_misalignment_px = 2.0;
-  const StereoRenderer nominal(world, smallRig(WorldConfig{})),
-      built(world, smallRig(misaligned));
+  const StereoRenderer nominal(world, smallRig(WorldConfig{})), built(world, smallRig(misaligned));
   const auto a = nominal.render(world.startCameraPose());
   const auto b = built.render(world.startCameraPose());
   EXPECT_EQ(cv::norm(a.left_bgr, b.left_bgr, cv::NORM_INF), 0.0);
   // Row v of the misaligned right image is row v - 2 of the nominal one.
   const int rows = a.right_bgr.rows - 2;
-  const cv::Mat shifted = b.right_bgr.rowRange(2, 2 + rows), reference = a.right_bgr.rowRange(0, rows);
+  const cv::Mat shifted = b.right_bgr.rowRange(2, 2 + rows),
+                reference = a.right_bgr.rowRange(0, rows);
   EXPECT_EQ(cv::norm(shifted, reference, cv::NORM_INF), 0.0);
   EXPECT_GT(cv::norm(a.right_bgr, b.right_bgr, cv::NORM_INF), 0.0);
 }

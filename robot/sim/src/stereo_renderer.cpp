@@ -405,8 +405,8 @@ RenderedView StereoRenderer::renderWithGroundTruth(const Eigen::Isometry3d& T_wo
       for (int u = 0; u < depth.cols; ++u)
         if (const float z = depth.at<float>(v, u); z > 0.0f)
           // What an ideal matcher measures on the rig as built (its true baseline).
-          view.frame.disparity_px.at<float>(v, u) = static_cast<float>(
-              K.disparityFromDepth(z) * impl_->config.right_baseline_scale);
+          view.frame.disparity_px.at<float>(v, u) =
+              static_cast<float>(K.disparityFromDepth(z) * impl_->config.right_baseline_scale);
   }
   return view;
 }
@@ -431,8 +431,8 @@ host::StereoFrame StereoRenderer::Impl::render(const Eigen::Isometry3d& T_world_
   }
   const Eigen::Matrix3d R = T_world_camera.linear();
   const double baseline_m = in.baseline_m * im.config.right_baseline_scale;  // the true one
-  const std::array<Eigen::Vector3d, 2> eyes = {T_world_camera.translation(),
-                                               T_world_camera.translation() + baseline_m * R.col(0)};
+  const std::array<Eigen::Vector3d, 2> eyes = {
+      T_world_camera.translation(), T_world_camera.translation() + baseline_m * R.col(0)};
   // One flash for the simultaneous exposure of both cameras, at the rig's centre.
   const Eigen::Vector3d flash = T_world_camera.translation() + 0.5 * baseline_m * R.col(0);
   // Noise differs per view: mix the seed with the pose's bits.
@@ -476,9 +476,8 @@ host::StereoFrame StereoRenderer::Impl::render(const Eigen::Isometry3d& T_world_
       try {
         for (int col = 0; col < corner_cols; ++col) {
           for (int camera = 0; camera < 2; ++camera) {
-            const ShadedSample sample =
-                im.radiance(eyes[camera], rayDir(camera, col - 0.5, row - 0.5), flash,
-                            options.with_leaves);
+            const ShadedSample sample = im.radiance(
+                eyes[camera], rayDir(camera, col - 0.5, row - 0.5), flash, options.with_leaves);
             corners[camera][static_cast<std::size_t>(row) * corner_cols + col] = {
                 sample.rgb.cast<float>(), sample.region};
           }
@@ -530,9 +529,9 @@ host::StereoFrame StereoRenderer::Impl::render(const Eigen::Isometry3d& T_world_
                 du = ((s % strata_x) + jx) / strata_x - 0.5;
                 dv = ((s / strata_x) + jy) / strata_y - 0.5;
               }
-              linear +=
-                  im.radiance(eyes[camera], rayDir(camera, col + du, row + dv), flash, options.with_leaves)
-                      .rgb;
+              linear += im.radiance(eyes[camera], rayDir(camera, col + du, row + dv), flash,
+                                    options.with_leaves)
+                            .rgb;
             }
             linear /= spp;
           }

@@ -70,8 +70,7 @@ const std::vector<KeySpec>& keySpecs() {
       {"view_translation_sigma_m", &WorldConfig::view_translation_sigma_m, 0.0, 0.02},
       {"view_rotation_sigma_deg", &WorldConfig::view_rotation_sigma_deg, 0.0, 5.0},
       {"stereo_baseline_error", &WorldConfig::stereo_baseline_error, -0.05, 0.05},
-      {"stereo_vertical_misalignment_px", &WorldConfig::stereo_vertical_misalignment_px, -5.0,
-       5.0},
+      {"stereo_vertical_misalignment_px", &WorldConfig::stereo_vertical_misalignment_px, -5.0, 5.0},
   };
   return specs;
 }
