@@ -21,6 +21,7 @@
 #include "fvp/host/core/gnuplot.h"
 #include "fvp/host/core/output_directory.h"
 #include "fvp/host/map/map_engine_registry.h"
+#include "number_text.h"
 
 namespace fvp::trials {
 namespace {
@@ -131,13 +132,6 @@ std::string oneLine(std::string text) {
     if (c == '\n' || c == '\r') c = ' ';
   while (!text.empty() && text.back() == ' ') text.pop_back();
   return text;
-}
-
-std::string fmt(const nlohmann::json& v, int precision) {
-  if (!v.is_number()) return "-";
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(precision) << v.get<double>();
-  return s.str();
 }
 
 /// A member that is a number, or null (absent, null or another type: an older or partial line).
@@ -410,11 +404,12 @@ bool writeReports(const fs::path& dir, const std::vector<nlohmann::json>& unsort
       {"fvp-octomap-paper-sizing", "FVP on octomap, paper's sizing estimator"}};
   for (const auto& [key, row] : summary.items()) {
     const auto name = names.count(key) ? names.at(key) : key;
-    md << "| " << name << " | " << row["trials"] << " | " << fmt(row["mean_views"], 1) << " | "
-       << fmt(row["match_percent"], 1) << " | " << fmt(row["mae_mm"], 2) << " | "
-       << fmt(row["mape_percent"], 2) << " | " << fmt(row["precision_percent"], 1) << " | "
-       << fmt(row["median_sim_s_per_cluster"], 1) << " | " << fmt(row["matched_per_sim_min"], 2)
-       << " |\n";
+    md << "| " << name << " | " << row["trials"] << " | " << fmtOrDash(row["mean_views"], 1)
+       << " | " << fmtOrDash(row["match_percent"], 1) << " | " << fmtOrDash(row["mae_mm"], 2)
+       << " | " << fmtOrDash(row["mape_percent"], 2) << " | "
+       << fmtOrDash(row["precision_percent"], 1) << " | "
+       << fmtOrDash(row["median_sim_s_per_cluster"], 1) << " | "
+       << fmtOrDash(row["matched_per_sim_min"], 2) << " |\n";
   }
   const std::string table = md.str();
   // The tables first: the figure is an extra that must not cost them.

@@ -6,6 +6,7 @@
 
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/trials/experiment_directory.h"
+#include "number_text.h"
 
 namespace fvp::trials {
 namespace {
@@ -86,13 +87,6 @@ std::string experimentName(const fs::path& dir) {
   return name.empty() ? normal.parent_path().filename().string() : name;
 }
 
-std::string number(const nlohmann::json& v, int precision) {
-  if (!v.is_number()) return "-";
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(precision) << v.get<double>();
-  return s.str();
-}
-
 }  // namespace
 
 void writeIndexPage(const fs::path& dir, const std::string& table_markdown,
@@ -128,11 +122,11 @@ void writeIndexPage(const fs::path& dir, const std::string& table_markdown,
     };
     const nlohmann::json& m = t.contains("metrics") ? t["metrics"] : nlohmann::json::object();
     html << "<tr><td>" << escapeHtml(trialRowKey(t)) << "</td><td>" << t.at("seed") << "</td><td>"
-         << t.value("views", 0) << "</td><td>" << number(t.value("sim_time_s", 0.0), 1)
+         << t.value("views", 0) << "</td><td>" << fmtOrDash(t.value("sim_time_s", 0.0), 1)
          << "</td><td>" << escapeHtml(t.value("stop_reason", "-")) << "</td><td>"
-         << number(m.value("match_percent", nlohmann::json()), 1) << "</td><td>"
-         << number(m.value("mae_mm", nlohmann::json()), 2) << "</td><td>"
-         << number(m.value("precision_percent", nlohmann::json()), 1) << "</td><td>"
+         << fmtOrDash(m.value("match_percent", nlohmann::json()), 1) << "</td><td>"
+         << fmtOrDash(m.value("mae_mm", nlohmann::json()), 2) << "</td><td>"
+         << fmtOrDash(m.value("precision_percent", nlohmann::json()), 1) << "</td><td>"
          << link("viewer.html") << "</td><td>" << link("report.md") << "</td></tr>\n";
   }
   html << "</table>\n</body></html>\n";

@@ -26,6 +26,7 @@
 #include "fvp/host/report/viewer_scene.h"
 #include "fvp/host/sizing/fruitlet_sizer.h"
 #include "fvp/host/tsdf/tsdf_volume.h"
+#include "number_text.h"
 
 namespace fvp::trials {
 // The simulator's parts and the arm, by their short names.
@@ -155,16 +156,6 @@ void keepViewImage(const std::filesystem::path& out_dir, int index,
 
 namespace fvp::trials {
 namespace {
-
-std::string fmt(double v, int precision) {
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(precision) << v;
-  return s.str();
-}
-
-std::string fmtOrDash(const nlohmann::json& v, int precision) {
-  return v.is_number() ? fmt(v.get<double>(), precision) : "-";
-}
 
 /// j[key], or null when j is not an object or lacks it (a result of an older build).
 const nlohmann::json& field(const nlohmann::json& j, const char* key) {

@@ -8,17 +8,24 @@
 
 namespace fvp::host::report {
 
+namespace {
+
+/// "C<c>.<kind><index>", or "<kind><index>" outside a tree. Appended, not "C" + to_string(...):
+/// GCC 12 warns falsely (-Wrestrict) on the latter.
+std::string label(const char* kind, std::size_t index, std::optional<int> cluster) {
+  std::string text;
+  if (cluster) text.append("C").append(std::to_string(*cluster)).append(".");
+  return text.append(kind).append(std::to_string(index));
+}
+
+}  // namespace
+
 std::string detectionLabel(bool kept, std::size_t index, std::optional<int> cluster) {
-  // Appended, not "C" + to_string(...): GCC 12 warns falsely (-Wrestrict) on the latter.
-  std::string label;
-  if (cluster) label.append("C").append(std::to_string(*cluster)).append(".");
-  return label.append(kept ? "D" : "X").append(std::to_string(index));
+  return label(kept ? "D" : "X", index, cluster);
 }
 
 std::string fruitletLabel(std::size_t index, std::optional<int> cluster) {
-  std::string label;
-  if (cluster) label.append("C").append(std::to_string(*cluster)).append(".");
-  return label.append("F").append(std::to_string(index));
+  return label("F", index, cluster);
 }
 
 nlohmann::json vec3Json(const Eigen::Vector3d& v) {
