@@ -9,6 +9,7 @@
 
 #include "fvp/host/report/view_overlay.h"
 #include "fvp/host/session/session_report.h"
+#include "small_intrinsics.h"
 
 namespace fvp::host {
 namespace {
@@ -17,11 +18,7 @@ namespace fs = std::filesystem;
 
 StereoFrame darkFrame() {
   StereoFrame frame;
-  frame.intrinsics.width_px = 320;
-  frame.intrinsics.height_px = 240;
-  frame.intrinsics.fx_px = frame.intrinsics.fy_px = 300.0;
-  frame.intrinsics.cx_px = 159.5;
-  frame.intrinsics.cy_px = 119.5;
+  frame.intrinsics = test::smallIntrinsics(320, 240, 300.0);
   frame.left_bgr = cv::Mat(240, 320, CV_8UC3, cv::Scalar(20, 20, 20));
   frame.right_bgr = frame.left_bgr.clone();
   return frame;

@@ -5,19 +5,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fvp/host/report/view_overlay.h"
+#include "small_intrinsics.h"
 
 namespace fvp::host::report {
 namespace {
-
-StereoIntrinsics smallCamera() {
-  StereoIntrinsics in;
-  in.width_px = 640;
-  in.height_px = 480;
-  in.fx_px = in.fy_px = 600.0;
-  in.cx_px = 319.5;
-  in.cy_px = 239.5;
-  return in;
-}
 
 int countColour(const cv::Mat& image, const cv::Scalar& bgr) {
   cv::Mat hit;
@@ -26,7 +17,7 @@ int countColour(const cv::Mat& image, const cv::Scalar& bgr) {
 }
 
 TEST(ViewOverlay, DrawsTheContourTheEllipseAndTheTagAxesAtTheOverlaysScale) {
-  const StereoIntrinsics in = smallCamera();
+  const StereoIntrinsics in = test::smallIntrinsics(640, 480, 600.0);
   const cv::Mat grey(in.height_px, in.width_px, CV_8UC3, cv::Scalar(90, 90, 90));
   cv::Mat mask = cv::Mat::zeros(in.height_px, in.width_px, CV_8U);
   cv::circle(mask, {200, 200}, 40, 255, cv::FILLED);
@@ -69,7 +60,7 @@ TEST(ViewOverlay, DrawsTheContourTheEllipseAndTheTagAxesAtTheOverlaysScale) {
 }
 
 TEST(ViewOverlay, TheRegionCropFramesTheRegionsProjection) {
-  const StereoIntrinsics in = smallCamera();
+  const StereoIntrinsics in = test::smallIntrinsics(640, 480, 600.0);
   // A 5 cm region 0.5 m ahead: 60 px radius, 75 px with the margin, around the centre pixel.
   const cv::Rect crop = regionCrop({0.0, 0.0, 0.5}, 0.05, Eigen::Isometry3d::Identity(), in);
   EXPECT_NEAR(crop.x, 319.5 - 75, 1.0);

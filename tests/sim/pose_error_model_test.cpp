@@ -12,6 +12,7 @@
 #include "fvp/robot/sim/pose_error_model.h"
 #include "fvp/robot/sim/simulated_camera.h"
 #include "fvp/robot/sim/world.h"
+#include "small_intrinsics.h"
 
 namespace fvp::robot::sim {
 namespace {
@@ -116,11 +117,7 @@ TEST(PoseErrorModel, TheCameraRendersFromTheTruePoseAndTheCloudMovesByExactlyThe
   c.hand_eye_rotation_sigma_deg = 0.5;
   const World world = World::generate(WorldConfig{}, 1);
   RenderConfig rc;
-  rc.intrinsics.width_px = 288;
-  rc.intrinsics.height_px = 216;
-  rc.intrinsics.fx_px = rc.intrinsics.fy_px = 220.0;
-  rc.intrinsics.cx_px = 143.5;
-  rc.intrinsics.cy_px = 107.5;
+  rc.intrinsics = test::smallIntrinsics(288, 216, 220.0);
   const StereoRenderer renderer(world, rc);
   SimClock clock(SimClock::Mode::kFixed);
   const PoseErrorModel model(c, 11);

@@ -5,17 +5,14 @@
 
 #include "fvp/robot/sim/stereo_renderer.h"
 #include "fvp/robot/sim/world.h"
+#include "small_intrinsics.h"
 
 namespace fvp::robot::sim {
 namespace {
 
 RenderConfig smallRig(const WorldConfig& world) {
   RenderConfig rc = renderConfigFor(world);
-  rc.intrinsics.width_px = 288;
-  rc.intrinsics.height_px = 216;
-  rc.intrinsics.fx_px = rc.intrinsics.fy_px = 220.0;
-  rc.intrinsics.cx_px = 143.5;
-  rc.intrinsics.cy_px = 107.5;
+  rc.intrinsics = test::smallIntrinsics(288, 216, 220.0);
   rc.samples_per_pixel = 1;  // one ray through each pixel centre: shifts are exact
   rc.noise_sigma = 0.0;
   return rc;

@@ -8,6 +8,7 @@
 #include "fvp/host/core/output_directory.h"
 #include "fvp/host/report/view_overlay.h"
 #include "fvp/host/report/viewer_page.h"
+#include "fvp/host/session/session_report.h"
 
 namespace fvp::trials {
 
@@ -49,9 +50,8 @@ void writeTrialViewer(host::report::ViewerScene& scene, const nlohmann::json& re
                       const std::optional<host::StereoIntrinsics>& intrinsics,
                       const std::filesystem::path& out_dir) {
   if (intrinsics) scene.setIntrinsics(*intrinsics);
-  std::map<int, std::string> overlay_of;
-  if (result.contains("overlays"))
-    for (const auto& o : result["overlays"]) overlay_of[o.at("view").get<int>()] = o.at("file");
+  const std::map<int, std::string> overlay_of =
+      host::overlayFileOfView(result.value("overlays", nlohmann::json::array()));
   for (const auto& v : result.at("view_log")) {
     const int view = v.at("index").get<int>();
     nlohmann::json extra = {
@@ -59,8 +59,8 @@ void writeTrialViewer(host::report::ViewerScene& scene, const nlohmann::json& re
         {"tag_detected", v.at("tag_detected")},
         {"roi_points", v.at("roi_points")},
         {"other_points", v.at("other_points")},
-        {"image",
-         overlay_of.count(view) ? overlay_of[view] : host::numberedFileName("views", view, "png")}};
+        {"image", overlay_of.count(view) ? overlay_of.at(view)
+                                         : host::numberedFileName("views", view, "png")}};
     if (v.contains("cluster")) extra["cluster"] = v["cluster"];
     scene.addCamera(view, poseOf(v.at("position_m"), v.at("quaternion_wxyz")), std::move(extra));
   }

@@ -80,8 +80,7 @@ void writeSetViewer(const MappingSession& session, nlohmann::json& out,
   };
   out["overlays"] = writeSessionOverlays(session, out, 0, std::nullopt, left_image, out_dir);
   writeFileAtomically(out_dir / "fruitlets.json", "fruitlets", out.dump(2) + "\n");
-  std::map<int, std::string> overlay_of;
-  for (const auto& o : out["overlays"]) overlay_of[o["view"].get<int>()] = o["file"];
+  const std::map<int, std::string> overlay_of = overlayFileOfView(out["overlays"]);
   report::ViewerScene scene("Capture set: " + captures_dir.lexically_normal().string(),
                             std::to_string(dirs.size()) + " captures, " +
                                 std::to_string(out["sized_fruitlets"].size()) + " fruitlets sized");
@@ -92,7 +91,8 @@ void writeSetViewer(const MappingSession& session, nlohmann::json& out,
                             {"tag_detected", session.views()[v].tag_detected},
                             {"roi_points", session.views()[v].roi_points},
                             {"other_points", session.views()[v].other_points}};
-    if (overlay_of.count(int(v))) extra["image"] = overlay_of[int(v)];
+    if (const auto it = overlay_of.find(int(v)); it != overlay_of.end())
+      extra["image"] = it->second;
     scene.addCamera(int(v), views[v].T_world_camera, std::move(extra));
   }
   if (!views.empty()) scene.setIntrinsics(views.front().intrinsics);

@@ -64,6 +64,12 @@ nlohmann::json writeSessionOverlays(const MappingSession& session, const nlohman
   return out;
 }
 
+std::map<int, std::string> overlayFileOfView(const nlohmann::json& overlays) {
+  std::map<int, std::string> file_of;
+  for (const auto& o : overlays) file_of[o.at("view").get<int>()] = o.at("file");
+  return file_of;
+}
+
 void addSessionToScene(report::ViewerScene& scene, const MappingSession& session,
                        const nlohmann::json& sizing, int first_view, std::optional<int> cluster) {
   if (const map::MapEngine* map = session.map()) scene.addFineVoxels(*map);

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <optional>
@@ -27,6 +28,9 @@ nlohmann::json writeSessionOverlays(const MappingSession& session, const nlohman
                                     const std::function<cv::Mat(int view)>& image_of,
                                     const std::filesystem::path& out_dir,
                                     const std::optional<std::string>& first_view_reason = {});
+
+/// The file of each view's overlay, from writeSessionOverlays' list: view -> "overlays/NNN.jpg".
+std::map<int, std::string> overlayFileOfView(const nlohmann::json& overlays);
 
 /// The session's occupied fine voxels, TSDF mesh, Cluster Region, tag and detections (views
 /// numbered from first_view).
