@@ -17,7 +17,7 @@ namespace fvp::apps {
 void addExperimentCommands(CLI::App& app) {
   struct Options {
     trials::ExperimentOptions experiment;
-    std::string planners = "fvp,rvp", shard, world, config, out;
+    std::string planners = "fvp,rvp", shard, world, config, out, error_scale;
     int max_views = 0;
   };
   auto opt = std::make_shared<Options>();
@@ -36,6 +36,9 @@ void addExperimentCommands(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--world", opt->world, "world config YAML")->check(CLI::ExistingFile);
   cmd->add_option("--config", opt->config, "planner config YAML")->check(CLI::ExistingFile);
+  cmd->add_option("--error-scale", opt->error_scale,
+                  "GROUP=FACTOR: the world's pose, stereo, wind, segmentation or all errors "
+                  "times FACTOR (a sweep point; written to OUT/world.yaml)");
   cmd->add_option("--budget-s", opt->experiment.trial.budget_s, "simulated budget per trial, s")
       ->check(finiteNumber())
       ->check(positiveNumber())
@@ -77,7 +80,9 @@ void addExperimentCommands(CLI::App& app) {
     if (opt->planners.empty()) o.planners.clear();
     if (!opt->shard.empty())
       std::tie(o.shard_index, o.shard_count) = trials::parseShard(opt->shard);
-    o.trial.world_config = opt->world;
+    o.trial.world_config = opt->error_scale.empty() ? std::filesystem::path(opt->world)
+                                                    : trials::writeScaledWorldConfig(
+                                                          opt->world, opt->error_scale, opt->out);
     o.trial.planner_config = opt->config;
     if (opt->max_views > 0) o.trial.max_views = opt->max_views;
     o.out_dir = opt->out;

@@ -10,6 +10,7 @@
 #include <optional>
 #include <sstream>
 
+#include "fvp/robot/sim/world_config.h"
 #include "fvp/trials/experiment.h"
 
 namespace fvp::trials {
@@ -365,6 +366,21 @@ TEST(Experiment, DuplicateOrNoPlannersAreErrors) {
   EXPECT_THROW(runExperiment(o, counting, nullptr), std::invalid_argument);
   EXPECT_EQ(calls, 0);
   EXPECT_FALSE(fs::exists(o.out_dir));
+}
+
+TEST(Experiment, AnErrorScaleWritesTheScaledWorldConfigTheTrialsRead) {
+  const fs::path out = fs::path(::testing::TempDir()) / "fvp_error_scale";
+  fs::remove_all(out);
+  const fs::path world = fs::path(FVP_SOURCE_DIR) / "robot/sim/config/world_field.yaml";
+  const fs::path written = writeScaledWorldConfig(world, "pose=2", out);
+  EXPECT_EQ(written, out / "world.yaml");
+  const auto scaled = robot::sim::WorldConfig::fromYamlFile(written);
+  const auto base = robot::sim::WorldConfig::fromYamlFile(world);
+  EXPECT_DOUBLE_EQ(scaled.hand_eye_translation_sigma_m, 2.0 * base.hand_eye_translation_sigma_m);
+  EXPECT_EQ(scaled.wind_leaf_tip_m, base.wind_leaf_tip_m);
+  for (const char* bad : {"pose", "pose=", "pose=x", "pose=1x", "=1", "sun=1", "pose=-1"})
+    EXPECT_THROW(writeScaledWorldConfig(world, bad, out), std::invalid_argument) << bad;
+  fs::remove_all(out);
 }
 
 TEST(Experiment, ShardTextIsParsedStrictly) {

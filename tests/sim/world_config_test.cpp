@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <fstream>
 #include <set>
 #include <stdexcept>
@@ -106,6 +107,30 @@ TEST(WorldConfig, ToJsonHasEveryKey) {
   for (const std::string& key : WorldConfig::keyNames()) {
     EXPECT_NE(json.find("\"" + key + "\""), std::string::npos) << key;
   }
+}
+
+TEST(WorldConfig, ErrorGroupsScaleTheirOwnKeysAndClampToTheirRanges) {
+  const WorldConfig field =
+      WorldConfig::fromYamlFile(std::string(FVP_SOURCE_DIR) + "/robot/sim/config/world_field.yaml");
+  const WorldConfig half = field.withErrorsScaled("wind", 0.5);
+  EXPECT_DOUBLE_EQ(half.wind_leaf_tip_m, 0.5 * field.wind_leaf_tip_m);
+  EXPECT_DOUBLE_EQ(half.wind_fruitlet_swing_m, 0.5 * field.wind_fruitlet_swing_m);
+  // Only the group: the others and the switches stay as they were.
+  EXPECT_EQ(half.hand_eye_translation_sigma_m, field.hand_eye_translation_sigma_m);
+  EXPECT_EQ(half.segmentation_boundary_px, field.segmentation_boundary_px);
+  const WorldConfig none = field.withErrorsScaled("all", 0.0);
+  EXPECT_EQ(none.hand_eye_rotation_sigma_deg, 0.0);
+  EXPECT_EQ(none.stereo_vertical_misalignment_px, 0.0);
+  EXPECT_EQ(none.segmentation_false_blobs, 0.0);
+  EXPECT_EQ(none.segmentation_model, 1);
+  EXPECT_EQ(none.fruitlet_green_fraction, 1.0);
+  // Clamped: a miss rate of 0.05 times 100 is the key's maximum, and the result validates.
+  const WorldConfig many = field.withErrorsScaled("segmentation", 100.0);
+  EXPECT_EQ(many.segmentation_miss_rate, 0.9);
+  EXPECT_NO_THROW(many.validate());
+  EXPECT_THROW(field.withErrorsScaled("sun", 1.0), std::invalid_argument);
+  EXPECT_THROW(field.withErrorsScaled("pose", -1.0), std::invalid_argument);
+  EXPECT_THROW(field.withErrorsScaled("pose", std::nan("")), std::invalid_argument);
 }
 
 }  // namespace

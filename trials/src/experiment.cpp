@@ -7,6 +7,7 @@
 #include <chrono>
 #include <climits>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <iomanip>
 #include <map>
@@ -21,6 +22,7 @@
 #include "fvp/host/core/gnuplot.h"
 #include "fvp/host/core/output_directory.h"
 #include "fvp/host/map/map_engine_registry.h"
+#include "fvp/robot/sim/world_config.h"
 #include "number_text.h"
 
 namespace fvp::trials {
@@ -70,6 +72,30 @@ ConfigFileStamp stampOf(const fs::path& path, const std::string& what) {
 }
 
 /// The manifest an experiment with these options has.
+}  // namespace
+
+fs::path writeScaledWorldConfig(const fs::path& world, const std::string& error_scale,
+                                const fs::path& out_dir) {
+  const std::size_t eq = error_scale.find('=');
+  const std::string group = error_scale.substr(0, eq);
+  const std::string factor_text = eq == std::string::npos ? "" : error_scale.substr(eq + 1);
+  char* end = nullptr;
+  const double factor = std::strtod(factor_text.c_str(), &end);
+  if (eq == std::string::npos || factor_text.empty() || *end != '\0' || !std::isfinite(factor))
+    throw std::invalid_argument("--error-scale '" + error_scale +
+                                "': expected GROUP=FACTOR, e.g. wind=0.5");
+  const robot::sim::WorldConfig base =
+      world.empty() ? robot::sim::WorldConfig{} : robot::sim::WorldConfig::fromYamlFile(world);
+  const robot::sim::WorldConfig scaled = base.withErrorsScaled(group, factor);
+  fs::create_directories(out_dir);
+  const fs::path path = out_dir / "world.yaml";
+  // JSON is YAML: the config's keys and values, read back by WorldConfig::fromYamlFile.
+  host::writeFileAtomically(path, "scaled world config", scaled.toJson() + "\n");
+  return path;
+}
+
+namespace {
+
 ExperimentManifest manifestOf(const ExperimentOptions& o) {
   ExperimentManifest m;
   m.kind = "run";

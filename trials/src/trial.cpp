@@ -352,8 +352,13 @@ struct Trial::Impl {
     if (clock->mode() == SimClock::Mode::kFixed)
       controller->setReproducibleMotionPlanning(options.seed);
     pose_errors = std::make_unique<PoseErrorModel>(world->config(), options.seed);
+    wind = std::make_unique<WindModel>(*world, options.seed);
+    segmentation = std::make_unique<SegmentationModel>(world->config(), options.seed);
     camera = std::make_unique<SimulatedCamera>(
-        *renderer, *clock, pose_errors->enabled() ? pose_errors.get() : nullptr);
+        *renderer, *clock,
+        SimulatedErrors{pose_errors->enabled() ? pose_errors.get() : nullptr,
+                        wind->enabled() ? wind.get() : nullptr,
+                        segmentation->enabled() ? segmentation.get() : nullptr});
     sim_arm = std::make_unique<SimulatedArm>(*controller, *workspace);
   }
 
@@ -429,6 +434,8 @@ struct Trial::Impl {
   std::unique_ptr<SimClock> clock;
   std::unique_ptr<ArmController> controller;
   std::unique_ptr<PoseErrorModel> pose_errors;
+  std::unique_ptr<WindModel> wind;
+  std::unique_ptr<SegmentationModel> segmentation;
   std::unique_ptr<SimulatedCamera> camera;
   std::unique_ptr<SimulatedArm> sim_arm;
   bool ran = false;

@@ -52,6 +52,13 @@ constexpr std::array<std::array<double, 3>, 6> kPaletteSrgb = {{
     {0.88, 0.05, 0.80},  // magenta, ~305 deg
 }};
 
+// A young apple's light yellow-green (hue ~80 deg, saturation 0.6): inside the leaves' green
+// band, so HSV segmentation cannot tell it from a leaf (docs/simulation.md "Appearance and
+// segmentation").
+constexpr std::array<double, 3> kGreenFruitletSrgb = {0.56, 0.70, 0.28};
+// "gren" in ASCII: the green fruitlets' stream, apart from the generator's.
+constexpr std::uint64_t kGreenStream = 0x6772656e;
+
 double srgbToLinear(double c) {
   return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
 }
@@ -99,18 +106,6 @@ double pointPlateDistance(const Eigen::Vector3d& p_world, const AprilTagPlacemen
   return std::sqrt(dx * dx + dy * dy + q.z() * q.z());
 }
 
-// Lower bound of the distance from p to a leaf: the distance to the leaf's bounding box
-// in the leaf frame (the box contains the curled ellipse).
-double pointLeafDistanceLowerBound(const Eigen::Vector3d& p_world, const Leaf& leaf) {
-  const Eigen::Vector3d q = leaf.T_world_leaf.inverse() * p_world;
-  const double sag = leaf.curl_per_m * leaf.half_length_m * leaf.half_length_m;
-  const double z_lo = std::min(0.0, sag), z_hi = std::max(0.0, sag);
-  const double dx = std::max(std::abs(q.x()) - leaf.half_length_m, 0.0);
-  const double dy = std::max(std::abs(q.y()) - leaf.half_width_m, 0.0);
-  const double dz = std::max({z_lo - q.z(), q.z() - z_hi, 0.0});
-  return std::sqrt(dx * dx + dy * dy + dz * dz);
-}
-
 // Whether any of a dense set of points on the leaf lies between the camera centre and the
 // tag plate (enlarged by kTagSightMarginM) as seen from that centre.
 bool leafHidesTag(const Leaf& leaf, const AprilTagPlacement& tag, const Eigen::Vector3d& camera_m) {
@@ -156,6 +151,43 @@ nlohmann::ordered_json toJson(const Eigen::Matrix3d& m) {
 }
 
 }  // namespace
+
+double Leaf::distanceLowerBound_m(const Eigen::Vector3d& p_world_m) const {
+  const Eigen::Vector3d q = T_world_leaf.inverse() * p_world_m;
+  const double sag = curl_per_m * half_length_m * half_length_m;
+  const double z_lo = std::min(0.0, sag), z_hi = std::max(0.0, sag);
+  const double dx = std::max(std::abs(q.x()) - half_length_m, 0.0);
+  const double dy = std::max(std::abs(q.y()) - half_width_m, 0.0);
+  const double dz = std::max({z_lo - q.z(), q.z() - z_hi, 0.0});
+  return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+Eigen::Vector3d Leaf::attachment_m() const {
+  return T_world_leaf *
+         Eigen::Vector3d(-half_length_m, 0.0, curl_per_m * half_length_m * half_length_m);
+}
+
+Eigen::Vector3d Leaf::tip_m() const {
+  return T_world_leaf *
+         Eigen::Vector3d(half_length_m, 0.0, curl_per_m * half_length_m * half_length_m);
+}
+
+World World::withMovedParts(std::vector<Fruitlet> fruitlets, std::vector<Leaf> leaves) const {
+  if (fruitlets.size() != fruitlets_.size() || leaves.size() != leaves_.size())
+    throw std::invalid_argument(
+        "World::withMovedParts: the counts of fruitlets and leaves must "
+        "stay the same");
+  for (std::size_t i = 0; i < fruitlets.size(); ++i)
+    if (fruitlets[i].index != fruitlets_[i].index)
+      throw std::invalid_argument("World::withMovedParts: fruitlet indices must stay in order");
+  for (std::size_t i = 0; i < leaves.size(); ++i)
+    if (leaves[i].index != leaves_[i].index)
+      throw std::invalid_argument("World::withMovedParts: leaf indices must stay in order");
+  World moved = *this;
+  moved.fruitlets_ = std::move(fruitlets);
+  moved.leaves_ = std::move(leaves);
+  return moved;
+}
 
 Eigen::Vector3d World::clusterCenter_m() const {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -458,7 +490,7 @@ World World::generate(const WorldConfig& config, std::uint64_t seed) {
         if (!clear) continue;
         leaf_placed = true;
         for (const Fruitlet& f : world.fruitlets_) {
-          leaf_placed = leaf_placed && pointLeafDistanceLowerBound(f.center_m, leaf) >=
+          leaf_placed = leaf_placed && leaf.distanceLowerBound_m(f.center_m) >=
                                            f.boundingRadius_m() + config.min_gap_m;
         }
         if (leaf_placed) world.leaves_.push_back(leaf);
@@ -468,6 +500,19 @@ World World::generate(const WorldConfig& config, std::uint64_t seed) {
                                  "): cannot place leaf " + std::to_string(leaf_index) +
                                  "; reduce leaf_count or enlarge leaf_region_m");
       }
+    }
+  }
+  // Green fruitlets, on a stream of their own so the rest of the world stays as it was.
+  if (config.fruitlet_green_fraction > 0.0) {
+    std::seed_seq seq{seed, kGreenStream};
+    std::mt19937_64 green_rng(seq);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    for (Fruitlet& f : world.fruitlets_) {
+      const double shade = 0.9 + 0.2 * unit(green_rng);  // a little lighter or darker
+      if (unit(green_rng) >= config.fruitlet_green_fraction) continue;
+      f.rgb = {srgbToLinear(std::min(1.0, shade * kGreenFruitletSrgb[0])),
+               srgbToLinear(std::min(1.0, shade * kGreenFruitletSrgb[1])),
+               srgbToLinear(std::min(1.0, shade * kGreenFruitletSrgb[2]))};
     }
   }
   return world;

@@ -5,9 +5,12 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <cmath>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 #include <variant>
 
 namespace fvp::robot::sim {
@@ -71,6 +74,14 @@ const std::vector<KeySpec>& keySpecs() {
       {"view_rotation_sigma_deg", &WorldConfig::view_rotation_sigma_deg, 0.0, 5.0},
       {"stereo_baseline_error", &WorldConfig::stereo_baseline_error, -0.05, 0.05},
       {"stereo_vertical_misalignment_px", &WorldConfig::stereo_vertical_misalignment_px, -5.0, 5.0},
+      // Gusts that move leaf tips by centimetres blur any camera: no sizing then.
+      {"wind_leaf_tip_m", &WorldConfig::wind_leaf_tip_m, 0.0, 0.02},
+      {"wind_fruitlet_swing_m", &WorldConfig::wind_fruitlet_swing_m, 0.0, 0.01},
+      {"fruitlet_green_fraction", &WorldConfig::fruitlet_green_fraction, 0.0, 1.0},
+      {"segmentation_model", &WorldConfig::segmentation_model, 0, 1},
+      {"segmentation_boundary_px", &WorldConfig::segmentation_boundary_px, 0.0, 5.0},
+      {"segmentation_miss_rate", &WorldConfig::segmentation_miss_rate, 0.0, 0.9},
+      {"segmentation_false_blobs", &WorldConfig::segmentation_false_blobs, 0.0, 20.0},
   };
   return specs;
 }
@@ -154,6 +165,44 @@ WorldConfig WorldConfig::fromYamlFile(const std::filesystem::path& path) {
   host::readYamlConfig(path, source, yamlKeys(), config);
   config.validate(source);
   return config;
+}
+
+const std::vector<std::string>& WorldConfig::errorGroups() {
+  static const std::vector<std::string> groups = {"pose", "stereo", "wind", "segmentation", "all"};
+  return groups;
+}
+
+WorldConfig WorldConfig::withErrorsScaled(const std::string& group, double factor) const {
+  static const std::vector<std::pair<std::string, std::vector<std::string>>> members = {
+      {"pose",
+       {"hand_eye_translation_sigma_m", "hand_eye_rotation_sigma_deg", "arm_position_error_m",
+        "view_translation_sigma_m", "view_rotation_sigma_deg"}},
+      {"stereo", {"stereo_baseline_error", "stereo_vertical_misalignment_px"}},
+      {"wind", {"wind_leaf_tip_m", "wind_fruitlet_swing_m"}},
+      {"segmentation",
+       {"segmentation_boundary_px", "segmentation_miss_rate", "segmentation_false_blobs"}}};
+  if (!(factor >= 0.0) || !std::isfinite(factor))
+    throw std::invalid_argument("error scale: expected a factor >= 0, got " + formatNumber(factor));
+  const bool all = group == "all";
+  bool known = all;
+  WorldConfig out = *this;
+  for (const auto& [name, keys] : members) {
+    if (!all && name != group) continue;
+    known = true;
+    for (const std::string& key : keys) {
+      const KeySpec& spec = specNamed(key);
+      std::visit(
+          [&](auto field) {
+            if constexpr (std::is_same_v<std::remove_reference_t<decltype(out.*field)>, double>)
+              out.*field = std::clamp(out.*field * factor, spec.lo, spec.hi);
+          },
+          spec.member);
+    }
+  }
+  if (!known)
+    throw std::invalid_argument("error scale: unknown error group '" + group +
+                                "'; expected pose, stereo, wind, segmentation or all");
+  return out;
 }
 
 std::string WorldConfig::toJson() const {

@@ -34,6 +34,14 @@ struct ExperimentOptions {
 using TrialRunner = std::function<nlohmann::json(const TrialOptions&)>;
 using MessageSink = std::function<void(const std::string&)>;
 
+/// --error-scale GROUP=FACTOR (docs/simulation.md "Sweeping an error"): the world config
+/// (world, or the default when empty) with that error group's magnitudes times FACTOR,
+/// written to out_dir/world.yaml (out_dir created) for the trials to read and the manifest
+/// to stamp. Returns that path. Throws std::invalid_argument for a bad GROUP=FACTOR.
+std::filesystem::path writeScaledWorldConfig(const std::filesystem::path& world,
+                                             const std::string& error_scale,
+                                             const std::filesystem::path& out_dir);
+
 /// Parses --shard's "i/n": two decimal integers (no sign, no leading zeros), 0 <= i < n.
 /// Throws std::invalid_argument.
 std::pair<int, int> parseShard(const std::string& text);

@@ -44,6 +44,14 @@ struct Leaf {
   double half_length_m = 0.0;                                      ///< along the leaf's x axis
   double half_width_m = 0.0;                                       ///< along the leaf's y axis
   double curl_per_m = 0.0;                                         ///< z = curl * x^2 (0: flat)
+  /// A lower bound of the distance from p to the leaf: the distance to the leaf's bounding
+  /// box in the leaf frame (the box contains the curled ellipse).
+  double distanceLowerBound_m(const Eigen::Vector3d& p_world_m) const;
+  /// Where the leaf's stalk joins it (its base, at -half_length_m along x): what wind
+  /// turns it about.
+  Eigen::Vector3d attachment_m() const;
+  /// Its tip, at +half_length_m along x.
+  Eigen::Vector3d tip_m() const;
 };
 
 /// A cylinder segment of bark (trunk or branch), rendered with hemispherical end caps.
@@ -110,6 +118,11 @@ class World {
   Eigen::Vector3d clusterCenter_m() const;
   /// The first cluster's start view (the run's start pose).
   Eigen::Isometry3d startCameraPose() const { return clusters_.front().T_world_start_camera; }
+
+  /// The same world with its fruitlets and leaves moved (by wind): the same counts and
+  /// indices; clusters, tags, branches, config and ground truth stay this world's (the rest
+  /// pose). Throws std::invalid_argument if the counts or indices differ.
+  World withMovedParts(std::vector<Fruitlet> fruitlets, std::vector<Leaf> leaves) const;
 
   /// Ground truth as JSON text (seed, config, fruitlets with centre / size, tag pose).
   std::string groundTruthJson() const;

@@ -72,12 +72,40 @@ struct WorldConfig {
   double stereo_baseline_error = 0.0;  ///< true baseline / nominal - 1 (0.005: 0.5 % longer)
   /// A point's row in the right image minus its row in the left, after rectification.
   double stereo_vertical_misalignment_px = 0.0;
+  // Wind (docs/simulation.md "Wind"): between views leaves and fruitlets move; ground truth
+  // is the rest pose. 0: a still canopy.
+  /// RMS displacement of a leaf's tip as it turns about its attachment, each view.
+  double wind_leaf_tip_m = 0.0;
+  /// Largest displacement of a fruitlet swinging on its stem (horizontal), each view.
+  double wind_fruitlet_swing_m = 0.0;
+  // Appearance and segmentation (docs/simulation.md "Appearance and segmentation").
+  /// Fraction of fruitlets painted a leaf-like green (real fruitlets at thinning time are
+  /// green); the HSV segmentation cannot see those, the segmentation model can.
+  double fruitlet_green_fraction = 0.0;
+  /// 1: the camera hands over a fruitlet mask from a segmentation model standing in for a
+  /// trained network (the renderer's instance masks with the errors below) and HSV does
+  /// not run; 0: no mask (HSV segmentation, the paper's).
+  int segmentation_model = 0;
+  /// RMS of the mask boundary's displacement, pixels (smooth along the boundary).
+  double segmentation_boundary_px = 0.0;
+  /// Probability that a visible fruitlet is missing from a view's mask.
+  double segmentation_miss_rate = 0.0;
+  /// Mean number of false fruitlet blobs on leaves per view (Poisson).
+  double segmentation_false_blobs = 0.0;
 
   /// Reads a YAML file; missing keys keep their defaults; unknown keys, wrong types and
   /// out-of-range values throw std::invalid_argument naming the file and the key.
   static WorldConfig fromYamlFile(const std::filesystem::path& path);
   /// Throws std::invalid_argument naming the first bad key and its expected range.
   void validate(const std::string& source = "world config") const;
+  /// The simulated errors in groups, for sweeps (docs/simulation.md "Sweeping an error"):
+  /// pose (hand_eye_*, arm_position_error_m, view_*), stereo (stereo_*), wind (wind_*),
+  /// segmentation (segmentation_boundary_px, _miss_rate, _false_blobs; not the switches
+  /// segmentation_model and fruitlet_green_fraction), and all of them.
+  static const std::vector<std::string>& errorGroups();
+  /// This config with the magnitudes of one error group times factor (>= 0), each clamped
+  /// to its key's range. Throws std::invalid_argument for an unknown group or a bad factor.
+  WorldConfig withErrorsScaled(const std::string& group, double factor) const;
   /// Every YAML key, in declaration order (the same names as the fields).
   static const std::vector<std::string>& keyNames();
   /// The config as a JSON object text {key: value, ...} (for ground truth and results).
