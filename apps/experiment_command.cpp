@@ -54,6 +54,9 @@ void addExperimentCommands(CLI::App& app) {
          "settled, the budget being the cap")
       ->check(CLI::IsMember({"budget", "auto"}))
       ->capture_default_str();
+  cmd->add_flag("--register-views", opt->experiment.trial.register_views,
+                "align each view to the earlier ones before fusing it (a counter-measure to "
+                "pose errors)");
   cmd->add_flag("--size-history", opt->experiment.trial.record_size_history,
                 "size after every view and keep each sizing in result.json (size_history; always "
                 "with --stop auto; not charged to the clock)");

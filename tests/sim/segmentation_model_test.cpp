@@ -125,8 +125,7 @@ TEST(SegmentationModel, FalseBlobsLandOnLeavesAsOftenAsConfigured) {
       // component's centroid may not be, so check the component touches a leaf.
       EXPECT_GT(cv::countNonZero(leaves & (labels == k)), 0) << "view " << view;
       (void)centre;
-      EXPECT_LE(stats.at<int>(k, cv::CC_STAT_WIDTH),
-                4 * SegmentationModel::kMaxBlobRadiusPx + 2);
+      EXPECT_LE(stats.at<int>(k, cv::CC_STAT_WIDTH), 4 * SegmentationModel::kMaxBlobRadiusPx + 2);
     }
     blobs += n - 1;
   }

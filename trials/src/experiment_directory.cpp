@@ -231,6 +231,7 @@ nlohmann::ordered_json ExperimentManifest::toJson() const {
   j["clock"] = clock;
   j["stop"] = stop;
   j["max_views"] = max_views;
+  j["register_views"] = register_views;
   j["world_config"] = configJson(world_config);
   j["planner_config"] = configJson(planner_config);
   if (kind == "merged") {
@@ -286,6 +287,12 @@ ExperimentManifest readManifest(const std::filesystem::path& path) {
   }
   m.max_views =
       int(readUnsigned(j, "max_views", where, INT_MAX, "a non-negative integer (0: no limit)"));
+  // Manifests written before view registration existed fused at the told poses.
+  if (member(j, "register_views")) {
+    if (!j["register_views"].is_boolean())
+      fieldError(where, "register_views", "true or false", &j["register_views"]);
+    m.register_views = j["register_views"].get<bool>();
+  }
   m.world_config = readConfig(j, "world_config", where);
   m.planner_config = readConfig(j, "planner_config", where);
   if (m.kind == "merged") {
@@ -334,6 +341,9 @@ std::optional<ManifestDifference> mergeDifference(const ExperimentManifest& a,
                               nlohmann::json(b.budget_s).dump()};
   if (a.clock != b.clock) return ManifestDifference{"clock", a.clock, b.clock};
   if (a.stop != b.stop) return ManifestDifference{"stop", a.stop, b.stop};
+  if (a.register_views != b.register_views)
+    return ManifestDifference{"register_views", a.register_views ? "true" : "false",
+                              b.register_views ? "true" : "false"};
   if (a.max_views != b.max_views)
     return ManifestDifference{"max_views", shownMaxViews(a.max_views), shownMaxViews(b.max_views)};
   if (a.world_config.fnv1a64 != b.world_config.fnv1a64)

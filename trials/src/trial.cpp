@@ -120,6 +120,13 @@ class TrialLog : public host::nbv::LoopObserver {
     if (cluster_ >= 0) views_.back()["cluster"] = cluster_;
     if (camera_.hasPoseErrors())
       views_.back()["pose_error"] = poseErrorJson(e.T_world_camera, camera_.lastTruePose());
+    if (v.registration) {
+      const host::RegistrationResult& r = *v.registration;
+      views_.back()["registration"] = {
+          {"status", host::toString(r.status)},     {"translation_mm", 1000.0 * r.translation_m},
+          {"rotation_deg", r.rotation_deg},         {"rms_before_mm", 1000.0 * r.rms_before_m},
+          {"rms_after_mm", 1000.0 * r.rms_after_m}, {"pairs", r.pairs}};
+    }
     if (!options_.out_dir.empty()) {
       keepViewImage(options_.out_dir, index, *e.frame);
       images_.add(index, e.frame->left_bgr);
@@ -494,6 +501,7 @@ nlohmann::json Trial::Impl::stopJson() const {
 void Trial::Impl::describeRun(nlohmann::json& result, const TrialLog& log,
                               const std::vector<Eigen::Vector3d>& camera_path) const {
   result["clock"] = nlohmann::json::parse(clock->toJson());
+  result["register_views"] = options.register_views;
   result["view_log"] = log.views();
   result["plan_log"] = log.plans();
   nlohmann::json path = nlohmann::json::array();

@@ -71,6 +71,7 @@ struct TrialParts::Impl {
         map_config(host::planner::plannerMapConfig(options.planner, engine)),
         session(perception, engine, map_config, backend) {
     session.enableTsdf();
+    if (options.register_views) session.enableViewRegistration();
     planner = host::planner::createPlanner(options.planner, options.planner_config, planner_seed,
                                            backend);
   }

@@ -41,8 +41,25 @@ ViewResult MappingSession::addView(const StereoFrame& frame, PerceptionResult* p
   view.perception = perceived.clouds.stats;
   views_.push_back(view);
 
+  Eigen::Isometry3d T_world_camera = frame.T_world_camera;
+  if (registration_ && region_) {
+    // Align the view to the model of the views before it, then fuse it where it aligned.
+    const RegistrationResult r = registration_->align(pointsInRegion(perceived.clouds));
+    views_.back().registration = r;
+    if (r.status == RegistrationStatus::kApplied) {
+      moveClouds(perceived.clouds, r.correction);
+      T_world_camera = r.correction * T_world_camera;
+    }
+    registration_->addToModel(pointsInRegion(perceived.clouds));
+  }
   if (!region_ && perceived.region) {
     region_ = perceived.region;
+    if (registration_) {
+      // The views up to this one anchor the model.
+      for (const auto& [index, clouds] : pending_)
+        registration_->addToModel(pointsInRegion(clouds));
+      registration_->addToModel(pointsInRegion(perceived.clouds));
+    }
     if (perceived.tag) T_world_tag_ = perceived.tag->T_world_tag;
     if (carried_map_) {
       map_ = std::move(carried_map_);
@@ -63,7 +80,7 @@ ViewResult MappingSession::addView(const StereoFrame& frame, PerceptionResult* p
     // What sizing needs of the view, and the fruitlets' TSDF from its ROI depth once the
     // region bounds the TSDF (views seen before the tag are fused when it is found).
     sizing_views_.push_back({perceived.fruitlet_mask, perceived.disparity.disparity_px,
-                             frame.intrinsics, frame.T_world_camera});
+                             frame.intrinsics, T_world_camera});
     if (region_ && !tsdf_) {
       const Eigen::Vector3d half = Eigen::Vector3d::Constant(region_->radius_m());
       tsdf_ = std::make_unique<tsdf::TsdfVolume>(
@@ -75,6 +92,26 @@ ViewResult MappingSession::addView(const StereoFrame& frame, PerceptionResult* p
   }
   if (perceived_out) *perceived_out = std::move(perceived);
   return views_.back();
+}
+
+void MappingSession::enableViewRegistration(const ViewRegistrationConfig& config) {
+  registration_.emplace(config);
+}
+
+std::vector<Eigen::Vector3f> MappingSession::pointsInRegion(const LabeledClouds& clouds) const {
+  std::vector<Eigen::Vector3f> points;
+  if (!region_) return points;
+  for (const auto* cloud : {&clouds.roi_points_m, &clouds.other_points_m})
+    for (const Eigen::Vector3f& p : *cloud)
+      if (region_->contains(p.cast<double>())) points.push_back(p);
+  return points;
+}
+
+void MappingSession::moveClouds(LabeledClouds& clouds, const Eigen::Isometry3d& T) {
+  const Eigen::Isometry3f Tf = T.cast<float>();
+  for (auto* cloud : {&clouds.roi_points_m, &clouds.other_points_m})
+    for (Eigen::Vector3f& p : *cloud) p = Tf * p;
+  clouds.sensor_origin_m = T * clouds.sensor_origin_m;
 }
 
 void MappingSession::enableTsdf(const tsdf::TsdfConfig& config) {

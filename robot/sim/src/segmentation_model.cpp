@@ -21,8 +21,7 @@ cv::Mat smoothField(cv::Size size, double rms_px, std::mt19937_64& rng) {
   for (int r = 0; r < coarse.rows; ++r)
     for (int c = 0; c < coarse.cols; ++c) coarse.at<float>(r, c) = normal(rng);
   cv::Mat fine;
-  cv::resize(coarse, fine, cv::Size(coarse.cols * step, coarse.rows * step), 0, 0,
-             cv::INTER_CUBIC);
+  cv::resize(coarse, fine, cv::Size(coarse.cols * step, coarse.rows * step), 0, 0, cv::INTER_CUBIC);
   fine = fine(cv::Rect(0, 0, size.width, size.height)).clone();
   cv::Scalar mean, stddev;
   cv::meanStdDev(fine, mean, stddev);
@@ -93,11 +92,10 @@ cv::Mat SegmentationModel::maskFor(const cv::Mat& object_id, int view) const {
         if (id[u] >= kFirstLeafId && id[u] < kTreeId) leaf_pixels.emplace_back(u, v);
     }
   }
-  const int blobs =
-      false_blobs_ > 0.0 ? std::poisson_distribution<int>(false_blobs_)(rng) : 0;
+  const int blobs = false_blobs_ > 0.0 ? std::poisson_distribution<int>(false_blobs_)(rng) : 0;
   for (int b = 0; b < blobs && !leaf_pixels.empty(); ++b) {
-    const cv::Point centre = leaf_pixels[std::uniform_int_distribution<std::size_t>(
-        0, leaf_pixels.size() - 1)(rng)];
+    const cv::Point centre =
+        leaf_pixels[std::uniform_int_distribution<std::size_t>(0, leaf_pixels.size() - 1)(rng)];
     std::uniform_real_distribution<double> radius(kMinBlobRadiusPx, kMaxBlobRadiusPx);
     const cv::Size axes(static_cast<int>(std::lround(radius(rng))),
                         static_cast<int>(std::lround(radius(rng))));

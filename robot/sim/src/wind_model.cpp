@@ -84,9 +84,8 @@ World WindModel::worldAt(int view) const {
     const Eigen::Vector3d along = (leaf.tip_m() - leaf.attachment_m()).normalized();
     Eigen::Vector3d axis(normal(rng), normal(rng), normal(rng));
     axis -= axis.dot(along) * along;
-    const double tip_m =
-        std::clamp(tip_sigma_m_ * normal(rng), -kMaxTipSigmas * tip_sigma_m_,
-                   kMaxTipSigmas * tip_sigma_m_);
+    const double tip_m = std::clamp(tip_sigma_m_ * normal(rng), -kMaxTipSigmas * tip_sigma_m_,
+                                    kMaxTipSigmas * tip_sigma_m_);
     if (!(axis.norm() > 1e-9) || tip_m == 0.0) continue;
     axis.normalize();
     const Leaf rest_leaf = leaf;

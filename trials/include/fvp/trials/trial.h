@@ -45,6 +45,10 @@ struct TrialOptions {
   /// size_history (always with stop auto). Under stop budget it is an observation for the
   /// accuracy-against-time figure, not part of the loop: not charged to the clock.
   bool record_size_history = false;
+  /// Align each view to the earlier ones before fusing it (MappingSession::
+  /// enableViewRegistration; docs/sizing.md "Registering views"): the counter-measure to
+  /// pose errors. Off: the paper's fusion at the told poses.
+  bool register_views = false;
   /// Where result.json, the maps, the TSDF surface, the clusters and report.md go; empty:
   /// nothing is written (the result is only returned).
   std::filesystem::path out_dir;

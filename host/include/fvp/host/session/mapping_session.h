@@ -17,6 +17,7 @@
 #include "fvp/host/map/map_engine.h"
 #include "fvp/host/perception/perception_pipeline.h"
 #include "fvp/host/perception/stereo_frame.h"
+#include "fvp/host/session/view_registration.h"
 #include "fvp/host/sizing/fruitlet_sizer.h"
 #include "fvp/host/tsdf/tsdf_volume.h"
 
@@ -40,6 +41,8 @@ struct ViewResult {
   /// Earlier views this call integrated (the region became known with this view).
   std::size_t earlier_views_integrated = 0;
   double tsdf_s = 0.0;  ///< TSDF integration of this view's ROI depth (0 without a TSDF)
+  /// With view registration on and the region known: the alignment tried for this view.
+  std::optional<RegistrationResult> registration;
 };
 
 class MappingSession {
@@ -72,6 +75,10 @@ class MappingSession {
   /// session's backend; a cpu backend of its own without one), from the view whose tag
   /// places the region on, earlier views included.
   void enableTsdf(const tsdf::TsdfConfig& config = {});
+  /// Aligns each view's points in the Cluster Region to the earlier views' before fusing it
+  /// (view_registration.h); the first views, up to the one that places the region, anchor
+  /// the model. Off unless called. Throws std::invalid_argument for a bad config.
+  void enableViewRegistration(const ViewRegistrationConfig& config = {});
   bool tsdfEnabled() const { return tsdf_config_.has_value(); }
   /// Null until enableTsdf() was called and the region is known.
   const tsdf::TsdfVolume* tsdf() const { return tsdf_.get(); }
@@ -98,6 +105,9 @@ class MappingSession {
 
  private:
   void integrate(std::size_t index, const LabeledClouds& clouds);
+  /// The clouds' points inside the Cluster Region (none before it is known).
+  std::vector<Eigen::Vector3f> pointsInRegion(const LabeledClouds& clouds) const;
+  static void moveClouds(LabeledClouds& clouds, const Eigen::Isometry3d& T);
   /// Fuses sizing_views_[i] into the TSDF; returns the seconds it took.
   double integrateTsdf(std::size_t sizing_view);
 
@@ -113,6 +123,7 @@ class MappingSession {
   // Clouds of views seen before the region was known, with the index of their view.
   std::vector<std::pair<std::size_t, LabeledClouds>> pending_;
   std::optional<tsdf::TsdfConfig> tsdf_config_;
+  std::optional<ViewRegistration> registration_;
   std::unique_ptr<tsdf::TsdfVolume> tsdf_;
   std::vector<sizing::SizingView> sizing_views_;
 };

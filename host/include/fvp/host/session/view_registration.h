@@ -1,0 +1,83 @@
+// Registration of each view to the views before it (docs/sizing.md "Registering views"): a
+// robot's told camera poses are off by its hand-eye calibration and arm accuracy, about a
+// millimetre, the size of the sizing error budget, and the error differs from view to view.
+// Before a view is fused, its points in the Cluster Region are aligned to a model of the
+// earlier views' points there by trimmed point-to-point ICP; the correction is applied only
+// when it is small (a calibration error, not a wrong match), enough pairs support it and it
+// lowers their RMS. Expected outcomes are statuses, never exceptions.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <unordered_set>
+#include <vector>
+
+namespace fvp::host {
+
+struct ViewRegistrationConfig {
+  /// Both clouds are thinned to one point per voxel of this size: the fine map's 1 mm.
+  double voxel_m = 0.001;
+  /// Pairs farther apart than this are not the same surface: views taken from opposite
+  /// sides disagree by up to twice a calibrated robot's 1-2 mm pose error, plus a voxel.
+  double max_pair_distance_m = 0.005;
+  int max_iterations = 30;
+  /// A correction that moves the view's points farther than this, or turns them more, is a
+  /// wrong match rather than a calibration error: not applied.
+  double max_translation_m = 0.008;
+  double max_rotation_deg = 0.5;
+  /// false: translation only. A camera's rotation error of a few tenths of a degree moves
+  /// the cluster 0.3 m away by ~1 mm as a whole but its 6.5 cm region by only ~0.2 mm
+  /// relative to itself, below the 1 mm voxel: a translation captures it, and three degrees
+  /// of freedom are better constrained by a partial overlap than six (which, tried first,
+  /// turned views by 1-1.5 degrees where the true error was 0.18).
+  bool estimate_rotation = false;
+  /// Fewer pairs than this constrain six degrees of freedom too weakly to trust.
+  std::size_t min_pairs = 300;
+  /// The pairs' RMS must fall by at least this fraction.
+  double min_rms_reduction = 0.1;
+
+  /// Throws std::invalid_argument naming the bad field.
+  void validate() const;
+};
+
+enum class RegistrationStatus {
+  kApplied,
+  kNoModel,        ///< no earlier view to align to (the first views)
+  kTooFewPairs,    ///< fewer than min_pairs pairs within max_pair_distance_m
+  kBeyondBounds,   ///< the correction was larger than a calibration error
+  kNoImprovement,  ///< the pairs' RMS did not fall by min_rms_reduction
+};
+std::string toString(RegistrationStatus status);
+
+struct RegistrationResult {
+  RegistrationStatus status = RegistrationStatus::kNoModel;
+  /// World-frame correction: p_aligned = correction * p (identity unless applied).
+  Eigen::Isometry3d correction = Eigen::Isometry3d::Identity();
+  double translation_m = 0.0;  ///< how far the correction moves the view's centroid
+  double rotation_deg = 0.0;
+  double rms_before_m = 0.0, rms_after_m = 0.0;
+  std::size_t pairs = 0;
+  int iterations = 0;
+};
+
+class ViewRegistration {
+ public:
+  explicit ViewRegistration(ViewRegistrationConfig config = {});
+  const ViewRegistrationConfig& config() const { return config_; }
+
+  /// The correction that aligns view_points_m (world frame, as the told pose put them) to the
+  /// model; the model is not changed.
+  RegistrationResult align(const std::vector<Eigen::Vector3f>& view_points_m) const;
+  /// Adds points (aligned) to the model, one per voxel.
+  void addToModel(const std::vector<Eigen::Vector3f>& points_m);
+  std::size_t modelSize() const { return model_.size(); }
+
+ private:
+  ViewRegistrationConfig config_;
+  std::vector<Eigen::Vector3f> model_;
+  std::unordered_set<std::uint64_t> model_voxels_;
+};
+
+}  // namespace fvp::host
