@@ -74,7 +74,7 @@ static void writeCaptureSet(std::uint64_t seed, const std::string& world_file, i
       world_file.empty() ? robot::sim::WorldConfig{}
                          : robot::sim::WorldConfig::fromYamlFile(world_file);
   const auto world = robot::sim::World::generate(world_config, seed);
-  robot::sim::RenderConfig render = robot::sim::renderConfigFor(world_config);
+  robot::sim::RenderConfig render = robot::sim::renderConfigFor(world_config, {}, seed);
   render.noise_seed = seed;
   robot::sim::StereoRenderer renderer(world, render);
   host::PerceptionConfig config;

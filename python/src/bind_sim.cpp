@@ -14,7 +14,7 @@ namespace {
 
 trials::TrialOptions trialOptions(const std::string& planner, std::uint64_t seed, double budget_s,
                                   const std::optional<int>& max_views, const std::string& clock,
-                                  const std::string& stop, bool size_history,
+                                  const std::string& stop, bool size_history, bool register_views,
                                   const std::string& backend, const std::string& engine,
                                   const std::string& world_config,
                                   const std::string& planner_config, const std::string& out_dir) {
@@ -26,6 +26,7 @@ trials::TrialOptions trialOptions(const std::string& planner, std::uint64_t seed
   o.clock = clock;
   o.stop = stop;
   o.record_size_history = size_history;
+  o.register_views = register_views;
   o.backend = backend;
   o.engine = engine;
   o.world_config = world_config;
@@ -36,12 +37,13 @@ trials::TrialOptions trialOptions(const std::string& planner, std::uint64_t seed
 }
 
 // The keyword arguments of fvp run, in one place for Trial and run_trial.
-#define FVP_TRIAL_ARGS                                                                          \
-  py::kw_only(),                                                                                \
-      py::arg("planner") = "fvp", py::arg("seed") = 1, py::arg("budget_s") = 180.0,             \
-      py::arg("max_views") = py::none(), py::arg("clock") = "wall", py::arg("stop") = "budget", \
-      py::arg("size_history") = false, py::arg("backend") = "auto", py::arg("engine") = "",     \
-      py::arg("world_config") = "", py::arg("planner_config") = "", py::arg("out_dir") = ""
+#define FVP_TRIAL_ARGS                                                                         \
+  py::kw_only(), py::arg("planner") = "fvp", py::arg("seed") = 1, py::arg("budget_s") = 180.0, \
+                 py::arg("max_views") = py::none(), py::arg("clock") = "wall",                 \
+                 py::arg("stop") = "budget", py::arg("size_history") = false,                  \
+                 py::arg("register_views") = false, py::arg("backend") = "auto",               \
+                 py::arg("engine") = "", py::arg("world_config") = "",                         \
+                 py::arg("planner_config") = "", py::arg("out_dir") = ""
 
 }  // namespace
 
@@ -53,12 +55,13 @@ void bindSim(py::module_& m) {
                             "as keywords). Its camera and arm are the simulator's.")
       .def(py::init([](const std::string& planner, std::uint64_t seed, double budget_s,
                        std::optional<int> max_views, const std::string& clock,
-                       const std::string& stop, bool size_history, const std::string& backend,
-                       const std::string& engine, const std::string& world_config,
-                       const std::string& planner_config, const std::string& out_dir) {
-             return std::make_unique<trials::Trial>(
-                 trialOptions(planner, seed, budget_s, max_views, clock, stop, size_history,
-                              backend, engine, world_config, planner_config, out_dir));
+                       const std::string& stop, bool size_history, bool register_views,
+                       const std::string& backend, const std::string& engine,
+                       const std::string& world_config, const std::string& planner_config,
+                       const std::string& out_dir) {
+             return std::make_unique<trials::Trial>(trialOptions(
+                 planner, seed, budget_s, max_views, clock, stop, size_history, register_views,
+                 backend, engine, world_config, planner_config, out_dir));
            }),
            FVP_TRIAL_ARGS)
       .def_property_readonly(
@@ -87,12 +90,12 @@ void bindSim(py::module_& m) {
       "run_trial",
       [](const std::string& planner, std::uint64_t seed, double budget_s,
          std::optional<int> max_views, const std::string& clock, const std::string& stop,
-         bool size_history, const std::string& backend, const std::string& engine,
-         const std::string& world_config, const std::string& planner_config,
-         const std::string& out_dir) {
+         bool size_history, bool register_views, const std::string& backend,
+         const std::string& engine, const std::string& world_config,
+         const std::string& planner_config, const std::string& out_dir) {
         const trials::TrialOptions o =
-            trialOptions(planner, seed, budget_s, max_views, clock, stop, size_history, backend,
-                         engine, world_config, planner_config, out_dir);
+            trialOptions(planner, seed, budget_s, max_views, clock, stop, size_history,
+                         register_views, backend, engine, world_config, planner_config, out_dir);
         nlohmann::json result;
         {
           py::gil_scoped_release release;

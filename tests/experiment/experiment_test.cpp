@@ -430,6 +430,10 @@ TEST(Experiment, ResumeWithAChangedSettingIsRefusedNamingIt) {
   const std::string stop = refused([](auto& r) { r.trial.stop = "auto"; });
   EXPECT_NE(stop.find("stop budget, this run asks for auto"), std::string::npos) << stop;
   EXPECT_EQ(manifest["stop"], "budget");
+  const std::string registration = refused([](auto& r) { r.trial.register_views = true; });
+  EXPECT_NE(registration.find("register_views false, this run asks for true"), std::string::npos)
+      << registration;
+  EXPECT_EQ(manifest["register_views"], false);
   EXPECT_NE(refused([](auto& r) {
               r.trial.engine = "octomap";
             }).find("engine (each planner's own), this run asks for octomap"),

@@ -340,7 +340,7 @@ struct Trial::Impl {
     parts = makeParts(0);
 
     // The simulated camera.
-    RenderConfig render_config = renderConfigFor(world->config());
+    RenderConfig render_config = renderConfigFor(world->config(), {}, options.seed);
     render_config.noise_seed = options.seed;
     renderer = std::make_unique<StereoRenderer>(*world, render_config);
 

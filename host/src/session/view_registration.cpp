@@ -4,24 +4,16 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <nanoflann.hpp>
 #include <numbers>
 #include <stdexcept>
+
+#include "fvp/host/core/point_kd_tree.h"
 
 namespace fvp::host {
 namespace {
 
-struct Cloud {
-  const std::vector<Eigen::Vector3f>& pts;
-  std::size_t kdtree_get_point_count() const { return pts.size(); }
-  float kdtree_get_pt(std::size_t i, std::size_t dim) const { return pts[i][dim]; }
-  template <class Box>
-  bool kdtree_get_bbox(Box&) const {
-    return false;
-  }
-};
-using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Cloud>, Cloud,
-                                                 3, std::size_t>;
+using Cloud = PointCloudAdaptor;
+using Tree = PointKdTree;
 
 // 21 bits per axis around the origin: +-1 048 m at 1 mm, far beyond any robot's reach.
 std::uint64_t voxelKey(const Eigen::Vector3f& p, double voxel_m) {

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <exception>
 #include <numbers>
+#include <random>
 #include <stdexcept>
 
 #include "fvp/accel/embree_check.h"
@@ -45,6 +46,8 @@ constexpr std::uint64_t kFruitSeed = 0x1f2e3d4cULL, kLeafSeed = 0x5b6a7988ULL,
 constexpr float kRayTNear = 1e-4f;  // ignore hits within 0.1 mm of the camera centre
 // Shadow rays end this short of the shaded point (float hit positions are ~1e-7 m exact).
 constexpr double kShadowRayGapM = 1e-5;
+// The sun's shadow rays reach this far: past the whole tree.
+constexpr double kSunRayM = 10.0;
 
 double linearToSrgb(double v) {
   v = std::clamp(v, 0.0, 1.0);
@@ -104,7 +107,10 @@ struct StereoRenderer::Impl {
   /// Albedo at a surface point; `subregion` gets the tag cell (print edges are edges too).
   Eigen::Vector3d albedo(const Primitive& prim, const detail::SurfacePoint& surface,
                          const Eigen::Vector3d& dir, std::uint32_t& subregion) const;
-  bool lit(const Eigen::Vector3d& p, const Eigen::Vector3d& flash, bool with_leaves) const;
+  /// Whether nothing lies between p and the light at `light` (a point) or, with
+  /// `directional`, along the direction `light` for kSunRayM.
+  bool lit(const Eigen::Vector3d& p, const Eigen::Vector3d& light, bool with_leaves,
+           bool directional = false) const;
   ShadedSample radiance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
                         const Eigen::Vector3d& flash, bool with_leaves) const;
   int threadCount() const { return config.threads > 0 ? config.threads : omp_get_max_threads(); }
@@ -300,11 +306,12 @@ Eigen::Vector3d StereoRenderer::Impl::albedo(const Primitive& prim,
   return Eigen::Vector3d::Zero();
 }
 
-bool StereoRenderer::Impl::lit(const Eigen::Vector3d& p, const Eigen::Vector3d& flash,
-                               bool with_leaves) const {
+bool StereoRenderer::Impl::lit(const Eigen::Vector3d& p, const Eigen::Vector3d& light,
+                               bool with_leaves, bool directional) const {
   SceneContext context;
   rtcInitIntersectContext(&context.embree);
   context.with_leaves = with_leaves;
+  const Eigen::Vector3d flash = directional ? Eigen::Vector3d(p + kSunRayM * light) : light;
   const Eigen::Vector3d to_point = p - flash;
   RTCRay ray;
   std::memset(&ray, 0, sizeof(ray));
@@ -326,22 +333,32 @@ ShadedSample StereoRenderer::Impl::radiance(const Eigen::Vector3d& origin,
                                             const Eigen::Vector3d& dir,
                                             const Eigen::Vector3d& flash, bool with_leaves) const {
   const Hit hit = trace(origin, dir, with_leaves);
-  if (hit.primitive < 0) return {};  // night sky: the flash reaches nothing
+  // Nothing hit: the night sky, or the daylit sky (region 0 either way).
+  if (hit.primitive < 0) return {Eigen::Vector3d::Constant(config.sky_irradiance), 0u};
   const Primitive& prim = primitives[hit.primitive];
   const Eigen::Vector3d p = origin + hit.t * dir;
-  // Regions: 4 per primitive (shadow, lit, and the tag's two print colours when lit).
-  const std::uint32_t base = 1u + 4u * static_cast<std::uint32_t>(hit.primitive);
-  if (!lit(p, flash, with_leaves)) return {Eigen::Vector3d::Zero(), base};
+  // Regions: 8 per primitive: in or out of the flash's shadow (the tag's two print colours
+  // when lit), times in or out of the sun's.
+  const bool sunny = config.sun_irradiance > 0.0;
   const detail::SurfacePoint surface = detail::surfaceAt(prim, p);
+  const bool in_sun = sunny && lit(p, config.sun_direction_world, with_leaves, true);
+  const std::uint32_t base =
+      1u + 8u * static_cast<std::uint32_t>(hit.primitive) + (in_sun ? 4u : 0u);
+  // Daylight: the sky's diffuse light everywhere, the sun's where it reaches (Lambert).
+  double daylight = config.sky_irradiance;
+  if (in_sun)
+    daylight +=
+        config.sun_irradiance * std::abs(surface.normal_world.dot(config.sun_direction_world));
+  std::uint32_t subregion = 0;
+  const Eigen::Vector3d reflectance = albedo(prim, surface, dir, subregion);
+  if (!lit(p, flash, with_leaves)) return {daylight * reflectance, base};
   // Lambert's cosine and the flash's inverse-square falloff.
   const Eigen::Vector3d to_light = flash - p;
   const double distance2 = to_light.squaredNorm();
   const double cosine = std::abs(surface.normal_world.dot(to_light)) / std::sqrt(distance2);
   const double irradiance =
       config.flash_power * kFlashFullScaleDistanceM * kFlashFullScaleDistanceM / distance2;
-  std::uint32_t subregion = 0;
-  const Eigen::Vector3d rgb = (cosine * irradiance) * albedo(prim, surface, dir, subregion);
-  return {rgb, base + 1u + subregion};
+  return {(cosine * irradiance + daylight) * reflectance, base + 1u + subregion};
 }
 
 StereoRenderer::StereoRenderer(const World& world, const RenderConfig& config)
@@ -373,9 +390,22 @@ StereoRenderer::StereoRenderer(const World& world, const RenderConfig& config)
 
 StereoRenderer::~StereoRenderer() = default;
 
-RenderConfig renderConfigFor(const WorldConfig& world, RenderConfig base) {
+RenderConfig renderConfigFor(const WorldConfig& world, RenderConfig base, std::uint64_t seed) {
   base.right_baseline_scale = 1.0 + world.stereo_baseline_error;
   base.right_vertical_offset_px = world.stereo_vertical_misalignment_px;
+  if (world.sun_strength > 0.0) {
+    // "sun" in ASCII: a stream apart from the generator's and the other errors'.
+    std::seed_seq seq{seed, std::uint64_t{0x73756e}};
+    std::mt19937_64 rng(seq);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    const double elevation = (20.0 + 50.0 * unit(rng)) * std::numbers::pi / 180.0;
+    const double azimuth = 2.0 * std::numbers::pi * unit(rng);
+    base.sun_direction_world =
+        Eigen::Vector3d(std::cos(elevation) * std::cos(azimuth),
+                        std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+    base.sun_irradiance = world.sun_strength;
+    base.sky_irradiance = kSkyToSunRatio * world.sun_strength;
+  }
   return base;
 }
 

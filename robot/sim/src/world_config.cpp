@@ -82,6 +82,8 @@ const std::vector<KeySpec>& keySpecs() {
       {"segmentation_boundary_px", &WorldConfig::segmentation_boundary_px, 0.0, 5.0},
       {"segmentation_miss_rate", &WorldConfig::segmentation_miss_rate, 0.0, 0.9},
       {"segmentation_false_blobs", &WorldConfig::segmentation_false_blobs, 0.0, 20.0},
+      // Ten times the flash saturates every lit surface: no camera would be exposed so.
+      {"sun_strength", &WorldConfig::sun_strength, 0.0, 10.0},
   };
   return specs;
 }

@@ -30,6 +30,10 @@ namespace fvp::robot::sim {
 /// scale after sRGB encoding).
 inline constexpr double kFlashFullScaleDistanceM = 0.18;
 
+/// Diffuse skylight on a surface against direct sun on one facing it: about a fifth on a
+/// clear day (the sky's share of global horizontal irradiance at mid elevations).
+inline constexpr double kSkyToSunRatio = 0.2;
+
 struct RenderConfig {
   host::StereoIntrinsics intrinsics;
   int samples_per_pixel = 4;  ///< anti-aliasing (stratified sub-pixel samples)
@@ -46,11 +50,22 @@ struct RenderConfig {
   /// rectification). The frame's intrinsics stay the nominal ones, as a robot's calibration.
   double right_baseline_scale = 1.0;
   double right_vertical_offset_px = 0.0;
+  /// Ambient light on top of the flash (docs/simulation.md "Ambient light"): the sun's
+  /// irradiance in units of the flash's at kFlashFullScaleDistanceM (0: night, the flash
+  /// alone), from sun_direction_world (unit, towards the sun), with shadow rays; and the
+  /// sky's uniform diffuse irradiance, in the same unit, on every surface, and as the
+  /// background's radiance where a ray hits nothing.
+  double sun_irradiance = 0.0;
+  Eigen::Vector3d sun_direction_world = Eigen::Vector3d::UnitZ();
+  double sky_irradiance = 0.0;
 };
 
 /// The render config of a world: its stereo calibration errors (stereo_baseline_error,
-/// stereo_vertical_misalignment_px) on top of base.
-RenderConfig renderConfigFor(const WorldConfig& world, RenderConfig base = {});
+/// stereo_vertical_misalignment_px) on top of base, and its ambient light (sun_strength;
+/// the sun's direction drawn from seed on a stream of its own: elevation 20-70 degrees,
+/// any azimuth).
+RenderConfig renderConfigFor(const WorldConfig& world, RenderConfig base = {},
+                             std::uint64_t seed = 0);
 
 struct RenderOptions {
   bool with_leaves = true;  ///< false: render without leaves (occlusion statistic)

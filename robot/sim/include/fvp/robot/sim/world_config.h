@@ -92,6 +92,10 @@ struct WorldConfig {
   double segmentation_miss_rate = 0.0;
   /// Mean number of false fruitlet blobs on leaves per view (Poisson).
   double segmentation_false_blobs = 0.0;
+  /// Ambient light (docs/simulation.md "Ambient light"): the sun's irradiance in units of the
+  /// flash's at its full-scale distance (0: the flash alone); its direction is drawn per
+  /// trial, and the sky adds kSkyToSunRatio of it as diffuse light.
+  double sun_strength = 0.0;
 
   /// Reads a YAML file; missing keys keep their defaults; unknown keys, wrong types and
   /// out-of-range values throw std::invalid_argument naming the file and the key.
