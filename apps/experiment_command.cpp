@@ -37,7 +37,7 @@ void addExperimentCommands(CLI::App& app) {
   cmd->add_option("--world", opt->world, "world config YAML")->check(CLI::ExistingFile);
   cmd->add_option("--config", opt->config, "planner config YAML")->check(CLI::ExistingFile);
   cmd->add_option("--error-scale", opt->error_scale,
-                  "GROUP=FACTOR: the world's pose, stereo, wind, segmentation or all errors "
+                  "GROUP=FACTOR: the world's pose, stereo, wind, segmentation, light or all errors "
                   "times FACTOR (a sweep point; written to OUT/world.yaml)");
   cmd->add_option("--budget-s", opt->experiment.trial.budget_s, "simulated budget per trial, s")
       ->check(finiteNumber())

@@ -170,7 +170,8 @@ WorldConfig WorldConfig::fromYamlFile(const std::filesystem::path& path) {
 }
 
 const std::vector<std::string>& WorldConfig::errorGroups() {
-  static const std::vector<std::string> groups = {"pose", "stereo", "wind", "segmentation", "all"};
+  static const std::vector<std::string> groups = {"pose",         "stereo", "wind",
+                                                  "segmentation", "light",  "all"};
   return groups;
 }
 
@@ -182,7 +183,8 @@ WorldConfig WorldConfig::withErrorsScaled(const std::string& group, double facto
       {"stereo", {"stereo_baseline_error", "stereo_vertical_misalignment_px"}},
       {"wind", {"wind_leaf_tip_m", "wind_fruitlet_swing_m"}},
       {"segmentation",
-       {"segmentation_boundary_px", "segmentation_miss_rate", "segmentation_false_blobs"}}};
+       {"segmentation_boundary_px", "segmentation_miss_rate", "segmentation_false_blobs"}},
+      {"light", {"sun_strength"}}};
   if (!(factor >= 0.0) || !std::isfinite(factor))
     throw std::invalid_argument("error scale: expected a factor >= 0, got " + formatNumber(factor));
   const bool all = group == "all";
@@ -203,7 +205,7 @@ WorldConfig WorldConfig::withErrorsScaled(const std::string& group, double facto
   }
   if (!known)
     throw std::invalid_argument("error scale: unknown error group '" + group +
-                                "'; expected pose, stereo, wind, segmentation or all");
+                                "'; expected pose, stereo, wind, segmentation, light or all");
   return out;
 }
 

@@ -105,7 +105,7 @@ struct WorldConfig {
   /// The simulated errors in groups, for sweeps (docs/simulation.md "Sweeping an error"):
   /// pose (hand_eye_*, arm_position_error_m, view_*), stereo (stereo_*), wind (wind_*),
   /// segmentation (segmentation_boundary_px, _miss_rate, _false_blobs; not the switches
-  /// segmentation_model and fruitlet_green_fraction), and all of them.
+  /// segmentation_model and fruitlet_green_fraction), light (sun_strength), and all of them.
   static const std::vector<std::string>& errorGroups();
   /// This config with the magnitudes of one error group times factor (>= 0), each clamped
   /// to its key's range. Throws std::invalid_argument for an unknown group or a bad factor.
