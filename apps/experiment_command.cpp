@@ -11,6 +11,7 @@
 #include "commands.h"
 #include "fvp/host/map/map_engine_registry.h"
 #include "fvp/trials/experiment.h"
+#include "fvp/trials/sensitivity_report.h"
 
 namespace fvp::apps {
 
@@ -83,6 +84,7 @@ void addExperimentCommands(CLI::App& app) {
     if (opt->planners.empty()) o.planners.clear();
     if (!opt->shard.empty())
       std::tie(o.shard_index, o.shard_count) = trials::parseShard(opt->shard);
+    o.error_scale = opt->error_scale;
     o.trial.world_config = opt->error_scale.empty() ? std::filesystem::path(opt->world)
                                                     : trials::writeScaledWorldConfig(
                                                           opt->world, opt->error_scale, opt->out);
@@ -118,6 +120,24 @@ void addExperimentCommands(CLI::App& app) {
     });
     std::cout << "merged " << dirs.size() << " shards into " << *merge_out << " (index.html: "
               << "Table 1, the figures and every trial's viewer)\n";
+  });
+
+  auto sweep_out = std::make_shared<std::string>();
+  auto points = std::make_shared<std::vector<std::string>>();
+  auto* sensitivity =
+      app.add_subcommand("sensitivity",
+                         "Tabulate and plot a sweep of experiments made with --error-scale; write "
+                         "sensitivity.json, sensitivity.md and sensitivity.png to --out");
+  sensitivity->add_option("experiments", *points, "experiment directories (the sweep's points)")
+      ->required();
+  sensitivity->add_option("--out", *sweep_out, "output directory")->required();
+  sensitivity->callback([sweep_out, points] {
+    std::vector<std::filesystem::path> dirs(points->begin(), points->end());
+    const bool drawn = trials::writeSensitivityReport(
+        dirs, *sweep_out,
+        [](const std::string& line) { std::cerr << "fvp: warning: " << line << "\n"; });
+    std::cout << "wrote " << *sweep_out << "/{sensitivity.json, sensitivity.md"
+              << (drawn ? ", sensitivity.png" : "") << "}\n";
   });
 }
 

@@ -12,6 +12,7 @@
 
 #include "fvp/robot/sim/world_config.h"
 #include "fvp/trials/experiment.h"
+#include "fvp/trials/sensitivity_report.h"
 
 namespace fvp::trials {
 namespace {
@@ -381,6 +382,43 @@ TEST(Experiment, AnErrorScaleWritesTheScaledWorldConfigTheTrialsRead) {
   for (const char* bad : {"pose", "pose=", "pose=x", "pose=1x", "=1", "sun=1", "pose=-1"})
     EXPECT_THROW(writeScaledWorldConfig(world, bad, out), std::invalid_argument) << bad;
   fs::remove_all(out);
+}
+
+TEST(Experiment, TheSensitivityReportHasAPointPerExperimentAndPlannerSortedByFactor) {
+  // Three sweep points of one group (fake trials: every point has the same metrics) and one
+  // with registration.
+  std::vector<fs::path> dirs;
+  for (const auto& [scale, registered] : std::vector<std::pair<std::string, bool>>{
+           {"wind=2", false}, {"wind=0", false}, {"wind=0.5", false}, {"wind=1", true}}) {
+    ExperimentOptions o = options(freshDir("sweep_" + scale + (registered ? "_reg" : "")), 2);
+    o.error_scale = scale;
+    o.trial.register_views = registered;
+    runExperiment(o, fakeTrial, nullptr);
+    EXPECT_EQ(nlohmann::json::parse(slurp(o.out_dir / "manifest.json"))["error_scale"], scale);
+    dirs.push_back(o.out_dir);
+  }
+  const fs::path out = freshDir("sweep_report");
+  EXPECT_TRUE(writeSensitivityReport(dirs, out, nullptr));
+  const nlohmann::json points = nlohmann::json::parse(slurp(out / "sensitivity.json"));
+  // 4 experiments x (fvp, rvp and each one's paper-sizing row).
+  ASSERT_EQ(points.size(), 16u);
+  std::vector<double> fvp_factors;
+  for (const auto& p : points)
+    if (p["planner"] == "fvp" && !p["register_views"].get<bool>())
+      fvp_factors.push_back(p["factor"].get<double>());
+  EXPECT_EQ(fvp_factors, (std::vector<double>{0.0, 0.5, 2.0}));
+  // fvp: 4 of 4 fruitlets matched (two worlds of two), errors +0.5 and -1 mm.
+  EXPECT_DOUBLE_EQ(points[0]["match_percent"].get<double>(), 100.0);
+  EXPECT_DOUBLE_EQ(points[0]["mae_mm"].get<double>(), 0.75);
+  EXPECT_EQ(slurp(out / "sensitivity.png").substr(1, 3), "PNG");
+  EXPECT_NE(slurp(out / "sensitivity.md").find("| wind | 0.50 | fvp | no | 2 |"), std::string::npos)
+      << slurp(out / "sensitivity.md");
+  // An experiment that is not a sweep point is named.
+  const fs::path plain = freshDir("sweep_plain");
+  runExperiment(options(plain, 1), fakeTrial, nullptr);
+  const std::string error = errorOf([&] { writeSensitivityReport({plain}, out, nullptr); });
+  EXPECT_NE(error.find(plain.string() + ": its manifest has no error scale"), std::string::npos)
+      << error;
 }
 
 TEST(Experiment, ShardTextIsParsedStrictly) {

@@ -232,6 +232,7 @@ nlohmann::ordered_json ExperimentManifest::toJson() const {
   j["stop"] = stop;
   j["max_views"] = max_views;
   j["register_views"] = register_views;
+  j["error_scale"] = error_scale;
   j["world_config"] = configJson(world_config);
   j["planner_config"] = configJson(planner_config);
   if (kind == "merged") {
@@ -293,6 +294,7 @@ ExperimentManifest readManifest(const std::filesystem::path& path) {
       fieldError(where, "register_views", "true or false", &j["register_views"]);
     m.register_views = j["register_views"].get<bool>();
   }
+  if (member(j, "error_scale")) m.error_scale = readString(j, "error_scale", where);
   m.world_config = readConfig(j, "world_config", where);
   m.planner_config = readConfig(j, "planner_config", where);
   if (m.kind == "merged") {

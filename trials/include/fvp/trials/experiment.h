@@ -27,6 +27,9 @@ struct ExperimentOptions {
   std::uint64_t first_seed = 1;
   int shard_index = 0, shard_count = 1;  ///< --shard i/n
   bool resume = false;
+  /// --error-scale's GROUP=FACTOR when the world config was scaled (writeScaledWorldConfig),
+  /// recorded in the manifest for the sensitivity report; empty otherwise.
+  std::string error_scale;
   TrialOptions trial;  ///< world, config, budget, backend, engine, clock, max views
   std::filesystem::path out_dir;
 };

@@ -66,6 +66,9 @@ struct ExperimentManifest {
   std::string stop = "budget";  ///< budget | auto (absent in a manifest: budget)
   int max_views = 0;            ///< 0: no limit
   bool register_views = false;  ///< --register-views (absent in a manifest: false)
+  /// --error-scale GROUP=FACTOR, or empty; the world config's hash already tells runs apart,
+  /// this names the sweep point (absent in a manifest: empty).
+  std::string error_scale;
   ConfigFileStamp world_config, planner_config;
   // The run's own plan (kind "run" only). Resume refuses a difference; merge does not
   // compare them (shards differ in them by design; the engine is in the row key).

@@ -1,0 +1,132 @@
+#include "fvp/trials/sensitivity_report.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+#include <tuple>
+
+#include "fvp/host/core/atomic_file.h"
+#include "fvp/host/core/gnuplot.h"
+#include "fvp/trials/experiment.h"
+#include "fvp/trials/experiment_directory.h"
+#include "number_text.h"
+
+namespace fvp::trials {
+namespace fs = std::filesystem;
+namespace {
+
+std::string seriesName(const SensitivityPoint& p) {
+  std::string name = p.planner == "fvp" ? "FVP" : p.planner == "rvp" ? "RVP" : p.planner;
+  return p.group + ", " + name + (p.registered ? " + registration" : "");
+}
+
+std::string figureScript(const std::vector<SensitivityPoint>& points) {
+  std::map<std::string, std::vector<const SensitivityPoint*>> series;
+  for (const auto& p : points)
+    if (p.planner.find("-paper-sizing") == std::string::npos) series[seriesName(p)].push_back(&p);
+  std::ostringstream gp;
+  gp << "set terminal pngcairo size 1200,520 font 'DejaVu Sans,11'\n"
+     << "set multiplot layout 1,2 title 'Sizing against the magnitude of each simulated error "
+        "(1 = the world config)'\n"
+     << "set grid\nset offsets graph 0.02, 0.02, 0.05, 0.05\nset key top left font ',9'\nset "
+        "xlabel 'error magnitude (x the world "
+        "config)'\n";
+  int k = 0;
+  for (const auto& [name, ps] : series) {
+    gp << "$s" << k++ << " << EOD\n";
+    for (const auto* p : ps) gp << p->factor << " " << p->mae_mm << " " << p->match_percent << "\n";
+    gp << "EOD\n";
+  }
+  const auto plot = [&](int column, const std::string& label) {
+    gp << "set ylabel '" << label << "'\nplot ";
+    int i = 0;
+    for (const auto& [name, ps] : series) {
+      gp << (i ? ", " : "") << "$s" << i << " using 1:" << column << " with linespoints lw 2 "
+         << "title '" << name << "'";
+      ++i;
+    }
+    gp << "\n";
+  };
+  plot(2, "MAE (mm)");
+  plot(3, "MP (%)");
+  gp << "unset multiplot\n";
+  return gp.str();
+}
+
+}  // namespace
+
+std::vector<SensitivityPoint> readSensitivityPoints(const std::vector<fs::path>& experiments) {
+  std::vector<SensitivityPoint> points;
+  for (const fs::path& dir : experiments) {
+    const ExperimentManifest m = readManifest(dir / "manifest.json");
+    const std::size_t eq = m.error_scale.find('=');
+    if (eq == std::string::npos)
+      throw std::runtime_error(dir.string() +
+                               ": its manifest has no error scale (make each sweep point with "
+                               "fvp experiment --error-scale GROUP=FACTOR)");
+    const std::vector<nlohmann::json> trials = readTrials(dir / "trials.jsonl", nullptr);
+    if (trials.empty()) throw std::runtime_error(dir.string() + ": no trials in trials.jsonl");
+    const nlohmann::json summary = summarize(trials);
+    for (const auto& [planner, row] : summary.items()) {
+      SensitivityPoint p;
+      p.group = m.error_scale.substr(0, eq);
+      p.factor = std::strtod(m.error_scale.c_str() + eq + 1, nullptr);
+      p.registered = m.register_views;
+      p.planner = planner;
+      p.trials = row.value("trials", 0);
+      p.match_percent = row.value("match_percent", 0.0);
+      p.mae_mm = row.value("mae_mm", 0.0);
+      p.precision_percent = row.value("precision_percent", 0.0);
+      p.experiment = dir.string();
+      points.push_back(p);
+    }
+  }
+  std::sort(points.begin(), points.end(), [](const auto& a, const auto& b) {
+    return std::tie(a.group, a.planner, a.registered, a.factor) <
+           std::tie(b.group, b.planner, b.registered, b.factor);
+  });
+  return points;
+}
+
+bool writeSensitivityReport(const std::vector<fs::path>& experiments, const fs::path& out_dir,
+                            const std::function<void(const std::string&)>& warning) {
+  const std::vector<SensitivityPoint> points = readSensitivityPoints(experiments);
+  fs::create_directories(out_dir);
+  nlohmann::json json = nlohmann::json::array();
+  std::ostringstream md;
+  md << "# Sensitivity to the simulated errors\n\n"
+     << "Each row is one experiment (`fvp experiment --error-scale GROUP=FACTOR`): the world "
+        "config's errors of that group times the factor.\n\n"
+     << "| group | factor | planner | registration | trials | MP (%) | MAE (mm) | precision (%) "
+        "| experiment |\n|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& p : points) {
+    json.push_back({{"group", p.group},
+                    {"factor", p.factor},
+                    {"planner", p.planner},
+                    {"register_views", p.registered},
+                    {"trials", p.trials},
+                    {"match_percent", p.match_percent},
+                    {"mae_mm", p.mae_mm},
+                    {"precision_percent", p.precision_percent},
+                    {"experiment", p.experiment}});
+    md << "| " << p.group << " | " << fmt(p.factor, 2) << " | " << p.planner << " | "
+       << (p.registered ? "yes" : "no") << " | " << p.trials << " | " << fmt(p.match_percent, 1)
+       << " | " << fmt(p.mae_mm, 2) << " | " << fmt(p.precision_percent, 1) << " | " << p.experiment
+       << " |\n";
+  }
+  host::writeFileAtomically(out_dir / "sensitivity.json", "sensitivity report",
+                            json.dump(2) + "\n");
+  host::writeFileAtomically(out_dir / "sensitivity.md", "sensitivity report", md.str());
+  try {
+    host::plotWithGnuplot(figureScript(points), out_dir / "sensitivity.png", "sensitivity.png");
+    return true;
+  } catch (const std::exception& e) {
+    if (warning) warning(std::string("sensitivity.png not drawn: ") + e.what());
+    return false;
+  }
+}
+
+}  // namespace fvp::trials
