@@ -74,16 +74,20 @@ ConfigFileStamp stampOf(const fs::path& path, const std::string& what) {
 /// The manifest an experiment with these options has.
 }  // namespace
 
-fs::path writeScaledWorldConfig(const fs::path& world, const std::string& error_scale,
-                                const fs::path& out_dir) {
+std::pair<std::string, double> parseErrorScale(const std::string& error_scale) {
   const std::size_t eq = error_scale.find('=');
-  const std::string group = error_scale.substr(0, eq);
   const std::string factor_text = eq == std::string::npos ? "" : error_scale.substr(eq + 1);
   char* end = nullptr;
   const double factor = std::strtod(factor_text.c_str(), &end);
   if (eq == std::string::npos || factor_text.empty() || *end != '\0' || !std::isfinite(factor))
     throw std::invalid_argument("--error-scale '" + error_scale +
                                 "': expected GROUP=FACTOR, e.g. wind=0.5");
+  return {error_scale.substr(0, eq), factor};
+}
+
+fs::path writeScaledWorldConfig(const fs::path& world, const std::string& error_scale,
+                                const fs::path& out_dir) {
+  const auto [group, factor] = parseErrorScale(error_scale);
   const robot::sim::WorldConfig base =
       world.empty() ? robot::sim::WorldConfig{} : robot::sim::WorldConfig::fromYamlFile(world);
   const robot::sim::WorldConfig scaled = base.withErrorsScaled(group, factor);

@@ -1,7 +1,6 @@
 #include "fvp/trials/sensitivity_report.h"
 
 #include <algorithm>
-#include <cstdlib>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -62,18 +61,18 @@ std::vector<SensitivityPoint> readSensitivityPoints(const std::vector<fs::path>&
   std::vector<SensitivityPoint> points;
   for (const fs::path& dir : experiments) {
     const ExperimentManifest m = readManifest(dir / "manifest.json");
-    const std::size_t eq = m.error_scale.find('=');
-    if (eq == std::string::npos)
+    if (m.error_scale.empty())
       throw std::runtime_error(dir.string() +
                                ": its manifest has no error scale (make each sweep point with "
                                "fvp experiment --error-scale GROUP=FACTOR)");
     const std::vector<nlohmann::json> trials = readTrials(dir / "trials.jsonl", nullptr);
     if (trials.empty()) throw std::runtime_error(dir.string() + ": no trials in trials.jsonl");
+    const auto [group, factor] = parseErrorScale(m.error_scale);
     const nlohmann::json summary = summarize(trials);
     for (const auto& [planner, row] : summary.items()) {
       SensitivityPoint p;
-      p.group = m.error_scale.substr(0, eq);
-      p.factor = std::strtod(m.error_scale.c_str() + eq + 1, nullptr);
+      p.group = group;
+      p.factor = factor;
       p.registered = m.register_views;
       p.planner = planner;
       p.trials = row.value("trials", 0);

@@ -26,12 +26,11 @@ std::uint64_t voxelKey(const Eigen::Vector3f& p, double voxel_m) {
   return key;
 }
 
-std::vector<Eigen::Vector3f> thinned(const std::vector<Eigen::Vector3f>& points, double voxel_m) {
-  std::unordered_set<std::uint64_t> seen;
-  std::vector<Eigen::Vector3f> out;
+// Appends to out each finite point whose voxel is not in `seen` yet (one point per voxel).
+void appendOnePerVoxel(const std::vector<Eigen::Vector3f>& points, double voxel_m,
+                       std::unordered_set<std::uint64_t>& seen, std::vector<Eigen::Vector3f>& out) {
   for (const Eigen::Vector3f& p : points)
     if (p.allFinite() && seen.insert(voxelKey(p, voxel_m)).second) out.push_back(p);
-  return out;
 }
 
 struct Pairs {
@@ -172,16 +171,16 @@ ViewRegistration::ViewRegistration(ViewRegistrationConfig config) : config_(conf
 }
 
 void ViewRegistration::addToModel(const std::vector<Eigen::Vector3f>& points_m) {
-  for (const Eigen::Vector3f& p : points_m)
-    if (p.allFinite() && model_voxels_.insert(voxelKey(p, config_.voxel_m)).second)
-      model_.push_back(p);
+  appendOnePerVoxel(points_m, config_.voxel_m, model_voxels_, model_);
 }
 
 RegistrationResult ViewRegistration::align(
     const std::vector<Eigen::Vector3f>& view_points_m) const {
   RegistrationResult result;
   if (model_.size() < config_.min_pairs) return result;  // kNoModel
-  const std::vector<Eigen::Vector3f> source = thinned(view_points_m, config_.voxel_m);
+  std::vector<Eigen::Vector3f> source;
+  std::unordered_set<std::uint64_t> source_voxels;
+  appendOnePerVoxel(view_points_m, config_.voxel_m, source_voxels, source);
   const Cloud cloud{model_};
   Tree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10));
   tree.buildIndex();

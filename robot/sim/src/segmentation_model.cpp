@@ -29,6 +29,19 @@ cv::Mat smoothField(cv::Size size, double rms_px, std::mt19937_64& rng) {
   return fine;
 }
 
+// 255 on the pixels of every fruitlet not in `missed` (indexed by fruitlet).
+cv::Mat fruitletPixels(const cv::Mat& object_id, const std::vector<bool>& missed) {
+  CV_Assert(object_id.type() == CV_32S);
+  cv::Mat mask(object_id.size(), CV_8U, cv::Scalar(0));
+  for (int v = 0; v < object_id.rows; ++v) {
+    const int* id = object_id.ptr<int>(v);
+    std::uint8_t* m = mask.ptr<std::uint8_t>(v);
+    for (int u = 0; u < object_id.cols; ++u)
+      m[u] = isFruitletId(id[u]) && !missed[id[u] - kFirstFruitletId] ? 255 : 0;
+  }
+  return mask;
+}
+
 }  // namespace
 
 SegmentationModel::SegmentationModel(const WorldConfig& c, std::uint64_t seed)
@@ -39,18 +52,10 @@ SegmentationModel::SegmentationModel(const WorldConfig& c, std::uint64_t seed)
       false_blobs_(c.segmentation_false_blobs) {}
 
 cv::Mat SegmentationModel::trueMask(const cv::Mat& object_id) {
-  CV_Assert(object_id.type() == CV_32S);
-  cv::Mat mask(object_id.size(), CV_8U, cv::Scalar(0));
-  for (int v = 0; v < object_id.rows; ++v) {
-    const int* id = object_id.ptr<int>(v);
-    std::uint8_t* m = mask.ptr<std::uint8_t>(v);
-    for (int u = 0; u < object_id.cols; ++u) m[u] = isFruitletId(id[u]) ? 255 : 0;
-  }
-  return mask;
+  return fruitletPixels(object_id, std::vector<bool>(kMaxFruitlets, false));
 }
 
 cv::Mat SegmentationModel::maskFor(const cv::Mat& object_id, int view) const {
-  CV_Assert(object_id.type() == CV_32S);
   std::seed_seq seq{seed_, kSegmentationStream, static_cast<std::uint64_t>(view)};
   std::mt19937_64 rng(seq);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -59,13 +64,7 @@ cv::Mat SegmentationModel::maskFor(const cv::Mat& object_id, int view) const {
   // so a fruitlet's fate in a view does not depend on which others are visible).
   std::vector<bool> missed(kMaxFruitlets);
   for (int i = 0; i < kMaxFruitlets; ++i) missed[i] = unit(rng) < miss_rate_;
-  cv::Mat mask(object_id.size(), CV_8U, cv::Scalar(0));
-  for (int v = 0; v < object_id.rows; ++v) {
-    const int* id = object_id.ptr<int>(v);
-    std::uint8_t* m = mask.ptr<std::uint8_t>(v);
-    for (int u = 0; u < object_id.cols; ++u)
-      m[u] = isFruitletId(id[u]) && !missed[id[u] - kFirstFruitletId] ? 255 : 0;
-  }
+  cv::Mat mask = fruitletPixels(object_id, missed);
 
   // Boundary: the signed distance to the mask's boundary (inside positive) plus a smooth
   // field; a pixel is fruitlet where the sum is positive. Far from fruitlets nothing changes.

@@ -339,11 +339,16 @@ ShadedSample StereoRenderer::Impl::radiance(const Eigen::Vector3d& origin,
   const Eigen::Vector3d p = origin + hit.t * dir;
   // Regions: 8 per primitive: in or out of the flash's shadow (the tag's two print colours
   // when lit), times in or out of the sun's.
-  const bool sunny = config.sun_irradiance > 0.0;
-  const detail::SurfacePoint surface = detail::surfaceAt(prim, p);
-  const bool in_sun = sunny && lit(p, config.sun_direction_world, with_leaves, true);
+  const bool in_sun = config.sun_irradiance > 0.0 &&
+                      lit(p, config.sun_direction_world, with_leaves, /*directional=*/true);
   const std::uint32_t base =
       1u + 8u * static_cast<std::uint32_t>(hit.primitive) + (in_sun ? 4u : 0u);
+  const bool in_flash = lit(p, flash, with_leaves);
+  // No light reaches it: black, without shading a surface (the flash's shadows cost what
+  // they did before daylight existed).
+  if (!in_flash && !in_sun && !(config.sky_irradiance > 0.0))
+    return {Eigen::Vector3d::Zero(), base};
+  const detail::SurfacePoint surface = detail::surfaceAt(prim, p);
   // Daylight: the sky's diffuse light everywhere, the sun's where it reaches (Lambert).
   double daylight = config.sky_irradiance;
   if (in_sun)
@@ -351,7 +356,7 @@ ShadedSample StereoRenderer::Impl::radiance(const Eigen::Vector3d& origin,
         config.sun_irradiance * std::abs(surface.normal_world.dot(config.sun_direction_world));
   std::uint32_t subregion = 0;
   const Eigen::Vector3d reflectance = albedo(prim, surface, dir, subregion);
-  if (!lit(p, flash, with_leaves)) return {daylight * reflectance, base};
+  if (!in_flash) return {daylight * reflectance, base};
   // Lambert's cosine and the flash's inverse-square falloff.
   const Eigen::Vector3d to_light = flash - p;
   const double distance2 = to_light.squaredNorm();

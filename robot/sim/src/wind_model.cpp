@@ -35,6 +35,15 @@ Leaf turnLeaf(const Leaf& rest, const Eigen::Vector3d& axis, double tip_m) {
   return moved;
 }
 
+// The largest scale of a move, 1, 1/2, ... 2^-kShortenings, at which clear(scale) holds, or
+// 0: a move that collides is shortened, then dropped.
+template <typename Clear>
+double clearScale(Clear&& clear) {
+  for (int k = 0; k <= WindModel::kShortenings; ++k)
+    if (const double scale = std::ldexp(1.0, -k); clear(scale)) return scale;
+  return 0.0;
+}
+
 }  // namespace
 
 WindModel::WindModel(const World& rest, std::uint64_t seed)
@@ -58,22 +67,20 @@ World WindModel::worldAt(int view) const {
     const double radius = swing_m_ * std::sqrt(unit(rng));
     const double angle = 2.0 * std::numbers::pi * unit(rng);
     const Eigen::Vector3d swing(radius * std::cos(angle), radius * std::sin(angle), 0.0);
-    const Eigen::Vector3d rest_centre = f.center_m;
-    for (int k = 0; k <= kShortenings + 1; ++k) {
-      const double scale = k <= kShortenings ? std::ldexp(1.0, -k) : 0.0;
-      f.center_m = rest_centre + scale * swing;
+    const Fruitlet& rest_f = rest_.fruitlets()[f.index];
+    const double scale = clearScale([&](double s) {
+      f.center_m = rest_f.center_m + s * swing;
       // No new contact: with the fruitlets already moved (and the rest of them at rest),
       // and with the leaves at rest (they move next, checked against these positions).
-      const Fruitlet& rest_f = rest_.fruitlets()[f.index];
-      bool clear = true;
       for (const Fruitlet& other : fruitlets)
         if (other.index != f.index && fruitletsOverlap(f, other, gap_m) &&
             !fruitletsOverlap(rest_f, rest_.fruitlets()[other.index], gap_m))
-          clear = false;
+          return false;
       for (const Leaf& leaf : rest_.leaves())
-        if (leafTouches(leaf, f) && !leafTouches(leaf, rest_f)) clear = false;
-      if (clear || scale == 0.0) break;
-    }
+        if (leafTouches(leaf, f) && !leafTouches(leaf, rest_f)) return false;
+      return true;
+    });
+    f.center_m = rest_f.center_m + scale * swing;
   }
 
   // Leaves: a random axis through the attachment, perpendicular to the stalk-to-tip line
@@ -89,16 +96,15 @@ World WindModel::worldAt(int view) const {
     if (!(axis.norm() > 1e-9) || tip_m == 0.0) continue;
     axis.normalize();
     const Leaf rest_leaf = leaf;
-    for (int k = 0; k <= kShortenings + 1; ++k) {
-      const double scale = k <= kShortenings ? std::ldexp(1.0, -k) : 0.0;
-      leaf = turnLeaf(rest_leaf, axis, scale * tip_m);
+    const double scale = clearScale([&](double s) {
+      const Leaf turned = turnLeaf(rest_leaf, axis, s * tip_m);
       // No new contact with the fruitlets where they are in this view.
-      bool clear = true;
       for (const Fruitlet& f : fruitlets)
-        if (leafTouches(leaf, f) && !leafTouches(rest_leaf, rest_.fruitlets()[f.index]))
-          clear = false;
-      if (clear || scale == 0.0) break;
-    }
+        if (leafTouches(turned, f) && !leafTouches(rest_leaf, rest_.fruitlets()[f.index]))
+          return false;
+      return true;
+    });
+    leaf = turnLeaf(rest_leaf, axis, scale * tip_m);
   }
   return rest_.withMovedParts(std::move(fruitlets), std::move(leaves));
 }

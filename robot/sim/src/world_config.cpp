@@ -169,12 +169,6 @@ WorldConfig WorldConfig::fromYamlFile(const std::filesystem::path& path) {
   return config;
 }
 
-const std::vector<std::string>& WorldConfig::errorGroups() {
-  static const std::vector<std::string> groups = {"pose",         "stereo", "wind",
-                                                  "segmentation", "light",  "all"};
-  return groups;
-}
-
 WorldConfig WorldConfig::withErrorsScaled(const std::string& group, double factor) const {
   static const std::vector<std::pair<std::string, std::vector<std::string>>> members = {
       {"pose",

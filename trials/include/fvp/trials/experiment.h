@@ -37,6 +37,10 @@ struct ExperimentOptions {
 using TrialRunner = std::function<nlohmann::json(const TrialOptions&)>;
 using MessageSink = std::function<void(const std::string&)>;
 
+/// --error-scale's GROUP=FACTOR split into its group and factor; throws
+/// std::invalid_argument naming the text when it is not of that form (a finite FACTOR).
+std::pair<std::string, double> parseErrorScale(const std::string& error_scale);
+
 /// --error-scale GROUP=FACTOR (docs/simulation.md "Sweeping an error"): the world config
 /// (world, or the default when empty) with that error group's magnitudes times FACTOR,
 /// written to out_dir/world.yaml (out_dir created) for the trials to read and the manifest

@@ -102,13 +102,12 @@ struct WorldConfig {
   static WorldConfig fromYamlFile(const std::filesystem::path& path);
   /// Throws std::invalid_argument naming the first bad key and its expected range.
   void validate(const std::string& source = "world config") const;
-  /// The simulated errors in groups, for sweeps (docs/simulation.md "Sweeping an error"):
+  /// This config with the magnitudes of one group of simulated errors times factor (>= 0),
+  /// each clamped to its key's range, for sweeps (docs/simulation.md "Sweeping an error"):
   /// pose (hand_eye_*, arm_position_error_m, view_*), stereo (stereo_*), wind (wind_*),
   /// segmentation (segmentation_boundary_px, _miss_rate, _false_blobs; not the switches
-  /// segmentation_model and fruitlet_green_fraction), light (sun_strength), and all of them.
-  static const std::vector<std::string>& errorGroups();
-  /// This config with the magnitudes of one error group times factor (>= 0), each clamped
-  /// to its key's range. Throws std::invalid_argument for an unknown group or a bad factor.
+  /// segmentation_model and fruitlet_green_fraction), light (sun_strength), or all. Throws
+  /// std::invalid_argument for an unknown group or a bad factor.
   WorldConfig withErrorsScaled(const std::string& group, double factor) const;
   /// Every YAML key, in declaration order (the same names as the fields).
   static const std::vector<std::string>& keyNames();
