@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <optional>
 #include <sstream>
 
@@ -385,11 +386,15 @@ TEST(Experiment, AnErrorScaleWritesTheScaledWorldConfigTheTrialsRead) {
 }
 
 TEST(Experiment, TheSensitivityReportHasAPointPerExperimentAndPlannerSortedByFactor) {
-  // Three sweep points of one group (fake trials: every point has the same metrics) and one
-  // with registration.
+  // Three sweep points of one group (fake trials: every point has the same metrics), one
+  // with registration, and the world config itself as another group's factor 1.
   std::vector<fs::path> dirs;
-  for (const auto& [scale, registered] : std::vector<std::pair<std::string, bool>>{
-           {"wind=2", false}, {"wind=0", false}, {"wind=0.5", false}, {"wind=1", true}}) {
+  for (const auto& [scale, registered] :
+       std::vector<std::pair<std::string, bool>>{{"wind=2", false},
+                                                 {"wind=0", false},
+                                                 {"wind=0.5", false},
+                                                 {"wind=1", true},
+                                                 {"pose=1", false}}) {
     ExperimentOptions o = options(freshDir("sweep_" + scale + (registered ? "_reg" : "")), 2);
     o.error_scale = scale;
     o.trial.register_views = registered;
@@ -400,14 +405,20 @@ TEST(Experiment, TheSensitivityReportHasAPointPerExperimentAndPlannerSortedByFac
   const fs::path out = freshDir("sweep_report");
   EXPECT_TRUE(writeSensitivityReport(dirs, out, nullptr));
   const nlohmann::json points = nlohmann::json::parse(slurp(out / "sensitivity.json"));
-  // 4 experiments x (fvp, rvp and each one's paper-sizing row).
-  ASSERT_EQ(points.size(), 16u);
-  std::vector<double> fvp_factors;
+  // 5 experiments x (fvp, rvp and each one's paper-sizing row), and factor 1 shared: pose's
+  // unregistered point stands for wind's, wind's registered one for pose's.
+  ASSERT_EQ(points.size(), 28u);
+  std::map<std::pair<std::string, bool>, std::vector<double>> fvp_factors;
   for (const auto& p : points)
-    if (p["planner"] == "fvp" && !p["register_views"].get<bool>())
-      fvp_factors.push_back(p["factor"].get<double>());
-  EXPECT_EQ(fvp_factors, (std::vector<double>{0.0, 0.5, 2.0}));
+    if (p["planner"] == "fvp")
+      fvp_factors[{p["group"].get<std::string>(), p["register_views"].get<bool>()}].push_back(
+          p["factor"].get<double>());
+  EXPECT_EQ(fvp_factors[std::pair("wind", false)], (std::vector<double>{0.0, 0.5, 1.0, 2.0}));
+  EXPECT_EQ(fvp_factors[std::pair("wind", true)], (std::vector<double>{1.0}));
+  EXPECT_EQ(fvp_factors[std::pair("pose", false)], (std::vector<double>{1.0}));
+  EXPECT_EQ(fvp_factors[std::pair("pose", true)], (std::vector<double>{1.0}));
   // fvp: 4 of 4 fruitlets matched (two worlds of two), errors +0.5 and -1 mm.
+  EXPECT_EQ(points[0]["group"], "pose");
   EXPECT_DOUBLE_EQ(points[0]["match_percent"].get<double>(), 100.0);
   EXPECT_DOUBLE_EQ(points[0]["mae_mm"].get<double>(), 0.75);
   EXPECT_EQ(slurp(out / "sensitivity.png").substr(1, 3), "PNG");

@@ -248,6 +248,67 @@ TEST(Sizing, SupportRuleDropsAFragmentAndKeepsTheFruitlet) {
   EXPECT_EQ(all.events.unsized_clusters, kept.events.unsized_clusters);
 }
 
+/// Points of a sphere's cap facing the camera at the origin (within cap_deg of the ray to
+/// its centre), at the TSDF's surface density (1.5 points per 0.5 mm voxel face).
+std::vector<Eigen::Vector3f> sphereCap(const Eigen::Vector3d& c, double r, double cap_deg) {
+  const int n = int(std::lround(1.5 / (0.0005 * 0.0005) * 4.0 * M_PI * r * r));
+  const Eigen::Vector3d towards_camera = -c.normalized();
+  std::vector<Eigen::Vector3f> pts;
+  for (int i = 0; i < n; ++i) {  // a Fibonacci sphere: even spacing
+    const double z = 1.0 - 2.0 * (i + 0.5) / n, ring = std::sqrt(1.0 - z * z);
+    const double a = i * M_PI * (3.0 - std::sqrt(5.0));
+    const Eigen::Vector3d normal(ring * std::cos(a), ring * std::sin(a), z);
+    if (normal.dot(towards_camera) >= std::cos(cap_deg * M_PI / 180.0))
+      pts.push_back((c + r * normal).cast<float>());
+  }
+  return pts;
+}
+
+TEST(Sizing, OverlapRuleMergesAFruitletSeenTwiceAndKeepsTouchingNeighbours) {
+  const Eigen::Vector3d c(0.0, 0.0, 0.3);
+  const double r = 0.005;
+  const SphereView v = renderSphere(c, r);
+  const sizing::SizingView view{v.mask, v.disparity, v.in, Eigen::Isometry3d::Identity()};
+  // The same fruitlet's near cap twice, 4 mm apart along the line of sight (views whose
+  // poses disagree): the caps stay over 2 mm apart, so DBSCAN keeps them as two detections,
+  // but their spheres overlap by 1.2 radii: no two firm fruitlets can.
+  std::vector<Eigen::Vector3f> pts = sphereCap(c, r, 70.0);
+  for (const auto& p : sphereCap(c + Eigen::Vector3d(0, 0, 0.004), r, 70.0)) pts.push_back(p);
+  sizing::SizingConfig config;
+  const auto merged = sizing::sizeFruitlets({view, view}, pts, nullptr, config);
+  ASSERT_EQ(merged.fruitlets.size(), 1u);
+  EXPECT_TRUE(merged.unsupported.empty());
+  EXPECT_EQ(merged.events.overlapping_detections_merged, 1u);
+  const auto& f = merged.fruitlets[0];
+  EXPECT_EQ(f.support.merged_detections, 1);
+  // One detection on its segment: sized from both well-seen images, not from a sphere fit
+  // of two shells; its centre between the copies.
+  EXPECT_EQ(f.support.well_seen_images, 2);
+  EXPECT_EQ(f.size_source, sizing::SizeSource::kWellSeenImages);
+  EXPECT_NEAR(f.size_ours_mm, 10.0, 0.15);
+  EXPECT_LT((f.sphere_center_m - c).norm(), 0.004);
+  // Without the rule the copies are two detections, each on the other's segment.
+  config.max_detection_overlap_fraction = INFINITY;
+  const auto both = sizing::sizeFruitlets({view, view}, pts, nullptr, config);
+  ASSERT_EQ(both.fruitlets.size(), 2u);
+  EXPECT_EQ(both.events.overlapping_detections_merged, 0u);
+  for (const auto& d : both.fruitlets) EXPECT_EQ(d.support.well_seen_images, 0);
+  EXPECT_EQ(f.points, both.fruitlets[0].points + both.fruitlets[1].points);
+
+  // Two fruitlets side by side, touching: their spheres meet but do not overlap.
+  const Eigen::Vector3d left(-0.005, 0.0, 0.3), right(0.005, 0.0, 0.3);
+  const SphereView pair = renderSphere(left, r);
+  const SphereView other = renderSphere(right, r);
+  cv::Mat mask = pair.mask | other.mask, disparity = cv::max(pair.disparity, other.disparity);
+  const sizing::SizingView pair_view{mask, disparity, pair.in, Eigen::Isometry3d::Identity()};
+  std::vector<Eigen::Vector3f> neighbours = sphereCap(left, r, 70.0);
+  for (const auto& p : sphereCap(right, r, 70.0)) neighbours.push_back(p);
+  config.max_detection_overlap_fraction = 0.5;
+  const auto two = sizing::sizeFruitlets({pair_view}, neighbours, nullptr, config);
+  EXPECT_EQ(two.fruitlets.size(), 2u);
+  EXPECT_EQ(two.events.overlapping_detections_merged, 0u);
+}
+
 TEST(Sizing, EmptyInputsAreCountedNotErrors) {
   sizing::SizingConfig config;
   const auto empty = sizing::sizeFruitlets({}, {}, nullptr, config);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <tuple>
@@ -19,38 +20,47 @@ namespace {
 
 std::string seriesName(const SensitivityPoint& p) {
   std::string name = p.planner == "fvp" ? "FVP" : p.planner == "rvp" ? "RVP" : p.planner;
-  return p.group + ", " + name + (p.registered ? " + registration" : "");
+  return name + (p.registered ? " + registration" : "");
 }
 
+/// One column of panels per error group (MAE above, MP below), a line per planner and
+/// registration setting in each.
 std::string figureScript(const std::vector<SensitivityPoint>& points) {
-  std::map<std::string, std::vector<const SensitivityPoint*>> series;
+  std::map<std::string, std::map<std::string, std::vector<const SensitivityPoint*>>> groups;
   for (const auto& p : points)
-    if (p.planner.find("-paper-sizing") == std::string::npos) series[seriesName(p)].push_back(&p);
+    if (p.planner.find("-paper-sizing") == std::string::npos)
+      groups[p.group][seriesName(p)].push_back(&p);
   std::ostringstream gp;
-  gp << "set terminal pngcairo size 1200,520 font 'DejaVu Sans,11'\n"
-     << "set multiplot layout 1,2 title 'Sizing against the magnitude of each simulated error "
-        "(1 = the world config)'\n"
-     << "set grid\nset offsets graph 0.02, 0.02, 0.05, 0.05\nset key top left font ',9'\nset "
-        "xlabel 'error magnitude (x the world "
-        "config)'\n";
+  const std::size_t columns = std::max<std::size_t>(groups.size(), 1);
+  gp << "set terminal pngcairo size " << 120 + 330 * columns << ",640 font 'DejaVu Sans,10'\n"
+     << "set multiplot layout 2," << columns
+     << " title 'Sizing against the magnitude of each simulated error (1 = the world config)'\n"
+     << "set grid\nset offsets graph 0, 0, 0.05, 0.05\nset key top left font ',8'\n";
+  double max_factor = 1.0;  // one x range for every panel, so that the groups compare
+  for (const auto& p : points) max_factor = std::max(max_factor, p.factor);
+  gp << "set xrange [" << -0.05 * max_factor << ":" << 1.05 * max_factor << "]\n";
   int k = 0;
-  for (const auto& [name, ps] : series) {
-    gp << "$s" << k++ << " << EOD\n";
-    for (const auto* p : ps) gp << p->factor << " " << p->mae_mm << " " << p->match_percent << "\n";
-    gp << "EOD\n";
-  }
-  const auto plot = [&](int column, const std::string& label) {
-    gp << "set ylabel '" << label << "'\nplot ";
-    int i = 0;
+  std::map<std::string, std::vector<int>> blocks;  // group -> data block per series
+  for (const auto& [group, series] : groups)
     for (const auto& [name, ps] : series) {
-      gp << (i ? ", " : "") << "$s" << i << " using 1:" << column << " with linespoints lw 2 "
-         << "title '" << name << "'";
-      ++i;
+      gp << "$s" << k << " << EOD\n";
+      for (const auto* p : ps)
+        gp << p->factor << " " << p->mae_mm << " " << p->match_percent << "\n";
+      gp << "EOD\n";
+      blocks[group].push_back(k++);
     }
-    gp << "\n";
-  };
-  plot(2, "MAE (mm)");
-  plot(3, "MP (%)");
+  for (const auto& [column, label] : {std::pair{2, "MAE (mm)"}, std::pair{3, "MP (%)"}})
+    for (const auto& [group, series] : groups) {
+      gp << "set title '" << group << "'\nset ylabel '" << label
+         << "'\nset xlabel 'x the world config'\nplot ";
+      int i = 0;
+      for (const auto& [name, ps] : series) {
+        gp << (i ? ", " : "") << "$s" << blocks[group][std::size_t(i)] << " using 1:" << column
+           << " with linespoints lw 2 title '" << name << "'";
+        ++i;
+      }
+      gp << "\n";
+    }
   gp << "unset multiplot\n";
   return gp.str();
 }
@@ -81,6 +91,28 @@ std::vector<SensitivityPoint> readSensitivityPoints(const std::vector<fs::path>&
       p.precision_percent = row.value("precision_percent", 0.0);
       p.experiment = dir.string();
       points.push_back(p);
+    }
+  }
+  // Factor 1 of any group is the world config itself: one such experiment stands for
+  // factor 1 of every group in the sweep that has no factor-1 point of its own.
+  std::set<std::string> groups;
+  for (const auto& p : points) groups.insert(p.group);
+  const std::vector<SensitivityPoint> measured = points;
+  for (const auto& unscaled : measured) {
+    if (unscaled.factor != 1.0) continue;
+    for (const auto& group : groups) {
+      const bool has_own = std::any_of(measured.begin(), measured.end(), [&](const auto& q) {
+        return q.group == group && q.factor == 1.0 && q.planner == unscaled.planner &&
+               q.registered == unscaled.registered;
+      });
+      const bool added = std::any_of(points.begin(), points.end(), [&](const auto& q) {
+        return q.group == group && q.factor == 1.0 && q.planner == unscaled.planner &&
+               q.registered == unscaled.registered;
+      });
+      if (has_own || added) continue;
+      SensitivityPoint shared = unscaled;
+      shared.group = group;
+      points.push_back(shared);
     }
   }
   std::sort(points.begin(), points.end(), [](const auto& a, const auto& b) {

@@ -118,13 +118,15 @@ host::planner::ViewPlanner& TrialParts::planner() {
 }
 
 nlohmann::json TrialParts::configJson() const {
-  return {{"engine", impl_->engine},
-          {"clock", impl_->options.clock},
-          {"fine_map_extent", host::map::toString(impl_->map_config.fine_map_extent)},
-          {"stop", impl_->options.stop},
-          {"sizing",
-           {{"estimator", host::sizing::toString(impl_->sizing_config.estimator)},
-            {"min_support_area_fraction", impl_->sizing_config.min_support_area_fraction}}}};
+  return {
+      {"engine", impl_->engine},
+      {"clock", impl_->options.clock},
+      {"fine_map_extent", host::map::toString(impl_->map_config.fine_map_extent)},
+      {"stop", impl_->options.stop},
+      {"sizing",
+       {{"estimator", host::sizing::toString(impl_->sizing_config.estimator)},
+        {"min_support_area_fraction", impl_->sizing_config.min_support_area_fraction},
+        {"max_detection_overlap_fraction", impl_->sizing_config.max_detection_overlap_fraction}}}};
 }
 
 std::vector<host::eval::GroundTruthFruitlet> groundTruthOf(const World& world,
@@ -589,7 +591,9 @@ void appendSupportRule(std::ostringstream& md, const nlohmann::json& result) {
     fraction = result["config"]["trial"]["sizing"].value("min_support_area_fraction", fraction);
   md << "A detection of size 2r is kept only if its surface shows at least " << fmt(fraction, 2)
      << " of its sphere's area: `points` >= `required_points` (docs/sizing.md, \"Which "
-        "detections are fruitlets\"). A kept detection no fruitlet matched is **spurious**. "
+        "detections are fruitlets\"); two whose spheres overlap by more than half the smaller "
+        "radius are one fruitlet seen twice and are merged (\"One fruitlet seen twice\"). A "
+        "kept detection no fruitlet matched is **spurious**. "
         "± stderr is the standard error of its well-seen sizes' median; sphere RMS the "
         "distance of its points to its fitted sphere.\n\n";
 }

@@ -114,7 +114,8 @@ nlohmann::json detectionJson(const sizing::FruitletEstimate& f) {
             {"well_seen_images", f.support.well_seen_images},
             {"sphere_rms_mm", f.support.sphere_rms_mm},
             {"required_points", f.support.required_points},
-            {"size_stderr_mm", f.support.size_stderr_mm}}},
+            {"size_stderr_mm", f.support.size_stderr_mm},
+            {"merged_detections", f.support.merged_detections}}},
           {"per_image", per_image}};
 }
 
@@ -139,7 +140,8 @@ nlohmann::json sizingDetails(const sizing::SizingResult& sz) {
               {"unsized_clusters", sz.events.unsized_clusters},
               {"failed_sphere_fits", sz.events.failed_sphere_fits},
               {"clusters_split_off", sz.events.clusters_split_off},
-              {"unsupported_detections", sz.events.unsupported_detections}}}}}};
+              {"unsupported_detections", sz.events.unsupported_detections},
+              {"overlapping_detections_merged", sz.events.overlapping_detections_merged}}}}}};
 }
 
 }  // namespace fvp::host::eval

@@ -197,6 +197,8 @@ void SizingConfig::validate() const {
     throw std::invalid_argument("sizing: min_support_area_fraction in [0, 1]");
   if (!(surface_voxel_size_m > 0.0))
     throw std::invalid_argument("sizing: surface_voxel_size_m > 0");
+  if (!(max_detection_overlap_fraction >= 0.0))
+    throw std::invalid_argument("sizing: max_detection_overlap_fraction >= 0");
   if (split_merged_clusters && min_cluster_points < 4)
     throw std::invalid_argument("sizing: min_cluster_points >= 4 (a sphere needs 4 points)");
 }
@@ -250,8 +252,8 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
 
   // Which segment of each image every cluster falls on, first for all clusters, so that a
   // segment two clusters fall on (touching fruitlets merged in 2-D) is known.
-  std::vector<std::pair<int, const std::vector<Eigen::Vector3f>*>> sized;
-  for (const auto& [label, pts] : clusters) {
+  std::vector<std::pair<int, std::vector<Eigen::Vector3f>*>> sized;
+  for (auto& [label, pts] : clusters) {
     if (int(pts.size()) < config.min_cluster_points) {
       ++result.events.small_clusters;
       continue;
@@ -264,7 +266,7 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
     double visible = 0.0;
   };
   std::vector<std::vector<Fall>> falls(sized.size(), std::vector<Fall>(views.size()));
-  for (std::size_t ci = 0; ci < sized.size(); ++ci)
+  const auto computeFalls = [&](std::size_t ci) {
     for (std::size_t vi = 0; vi < views.size(); ++vi) {
       const Eigen::Isometry3d T_camera_world = views[vi].T_world_camera.inverse();
       const cv::Mat& labels = segments[vi].labels;
@@ -281,17 +283,18 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
       int best = 0, best_votes = 0;
       for (const auto& [l, n] : votes)
         if (n > best_votes) best = l, best_votes = n;
-      if (in_image > 0) falls[ci][vi] = {true, best, double(best_votes) / in_image};
+      falls[ci][vi] = in_image > 0 ? Fall{true, best, double(best_votes) / in_image} : Fall{};
     }
+  };
 
   // Each cluster's own measurements, once: its centroid and sphere, and Eq. 4 in every image
   // it is visible in. Only whether an image's segment is shared depends on which other
   // detections are kept (below).
-  // (centroid, sphere, points; per_image without shared flags)
   std::vector<FruitletEstimate> measured(sized.size());
-  for (std::size_t ci = 0; ci < sized.size(); ++ci) {
+  const auto measure = [&](std::size_t ci) {
     const std::vector<Eigen::Vector3f>& pts = *sized[ci].second;
     FruitletEstimate& f = measured[ci];
+    f = FruitletEstimate{};
     f.points = pts.size();
     for (const auto& p : pts) f.centroid_m += p.cast<double>();
     f.centroid_m /= double(pts.size());
@@ -318,11 +321,16 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
       }
       f.support.sphere_rms_mm = 1000.0 * std::sqrt(sum_sq / double(pts.size()));
     }
+  };
+  for (std::size_t ci = 0; ci < sized.size(); ++ci) {
+    computeFalls(ci);
+    measure(ci);
   }
 
   // Sizes every kept cluster from its images, an image's segment shared when another
   // cluster that still marks segments falls on it.
   std::vector<bool> dropped(sized.size(), false), marks_segments(sized.size(), true);
+  std::vector<int> merged_into(sized.size(), 0);
   const auto sizeKept = [&](std::size_t ci) {
     FruitletEstimate f = measured[ci];
     for (auto& s : f.per_image) {
@@ -335,30 +343,67 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
                             falls[other][vi].visible >= config.min_visible_fraction;
     }
     aggregate(f, config);
+    f.support.merged_detections = merged_into[ci];
     return f;
   };
-  // The support rule, one detection at a time: the worst-supported one that fails is dropped
-  // and the rest are sized again, since a dropped phantom (no segment of its own: it lay on
-  // a fruitlet's) no longer makes that fruitlet's images shared. A dropped detection that
-  // had a segment of its own keeps marking segments: it may be a real fruitlet merged in
-  // 2-D with a neighbour, whose merged outline must not size the neighbour.
+  const auto supportRatio = [](const FruitletEstimate& f) {
+    return f.support.required_points > 0.0 ? double(f.points) / f.support.required_points
+                                           : INFINITY;
+  };
   std::vector<FruitletEstimate> estimates(sized.size());
   for (;;) {
-    std::optional<std::size_t> worst;
-    double worst_ratio = 1.0;
-    for (std::size_t ci = 0; ci < sized.size(); ++ci) {
-      if (dropped[ci]) continue;
-      estimates[ci] = sizeKept(ci);
-      const FruitletEstimate& f = estimates[ci];
-      if (f.per_image.empty()) continue;  // unsized: dropped below, not by the rule
-      const double ratio =
-          f.support.required_points > 0.0 ? double(f.points) / f.support.required_points : INFINITY;
-      if (ratio < worst_ratio) worst = ci, worst_ratio = ratio;
+    // The support rule, one detection at a time: the worst-supported one that fails is
+    // dropped and the rest are sized again, since a dropped phantom (no segment of its own:
+    // it lay on a fruitlet's) no longer makes that fruitlet's images shared. A dropped
+    // detection that had a segment of its own keeps marking segments: it may be a real
+    // fruitlet merged in 2-D with a neighbour, whose merged outline must not size the
+    // neighbour.
+    for (;;) {
+      std::optional<std::size_t> worst;
+      double worst_ratio = 1.0;
+      for (std::size_t ci = 0; ci < sized.size(); ++ci) {
+        if (dropped[ci]) continue;
+        estimates[ci] = sizeKept(ci);
+        const FruitletEstimate& f = estimates[ci];
+        if (f.per_image.empty()) continue;  // unsized: dropped below, not by the rule
+        if (const double ratio = supportRatio(f); ratio < worst_ratio)
+          worst = ci, worst_ratio = ratio;
+      }
+      if (!worst) break;
+      dropped[*worst] = true;
+      marks_segments[*worst] = estimates[*worst].support.own_segment_images > 0;
+      result.unsupported.push_back(std::move(estimates[*worst]));
     }
-    if (!worst) break;
-    dropped[*worst] = true;
-    marks_segments[*worst] = estimates[*worst].support.own_segment_images > 0;
-    result.unsupported.push_back(std::move(estimates[*worst]));
+    // The overlap rule: two fruitlets are firm bodies that touch but do not interpenetrate,
+    // so two kept spheres that overlap by more than half the smaller one's radius are one
+    // fruitlet seen twice (views whose poses disagree fuse its surface at two places). The
+    // pair overlapping most is merged into the better-supported one, its points added, and
+    // everything is sized again.
+    std::optional<std::pair<std::size_t, std::size_t>> pair;
+    double deepest = config.max_detection_overlap_fraction;
+    for (std::size_t a = 0; a < sized.size(); ++a)
+      for (std::size_t b = a + 1; b < sized.size(); ++b) {
+        if (dropped[a] || dropped[b]) continue;
+        const FruitletEstimate &fa = estimates[a], &fb = estimates[b];
+        if (fa.per_image.empty() || fb.per_image.empty()) continue;
+        const double ra = 0.0005 * fa.size_ours_mm, rb = 0.0005 * fb.size_ours_mm;
+        const double overlap = ra + rb - (fa.sphere_center_m - fb.sphere_center_m).norm();
+        if (const double depth = overlap / std::min(ra, rb); depth > deepest)
+          deepest = depth, pair = {a, b};
+      }
+    if (!pair) break;
+    auto [keep, gone] = *pair;
+    if (supportRatio(estimates[gone]) > supportRatio(estimates[keep])) std::swap(keep, gone);
+    sized[keep].second->insert(sized[keep].second->end(), sized[gone].second->begin(),
+                               sized[gone].second->end());
+    for (int& label : result.labels)
+      if (label == sized[gone].first) label = sized[keep].first;
+    merged_into[keep] += 1 + merged_into[gone];
+    dropped[gone] = true;
+    marks_segments[gone] = false;
+    ++result.events.overlapping_detections_merged;
+    computeFalls(keep);
+    measure(keep);
   }
   for (std::size_t ci = 0; ci < sized.size(); ++ci) {
     if (dropped[ci]) continue;

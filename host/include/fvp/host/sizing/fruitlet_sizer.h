@@ -77,6 +77,11 @@ struct SizingConfig {
   /// crossings between face neighbours number (|n_x| + |n_y| + |n_z|) per voxel face on a
   /// surface of normal n: 1.5 on average over a sphere.
   double surface_voxel_size_m = 0.0005;
+  /// The overlap rule (docs/sizing.md, "One fruitlet seen twice"): two detections whose
+  /// spheres (our size, the sphere fit's centre) overlap by more than this fraction of the
+  /// smaller radius are merged. Touching fruitlets overlap by 0; neighbours' measured centres
+  /// err by up to ~1 mm each, half the radius of the smallest fruitlet. INFINITY: never.
+  double max_detection_overlap_fraction = 0.5;
   void validate() const;
 };
 
@@ -116,6 +121,7 @@ struct DetectionSupport {
   /// Ours' confidence: the standard error of the median of its well-seen images' sizes
   /// (1.2533 x 1.4826 MAD / sqrt(n)); -1 with fewer than two.
   double size_stderr_mm = -1.0;
+  int merged_detections = 0;  ///< detections the overlap rule merged into this one
 };
 
 struct FruitletEstimate {
@@ -140,7 +146,8 @@ struct SizingEvents {
   std::size_t unsized_clusters = 0;    ///< no image gave a size (dropped)
   std::size_t failed_sphere_fits = 0;  ///< centre fell back to the centroid
   std::size_t clusters_split_off = 0;  ///< parts of DBSCAN clusters split off (one per fruitlet)
-  std::size_t unsupported_detections = 0;  ///< too little surface for their size (dropped)
+  std::size_t unsupported_detections = 0;         ///< too little surface for their size (dropped)
+  std::size_t overlapping_detections_merged = 0;  ///< one fruitlet seen twice (overlap rule)
 };
 
 struct SizingResult {
