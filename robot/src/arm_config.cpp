@@ -50,6 +50,7 @@ const std::vector<KeySpec>& keySpecs() {
       {"reproducible_planning_checks", &ArmConfig::reproducible_planning_checks, 100, 1e9},
       {"reproducible_simplify_checks", &ArmConfig::reproducible_simplify_checks, 0, 1e9},
       {"validity_step_rad", &ArmConfig::validity_step_rad, 1e-4, 0.5},
+      {"trajectory_timing", &ArmConfig::trajectory_timing},
       {"workspace_samples", &ArmConfig::workspace_samples, 1000, 1e10},
       {"workspace_resolution_m", &ArmConfig::workspace_resolution_m, 0.005, 0.5},
       {"workspace_direction_bins", &ArmConfig::workspace_direction_bins, 1, 16},
@@ -119,6 +120,9 @@ void ArmConfig::validate(const std::string& source) const {
     throw std::invalid_argument(source + ": key 'planner' = '" + planner +
                                 "' is not a known OMPL planner; expected one of " + list);
   }
+  if (trajectory_timing != "rest_to_rest" && trajectory_timing != "blended")
+    throw std::invalid_argument(source + ": key 'trajectory_timing' = '" + trajectory_timing +
+                                "' is not a timing; expected rest_to_rest or blended");
 }
 
 ArmConfig ArmConfig::fromYamlFile(const std::filesystem::path& path) {

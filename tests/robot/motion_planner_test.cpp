@@ -23,6 +23,21 @@ TEST(MotionPlanner, SucceedsOnRandomFeasibleQueriesInClutteredWorlds) {
   EXPECT_EQ(stats.path_invalid, 0);
 }
 
+TEST(MotionPlanner, BlendedTimingIsFasterAndStaysCollisionFree) {
+  // The same queries timed through the via points: every blended trajectory is checked
+  // against the unpadded arm every 5 ms, and none takes longer than rest to rest.
+  const testing::QueryStats stats = testing::runPlanningQueries(3, 5, 100, 10.0, "blended");
+  stats.print(std::cout);
+  EXPECT_EQ(stats.feasible, 15);
+  EXPECT_GE(stats.succeeded, 14);
+  EXPECT_EQ(stats.path_invalid, 0);
+  EXPECT_GT(stats.blended, 0);
+  for (std::size_t i = 0; i < stats.motion_s.size(); ++i)
+    EXPECT_LE(stats.motion_s[i], stats.rest_to_rest_s[i] * (1.0 + 1e-9));
+  EXPECT_LT(testing::QueryStats::mean(stats.motion_s),
+            testing::QueryStats::mean(stats.rest_to_rest_s));
+}
+
 TEST(MotionPlanner, ReportsStatusesWithoutThrowing) {
   const ArmModel arm{ArmConfig{}};
   ArmCollisionChecker checker(arm);

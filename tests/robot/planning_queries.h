@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <iostream>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "fvp/robot/sim/arm_controller.h"
@@ -22,9 +23,10 @@ using sim::ArmController;
 using sim::SimClock;
 
 struct QueryStats {
-  int feasible = 0, succeeded = 0, infeasible = 0, path_invalid = 0;
+  int feasible = 0, succeeded = 0, infeasible = 0, path_invalid = 0, blended = 0;
   int by_status[6] = {};
-  std::vector<double> planning_s, path_length, motion_s;
+  std::vector<double> planning_s, path_length, motion_s, waypoints;
+  std::vector<double> rest_to_rest_s;  ///< the same paths timed rest to rest
 
   static double mean(const std::vector<double>& v) {
     double s = 0.0;
@@ -41,8 +43,9 @@ struct QueryStats {
         << 100.0 * succeeded / std::max(1, feasible) << " %); " << infeasible
         << " sampled poses had no collision-free IK; planning time mean " << mean(planning_s)
         << " s, median " << quantile(planning_s, 0.5) << " s, p95 " << quantile(planning_s, 0.95)
-        << " s; joint-space path length mean " << mean(path_length) << "; motion time mean "
-        << mean(motion_s) << " s\n";
+        << " s; joint-space path length mean " << mean(path_length) << ", waypoints mean "
+        << mean(waypoints) << "; motion time mean " << mean(motion_s) << " s (" << blended
+        << " blended; rest to rest " << mean(rest_to_rest_s) << " s)\n";
   }
 };
 
@@ -60,12 +63,23 @@ inline bool pathValid(const ArmCollisionChecker& checker, const Trajectory& traj
   return true;
 }
 
-/// planning_time_s: OMPL's limit per query (default: the config's).
+/// Whether a trajectory is valid at every 5 ms of its timing (a blended one leaves the
+/// straight segments near its via points).
+inline bool timedPathValid(const ArmCollisionChecker& checker, const Trajectory& traj) {
+  for (double t = 0.0; t < traj.duration_s() + 0.005; t += 0.005)
+    if (!checker.isValid(traj.position(std::min(t, traj.duration_s())))) return false;
+  return true;
+}
+
+/// planning_time_s: OMPL's limit per query (default: the config's); timing: the arm config's
+/// trajectory_timing.
 inline QueryStats runPlanningQueries(int worlds, int queries_per_world, std::uint64_t seed,
-                                     double planning_time_s = ArmConfig{}.planning_time_s) {
+                                     double planning_time_s = ArmConfig{}.planning_time_s,
+                                     const std::string& timing = ArmConfig{}.trajectory_timing) {
   QueryStats stats;
   ArmConfig config;
   config.planning_time_s = planning_time_s;
+  config.trajectory_timing = timing;
   const ArmModel arm{config};
   ArmConfig unpadded_config = config;
   unpadded_config.collision_padding_m = 0.0;
@@ -106,10 +120,17 @@ inline QueryStats runPlanningQueries(int worlds, int queries_per_world, std::uin
         ++stats.succeeded;
         stats.path_length.push_back(plan.trajectory.pathLength());
         stats.motion_s.push_back(plan.trajectory.duration_s());
+        stats.waypoints.push_back(double(plan.trajectory.waypoints().size()));
+        stats.rest_to_rest_s.push_back(
+            Trajectory(plan.trajectory.waypoints(), arm.maxVelocity(), arm.maxAcceleration())
+                .duration_s());
+        stats.blended += plan.trajectory.isBlended();
         const Eigen::Isometry3d reached = controller.cameraPose();
         EXPECT_LT((reached.translation() - T.translation()).norm(), 1e-6);
         EXPECT_LT((reached.linear() - T.linear()).norm(), 1e-6);
-        if (!pathValid(exact, plan.trajectory, 0.004)) ++stats.path_invalid;
+        if (!pathValid(exact, plan.trajectory, 0.004) && !plan.trajectory.isBlended())
+          ++stats.path_invalid;
+        if (!timedPathValid(exact, plan.trajectory)) ++stats.path_invalid;
       } else {
         std::cout << "world " << world.seed() << ": " << toString(plan.status) << " after "
                   << plan.planning_wall_s << " s\n";

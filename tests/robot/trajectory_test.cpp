@@ -71,5 +71,89 @@ TEST(Trajectory, MinimumTimeForOneJoint) {
   EXPECT_EQ(still.position(1.0), a);
 }
 
+TEST(Trajectory, BlendedKeepsTheLimitsPassesNearTheViaPointsAndIsNeverSlower) {
+  const ArmModel arm{ArmConfig{}};
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  int blended = 0;
+  for (int trial = 0; trial < 50; ++trial) {
+    std::vector<JointVector> waypoints;
+    const int n = 2 + trial % 6;
+    for (int i = 0; i < n; ++i) {
+      JointVector q;
+      for (int j = 0; j < kArmJoints; ++j)
+        q[j] = (j == 0 ? 0.5 : (trial % 2 ? 0.2 : 2.0)) * unit(rng);
+      if (trial % 7 == 0 && i > 0) q = waypoints.back();  // zero-length segments too
+      waypoints.push_back(q);
+    }
+    const Trajectory rest(waypoints, arm.maxVelocity(), arm.maxAcceleration());
+    const Trajectory traj =
+        Trajectory::blended(waypoints, arm.maxVelocity(), arm.maxAcceleration());
+    blended += traj.isBlended();
+    EXPECT_LE(traj.duration_s(), rest.duration_s() * (1.0 + 1e-9)) << "trial " << trial;
+    // Starts and ends on the path's ends, at rest.
+    EXPECT_LT((traj.position(0.0) - waypoints.front()).norm(), 1e-12);
+    EXPECT_LT((traj.position(traj.duration_s()) - waypoints.back()).norm(), 1e-9);
+    EXPECT_LT(traj.velocity(0.0).norm(), 1e-12);
+    const int steps = 4000;
+    const double dt = traj.duration_s() / steps;
+    std::vector<JointVector> samples;
+    for (int k = 0; k <= steps; ++k) {
+      const double t = k * dt;
+      const JointVector v = traj.velocity(t), a = traj.acceleration(t);
+      for (int j = 0; j < kArmJoints; ++j) {
+        ASSERT_LE(std::abs(v[j]), arm.maxVelocity()[j] * (1.0 + 1e-9)) << "t " << t;
+        ASSERT_LE(std::abs(a[j]), arm.maxAcceleration()[j] * (1.0 + 1e-9)) << "t " << t;
+      }
+      if (k > 0 && k < steps) {  // continuous, and v its derivative
+        const JointVector fd = (traj.position(t + 1e-6) - traj.position(t - 1e-6)) / 2e-6;
+        ASSERT_LT((fd - v).norm(), 1e-4) << "t " << t;
+      }
+      samples.push_back(traj.position(t));
+    }
+    // Every via point is passed within the stated corner deviation (per joint).
+    const double tolerance = traj.maxCornerDeviation() + 1e-9;
+    for (std::size_t i = 1; i + 1 < waypoints.size(); ++i) {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const auto& q : samples)
+        nearest = std::min(nearest, (q - waypoints[i]).cwiseAbs().maxCoeff());
+      // Sampling adds at most the distance moved in half a step.
+      EXPECT_LE(nearest, tolerance + 0.5 * dt * arm.maxVelocity().maxCoeff()) << "via " << i;
+    }
+    if (!traj.isBlended()) {
+      EXPECT_EQ(traj.duration_s(), rest.duration_s());
+    }
+  }
+  EXPECT_GT(blended, 30);
+}
+
+TEST(Trajectory, BlendedOneSegmentIsRestToRestAndACornerIsFaster) {
+  const ArmModel arm{ArmConfig{}};
+  JointVector a = JointVector::Zero(), b = a, c = a;
+  b[1] = 0.5;
+  const Trajectory one = Trajectory::blended({a, b}, arm.maxVelocity(), arm.maxAcceleration());
+  EXPECT_FALSE(one.isBlended());
+  EXPECT_NEAR(one.duration_s(), 2.0 * std::sqrt(0.5 / 1.4), 1e-12);
+  // Two collinear halves: blended, the same time as one segment (no stop in the middle),
+  // against two rest-to-rest halves at sqrt(2) times it.
+  JointVector half = a;
+  half[1] = 0.25;
+  const Trajectory straight =
+      Trajectory::blended({a, half, b}, arm.maxVelocity(), arm.maxAcceleration());
+  EXPECT_TRUE(straight.isBlended());
+  EXPECT_NEAR(straight.duration_s(), one.duration_s(), 1e-6);
+  EXPECT_NEAR(Trajectory({a, half, b}, arm.maxVelocity(), arm.maxAcceleration()).duration_s(),
+              std::sqrt(2.0) * one.duration_s(), 1e-9);
+  EXPECT_LT(straight.maxCornerDeviation(), 1e-9);
+  // A right-angle corner: faster than stopping, and the corner is cut.
+  c[1] = 0.5, c[2] = 0.5;
+  const Trajectory corner =
+      Trajectory::blended({a, b, c}, arm.maxVelocity(), arm.maxAcceleration());
+  EXPECT_TRUE(corner.isBlended());
+  EXPECT_LT(corner.duration_s(),
+            Trajectory({a, b, c}, arm.maxVelocity(), arm.maxAcceleration()).duration_s());
+  EXPECT_GT(corner.maxCornerDeviation(), 0.0);
+}
+
 }  // namespace
 }  // namespace fvp::robot

@@ -38,6 +38,7 @@ inline constexpr double kDefaultCollisionPaddingM = 0.01;
 inline constexpr double kDefaultGroundZM = 0.0;
 inline constexpr int kDefaultIkSliderSamples = 25;
 inline constexpr const char* kDefaultPlanner = "RRTConnect";
+inline constexpr const char* kDefaultTrajectoryTiming = "rest_to_rest";
 inline constexpr double kDefaultPlanningTimeS = 1.0;
 inline constexpr double kDefaultSimplifyTimeS = 0.1;
 // About the checks planning_time_s and simplify_time_s allow at the measured rate of
@@ -85,6 +86,10 @@ struct ArmConfig {
   std::int64_t reproducible_planning_checks = kDefaultReproduciblePlanningChecks;
   std::int64_t reproducible_simplify_checks = kDefaultReproducibleSimplifyChecks;
   double validity_step_rad = kDefaultValidityStepRad;  ///< joint-space step of motion checks
+  /// How a planned path is timed (trajectory.h): "rest_to_rest" stops at every waypoint;
+  /// "blended" moves through the via points with parabolic blends, where the blended path is
+  /// collision-free (else rest to rest).
+  std::string trajectory_timing = kDefaultTrajectoryTiming;
   // Workspace tree.
   std::int64_t workspace_samples = kDefaultWorkspaceSamples;
   double workspace_resolution_m = kDefaultWorkspaceResolutionM;
