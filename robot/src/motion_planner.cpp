@@ -332,7 +332,10 @@ MotionPlan MotionPlanner::plan_(const JointVector& current, const std::vector<Jo
   if (arm.config().trajectory_timing == "blended") {
     // Through the via points without stopping, where the cut corners are collision-free.
     Trajectory blended = Trajectory::blended(waypoints, arm.maxVelocity(), arm.maxAcceleration());
-    if (blended.isBlended() && trajectoryValid(checker_, blended)) {
+    const double rest_to_rest_s =
+        Trajectory(waypoints, arm.maxVelocity(), arm.maxAcceleration()).duration_s();
+    if (blended.isBlended() && blended.duration_s() < rest_to_rest_s &&
+        trajectoryValid(checker_, blended)) {
       plan.trajectory = std::move(blended);
       return finish(MotionStatus::kSuccess);
     }

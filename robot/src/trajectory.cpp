@@ -124,6 +124,7 @@ const Trajectory::Piece& Trajectory::pieceAt(double t_s, double& tau) const {
 
 JointVector Trajectory::position(double t_s) const {
   // The ends exactly (a goal on a joint limit must not land an ulp beyond it).
+  if (waypoints_.empty()) return JointVector::Zero();
   if (pieces_.empty() || t_s >= duration_s()) return waypoints_.back();
   if (t_s <= 0.0) return waypoints_.front();
   double tau;

@@ -110,6 +110,12 @@ TEST(Trajectory, BlendedKeepsTheLimitsPassesNearTheViaPointsAndIsNeverSlower) {
         ASSERT_LT((fd - v).norm(), 1e-4) << "t " << t;
       }
       samples.push_back(traj.position(t));
+      // No jump between pieces: no joint moves faster than its limit between samples.
+      for (int j = 0; k > 0 && j < kArmJoints; ++j) {
+        ASSERT_LE(std::abs(samples[k][j] - samples[k - 1][j]),
+                  arm.maxVelocity()[j] * dt * (1.0 + 1e-6) + 1e-12)
+            << "t " << t << " joint " << j;
+      }
     }
     // Every via point is passed within the stated corner deviation (per joint).
     const double tolerance = traj.maxCornerDeviation() + 1e-9;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <random>
+#include <set>
 
 #include "backend_test_support.h"
 #include "fvp/host/eval/fruitlet_matching.h"
@@ -287,6 +288,11 @@ TEST(Sizing, OverlapRuleMergesAFruitletSeenTwiceAndKeepsTouchingNeighbours) {
   EXPECT_EQ(f.size_source, sizing::SizeSource::kWellSeenImages);
   EXPECT_NEAR(f.size_ours_mm, 10.0, 0.15);
   EXPECT_LT((f.sphere_center_m - c).norm(), 0.004);
+  // The clusters' points carry one label.
+  std::set<int> labels;
+  for (int label : merged.labels)
+    if (label != sizing::kDbscanNoise) labels.insert(label);
+  EXPECT_EQ(labels.size(), 1u);
   // Without the rule the copies are two detections, each on the other's segment.
   config.max_detection_overlap_fraction = INFINITY;
   const auto both = sizing::sizeFruitlets({view, view}, pts, nullptr, config);

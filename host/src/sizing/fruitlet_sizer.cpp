@@ -291,7 +291,7 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
   // it is visible in. Only whether an image's segment is shared depends on which other
   // detections are kept (below).
   std::vector<FruitletEstimate> measured(sized.size());
-  const auto measure = [&](std::size_t ci) {
+  const auto measure = [&](std::size_t ci, SizingEvents& events) {
     const std::vector<Eigen::Vector3f>& pts = *sized[ci].second;
     FruitletEstimate& f = measured[ci];
     f = FruitletEstimate{};
@@ -301,7 +301,7 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
     for (std::size_t vi = 0; vi < views.size(); ++vi) {
       if (!falls[ci][vi].in_image) continue;
       if (auto s = measureImage(views[vi], segments[vi], falls[ci][vi].segment,
-                                falls[ci][vi].visible, config, result.events)) {
+                                falls[ci][vi].visible, config, events)) {
         s->view = int(vi);
         f.per_image.push_back(*s);
       }
@@ -324,7 +324,7 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
   };
   for (std::size_t ci = 0; ci < sized.size(); ++ci) {
     computeFalls(ci);
-    measure(ci);
+    measure(ci, result.events);
   }
 
   // Sizes every kept cluster from its images, an image's segment shared when another
@@ -385,7 +385,10 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
       for (std::size_t b = a + 1; b < sized.size(); ++b) {
         if (dropped[a] || dropped[b]) continue;
         const FruitletEstimate &fa = estimates[a], &fb = estimates[b];
-        if (fa.per_image.empty() || fb.per_image.empty()) continue;
+        // Only fitted spheres: a centroid lies inside its fruitlet, nearer the camera.
+        if (fa.per_image.empty() || fb.per_image.empty() || !(fa.sphere_radius_m > 0.0) ||
+            !(fb.sphere_radius_m > 0.0))
+          continue;
         const double ra = 0.0005 * fa.size_ours_mm, rb = 0.0005 * fb.size_ours_mm;
         const double overlap = ra + rb - (fa.sphere_center_m - fb.sphere_center_m).norm();
         if (const double depth = overlap / std::min(ra, rb); depth > deepest)
@@ -403,7 +406,8 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
     marks_segments[gone] = false;
     ++result.events.overlapping_detections_merged;
     computeFalls(keep);
-    measure(keep);
+    SizingEvents counted_already;  // both parts' images were counted when first measured
+    measure(keep, counted_already);
   }
   for (std::size_t ci = 0; ci < sized.size(); ++ci) {
     if (dropped[ci]) continue;
