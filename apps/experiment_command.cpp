@@ -18,7 +18,7 @@ namespace fvp::apps {
 void addExperimentCommands(CLI::App& app) {
   struct Options {
     trials::ExperimentOptions experiment;
-    std::string planners = "fvp,rvp", shard, world, config, out, error_scale;
+    std::string planners = "fvp,rvp", shard, world, config, arm, out, error_scale;
     int max_views = 0;
   };
   auto opt = std::make_shared<Options>();
@@ -37,6 +37,8 @@ void addExperimentCommands(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--world", opt->world, "world config YAML")->check(CLI::ExistingFile);
   cmd->add_option("--config", opt->config, "planner config YAML")->check(CLI::ExistingFile);
+  cmd->add_option("--arm", opt->arm, "arm config YAML (default: built-in)")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--error-scale", opt->error_scale,
                   "GROUP=FACTOR: the world's pose, stereo, wind, segmentation, light or all errors "
                   "times FACTOR (a sweep point; written to OUT/world.yaml)");
@@ -89,6 +91,7 @@ void addExperimentCommands(CLI::App& app) {
                                                     : trials::writeScaledWorldConfig(
                                                           opt->world, opt->error_scale, opt->out);
     o.trial.planner_config = opt->config;
+    o.trial.arm_config = opt->arm;
     if (opt->max_views > 0) o.trial.max_views = opt->max_views;
     o.out_dir = opt->out;
     const bool tty = isatty(STDERR_FILENO);

@@ -17,7 +17,7 @@ namespace fvp::apps {
 void addRunCommand(CLI::App& app) {
   struct Options {
     trials::TrialOptions trial;
-    std::string world, config, out;
+    std::string world, config, arm, out;
     int max_views = 0;
   };
   auto opt = std::make_shared<Options>();
@@ -33,6 +33,9 @@ void addRunCommand(CLI::App& app) {
   cmd->add_option("--world", opt->world, "world config YAML (default: built-in defaults)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--config", opt->config, "planner config YAML (default: the planner's)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--arm", opt->arm,
+                  "arm config YAML (default: built-in, robot/config/arm_default.yaml)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--budget-s", opt->trial.budget_s, "simulated time budget, seconds")
       ->check(finiteNumber())
@@ -66,6 +69,7 @@ void addRunCommand(CLI::App& app) {
     trials::TrialOptions trial = opt->trial;
     trial.world_config = opt->world;
     trial.planner_config = opt->config;
+    trial.arm_config = opt->arm;
     trial.out_dir = opt->out;
     if (opt->max_views > 0) trial.max_views = opt->max_views;
     const bool tty = isatty(STDERR_FILENO);

@@ -17,7 +17,8 @@ trials::TrialOptions trialOptions(const std::string& planner, std::uint64_t seed
                                   const std::string& stop, bool size_history, bool register_views,
                                   const std::string& backend, const std::string& engine,
                                   const std::string& world_config,
-                                  const std::string& planner_config, const std::string& out_dir) {
+                                  const std::string& planner_config, const std::string& arm_config,
+                                  const std::string& out_dir) {
   trials::TrialOptions o;
   o.planner = planner;
   o.seed = seed;
@@ -31,19 +32,20 @@ trials::TrialOptions trialOptions(const std::string& planner, std::uint64_t seed
   o.engine = engine;
   o.world_config = world_config;
   o.planner_config = planner_config;
+  o.arm_config = arm_config;
   o.out_dir = out_dir;
   // Warnings stay in result["warnings"]; Python callers read them there.
   return o;
 }
 
 // The keyword arguments of fvp run, in one place for Trial and run_trial.
-#define FVP_TRIAL_ARGS                                                                         \
-  py::kw_only(), py::arg("planner") = "fvp", py::arg("seed") = 1, py::arg("budget_s") = 180.0, \
-                 py::arg("max_views") = py::none(), py::arg("clock") = "wall",                 \
-                 py::arg("stop") = "budget", py::arg("size_history") = false,                  \
-                 py::arg("register_views") = false, py::arg("backend") = "auto",               \
-                 py::arg("engine") = "", py::arg("world_config") = "",                         \
-                 py::arg("planner_config") = "", py::arg("out_dir") = ""
+#define FVP_TRIAL_ARGS                                                                          \
+  py::kw_only(),                                                                                \
+      py::arg("planner") = "fvp", py::arg("seed") = 1, py::arg("budget_s") = 180.0,             \
+      py::arg("max_views") = py::none(), py::arg("clock") = "wall", py::arg("stop") = "budget", \
+      py::arg("size_history") = false, py::arg("register_views") = false,                       \
+      py::arg("backend") = "auto", py::arg("engine") = "", py::arg("world_config") = "",        \
+      py::arg("planner_config") = "", py::arg("arm_config") = "", py::arg("out_dir") = ""
 
 }  // namespace
 
@@ -58,10 +60,10 @@ void bindSim(py::module_& m) {
                        const std::string& stop, bool size_history, bool register_views,
                        const std::string& backend, const std::string& engine,
                        const std::string& world_config, const std::string& planner_config,
-                       const std::string& out_dir) {
+                       const std::string& arm_config, const std::string& out_dir) {
              return std::make_unique<trials::Trial>(trialOptions(
                  planner, seed, budget_s, max_views, clock, stop, size_history, register_views,
-                 backend, engine, world_config, planner_config, out_dir));
+                 backend, engine, world_config, planner_config, arm_config, out_dir));
            }),
            FVP_TRIAL_ARGS)
       .def_property_readonly(
@@ -92,10 +94,11 @@ void bindSim(py::module_& m) {
          std::optional<int> max_views, const std::string& clock, const std::string& stop,
          bool size_history, bool register_views, const std::string& backend,
          const std::string& engine, const std::string& world_config,
-         const std::string& planner_config, const std::string& out_dir) {
-        const trials::TrialOptions o =
-            trialOptions(planner, seed, budget_s, max_views, clock, stop, size_history,
-                         register_views, backend, engine, world_config, planner_config, out_dir);
+         const std::string& planner_config, const std::string& arm_config,
+         const std::string& out_dir) {
+        const trials::TrialOptions o = trialOptions(
+            planner, seed, budget_s, max_views, clock, stop, size_history, register_views, backend,
+            engine, world_config, planner_config, arm_config, out_dir);
         nlohmann::json result;
         {
           py::gil_scoped_release release;

@@ -126,3 +126,19 @@ def test_a_trial_runs_once():
         assert "runs once" in str(e)
     else:
         raise AssertionError("a second run() must fail")
+
+
+def test_run_trial_takes_an_arm_config(tmp_path):
+    blended = tmp_path / "arm.yaml"
+    blended.write_text("trajectory_timing: blended\n")
+    result = fvp.run_trial(seed=SEED, clock="fixed", max_views=2, backend="cpu",
+                           arm_config=str(blended))
+    assert result["config"]["arm"]["trajectory_timing"] == "blended"
+    bad = tmp_path / "bad_arm.yaml"
+    bad.write_text("trajectory_timing: smooth\n")
+    try:
+        fvp.run_trial(seed=SEED, clock="fixed", max_views=1, backend="cpu", arm_config=str(bad))
+    except ValueError as e:
+        assert "trajectory_timing" in str(e) and "bad_arm.yaml" in str(e)
+    else:
+        raise AssertionError("a bad arm config must be refused")

@@ -500,6 +500,11 @@ TEST(Experiment, ResumeWithAChangedSettingIsRefusedNamingIt) {
               r.trial.planner_config = r.trial.world_config;
             }).find("planner_config built-in defaults"),
             std::string::npos);
+  EXPECT_EQ(manifest["arm_config"]["path"], "");
+  EXPECT_NE(refused([](auto& r) {
+              r.trial.arm_config = r.trial.world_config;
+            }).find("arm_config built-in defaults"),
+            std::string::npos);
   // An edited config file under the same path is caught by its hash.
   writeText(world, "fruitlets: 6\n");
   EXPECT_NE(refused([](auto&) {})

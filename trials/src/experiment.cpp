@@ -111,6 +111,7 @@ ExperimentManifest manifestOf(const ExperimentOptions& o) {
   m.error_scale = o.error_scale;
   m.world_config = stampOf(o.trial.world_config, "world config");
   m.planner_config = stampOf(o.trial.planner_config, "planner config");
+  m.arm_config = stampOf(o.trial.arm_config, "arm config");
   m.engine = o.trial.engine;
   m.backend = o.trial.backend;
   m.planners = o.planners;

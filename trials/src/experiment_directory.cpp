@@ -235,6 +235,7 @@ nlohmann::ordered_json ExperimentManifest::toJson() const {
   j["error_scale"] = error_scale;
   j["world_config"] = configJson(world_config);
   j["planner_config"] = configJson(planner_config);
+  j["arm_config"] = configJson(arm_config);
   if (kind == "merged") {
     j["sources"] = sources;
     return j;
@@ -297,6 +298,8 @@ ExperimentManifest readManifest(const std::filesystem::path& path) {
   if (member(j, "error_scale")) m.error_scale = readString(j, "error_scale", where);
   m.world_config = readConfig(j, "world_config", where);
   m.planner_config = readConfig(j, "planner_config", where);
+  // Manifests written before --arm existed ran the built-in arm.
+  if (member(j, "arm_config")) m.arm_config = readConfig(j, "arm_config", where);
   if (m.kind == "merged") {
     const nlohmann::json& sources = required(j, "sources", where, "an array of directories");
     if (!sources.is_array()) fieldError(where, "sources", "an array of directories", &sources);
@@ -354,6 +357,8 @@ std::optional<ManifestDifference> mergeDifference(const ExperimentManifest& a,
   if (a.planner_config.fnv1a64 != b.planner_config.fnv1a64)
     return ManifestDifference{"planner_config", shownConfig(a.planner_config),
                               shownConfig(b.planner_config)};
+  if (a.arm_config.fnv1a64 != b.arm_config.fnv1a64)
+    return ManifestDifference{"arm_config", shownConfig(a.arm_config), shownConfig(b.arm_config)};
   return std::nullopt;
 }
 

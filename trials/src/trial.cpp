@@ -345,6 +345,7 @@ struct Trial::Impl {
     renderer = std::make_unique<StereoRenderer>(*world, render_config);
 
     // The arm, its workspace tree and the simulated clock.
+    if (!options.arm_config.empty()) arm_config = ArmConfig::fromYamlFile(options.arm_config);
     if (arm_config.workspace_cache_dir.empty()) arm_config.workspace_cache_dir = defaultCacheDir();
     arm = std::make_unique<ArmModel>(arm_config);
     workspace = std::make_unique<WorkspaceTree>(

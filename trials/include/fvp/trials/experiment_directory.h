@@ -69,7 +69,7 @@ struct ExperimentManifest {
   /// --error-scale GROUP=FACTOR, or empty; the world config's hash already tells runs apart,
   /// this names the sweep point (absent in a manifest: empty).
   std::string error_scale;
-  ConfigFileStamp world_config, planner_config;
+  ConfigFileStamp world_config, planner_config, arm_config;
   // The run's own plan (kind "run" only). Resume refuses a difference; merge does not
   // compare them (shards differ in them by design; the engine is in the row key).
   std::string engine;  ///< the --engine override; empty: each planner's default
@@ -100,7 +100,8 @@ std::optional<ManifestDifference> resumeDifference(const ExperimentManifest& old
                                                    const ExperimentManifest& now);
 
 /// The first row-defining setting in which two experiments differ (what merge refuses):
-/// budget_s, clock, stop, max_views, world_config, planner_config (configs by content hash).
+/// budget_s, clock, stop, max_views, world_config, planner_config, arm_config (configs by
+/// content hash).
 std::optional<ManifestDifference> mergeDifference(const ExperimentManifest& a,
                                                   const ExperimentManifest& b);
 

@@ -33,11 +33,12 @@ struct TrialOptions {
   std::uint64_t seed = 1;
   std::filesystem::path world_config;    ///< empty: robot/sim/config/world_default.yaml
   std::filesystem::path planner_config;  ///< empty: the planner's default config
-  double budget_s = 180.0;               ///< simulated seconds (paper: 180)
-  std::string backend = "auto";          ///< cpu | opencl | vulkan | auto
-  std::string engine;                    ///< grid | octomap; empty: the planner's default
-  std::optional<int> max_views;          ///< stop after this many views (tests)
-  std::string clock = "wall";            ///< wall | fixed
+  std::filesystem::path arm_config;  ///< empty: the built-in arm (robot/config/arm_default.yaml)
+  double budget_s = 180.0;           ///< simulated seconds (paper: 180)
+  std::string backend = "auto";      ///< cpu | opencl | vulkan | auto
+  std::string engine;                ///< grid | octomap; empty: the planner's default
+  std::optional<int> max_views;      ///< stop after this many views (tests)
+  std::string clock = "wall";        ///< wall | fixed
   /// budget: the paper's protocol (budget_s, max_views); auto: also stop once the cluster's
   /// sizes have settled (host/nbv/cluster_completion.h), budget_s being the cap.
   std::string stop = "budget";
