@@ -51,11 +51,6 @@ class ArmValidityChecker : public ob::StateValidityChecker {
   const ArmCollisionChecker& checker_;
 };
 
-// OMPL's local planner, replaced so that the 1 cm collision padding really covers the gaps
-// between checks: states along a motion are checked closely enough that no point of the arm
-// moves more than the padding between two of them (ArmModel::sweepBound_m), and never farther
-// apart than validity_step_rad in joint space. OMPL's default uses the joint-space step
-// alone, which lets the far end of the arm move ~1.5 cm per 0.01 rad.
 /// Checks from a to b (b included): the joint-space step, and no point of the arm moving
 /// farther than the collision padding between checks.
 int motionSteps(const ArmCollisionChecker& checker, const JointVector& a, const JointVector& b) {
@@ -66,6 +61,11 @@ int motionSteps(const ArmCollisionChecker& checker, const JointVector& a, const 
   return std::max(1, static_cast<int>(std::ceil(steps)));
 }
 
+// OMPL's local planner, replaced so that the 1 cm collision padding really covers the gaps
+// between checks: states along a motion are checked closely enough that no point of the arm
+// moves more than the padding between two of them (ArmModel::sweepBound_m), and never farther
+// apart than validity_step_rad in joint space. OMPL's default uses the joint-space step
+// alone, which lets the far end of the arm move ~1.5 cm per 0.01 rad.
 class ArmMotionValidator : public ob::MotionValidator {
  public:
   ArmMotionValidator(const ob::SpaceInformationPtr& si, const ArmCollisionChecker& checker)
@@ -329,18 +329,14 @@ MotionPlan MotionPlanner::plan_(const JointVector& current, const std::vector<Jo
   for (std::size_t i = 0; i < path.getStateCount(); ++i)
     waypoints.push_back(toJoints(path.getState(i)));
   plan.goal = waypoints.back();
+  plan.trajectory = Trajectory(waypoints, arm.maxVelocity(), arm.maxAcceleration());
   if (arm.config().trajectory_timing == "blended") {
     // Through the via points without stopping, where the cut corners are collision-free.
     Trajectory blended = Trajectory::blended(waypoints, arm.maxVelocity(), arm.maxAcceleration());
-    const double rest_to_rest_s =
-        Trajectory(waypoints, arm.maxVelocity(), arm.maxAcceleration()).duration_s();
-    if (blended.isBlended() && blended.duration_s() < rest_to_rest_s &&
-        trajectoryValid(checker_, blended)) {
+    if (blended.isBlended() && blended.duration_s() < plan.trajectory.duration_s() &&
+        trajectoryValid(checker_, blended))
       plan.trajectory = std::move(blended);
-      return finish(MotionStatus::kSuccess);
-    }
   }
-  plan.trajectory = Trajectory(std::move(waypoints), arm.maxVelocity(), arm.maxAcceleration());
   return finish(MotionStatus::kSuccess);
 }
 
