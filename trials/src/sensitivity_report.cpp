@@ -101,15 +101,12 @@ std::vector<SensitivityPoint> readSensitivityPoints(const std::vector<fs::path>&
   for (const auto& unscaled : measured) {
     if (unscaled.factor != 1.0) continue;
     for (const auto& group : groups) {
-      const bool has_own = std::any_of(measured.begin(), measured.end(), [&](const auto& q) {
-        return q.group == group && q.factor == 1.0 && q.planner == unscaled.planner &&
-               q.registered == unscaled.registered;
-      });
-      const bool added = std::any_of(points.begin(), points.end(), [&](const auto& q) {
-        return q.group == group && q.factor == 1.0 && q.planner == unscaled.planner &&
-               q.registered == unscaled.registered;
-      });
-      if (has_own || added) continue;
+      // points holds every measured point and those added so far.
+      if (std::any_of(points.begin(), points.end(), [&](const auto& q) {
+            return q.group == group && q.factor == 1.0 && q.planner == unscaled.planner &&
+                   q.registered == unscaled.registered;
+          }))
+        continue;
       SensitivityPoint shared = unscaled;
       shared.group = group;
       points.push_back(shared);
