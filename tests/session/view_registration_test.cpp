@@ -6,6 +6,7 @@
 
 #include "fvp/host/session/view_registration.h"
 #include "fvp/robot/sim/camera_views.h"
+#include "fvp/robot/sim/pose_error_model.h"
 #include "fvp/robot/sim/stereo_renderer.h"
 #include "fvp/robot/sim/world.h"
 
@@ -117,6 +118,60 @@ TEST_F(ViewRegistrationTest, RefusalsAreStatuses) {
   away.translation() = Eigen::Vector3d(0.5, 0.0, 0.0);
   EXPECT_EQ(registration.align(moved(view_, away)).status, RegistrationStatus::kTooFewPairs);
   EXPECT_THROW(ViewRegistration(ViewRegistrationConfig{.voxel_m = 0.0}), std::invalid_argument);
+}
+
+TEST_F(ViewRegistrationTest, TheConsensusShiftMovesTheRegisteredMapToTheViewsMeanFrame) {
+  // The field preset's pose errors (a hand-eye error and the arm's, drawn for seed 5), views
+  // spread as the planner spreads them: from the start view's side, turned up to 35 degrees
+  // across and 25 up and down, nearer than the start view. Each image is taken from the true pose;
+  // the robot fuses it at the told one, registered to the first view.
+  robot::sim::WorldConfig errors;
+  errors.hand_eye_translation_sigma_m = 0.0015;
+  errors.hand_eye_rotation_sigma_deg = 0.3;
+  errors.arm_position_error_m = 0.001;
+  const robot::sim::PoseErrorModel pose_errors(errors, 5);
+  const Eigen::Vector3d c = world_.clusterCenter_m();
+  const Eigen::Isometry3d start = world_.startCameraPose();
+  const double distance_m = (start.translation() - c).norm();
+  ViewRegistration registration;
+  std::vector<RegistrationResult> results;
+  std::vector<Eigen::Vector3d> true_shifts;  // where each told frame puts c, back to the truth
+  int view = 0;
+  for (const auto& [across_deg, up_deg] : std::vector<std::pair<double, double>>{
+           {0, 0}, {-35, 0}, {35, 0}, {0, 25}, {0, -25}, {-25, 20}, {25, -20}, {20, 20}}) {
+    const Eigen::Matrix3d R =
+        start.linear() *
+        Eigen::AngleAxisd(across_deg * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix() *
+        Eigen::AngleAxisd(up_deg * M_PI / 180.0, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    // The planner's views come nearer than the start view (0.28 of its 0.40 m).
+    const double d = view == 0 ? distance_m : 0.7 * distance_m;
+    const Eigen::Isometry3d told = robot::sim::lookAt(c - d * R.col(2), c);
+    const Eigen::Isometry3d truth = pose_errors.truePose(told, view++);
+    true_shifts.push_back(truth * told.inverse() * c - c);
+    const std::vector<Eigen::Vector3f> seen =
+        moved(exactPoints(world_, renderer_, truth, 0.065), told * truth.inverse());
+    const RegistrationResult r = registration.align(seen);
+    results.push_back(r);
+    registration.addToModel(moved(seen, r.correction));
+  }
+  Eigen::Vector3d counted_mean = Eigen::Vector3d::Zero();
+  int counted = 0;
+  for (std::size_t i = 0; i < results.size(); ++i)
+    if (results[i].status != RegistrationStatus::kTooFewPairs &&
+        results[i].status != RegistrationStatus::kBeyondBounds) {
+      counted_mean += true_shifts[i];
+      ++counted;
+    }
+  ASSERT_GE(counted, 6);
+  counted_mean /= counted;
+  // The registered map sits where the anchor's pose put it; the consensus is the mean of
+  // the views' frames. The test is only of interest when the two differ.
+  const Eigen::Vector3d needed = true_shifts.front() - counted_mean;
+  ASSERT_GT(needed.norm(), 0.001) << needed.transpose();
+  const Eigen::Vector3d shift = consensusShift(results);
+  EXPECT_LT((shift - needed).norm(), 0.0005)
+      << "shift " << shift.transpose() << ", needed " << needed.transpose();
+  EXPECT_EQ(consensusShift({}), Eigen::Vector3d::Zero());
 }
 
 }  // namespace

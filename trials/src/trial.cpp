@@ -61,6 +61,19 @@ nlohmann::json poseErrorJson(const Eigen::Isometry3d& T_told, const Eigen::Isome
           {"rotation_deg", Eigen::AngleAxisd(d.rotation()).angle() * 180.0 / std::numbers::pi}};
 }
 
+/// With view registration: the shift from the anchor's frame to the views' consensus and,
+/// where the simulator has pose errors, how far the maps and the result sit from the truth
+/// at the cluster's centre.
+nlohmann::json consensusJson(const Eigen::Vector3d& shift_m,
+                             const std::optional<Eigen::Vector3d>& true_anchor_shift_m) {
+  nlohmann::json j = {{"shift_mm", vec3Json(1000.0 * shift_m)}};
+  if (true_anchor_shift_m) {
+    j["anchor_error_mm"] = 1000.0 * true_anchor_shift_m->norm();
+    j["consensus_error_mm"] = 1000.0 * (*true_anchor_shift_m - shift_m).norm();
+  }
+  return j;
+}
+
 /// R_world_camera as [w, x, y, z]; the camera looks along its z axis (OpenCV frame).
 nlohmann::json quaternionWxyz(const Eigen::Isometry3d& T) {
   return host::report::poseJson(T).at("quaternion_wxyz");
@@ -118,14 +131,28 @@ class TrialLog : public host::nbv::LoopObserver {
                       {"tsdf_s", v.tsdf_s},
                       {"sim_time_s", e.now_s}});
     if (cluster_ >= 0) views_.back()["cluster"] = cluster_;
-    if (camera_.hasPoseErrors())
+    if (camera_.hasPoseErrors()) {
       views_.back()["pose_error"] = poseErrorJson(e.T_world_camera, camera_.lastTruePose());
+      // Where the view's told pose puts a point at the cluster's centre, moved back to the truth.
+      if (cluster_center_m_) {
+        const Eigen::Vector3d shift =
+            camera_.lastTruePose() * e.T_world_camera.inverse() * *cluster_center_m_ -
+            *cluster_center_m_;
+        views_.back()["true_shift_mm"] = vec3Json(1000.0 * shift);
+        if (!v.registration || v.registration->status == host::RegistrationStatus::kNoModel)
+          anchor_shifts_m_.push_back(shift);
+      }
+    }
     if (v.registration) {
       const host::RegistrationResult& r = *v.registration;
       views_.back()["registration"] = {
-          {"status", host::toString(r.status)},     {"translation_mm", 1000.0 * r.translation_m},
-          {"rotation_deg", r.rotation_deg},         {"rms_before_mm", 1000.0 * r.rms_before_m},
-          {"rms_after_mm", 1000.0 * r.rms_after_m}, {"pairs", r.pairs}};
+          {"status", host::toString(r.status)},
+          {"correction_mm", vec3Json(1000.0 * r.correction.translation())},
+          {"translation_mm", 1000.0 * r.translation_m},
+          {"rotation_deg", r.rotation_deg},
+          {"rms_before_mm", 1000.0 * r.rms_before_m},
+          {"rms_after_mm", 1000.0 * r.rms_after_m},
+          {"pairs", r.pairs}};
     }
     if (!options_.out_dir.empty()) {
       keepViewImage(options_.out_dir, index, *e.frame);
@@ -160,6 +187,15 @@ class TrialLog : public host::nbv::LoopObserver {
 
   const nlohmann::json& views() const { return views_; }
   const nlohmann::json& plans() const { return plans_; }
+  /// With pose errors and the cluster's centre known: the mean of the anchor views' true
+  /// displacement there (what the registered map's shift should be).
+  void setClusterCenter(const Eigen::Vector3d& c) { cluster_center_m_ = c; }
+  std::optional<Eigen::Vector3d> trueAnchorShift() const {
+    if (anchor_shifts_m_.empty()) return std::nullopt;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const auto& d : anchor_shifts_m_) sum += d;
+    return sum / double(anchor_shifts_m_.size());
+  }
   /// The views' images for the overlays (kept only with an output directory).
   const ViewImages& images() const { return images_; }
   const std::optional<host::StereoIntrinsics>& intrinsics() const { return intrinsics_; }
@@ -173,6 +209,8 @@ class TrialLog : public host::nbv::LoopObserver {
   std::optional<host::StereoIntrinsics> intrinsics_;
   Clock::time_point wall_start_;
   int cluster_ = -1, first_view_ = 0;  ///< -1: a one-cluster world
+  std::optional<Eigen::Vector3d> cluster_center_m_;
+  std::vector<Eigen::Vector3d> anchor_shifts_m_;
   nlohmann::json views_ = nlohmann::json::array(), plans_ = nlohmann::json::array();
 };
 
@@ -518,6 +556,7 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
   // The loop, driven through the camera, arm and clock like a robot's.
   SimulatedLoopClock loop_clock(*clock);
   TrialLog log(*camera, options, wall_start);
+  log.setClusterCenter(world->clusterCenter_m());
   const ClusterOutcome outcome =
       runCluster(*parts, world->clusters().front(), loop_camera, loop_arm, loop_clock, log);
   const host::nbv::NbvResult& run = outcome.run;
@@ -540,6 +579,9 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
                       {"trial", parts->configJson()}};
   for (auto& [key, value] : outcome.sizing.items()) result[key] = value;
   result["events"] = eventsJson(run.events);
+  if (options.register_views)
+    result["consensus_frame"] =
+        consensusJson(parts->session().consensusShift_m(), log.trueAnchorShift());
   result["wall_breakdown_s"] = {{"rendering", camera->totalRenderSeconds()},
                                 {"perception", run.wall_s.perception},
                                 {"mapping", run.wall_s.mapping},

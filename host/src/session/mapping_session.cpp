@@ -31,6 +31,7 @@ void MappingSession::carryOnWith(std::unique_ptr<map::MapEngine> map) {
 ViewResult MappingSession::addView(const StereoFrame& frame, PerceptionResult* perceived_out) {
   ViewResult view;
   view.index = views_.size();
+  view.T_world_camera_told = frame.T_world_camera;
   const auto t0 = std::chrono::steady_clock::now();
   PerceptionResult perceived = perception_.process(frame, region_);
   view.perceive_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -144,7 +145,19 @@ sizing::SizingResult MappingSession::sizeFruitlets(const sizing::SizingConfig& c
   };
   sizing::SizingConfig own = config;
   own.surface_voxel_size_m = tsdf_config_->voxel_size_m;
-  return sizing::sizeFruitlets(sizing_views_, surfacePoints(), in_roi_voxel, own);
+  sizing::SizingResult result =
+      sizing::sizeFruitlets(sizing_views_, surfacePoints(), in_roi_voxel, own);
+  const Eigen::Vector3d shift = consensusShift_m();
+  if (!shift.isZero()) sizing::translate(result, shift);
+  return result;
+}
+
+Eigen::Vector3d MappingSession::consensusShift_m() const {
+  if (!registration_ || !registration_->config().consensus_frame) return Eigen::Vector3d::Zero();
+  std::vector<RegistrationResult> results;
+  for (const ViewResult& v : views_)
+    results.push_back(v.registration.value_or(RegistrationResult{}));
+  return consensusShift(results);
 }
 
 void MappingSession::integrate(std::size_t index, const LabeledClouds& clouds) {

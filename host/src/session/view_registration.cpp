@@ -133,6 +133,27 @@ Eigen::Isometry3d pointToPlaneStep(const Pairs& pairs, bool rotation) {
 
 }  // namespace
 
+Eigen::Vector3d consensusShift(const std::vector<RegistrationResult>& views) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  std::size_t counted = 0;
+  for (const RegistrationResult& r : views) {
+    switch (r.status) {
+      case RegistrationStatus::kApplied:
+        sum += r.correction.translation();
+        ++counted;
+        break;
+      case RegistrationStatus::kNoModel:
+      case RegistrationStatus::kNoImprovement:
+        ++counted;
+        break;
+      case RegistrationStatus::kTooFewPairs:
+      case RegistrationStatus::kBeyondBounds:
+        break;
+    }
+  }
+  return counted ? Eigen::Vector3d(-sum / double(counted)) : Eigen::Vector3d::Zero();
+}
+
 void ViewRegistrationConfig::validate() const {
   const auto positive = [](double v, const char* name) {
     if (!(v > 0.0) || !std::isfinite(v))

@@ -31,6 +31,7 @@ namespace fvp::host {
 /// the region was known gets its scan when a later view detects the tag (see views()).
 struct ViewResult {
   std::size_t index = 0;  ///< position of the view in the session
+  Eigen::Isometry3d T_world_camera_told = Eigen::Isometry3d::Identity();  ///< the frame's pose
   bool tag_detected = false;
   std::optional<TagDetection> tag;  ///< the cluster's tag as this view saw it
   std::size_t roi_points = 0, other_points = 0;
@@ -88,8 +89,16 @@ class MappingSession {
   tsdf::TriangleMesh surfaceMesh() const;
   const std::vector<sizing::SizingView>& sizingViews() const { return sizing_views_; }
   /// The sizing chain on the session's TSDF surface and views, keeping surface points in
-  /// ROI-occupied fine voxels. Needs enableTsdf(); without a map no point is kept.
+  /// ROI-occupied fine voxels. Needs enableTsdf(); without a map no point is kept. With view
+  /// registration, positions (centres, points) are moved by consensusShift_m(): the maps
+  /// stay in the anchor's frame, the result is in the views' consensus frame.
   sizing::SizingResult sizeFruitlets(const sizing::SizingConfig& config) const;
+
+  /// With view registration on: what moves the registered maps from the anchor views'
+  /// frame to the consensus of the views' told poses (view_registration.h,
+  /// consensusShift); sizeFruitlets() reports positions moved by it. Zero without
+  /// registration.
+  Eigen::Vector3d consensusShift_m() const;
 
   /// Hands the map over (or the carried one it never needed: no view showed its tag); the
   /// session is done with it.

@@ -37,6 +37,9 @@ struct ViewRegistrationConfig {
   std::size_t min_pairs = 300;
   /// The pairs' RMS must fall by at least this fraction.
   double min_rms_reduction = 0.1;
+  /// Report positions in the consensus of the views' told poses rather than in the anchor
+  /// view's (consensusShift): every view's pose error is a draw, the anchor's one of them.
+  bool consensus_frame = true;
 
   /// Throws std::invalid_argument naming the bad field.
   void validate() const;
@@ -61,6 +64,14 @@ struct RegistrationResult {
   std::size_t pairs = 0;
   int iterations = 0;
 };
+
+/// What moves points from the registered maps' frame (the anchor views') to the consensus
+/// of every view's told frame: minus the mean correction over the views whose offset from
+/// the model is known, the anchors and the views that needed none (kNoModel,
+/// kNoImprovement: zero) and the aligned ones (kApplied: their correction's translation).
+/// Views that could not be aligned (kTooFewPairs, kBeyondBounds) are left out. Zero for no
+/// view. docs/sizing.md "The consensus frame".
+Eigen::Vector3d consensusShift(const std::vector<RegistrationResult>& views);
 
 class ViewRegistration {
  public:
