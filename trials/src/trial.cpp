@@ -61,12 +61,12 @@ nlohmann::json poseErrorJson(const Eigen::Isometry3d& T_told, const Eigen::Isome
           {"rotation_deg", Eigen::AngleAxisd(d.rotation()).angle() * 180.0 / std::numbers::pi}};
 }
 
-/// With view registration: the shift from the anchor's frame to the views' consensus and,
-/// where the simulator has pose errors, how far the maps and the result sit from the truth
-/// at the cluster's centre.
-nlohmann::json consensusJson(const Eigen::Vector3d& shift_m,
+/// With view registration: the shift from the anchor's frame to the views' consensus,
+/// whether the result was moved by it, and, where the simulator has pose errors, how far
+/// each frame sits from the truth at the cluster's centre.
+nlohmann::json consensusJson(const Eigen::Vector3d& shift_m, bool applied,
                              const std::optional<Eigen::Vector3d>& true_anchor_shift_m) {
-  nlohmann::json j = {{"shift_mm", vec3Json(1000.0 * shift_m)}};
+  nlohmann::json j = {{"shift_mm", vec3Json(1000.0 * shift_m)}, {"applied", applied}};
   if (true_anchor_shift_m) {
     j["anchor_error_mm"] = 1000.0 * true_anchor_shift_m->norm();
     j["consensus_error_mm"] = 1000.0 * (*true_anchor_shift_m - shift_m).norm();
@@ -581,7 +581,8 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
   result["events"] = eventsJson(run.events);
   if (options.register_views)
     result["consensus_frame"] =
-        consensusJson(parts->session().consensusShift_m(), log.trueAnchorShift());
+        consensusJson(parts->session().consensusShift_m(),
+                      parts->session().reportsInConsensusFrame(), log.trueAnchorShift());
   result["wall_breakdown_s"] = {{"rendering", camera->totalRenderSeconds()},
                                 {"perception", run.wall_s.perception},
                                 {"mapping", run.wall_s.mapping},

@@ -147,13 +147,12 @@ sizing::SizingResult MappingSession::sizeFruitlets(const sizing::SizingConfig& c
   own.surface_voxel_size_m = tsdf_config_->voxel_size_m;
   sizing::SizingResult result =
       sizing::sizeFruitlets(sizing_views_, surfacePoints(), in_roi_voxel, own);
-  const Eigen::Vector3d shift = consensusShift_m();
-  if (!shift.isZero()) sizing::translate(result, shift);
+  if (reportsInConsensusFrame()) sizing::translate(result, consensusShift_m());
   return result;
 }
 
 Eigen::Vector3d MappingSession::consensusShift_m() const {
-  if (!registration_ || !registration_->config().consensus_frame) return Eigen::Vector3d::Zero();
+  if (!registration_) return Eigen::Vector3d::Zero();
   std::vector<RegistrationResult> results;
   for (const ViewResult& v : views_)
     results.push_back(v.registration.value_or(RegistrationResult{}));

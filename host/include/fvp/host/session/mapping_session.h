@@ -90,15 +90,20 @@ class MappingSession {
   const std::vector<sizing::SizingView>& sizingViews() const { return sizing_views_; }
   /// The sizing chain on the session's TSDF surface and views, keeping surface points in
   /// ROI-occupied fine voxels. Needs enableTsdf(); without a map no point is kept. With view
-  /// registration, positions (centres, points) are moved by consensusShift_m(): the maps
-  /// stay in the anchor's frame, the result is in the views' consensus frame.
+  /// registration and its consensus_frame, positions (centres, points) are moved by
+  /// consensusShift_m(): the maps stay in the anchor's frame, the result is in the views'
+  /// consensus frame.
   sizing::SizingResult sizeFruitlets(const sizing::SizingConfig& config) const;
 
   /// With view registration on: what moves the registered maps from the anchor views'
   /// frame to the consensus of the views' told poses (view_registration.h,
-  /// consensusShift); sizeFruitlets() reports positions moved by it. Zero without
-  /// registration.
+  /// consensusShift); with ViewRegistrationConfig::consensus_frame, sizeFruitlets() reports
+  /// positions moved by it. Zero without registration.
   Eigen::Vector3d consensusShift_m() const;
+  /// Whether sizeFruitlets() reports positions in the consensus frame.
+  bool reportsInConsensusFrame() const {
+    return registration_ && registration_->config().consensus_frame;
+  }
 
   /// Hands the map over (or the carried one it never needed: no view showed its tag); the
   /// session is done with it.
