@@ -1,6 +1,6 @@
 // MappingSession on rendered stereo pairs: the map appears with the first view whose tag is
 // detected, and views seen before it are integrated, in order, once the region is known;
-// with view registration, sizes are reported in the views' consensus frame.
+// with view registration, positions are corrected by the anchor's estimated offset.
 #include "fvp/host/session/mapping_session.h"
 
 #include <gtest/gtest.h>
@@ -97,19 +97,19 @@ TEST_F(MappingSessionTest, ViewsBeforeTheTagAreIntegratedInOrderOnceItIsSeen) {
   }
 }
 
-TEST_F(MappingSessionTest, WithRegistrationSizesAreReportedInTheViewsConsensusFrame) {
+TEST_F(MappingSessionTest, WithRegistrationPositionsAreCorrectedByTheAnchorsOffset) {
   // The tagged view anchors; the other is told a pose 2 mm off, so registration moves it
-  // back and the consensus of the two frames lies half way: positions move by minus half
-  // the correction, sizes stay. The same session with the anchor's frame is the reference.
+  // back and the anchor's estimated offset is nonzero: positions move by it, sizes stay.
+  // The same session without the correction is the reference.
   StereoFrame off = untagged();
   off.T_world_camera.translation() += Eigen::Vector3d(0.002, -0.001, 0.0);
   auto cpu = accel::createBackend(accel::BackendKind::kCpu);
   sizing::SizingResult sized[2];
-  Eigen::Vector3d shift[2];
-  for (const bool consensus : {true, false}) {
+  AnchorOffset offset[2];
+  for (const bool correct : {true, false}) {
     MappingSession session({}, "grid", map::MapConfig{}, cpu.get());
     ViewRegistrationConfig config;
-    config.consensus_frame = consensus;
+    config.correct_anchor_offset = correct;
     session.enableViewRegistration(config);
     session.enableTsdf();
     session.addView(tagged());
@@ -117,27 +117,28 @@ TEST_F(MappingSessionTest, WithRegistrationSizesAreReportedInTheViewsConsensusFr
     ASSERT_TRUE(moved.registration.has_value());
     ASSERT_EQ(moved.registration->status, RegistrationStatus::kApplied);
     EXPECT_GT(moved.registration->correction.translation().norm(), 0.0015);
-    EXPECT_EQ(session.reportsInConsensusFrame(), consensus);
-    // The shift is known either way; only the consensus frame moves the result by it.
-    shift[consensus] = session.consensusShift_m();
-    EXPECT_TRUE(
-        shift[consensus].isApprox(-0.5 * moved.registration->correction.translation(), 1e-12));
-    sized[consensus] = session.sizeFruitlets({});
+    EXPECT_EQ(session.correctsAnchorOffset(), correct);
+    // Known either way; only the correction moves the result by it.
+    offset[correct] = session.anchorOffset();
+    EXPECT_EQ(offset[correct].views, 2u);
+    sized[correct] = session.sizeFruitlets({});
   }
-  EXPECT_TRUE(shift[false].isApprox(shift[true], 1e-12));
+  const Eigen::Vector3d shift = offset[true].shift_m;
+  EXPECT_TRUE(offset[false].shift_m.isApprox(shift, 1e-12));
+  EXPECT_GT(shift.norm(), 1e-4);
   ASSERT_FALSE(sized[true].fruitlets.empty());
   ASSERT_EQ(sized[true].fruitlets.size(), sized[false].fruitlets.size());
   for (std::size_t i = 0; i < sized[true].fruitlets.size(); ++i) {
     const auto& a = sized[true].fruitlets[i];
     const auto& b = sized[false].fruitlets[i];
     EXPECT_EQ(a.size_mm, b.size_mm);
-    EXPECT_TRUE(a.center_m.isApprox(b.center_m + shift[true], 1e-12));
-    EXPECT_TRUE(a.sphere_center_m.isApprox(b.sphere_center_m + shift[true], 1e-12));
-    EXPECT_TRUE(a.centroid_m.isApprox(b.centroid_m + shift[true], 1e-12));
+    EXPECT_TRUE(a.center_m.isApprox(b.center_m + shift, 1e-12));
+    EXPECT_TRUE(a.sphere_center_m.isApprox(b.sphere_center_m + shift, 1e-12));
+    EXPECT_TRUE(a.centroid_m.isApprox(b.centroid_m + shift, 1e-12));
   }
   ASSERT_EQ(sized[true].points.size(), sized[false].points.size());
-  EXPECT_TRUE(sized[true].points.front().isApprox(
-      sized[false].points.front() + shift[true].cast<float>(), 1e-6f));
+  EXPECT_TRUE(sized[true].points.front().isApprox(sized[false].points.front() + shift.cast<float>(),
+                                                  1e-6f));
 }
 
 TEST(MappingSession, RejectsABadEngineBeforeAnyView) {

@@ -1,8 +1,10 @@
 // View registration: a view whose points are shifted by a known pose error is moved back onto
 // the view before it to within a stated tolerance; a correction beyond a calibration error,
 // a view that shares nothing with the model and a view that needs no correction are
-// refused with their statuses.
+// refused with their statuses; the anchor's own error is recovered from the corrections.
 #include <gtest/gtest.h>
+
+#include <random>
 
 #include "fvp/host/session/view_registration.h"
 #include "fvp/robot/sim/camera_views.h"
@@ -120,58 +122,106 @@ TEST_F(ViewRegistrationTest, RefusalsAreStatuses) {
   EXPECT_THROW(ViewRegistration(ViewRegistrationConfig{.voxel_m = 0.0}), std::invalid_argument);
 }
 
-TEST_F(ViewRegistrationTest, TheConsensusShiftMovesTheRegisteredMapToTheViewsMeanFrame) {
-  // The field preset's pose errors (a hand-eye error and the arm's, drawn for seed 5), views
-  // spread as the planner spreads them: from the start view's side, turned up to 35 degrees
-  // across and 25 up and down, nearer than the start view. Each image is taken from the true pose;
-  // the robot fuses it at the told one, registered to the first view.
-  robot::sim::WorldConfig errors;
-  errors.hand_eye_translation_sigma_m = 0.0015;
-  errors.hand_eye_rotation_sigma_deg = 0.3;
-  errors.arm_position_error_m = 0.001;
-  const robot::sim::PoseErrorModel pose_errors(errors, 5);
-  const Eigen::Vector3d c = world_.clusterCenter_m();
-  const Eigen::Isometry3d start = world_.startCameraPose();
+/// Views as the planner spreads them: from the start view's side, turned up to 35 degrees
+/// across and 25 up and down, nearer than the start view (0.28 of its 0.40 m).
+std::vector<Eigen::Isometry3d> spreadViews(const robot::sim::World& world) {
+  const Eigen::Vector3d c = world.clusterCenter_m();
+  const Eigen::Isometry3d start = world.startCameraPose();
   const double distance_m = (start.translation() - c).norm();
-  ViewRegistration registration;
-  std::vector<RegistrationResult> results;
-  std::vector<Eigen::Vector3d> true_shifts;  // where each told frame puts c, back to the truth
-  int view = 0;
+  std::vector<Eigen::Isometry3d> views;
   for (const auto& [across_deg, up_deg] : std::vector<std::pair<double, double>>{
            {0, 0}, {-35, 0}, {35, 0}, {0, 25}, {0, -25}, {-25, 20}, {25, -20}, {20, 20}}) {
     const Eigen::Matrix3d R =
         start.linear() *
         Eigen::AngleAxisd(across_deg * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix() *
         Eigen::AngleAxisd(up_deg * M_PI / 180.0, Eigen::Vector3d::UnitX()).toRotationMatrix();
-    // The planner's views come nearer than the start view (0.28 of its 0.40 m).
-    const double d = view == 0 ? distance_m : 0.7 * distance_m;
-    const Eigen::Isometry3d told = robot::sim::lookAt(c - d * R.col(2), c);
-    const Eigen::Isometry3d truth = pose_errors.truePose(told, view++);
-    true_shifts.push_back(truth * told.inverse() * c - c);
+    const double d = views.empty() ? distance_m : 0.7 * distance_m;
+    views.push_back(robot::sim::lookAt(c - d * R.col(2), c));
+  }
+  return views;
+}
+
+TEST_F(ViewRegistrationTest, TheAnchorsOffsetFromTheWorldIsRecoveredFromTheCorrections) {
+  // A hand-eye error of the field preset's size (drawn for seed 5): each image is taken from
+  // the true pose, the robot fuses it at the told one, registered to the first view.
+  robot::sim::WorldConfig errors;
+  errors.hand_eye_translation_sigma_m = 0.0015;
+  errors.hand_eye_rotation_sigma_deg = 0.3;
+  const robot::sim::PoseErrorModel pose_errors(errors, 5);
+  const Eigen::Vector3d c = world_.clusterCenter_m();
+  ViewRegistration registration;
+  std::vector<RegisteredView> views;
+  Eigen::Vector3d anchor_error = Eigen::Vector3d::Zero();
+  for (const Eigen::Isometry3d& told : spreadViews(world_)) {
+    const Eigen::Isometry3d truth = pose_errors.truePose(told, int(views.size()));
+    // Where the told pose puts the cluster's centre, moved back to the truth.
+    if (views.empty()) anchor_error = truth * told.inverse() * c - c;
     const std::vector<Eigen::Vector3f> seen =
         moved(exactPoints(world_, renderer_, truth, 0.065), told * truth.inverse());
     const RegistrationResult r = registration.align(seen);
-    results.push_back(r);
+    views.push_back({told.linear(), r});
     registration.addToModel(moved(seen, r.correction));
   }
-  Eigen::Vector3d counted_mean = Eigen::Vector3d::Zero();
-  int counted = 0;
-  for (std::size_t i = 0; i < results.size(); ++i)
-    if (results[i].status != RegistrationStatus::kTooFewPairs &&
-        results[i].status != RegistrationStatus::kBeyondBounds) {
-      counted_mean += true_shifts[i];
-      ++counted;
+  ASSERT_GT(anchor_error.norm(), 0.002) << anchor_error.transpose();
+  const AnchorOffset offset = estimateAnchorOffset(views, 0.002);
+  EXPECT_GE(offset.views, 7u);
+  // Registration's corrections agree with the true ones to about 0.2 mm here, so the noise
+  // the estimate finds is small and the prior hardly pulls: the anchor's 5.9 mm error comes
+  // back to half a millimetre.
+  EXPECT_LT((offset.shift_m - anchor_error).norm(), 0.0005)
+      << "estimated " << offset.shift_m.transpose() << ", true " << anchor_error.transpose();
+}
+
+TEST(AnchorOffset, ConstructedCorrectionsGiveTheAnchorsErrorBack) {
+  // c_k = R_k u - e_anchor exactly, for views turned about two axes.
+  const Eigen::Vector3d u(0.0021, -0.0013, 0.0017), e_anchor(0.001, 0.003, -0.002);
+  std::vector<RegisteredView> views;
+  for (double a : {-40.0, -15.0, 0.0, 20.0, 40.0})
+    for (double e : {-25.0, 0.0, 25.0}) {
+      RegisteredView v;
+      v.R_world_camera = (Eigen::AngleAxisd(a * M_PI / 180.0, Eigen::Vector3d::UnitZ()) *
+                          Eigen::AngleAxisd(e * M_PI / 180.0, Eigen::Vector3d::UnitX()))
+                             .toRotationMatrix();
+      v.registration.status = RegistrationStatus::kApplied;
+      v.registration.correction.translation() = v.R_world_camera * u - e_anchor;
+      views.push_back(v);
     }
-  ASSERT_GE(counted, 6);
-  counted_mean /= counted;
-  // The registered map sits where the anchor's pose put it; the consensus is the mean of
-  // the views' frames. The test is only of interest when the two differ.
-  const Eigen::Vector3d needed = true_shifts.front() - counted_mean;
-  ASSERT_GT(needed.norm(), 0.001) << needed.transpose();
-  const Eigen::Vector3d shift = consensusShift(results);
-  EXPECT_LT((shift - needed).norm(), 0.0005)
-      << "shift " << shift.transpose() << ", needed " << needed.transpose();
-  EXPECT_EQ(consensusShift({}), Eigen::Vector3d::Zero());
+  // Exact corrections leave no residual: the prior's weight falls away and the estimate is
+  // exact.
+  const AnchorOffset exact = estimateAnchorOffset(views, 0.002);
+  EXPECT_EQ(exact.views, views.size());
+  EXPECT_LT((exact.shift_m - e_anchor).norm(), 1e-6);
+  EXPECT_LT((exact.hand_eye_m - u).norm(), 1e-6);
+  // Noisy ones: near it, and nearer than the views' mean frame.
+  std::vector<RegisteredView> noisy = views;
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> n(0.0, 0.0005);
+  for (auto& v : noisy)
+    v.registration.correction.translation() += Eigen::Vector3d(n(rng), n(rng), n(rng));
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& v : noisy) mean += v.registration.correction.translation();
+  mean /= double(noisy.size());
+  const double noisy_error = (estimateAnchorOffset(noisy, 0.002).shift_m - e_anchor).norm();
+  EXPECT_LT(noisy_error, 0.001);
+  EXPECT_LT(noisy_error, (-mean - e_anchor).norm());
+  // A prior that forbids a hand-eye term: the views' mean frame, minus the mean correction.
+  EXPECT_LT((estimateAnchorOffset(noisy, 1e-9).shift_m + mean).norm(), 1e-6);
+  // Views registration could not align are left out; those that needed nothing count as 0.
+  std::vector<RegisteredView> mixed = views;
+  mixed[3].registration.status = RegistrationStatus::kTooFewPairs;
+  mixed[4].registration.status = RegistrationStatus::kBeyondBounds;
+  EXPECT_EQ(estimateAnchorOffset(mixed, 0.002).views, views.size() - 2);
+  mixed[5].registration = RegistrationResult{};  // kNoModel: an anchor
+  EXPECT_EQ(estimateAnchorOffset(mixed, 0.002).views, views.size() - 2);
+  // Two views: their mean frame, no hand-eye term; one: nothing.
+  const AnchorOffset two = estimateAnchorOffset({views[0], views[1]}, 0.002);
+  EXPECT_LT(two.hand_eye_m.norm(), 1e-12);
+  EXPECT_LT((two.shift_m + 0.5 * (views[0].registration.correction.translation() +
+                                  views[1].registration.correction.translation()))
+                .norm(),
+            1e-9);
+  EXPECT_EQ(estimateAnchorOffset({views.front()}, 0.002).shift_m, Eigen::Vector3d::Zero());
+  EXPECT_EQ(estimateAnchorOffset({}, 0.002).views, 0u);
 }
 
 }  // namespace

@@ -61,15 +61,18 @@ nlohmann::json poseErrorJson(const Eigen::Isometry3d& T_told, const Eigen::Isome
           {"rotation_deg", Eigen::AngleAxisd(d.rotation()).angle() * 180.0 / std::numbers::pi}};
 }
 
-/// With view registration: the shift from the anchor's frame to the views' consensus,
-/// whether the result was moved by it, and, where the simulator has pose errors, how far
-/// each frame sits from the truth at the cluster's centre.
-nlohmann::json consensusJson(const Eigen::Vector3d& shift_m, bool applied,
-                             const std::optional<Eigen::Vector3d>& true_anchor_shift_m) {
-  nlohmann::json j = {{"shift_mm", vec3Json(1000.0 * shift_m)}, {"applied", applied}};
-  if (true_anchor_shift_m) {
-    j["anchor_error_mm"] = 1000.0 * true_anchor_shift_m->norm();
-    j["consensus_error_mm"] = 1000.0 * (*true_anchor_shift_m - shift_m).norm();
+/// With view registration: where the registered maps sit off the world as the views tell,
+/// whether the reported positions were moved by it, and, where the simulator has pose
+/// errors, the anchor frame's true error at the cluster's centre before and after.
+nlohmann::json anchorOffsetJson(const host::AnchorOffset& offset, bool applied,
+                                const std::optional<Eigen::Vector3d>& true_anchor_error_m) {
+  nlohmann::json j = {{"shift_mm", vec3Json(1000.0 * offset.shift_m)},
+                      {"hand_eye_mm", vec3Json(1000.0 * offset.hand_eye_m)},
+                      {"views", offset.views},
+                      {"applied", applied}};
+  if (true_anchor_error_m) {
+    j["anchor_error_mm"] = 1000.0 * true_anchor_error_m->norm();
+    j["corrected_error_mm"] = 1000.0 * (*true_anchor_error_m - offset.shift_m).norm();
   }
   return j;
 }
@@ -580,9 +583,9 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
   for (auto& [key, value] : outcome.sizing.items()) result[key] = value;
   result["events"] = eventsJson(run.events);
   if (options.register_views)
-    result["consensus_frame"] =
-        consensusJson(parts->session().consensusShift_m(),
-                      parts->session().reportsInConsensusFrame(), log.trueAnchorShift());
+    result["anchor_offset"] =
+        anchorOffsetJson(parts->session().anchorOffset(), parts->session().correctsAnchorOffset(),
+                         log.trueAnchorShift());
   result["wall_breakdown_s"] = {{"rendering", camera->totalRenderSeconds()},
                                 {"perception", run.wall_s.perception},
                                 {"mapping", run.wall_s.mapping},

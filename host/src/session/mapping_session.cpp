@@ -147,16 +147,17 @@ sizing::SizingResult MappingSession::sizeFruitlets(const sizing::SizingConfig& c
   own.surface_voxel_size_m = tsdf_config_->voxel_size_m;
   sizing::SizingResult result =
       sizing::sizeFruitlets(sizing_views_, surfacePoints(), in_roi_voxel, own);
-  if (reportsInConsensusFrame()) sizing::translate(result, consensusShift_m());
+  if (correctsAnchorOffset()) sizing::translate(result, anchorOffset().shift_m);
   return result;
 }
 
-Eigen::Vector3d MappingSession::consensusShift_m() const {
-  if (!registration_) return Eigen::Vector3d::Zero();
-  std::vector<RegistrationResult> results;
+AnchorOffset MappingSession::anchorOffset() const {
+  if (!registration_) return {};
+  std::vector<RegisteredView> views;
   for (const ViewResult& v : views_)
-    results.push_back(v.registration.value_or(RegistrationResult{}));
-  return consensusShift(results);
+    views.push_back(
+        {v.T_world_camera_told.linear(), v.registration.value_or(RegistrationResult{})});
+  return estimateAnchorOffset(views, registration_->config().hand_eye_prior_sigma_m);
 }
 
 void MappingSession::integrate(std::size_t index, const LabeledClouds& clouds) {

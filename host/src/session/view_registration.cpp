@@ -133,25 +133,58 @@ Eigen::Isometry3d pointToPlaneStep(const Pairs& pairs, bool rotation) {
 
 }  // namespace
 
-Eigen::Vector3d consensusShift(const std::vector<RegistrationResult>& views) {
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  std::size_t counted = 0;
-  for (const RegistrationResult& r : views) {
-    switch (r.status) {
+AnchorOffset estimateAnchorOffset(const std::vector<RegisteredView>& views,
+                                  double hand_eye_prior_sigma_m) {
+  // Unknowns x = (u, k), k = -e_anchor; each counted view adds c = [R I] x.
+  std::vector<Eigen::Matrix<double, 3, 6>> rows;
+  std::vector<Eigen::Vector3d> corrections;
+  for (const RegisteredView& v : views) {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    switch (v.registration.status) {
       case RegistrationStatus::kApplied:
-        sum += r.correction.translation();
-        ++counted;
+        c = v.registration.correction.translation();
         break;
       case RegistrationStatus::kNoModel:
       case RegistrationStatus::kNoImprovement:
-        ++counted;
         break;
       case RegistrationStatus::kTooFewPairs:
       case RegistrationStatus::kBeyondBounds:
-        break;
+        continue;
     }
+    Eigen::Matrix<double, 3, 6> A;
+    A << v.R_world_camera, Eigen::Matrix3d::Identity();
+    rows.push_back(A);
+    corrections.push_back(c);
   }
-  return counted ? Eigen::Vector3d(-sum / double(counted)) : Eigen::Vector3d::Zero();
+  AnchorOffset out;
+  out.views = rows.size();
+  if (rows.size() < 2) return out;
+  Eigen::Matrix<double, 6, 6> AtA = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> Atb = Eigen::Matrix<double, 6, 1>::Zero();
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    AtA += rows[i].transpose() * rows[i];
+    Atb += rows[i].transpose() * corrections[i];
+  }
+  // The prior's weight is the noise's variance over the prior's: start as if they were
+  // equal, then take the noise from the residuals (a few rounds settle it). Two views fit
+  // any u exactly: no hand-eye term then.
+  const double prior_var = hand_eye_prior_sigma_m * hand_eye_prior_sigma_m;
+  const double dof = 3.0 * double(rows.size()) - 6.0;
+  double weight = rows.size() < 3 ? 1e12 : 1.0;
+  Eigen::Matrix<double, 6, 1> x = Eigen::Matrix<double, 6, 1>::Zero();
+  for (int round = 0; round < (rows.size() < 3 ? 1 : 5); ++round) {
+    Eigen::Matrix<double, 6, 6> M = AtA;
+    M.topLeftCorner<3, 3>() += std::max(weight, 1e-9) * Eigen::Matrix3d::Identity();
+    x = M.ldlt().solve(Atb);
+    if (!x.allFinite()) return out;
+    double rss = 0.0;
+    for (std::size_t i = 0; i < rows.size(); ++i)
+      rss += (rows[i] * x - corrections[i]).squaredNorm();
+    weight = rss / dof / prior_var;
+  }
+  out.hand_eye_m = x.head<3>();
+  out.shift_m = -x.tail<3>();
+  return out;
 }
 
 void ViewRegistrationConfig::validate() const {
@@ -164,6 +197,7 @@ void ViewRegistrationConfig::validate() const {
   positive(max_pair_distance_m, "max_pair_distance_m");
   positive(max_translation_m, "max_translation_m");
   positive(max_rotation_deg, "max_rotation_deg");
+  positive(hand_eye_prior_sigma_m, "hand_eye_prior_sigma_m");
   if (max_iterations < 1)
     throw std::invalid_argument("view registration: max_iterations must be at least 1");
   if (min_pairs < 3) throw std::invalid_argument("view registration: min_pairs must be at least 3");

@@ -90,19 +90,19 @@ class MappingSession {
   const std::vector<sizing::SizingView>& sizingViews() const { return sizing_views_; }
   /// The sizing chain on the session's TSDF surface and views, keeping surface points in
   /// ROI-occupied fine voxels. Needs enableTsdf(); without a map no point is kept. With view
-  /// registration and its consensus_frame, positions (centres, points) are moved by
-  /// consensusShift_m(): the maps stay in the anchor's frame, the result is in the views'
-  /// consensus frame.
+  /// registration and its correct_anchor_offset, positions (centres, points) are moved by
+  /// anchorOffset().shift_m: the maps stay in the anchor's frame, the result is put back in
+  /// the world as well as the views tell.
   sizing::SizingResult sizeFruitlets(const sizing::SizingConfig& config) const;
 
-  /// With view registration on: what moves the registered maps from the anchor views'
-  /// frame to the consensus of the views' told poses (view_registration.h,
-  /// consensusShift); with ViewRegistrationConfig::consensus_frame, sizeFruitlets() reports
-  /// positions moved by it. Zero without registration.
-  Eigen::Vector3d consensusShift_m() const;
-  /// Whether sizeFruitlets() reports positions in the consensus frame.
-  bool reportsInConsensusFrame() const {
-    return registration_ && registration_->config().consensus_frame;
+  /// With view registration on: where the registered maps (the anchor views' frame) sit off
+  /// the world, from the corrections registration applied (view_registration.h,
+  /// estimateAnchorOffset); with ViewRegistrationConfig::correct_anchor_offset,
+  /// sizeFruitlets() reports positions moved by its shift. Zero without registration.
+  AnchorOffset anchorOffset() const;
+  /// Whether sizeFruitlets() reports positions corrected by anchorOffset().
+  bool correctsAnchorOffset() const {
+    return registration_ && registration_->config().correct_anchor_offset;
   }
 
   /// Hands the map over (or the carried one it never needed: no view showed its tag); the
