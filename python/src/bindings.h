@@ -22,7 +22,8 @@ std::unique_ptr<accel::Backend> backendFor(const std::string& name, const std::s
 /// fvp.MappingSession: the session with the backend it runs on.
 struct Session {
   Session(const host::PerceptionConfig& perception, const std::string& engine,
-          const std::string& backend_name, const std::string& planner, bool tsdf);
+          const std::string& backend_name, const std::string& planner, bool tsdf,
+          bool register_views);
   std::unique_ptr<accel::Backend> backend;
   std::string engine;
   std::unique_ptr<host::MappingSession> session;

@@ -38,11 +38,13 @@ std::unique_ptr<accel::Backend> backendOrNone(const std::string& name) {
 }  // namespace
 
 Session::Session(const host::PerceptionConfig& perception, const std::string& engine_name,
-                 const std::string& backend_name, const std::string& planner, bool tsdf)
+                 const std::string& backend_name, const std::string& planner, bool tsdf,
+                 bool register_views)
     : backend(backendFor(backend_name, engine_name)), engine(engine_name) {
   session = std::make_unique<host::MappingSession>(
       perception, engine, host::planner::plannerMapConfig(planner, engine), backend.get());
   if (tsdf) session->enableTsdf();
+  if (register_views) session->enableViewRegistration();
 }
 
 Planner::Planner(const std::string& name, const std::string& config_yaml, std::uint64_t seed,
@@ -205,14 +207,19 @@ PYBIND11_MODULE(fvp, m) {
   py::class_<Session>(m, "MappingSession",
                       "Views through perception into the maps and the TSDF; sizing on demand.")
       .def(py::init([](const py::object& perception, const std::string& engine,
-                       const std::string& backend, const std::string& planner, bool tsdf) {
+                       const std::string& backend, const std::string& planner, bool tsdf,
+                       bool register_views) {
              const host::PerceptionConfig config = perception.is_none()
                                                        ? host::PerceptionConfig{}
                                                        : perception.cast<host::PerceptionConfig>();
-             return std::make_unique<Session>(config, engine, backend, planner, tsdf);
+             return std::make_unique<Session>(config, engine, backend, planner, tsdf,
+                                              register_views);
            }),
            py::arg("perception") = py::none(), py::arg("engine") = "grid",
-           py::arg("backend") = "auto", py::arg("planner") = "fvp", py::arg("tsdf") = true)
+           py::arg("backend") = "auto", py::arg("planner") = "fvp", py::arg("tsdf") = true,
+           py::arg("register_views") = false,
+           "register_views: align each view to the earlier ones before fusing it and report "
+           "sizes corrected by the registered map's estimated offset (docs/sizing.md).")
       .def(
           "add_view",
           [](Session& s, const host::StereoFrame& frame) {
@@ -248,6 +255,27 @@ PYBIND11_MODULE(fvp, m) {
       .def_property_readonly(
           "map", [](Session& s) -> host::map::MapEngine* { return s.session->map(); },
           py::return_value_policy::reference_internal)
+      .def_property_readonly(
+          "anchor_offset",
+          [](const Session& s) {
+            host::AnchorOffset offset;
+            bool applied = false;
+            {
+              py::gil_scoped_release release;
+              const std::lock_guard lock(s.mutex);
+              offset = s.session->anchorOffset();
+              applied = s.session->correctsAnchorOffset();
+            }
+            py::dict d;
+            d["shift_m"] = vectorToArray(offset.shift_m);
+            d["hand_eye_m"] = vectorToArray(offset.hand_eye_m);
+            d["views"] = offset.views;
+            d["applied"] = applied;
+            return d;
+          },
+          "With register_views: the registered map's estimated offset from the world at the "
+          "cluster (shift_m, added to reported positions when applied), its hand-eye term and "
+          "the views it rests on; zeros without registration.")
       .def(
           "surface_points",
           [](const Session& s) {

@@ -70,6 +70,25 @@ def test_session_maps_plans_and_sizes(seed2_frames):
         assert 3.0 < f["size_mm"] < 30.0
 
 
+def test_registered_views_report_the_maps_offset(seed2_frames):
+    # The third view told 2 mm off: registration moves it back, the registered map's offset
+    # is estimated from that, and the sized positions are moved by it.
+    off = numpy_frame(seed2_frames[2])
+    pose = np.array(off.T_world_camera)
+    pose[0, 3] += 0.002
+    moved = fvp.StereoFrame(np.array(off.left), np.array(off.right), off.intrinsics, pose)
+    plain = fvp.MappingSession(backend="cpu")
+    assert plain.anchor_offset["views"] == 0 and not plain.anchor_offset["applied"]
+    session = fvp.MappingSession(backend="cpu", register_views=True)
+    for f in (seed2_frames[0], seed2_frames[1], moved):
+        session.add_view(f)
+    offset = session.anchor_offset
+    assert offset["applied"] and offset["views"] >= 2
+    assert offset["shift_m"].shape == (3,) and np.isfinite(offset["shift_m"]).all()
+    assert 0.0 < np.linalg.norm(offset["shift_m"]) < 0.01
+    assert len(session.size_fruitlets()["sized_fruitlets"]) >= 1
+
+
 def test_a_reachability_filter_from_python(seed2_frames):
     session = fvp.MappingSession(backend="cpu")
     for f in seed2_frames:
