@@ -270,12 +270,13 @@ PYBIND11_MODULE(fvp, m) {
             d["shift_m"] = vectorToArray(offset.shift_m);
             d["hand_eye_m"] = vectorToArray(offset.hand_eye_m);
             d["views"] = offset.views;
-            d["applied"] = applied;
+            d["valid"] = offset.valid;
+            d["applied"] = applied && offset.valid;
             return d;
           },
           "With register_views: the registered map's estimated offset from the world at the "
           "cluster (shift_m, added to reported positions when applied), its hand-eye term and "
-          "the views it rests on; zeros without registration.")
+          "the views it rests on, whether valid; zeros without registration.")
       .def(
           "surface_points",
           [](const Session& s) {

@@ -97,14 +97,15 @@ TEST_F(MappingSessionTest, ViewsBeforeTheTagAreIntegratedInOrderOnceItIsSeen) {
   }
 }
 
-TEST_F(MappingSessionTest, WithRegistrationPositionsAreCorrectedByTheAnchorsOffset) {
+TEST_F(MappingSessionTest, WithRegistrationDetectionsAreMovedByTheAnchorsOffset) {
   // The tagged view anchors; the other is told a pose 2 mm off, so registration moves it
-  // back and the anchor's estimated offset is nonzero: positions move by it, sizes stay.
-  // The same session without the correction is the reference.
+  // back. Two views leave no hand-eye term: the offset is their mean frame's, minus half the
+  // correction. Detections move by it, sizes and the clustered points stay; the same
+  // session without the correction, and sizing in the maps' frame, are the references.
   StereoFrame off = untagged();
   off.T_world_camera.translation() += Eigen::Vector3d(0.002, -0.001, 0.0);
   auto cpu = accel::createBackend(accel::BackendKind::kCpu);
-  sizing::SizingResult sized[2];
+  sizing::SizingResult sized[2], in_map_frame;
   AnchorOffset offset[2];
   for (const bool correct : {true, false}) {
     MappingSession session({}, "grid", map::MapConfig{}, cpu.get());
@@ -116,29 +117,33 @@ TEST_F(MappingSessionTest, WithRegistrationPositionsAreCorrectedByTheAnchorsOffs
     const ViewResult moved = session.addView(off);
     ASSERT_TRUE(moved.registration.has_value());
     ASSERT_EQ(moved.registration->status, RegistrationStatus::kApplied);
-    EXPECT_GT(moved.registration->correction.translation().norm(), 0.0015);
+    EXPECT_GT(moved.registration->centroid_shift_m.norm(), 0.0015);
     EXPECT_EQ(session.correctsAnchorOffset(), correct);
     // Known either way; only the correction moves the result by it.
     offset[correct] = session.anchorOffset();
+    EXPECT_TRUE(offset[correct].valid);
     EXPECT_EQ(offset[correct].views, 2u);
+    EXPECT_TRUE(
+        offset[correct].shift_m.isApprox(-0.5 * moved.registration->centroid_shift_m, 1e-12));
     sized[correct] = session.sizeFruitlets({});
+    if (correct) in_map_frame = session.sizeFruitletsInMapFrame({});
   }
   const Eigen::Vector3d shift = offset[true].shift_m;
   EXPECT_TRUE(offset[false].shift_m.isApprox(shift, 1e-12));
-  EXPECT_GT(shift.norm(), 1e-4);
   ASSERT_FALSE(sized[true].fruitlets.empty());
   ASSERT_EQ(sized[true].fruitlets.size(), sized[false].fruitlets.size());
-  for (std::size_t i = 0; i < sized[true].fruitlets.size(); ++i) {
-    const auto& a = sized[true].fruitlets[i];
-    const auto& b = sized[false].fruitlets[i];
-    EXPECT_EQ(a.size_mm, b.size_mm);
-    EXPECT_TRUE(a.center_m.isApprox(b.center_m + shift, 1e-12));
-    EXPECT_TRUE(a.sphere_center_m.isApprox(b.sphere_center_m + shift, 1e-12));
-    EXPECT_TRUE(a.centroid_m.isApprox(b.centroid_m + shift, 1e-12));
-  }
-  ASSERT_EQ(sized[true].points.size(), sized[false].points.size());
-  EXPECT_TRUE(sized[true].points.front().isApprox(sized[false].points.front() + shift.cast<float>(),
-                                                  1e-6f));
+  ASSERT_EQ(sized[true].unsupported.size(), sized[false].unsupported.size());
+  for (const auto list : {&sizing::SizingResult::fruitlets, &sizing::SizingResult::unsupported})
+    for (std::size_t i = 0; i < (sized[true].*list).size(); ++i) {
+      const auto& a = (sized[true].*list)[i];
+      const auto& b = (sized[false].*list)[i];
+      EXPECT_EQ(a.size_mm, b.size_mm);
+      EXPECT_TRUE(a.center_m.isApprox(b.center_m + shift, 1e-12));
+      EXPECT_TRUE(a.sphere_center_m.isApprox(b.sphere_center_m + shift, 1e-12));
+      EXPECT_TRUE(a.centroid_m.isApprox(b.centroid_m + shift, 1e-12));
+      EXPECT_TRUE((in_map_frame.*list)[i].center_m.isApprox(b.center_m, 1e-12));
+    }
+  EXPECT_EQ(sized[true].points, sized[false].points);
 }
 
 TEST(MappingSession, RejectsABadEngineBeforeAnyView) {

@@ -69,7 +69,8 @@ nlohmann::json anchorOffsetJson(const host::AnchorOffset& offset, bool applied,
   nlohmann::json j = {{"shift_mm", vec3Json(1000.0 * offset.shift_m)},
                       {"hand_eye_mm", vec3Json(1000.0 * offset.hand_eye_m)},
                       {"views", offset.views},
-                      {"applied", applied}};
+                      {"valid", offset.valid},
+                      {"applied", applied && offset.valid}};
   if (true_anchor_error_m) {
     j["anchor_error_mm"] = 1000.0 * true_anchor_error_m->norm();
     j["corrected_error_mm"] = 1000.0 * (*true_anchor_error_m - offset.shift_m).norm();
@@ -111,9 +112,11 @@ class TrialLog : public host::nbv::LoopObserver {
       : camera_(camera), options_(options), wall_start_(wall_start) {}
 
   /// The views that follow are of this cluster of a tree (their log entries say which).
-  void startCluster(int cluster) {
+  void startCluster(int cluster, const Eigen::Vector3d& center_m) {
     cluster_ = cluster;
     first_view_ = static_cast<int>(views_.size());
+    cluster_center_m_ = center_m;
+    anchor_shifts_m_.clear();
   }
 
   void onView(const host::nbv::ViewEvent& e) override {
@@ -150,7 +153,9 @@ class TrialLog : public host::nbv::LoopObserver {
       const host::RegistrationResult& r = *v.registration;
       views_.back()["registration"] = {
           {"status", host::toString(r.status)},
-          {"correction_mm", vec3Json(1000.0 * r.correction.translation())},
+          {"correction_mm",
+           vec3Json(r.status == host::RegistrationStatus::kApplied ? 1000.0 * r.centroid_shift_m
+                                                                   : Eigen::Vector3d::Zero())},
           {"translation_mm", 1000.0 * r.translation_m},
           {"rotation_deg", r.rotation_deg},
           {"rms_before_mm", 1000.0 * r.rms_before_m},
@@ -267,9 +272,9 @@ nlohmann::json sizeHistoryJson(const std::vector<host::nbv::SizingSnapshot>& his
     std::vector<double> sizes;
     nlohmann::json fruitlets = nlohmann::json::array();
     for (const auto& f : snapshot.fruitlets) {
-      centres.push_back(f.center_m);
+      centres.push_back(f.center_m + snapshot.world_shift_m);
       sizes.push_back(f.size_mm);
-      fruitlets.push_back({{"center_m", vec3Json(f.center_m)},
+      fruitlets.push_back({{"center_m", vec3Json(f.center_m + snapshot.world_shift_m)},
                            {"size_mm", f.size_mm},
                            {"well_seen_images", f.well_seen_images},
                            {"view_span_deg", f.view_span_deg},
@@ -685,10 +690,14 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
     if (!cluster_parts) cluster_parts = makeParts(k);
     if (carried_map) cluster_parts->session().carryOnWith(std::move(carried_map));
     const double t0_s = loop_clock.now_s();
-    log.startCluster(static_cast<int>(k));
+    log.startCluster(static_cast<int>(k), cluster.center_m);
     const ClusterOutcome outcome =
         runCluster(*cluster_parts, cluster, loop_camera, loop_arm, loop_clock, log);
     const bool mapped = cluster_parts->map() != nullptr;
+    if (options.register_views)
+      entry["anchor_offset"] =
+          anchorOffsetJson(cluster_parts->session().anchorOffset(),
+                           cluster_parts->session().correctsAnchorOffset(), log.trueAnchorShift());
     entry["status"] = mapped ? "sized" : "no_tag";
     ++cluster_status[entry["status"].get<std::string>()];
     entry["views"] = outcome.run.views;

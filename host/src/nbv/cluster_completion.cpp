@@ -38,7 +38,9 @@ ClusterCompletion::ClusterCompletion(const MappingSession& session, LoopClock& c
 void ClusterCompletion::onView(const ViewEvent& event) {
   if (!session_.tsdf()) return;  // no Cluster Region yet: nothing to size
   const auto start = std::chrono::steady_clock::now();
-  const sizing::SizingResult sized = session_.sizeFruitlets(sizing_config_);
+  // Compared over time in the maps' own frame: the anchor offset's estimate moves as views
+  // arrive, the maps do not.
+  const sizing::SizingResult sized = session_.sizeFruitletsInMapFrame(sizing_config_);
   const double sizing_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   clock_.chargeCompute(LoopStage::kSizing, sizing_s);
@@ -46,6 +48,7 @@ void ClusterCompletion::onView(const ViewEvent& event) {
   snapshot.view = event.index;
   snapshot.now_s = clock_.now_s();
   snapshot.sizing_s = sizing_s;
+  if (session_.correctsAnchorOffset()) snapshot.world_shift_m = session_.anchorOffset().shift_m;
   const auto& views = session_.sizingViews();
   for (const auto& f : sized.fruitlets) {
     std::vector<Eigen::Vector3d> directions;

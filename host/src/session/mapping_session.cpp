@@ -134,7 +134,8 @@ tsdf::TriangleMesh MappingSession::surfaceMesh() const {
   return tsdf_ ? tsdf_->extractMesh() : tsdf::TriangleMesh{};
 }
 
-sizing::SizingResult MappingSession::sizeFruitlets(const sizing::SizingConfig& config) const {
+sizing::SizingResult MappingSession::sizeFruitletsInMapFrame(
+    const sizing::SizingConfig& config) const {
   if (!tsdf_config_)
     throw std::logic_error("MappingSession::sizeFruitlets: call enableTsdf() first");
   const map::MapEngine* map = map_.get();
@@ -147,7 +148,12 @@ sizing::SizingResult MappingSession::sizeFruitlets(const sizing::SizingConfig& c
   own.surface_voxel_size_m = tsdf_config_->voxel_size_m;
   sizing::SizingResult result =
       sizing::sizeFruitlets(sizing_views_, surfacePoints(), in_roi_voxel, own);
-  if (correctsAnchorOffset()) sizing::translate(result, anchorOffset().shift_m);
+  return result;
+}
+
+sizing::SizingResult MappingSession::sizeFruitlets(const sizing::SizingConfig& config) const {
+  sizing::SizingResult result = sizeFruitletsInMapFrame(config);
+  if (correctsAnchorOffset()) sizing::translateDetections(result, anchorOffset().shift_m);
   return result;
 }
 
@@ -157,7 +163,8 @@ AnchorOffset MappingSession::anchorOffset() const {
   for (const ViewResult& v : views_)
     views.push_back(
         {v.T_world_camera_told.linear(), v.registration.value_or(RegistrationResult{})});
-  return estimateAnchorOffset(views, registration_->config().hand_eye_prior_sigma_m);
+  return estimateAnchorOffset(views, registration_->config().hand_eye_prior_sigma_m,
+                              registration_->config().max_translation_m);
 }
 
 void MappingSession::integrate(std::size_t index, const LabeledClouds& clouds) {

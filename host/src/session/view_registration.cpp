@@ -134,7 +134,7 @@ Eigen::Isometry3d pointToPlaneStep(const Pairs& pairs, bool rotation) {
 }  // namespace
 
 AnchorOffset estimateAnchorOffset(const std::vector<RegisteredView>& views,
-                                  double hand_eye_prior_sigma_m) {
+                                  double hand_eye_prior_sigma_m, double max_shift_m) {
   // Unknowns x = (u, k), k = -e_anchor; each counted view adds c = [R I] x.
   std::vector<Eigen::Matrix<double, 3, 6>> rows;
   std::vector<Eigen::Vector3d> corrections;
@@ -142,7 +142,7 @@ AnchorOffset estimateAnchorOffset(const std::vector<RegisteredView>& views,
     Eigen::Vector3d c = Eigen::Vector3d::Zero();
     switch (v.registration.status) {
       case RegistrationStatus::kApplied:
-        c = v.registration.correction.translation();
+        c = v.registration.centroid_shift_m;
         break;
       case RegistrationStatus::kNoModel:
       case RegistrationStatus::kNoImprovement:
@@ -166,24 +166,28 @@ AnchorOffset estimateAnchorOffset(const std::vector<RegisteredView>& views,
     Atb += rows[i].transpose() * corrections[i];
   }
   // The prior's weight is the noise's variance over the prior's: start as if they were
-  // equal, then take the noise from the residuals (a few rounds settle it). Two views fit
-  // any u exactly: no hand-eye term then.
+  // equal, then take the noise from the residuals, never below registration's precision
+  // (a few rounds settle it). Fewer than four views leave too few residuals: no u then.
   const double prior_var = hand_eye_prior_sigma_m * hand_eye_prior_sigma_m;
+  const double min_weight = kMinCorrectionNoiseM * kMinCorrectionNoiseM / prior_var;
+  const bool with_hand_eye = rows.size() >= 4;
   const double dof = 3.0 * double(rows.size()) - 6.0;
-  double weight = rows.size() < 3 ? 1e12 : 1.0;
+  double weight = with_hand_eye ? 1.0 : 1e12;
   Eigen::Matrix<double, 6, 1> x = Eigen::Matrix<double, 6, 1>::Zero();
-  for (int round = 0; round < (rows.size() < 3 ? 1 : 5); ++round) {
+  for (int round = 0; round < (with_hand_eye ? 5 : 1); ++round) {
     Eigen::Matrix<double, 6, 6> M = AtA;
-    M.topLeftCorner<3, 3>() += std::max(weight, 1e-9) * Eigen::Matrix3d::Identity();
+    M.topLeftCorner<3, 3>() += weight * Eigen::Matrix3d::Identity();
     x = M.ldlt().solve(Atb);
     if (!x.allFinite()) return out;
     double rss = 0.0;
     for (std::size_t i = 0; i < rows.size(); ++i)
       rss += (rows[i] * x - corrections[i]).squaredNorm();
-    weight = rss / dof / prior_var;
+    weight = std::max(rss / dof / prior_var, min_weight);
   }
+  if (!(x.tail<3>().norm() <= max_shift_m)) return out;
   out.hand_eye_m = x.head<3>();
   out.shift_m = -x.tail<3>();
+  out.valid = true;
   return out;
 }
 
@@ -197,7 +201,10 @@ void ViewRegistrationConfig::validate() const {
   positive(max_pair_distance_m, "max_pair_distance_m");
   positive(max_translation_m, "max_translation_m");
   positive(max_rotation_deg, "max_rotation_deg");
-  positive(hand_eye_prior_sigma_m, "hand_eye_prior_sigma_m");
+  // Squared in the estimate: far below a micrometre it would underflow.
+  if (!(hand_eye_prior_sigma_m >= 1e-6) || !std::isfinite(hand_eye_prior_sigma_m))
+    throw std::invalid_argument(
+        "view registration: hand_eye_prior_sigma_m must be at least a micrometre (1e-6 m)");
   if (max_iterations < 1)
     throw std::invalid_argument("view registration: max_iterations must be at least 1");
   if (min_pairs < 3) throw std::invalid_argument("view registration: min_pairs must be at least 3");
@@ -265,7 +272,8 @@ RegistrationResult ViewRegistration::align(
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3f& s : source) centroid += s.cast<double>();
   centroid /= double(source.size());
-  result.translation_m = (T * centroid - centroid).norm();
+  result.centroid_shift_m = T * centroid - centroid;
+  result.translation_m = result.centroid_shift_m.norm();
   result.rotation_deg = Eigen::AngleAxisd(T.linear()).angle() * 180.0 / std::numbers::pi;
   // The same pairs' source points as at the start, measured against the model after the move.
   double sum_sq = 0.0;

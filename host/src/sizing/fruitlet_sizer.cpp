@@ -220,15 +220,13 @@ std::vector<std::array<std::uint8_t, 3>> clusterColours(const std::vector<int>& 
   return out;
 }
 
-void translate(SizingResult& result, const Eigen::Vector3d& shift_m) {
+void translateDetections(SizingResult& result, const Eigen::Vector3d& shift_m) {
   for (auto* list : {&result.fruitlets, &result.unsupported})
     for (FruitletEstimate& f : *list) {
       f.center_m += shift_m;
       f.centroid_m += shift_m;
       f.sphere_center_m += shift_m;
     }
-  const Eigen::Vector3f shift = shift_m.cast<float>();
-  for (Eigen::Vector3f& p : result.points) p += shift;
 }
 
 SizingResult sizeFruitlets(const std::vector<SizingView>& views,

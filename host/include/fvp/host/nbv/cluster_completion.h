@@ -65,6 +65,9 @@ struct SizingSnapshot {
   int view = 0;        ///< 0-based index of the view it followed
   double now_s = 0.0;  ///< the loop clock when the view was mapped
   double sizing_s = 0.0;
+  /// Centres are in the registered maps' frame; this added puts them in the world as the
+  /// final sizing reports them (MappingSession::anchorOffset; zero without the correction).
+  Eigen::Vector3d world_shift_m = Eigen::Vector3d::Zero();
   std::vector<FruitletSnapshot> fruitlets;
 };
 

@@ -90,10 +90,13 @@ class MappingSession {
   const std::vector<sizing::SizingView>& sizingViews() const { return sizing_views_; }
   /// The sizing chain on the session's TSDF surface and views, keeping surface points in
   /// ROI-occupied fine voxels. Needs enableTsdf(); without a map no point is kept. With view
-  /// registration and its correct_anchor_offset, positions (centres, points) are moved by
-  /// anchorOffset().shift_m: the maps stay in the anchor's frame, the result is put back in
-  /// the world as well as the views tell.
+  /// registration and its correct_anchor_offset, the detections' positions (centres) are
+  /// moved by anchorOffset().shift_m, back into the world as well as the views tell; the
+  /// maps, the TSDF and the clustered points stay in the registered maps' frame.
   sizing::SizingResult sizeFruitlets(const sizing::SizingConfig& config) const;
+  /// The same, every position in the registered maps' frame (what a rule that compares
+  /// sizings over time needs: the offset's estimate changes as views arrive).
+  sizing::SizingResult sizeFruitletsInMapFrame(const sizing::SizingConfig& config) const;
 
   /// With view registration on: where the registered maps (the anchor views' frame) sit off
   /// the world, from the corrections registration applied (view_registration.h,

@@ -2,7 +2,7 @@
 // robot's told camera poses are off by its hand-eye calibration and arm accuracy, about a
 // millimetre, the size of the sizing error budget, and the error differs from view to view.
 // Before a view is fused, its points in the Cluster Region are aligned to a model of the
-// earlier views' points there by trimmed point-to-point ICP; the correction is applied only
+// earlier views' points there by point-to-plane ICP; the correction is applied only
 // when it is small (a calibration error, not a wrong match), enough pairs support it and it
 // lowers their RMS. Expected outcomes are statuses, never exceptions.
 #pragma once
@@ -41,8 +41,9 @@ struct ViewRegistrationConfig {
   /// (estimateAnchorOffset) rather than in the anchor's frame.
   bool correct_anchor_offset = true;
   /// The estimate's prior on the hand-eye term, per axis: a calibrated arm's hand-eye
-  /// residual seen at the cluster, a millimetre or two (the field preset's 1.5 mm and 0.3
-  /// degrees make 1.6 mm at 0.3 m). Measured on 10 field worlds, 1-3 mm gave the same.
+  /// residual seen at the cluster, a millimetre or two (the field preset's 1.5 mm per axis,
+  /// and 0.3 degrees turning points 0.3 m away by 1.6 mm, about 2.2 mm together). Measured
+  /// on 10 field worlds, 1-3 mm gave the same.
   double hand_eye_prior_sigma_m = 0.002;
 
   /// Throws std::invalid_argument naming the bad field.
@@ -63,6 +64,9 @@ struct RegistrationResult {
   /// World-frame correction: p_aligned = correction * p (identity unless applied).
   Eigen::Isometry3d correction = Eigen::Isometry3d::Identity();
   double translation_m = 0.0;  ///< how far the correction moves the view's centroid
+  /// The correction's displacement of the view's centroid (with rotation estimated, the
+  /// correction's translation is the world origin's, a metre away).
+  Eigen::Vector3d centroid_shift_m = Eigen::Vector3d::Zero();
   double rotation_deg = 0.0;
   double rms_before_m = 0.0, rms_after_m = 0.0;
   std::size_t pairs = 0;
@@ -82,6 +86,9 @@ struct AnchorOffset {
   /// The hand-eye term: the constant camera-frame displacement of points at the cluster.
   Eigen::Vector3d hand_eye_m = Eigen::Vector3d::Zero();
   std::size_t views = 0;  ///< views whose offset from the anchor is known
+  /// False (and the shift zero) with fewer than two views, a fit that failed, or a shift
+  /// beyond max_shift_m: nothing to correct by.
+  bool valid = false;
 };
 
 /// The anchor's error at the cluster from the corrections registration measured
@@ -94,10 +101,17 @@ struct AnchorOffset {
 /// hand_eye_prior_sigma_m per axis on u and the noise's variance estimated from the fit's
 /// residuals, gives e_anchor; where the views' directions cannot tell u apart, the prior
 /// keeps it small and the estimate falls back to the views' mean frame. Views that could not
-/// be aligned (kTooFewPairs, kBeyondBounds) are left out. With two views, u = 0 (nothing to
-/// estimate the noise from); with fewer, zero.
+/// be aligned (kTooFewPairs, kBeyondBounds) are left out; each correction is taken where it
+/// moved the view's points (RegistrationResult::centroid_shift_m). The noise is floored at
+/// registration's own precision (kMinCorrectionNoiseM). With fewer than four views,
+/// u = 0 (too few residuals to estimate the noise from): the views' mean frame. Invalid with
+/// fewer than two views or a shift over max_shift_m (a calibration is not that far off).
 AnchorOffset estimateAnchorOffset(const std::vector<RegisteredView>& views,
-                                  double hand_eye_prior_sigma_m);
+                                  double hand_eye_prior_sigma_m, double max_shift_m);
+
+/// Registration's own precision per axis: exact views' corrections agree with the true ones
+/// to about 0.2 mm (view_registration_test.cpp).
+inline constexpr double kMinCorrectionNoiseM = 0.0002;
 
 class ViewRegistration {
  public:

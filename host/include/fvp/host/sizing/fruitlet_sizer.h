@@ -167,8 +167,9 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
                            const std::function<bool(const Eigen::Vector3f&)>& in_roi_voxel,
                            const SizingConfig& config);
 
-/// Moves every position of the result (centres, points) by shift_m; sizes are unchanged.
-void translate(SizingResult& result, const Eigen::Vector3d& shift_m);
+/// Moves the detections' centres (kept and unsupported) by shift_m; sizes and the clustered
+/// points are unchanged.
+void translateDetections(SizingResult& result, const Eigen::Vector3d& shift_m);
 
 /// A distinct colour per DBSCAN label (grey for noise), for clusters.ply.
 std::vector<std::array<std::uint8_t, 3>> clusterColours(const std::vector<int>& labels);
