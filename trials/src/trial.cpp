@@ -153,9 +153,9 @@ class TrialLog : public host::nbv::LoopObserver {
       const host::RegistrationResult& r = *v.registration;
       views_.back()["registration"] = {
           {"status", host::toString(r.status)},
-          {"correction_mm",
-           vec3Json(r.status == host::RegistrationStatus::kApplied ? 1000.0 * r.centroid_shift_m
-                                                                   : Eigen::Vector3d::Zero())},
+          {"correction_mm", vec3Json(r.status == host::RegistrationStatus::kApplied
+                                         ? Eigen::Vector3d(1000.0 * r.centroid_shift_m)
+                                         : Eigen::Vector3d::Zero())},
           {"translation_mm", 1000.0 * r.translation_m},
           {"rotation_deg", r.rotation_deg},
           {"rms_before_mm", 1000.0 * r.rms_before_m},
