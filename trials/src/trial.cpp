@@ -64,13 +64,14 @@ nlohmann::json poseErrorJson(const Eigen::Isometry3d& T_told, const Eigen::Isome
 /// With view registration: where the registered maps sit off the world as the views tell,
 /// whether the reported positions were moved by it, and, where the simulator has pose
 /// errors, the anchor frame's true error at the cluster's centre before and after.
-nlohmann::json anchorOffsetJson(const host::AnchorOffset& offset, bool applied,
+nlohmann::json anchorOffsetJson(const host::MappingSession& session,
                                 const std::optional<Eigen::Vector3d>& true_anchor_error_m) {
+  const host::AnchorOffset offset = session.anchorOffset();
   nlohmann::json j = {{"shift_mm", vec3Json(1000.0 * offset.shift_m)},
                       {"hand_eye_mm", vec3Json(1000.0 * offset.hand_eye_m)},
                       {"views", offset.views},
                       {"valid", offset.valid},
-                      {"applied", applied && offset.valid}};
+                      {"applied", session.correctsAnchorOffset() && offset.valid}};
   if (true_anchor_error_m) {
     j["anchor_error_mm"] = 1000.0 * true_anchor_error_m->norm();
     j["corrected_error_mm"] = 1000.0 * (*true_anchor_error_m - offset.shift_m).norm();
@@ -588,9 +589,7 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
   for (auto& [key, value] : outcome.sizing.items()) result[key] = value;
   result["events"] = eventsJson(run.events);
   if (options.register_views)
-    result["anchor_offset"] =
-        anchorOffsetJson(parts->session().anchorOffset(), parts->session().correctsAnchorOffset(),
-                         log.trueAnchorShift());
+    result["anchor_offset"] = anchorOffsetJson(parts->session(), log.trueAnchorShift());
   result["wall_breakdown_s"] = {{"rendering", camera->totalRenderSeconds()},
                                 {"perception", run.wall_s.perception},
                                 {"mapping", run.wall_s.mapping},
@@ -695,9 +694,7 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
         runCluster(*cluster_parts, cluster, loop_camera, loop_arm, loop_clock, log);
     const bool mapped = cluster_parts->map() != nullptr;
     if (options.register_views)
-      entry["anchor_offset"] =
-          anchorOffsetJson(cluster_parts->session().anchorOffset(),
-                           cluster_parts->session().correctsAnchorOffset(), log.trueAnchorShift());
+      entry["anchor_offset"] = anchorOffsetJson(cluster_parts->session(), log.trueAnchorShift());
     entry["status"] = mapped ? "sized" : "no_tag";
     ++cluster_status[entry["status"].get<std::string>()];
     entry["views"] = outcome.run.views;

@@ -146,9 +146,7 @@ sizing::SizingResult MappingSession::sizeFruitletsInMapFrame(
   };
   sizing::SizingConfig own = config;
   own.surface_voxel_size_m = tsdf_config_->voxel_size_m;
-  sizing::SizingResult result =
-      sizing::sizeFruitlets(sizing_views_, surfacePoints(), in_roi_voxel, own);
-  return result;
+  return sizing::sizeFruitlets(sizing_views_, surfacePoints(), in_roi_voxel, own);
 }
 
 sizing::SizingResult MappingSession::sizeFruitlets(const sizing::SizingConfig& config) const {
