@@ -41,7 +41,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         (c.disparity_px.empty() ||
          (c.disparity_px.size() == c.left_bgr.size() && c.disparity_px.type() == CV_32F)) &&
         (c.fruitlet_mask.empty() ||
-         (c.fruitlet_mask.size() == c.left_bgr.size() && c.fruitlet_mask.type() == CV_8U)) &&
+         (c.fruitlet_mask.size() == c.left_bgr.size() &&
+          (c.fruitlet_mask.type() == CV_8U || c.fruitlet_mask.type() == CV_16U))) &&
         c.T_world_camera.matrix().allFinite();
     if (!ok) {
       std::fprintf(stderr, "fvp fuzz: readCapture accepted an inconsistent capture\n");

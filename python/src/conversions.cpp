@@ -98,6 +98,14 @@ cv::Mat bgrFromArray(const py::handle& object, const std::string& what) {
 
 cv::Mat maskFromArray(const py::handle& object, const std::string& what) {
   if (!object.is_none()) requireKind(object, "uib", false, what, "an integer or bool mask");
+  // uint16: an instance segmentation, kept as its ids (StereoFrame::fruitlet_mask).
+  if (py::isinstance<py::array_t<std::uint16_t>>(object)) {
+    const auto ids = asArray<std::uint16_t>(object, what);
+    requireShape(ids, {-1, -1}, what);
+    cv::Mat instances(int(ids.shape(0)), int(ids.shape(1)), CV_16U);
+    std::memcpy(instances.data, ids.data(), instances.total() * sizeof(std::uint16_t));
+    return instances;
+  }
   const auto array = asArray<std::int64_t>(object, what);
   requireShape(array, {-1, -1}, what);
   cv::Mat mask(int(array.shape(0)), int(array.shape(1)), CV_8U);
@@ -124,6 +132,9 @@ py::object imageToArray(const cv::Mat& image) {
   switch (dense.depth()) {
     case CV_8U:
       out = py::array_t<std::uint8_t>(shape);
+      break;
+    case CV_16U:
+      out = py::array_t<std::uint16_t>(shape);
       break;
     case CV_32F:
       out = py::array_t<float>(shape);

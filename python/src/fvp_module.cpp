@@ -158,7 +158,10 @@ PYBIND11_MODULE(fvp, m) {
 
   py::class_<host::StereoFrame>(m, "StereoFrame",
                                 "One rectified stereo view with its pose; optionally the "
-                                "robot's own fruitlet mask and disparity, used as given.")
+                                "robot's own fruitlet mask and disparity, used as given. A "
+                                "uint16 fruitlet_mask is an instance segmentation (0 = "
+                                "background, each id one fruitlet); any other is a binary "
+                                "mask (nonzero = fruitlet).")
       .def(py::init([](const py::handle& left, const py::handle& right,
                        const host::StereoIntrinsics& intrinsics, const py::handle& T_world_camera,
                        const py::handle& fruitlet_mask, const py::handle& disparity_px) {

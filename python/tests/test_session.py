@@ -34,6 +34,13 @@ def test_frame_arrays_round_trip(seed2_frames):
     assert np.array_equal(g.left, f.left) and np.array_equal(g.right, f.right)
     assert np.array_equal(g.T_world_camera, f.T_world_camera)
     assert g.fruitlet_mask is None
+    # A uint16 mask is an instance segmentation, kept as its ids; others become 0 / 255.
+    ids = np.zeros((k.height_px, k.width_px), np.uint16)
+    ids[10:20, 10:20], ids[10:20, 20:30] = 7, 300
+    m = numpy_frame(f, fruitlet_mask=ids).fruitlet_mask
+    assert m.dtype == np.uint16 and np.array_equal(m, ids)
+    m = numpy_frame(f, fruitlet_mask=ids.astype(np.int32)).fruitlet_mask
+    assert m.dtype == np.uint8 and set(np.unique(m)) == {0, 255}
 
 
 def test_session_maps_plans_and_sizes(seed2_frames):

@@ -51,6 +51,37 @@ TEST(SegmentationModel, OffByDefaultAndExactWithoutErrors) {
   EXPECT_EQ(cv::countNonZero(model.maskFor(world1Ids(), 0) != truth), 0);
 }
 
+TEST(SegmentationModel, InstancesKeepTouchingFruitletsApart) {
+  WorldConfig c = withModel();
+  c.segmentation_boundary_px = 1.0;
+  const cv::Mat& ids = world1Ids();
+  const SegmentationModel model(c, 9);
+  for (int view = 0; view < 3; ++view) {
+    const cv::Mat instances = model.instancesFor(ids, view);
+    ASSERT_EQ(instances.type(), CV_16U);
+    EXPECT_EQ(cv::countNonZero((instances != 0) != model.maskFor(ids, view)), 0);
+    EXPECT_EQ(cv::countNonZero(instances != model.instancesFor(ids, view)), 0);
+    // Well inside its outline (beyond the boundary noise), every fruitlet is one instance of
+    // its own.
+    std::map<int, int> instance_of;  // fruitlet id -> instance id
+    int fruitlets = 0;
+    for (int f = kFirstFruitletId; f < kFirstFruitletId + kMaxFruitlets; ++f) {
+      cv::Mat inside = ids == f;
+      if (cv::countNonZero(inside) == 0) continue;
+      cv::erode(inside, inside, cv::Mat(), cv::Point(-1, -1), 4);
+      if (cv::countNonZero(inside) < 20) continue;
+      ++fruitlets;
+      double lo = 0, hi = 0;
+      cv::minMaxLoc(instances, &lo, &hi, nullptr, nullptr, inside);
+      EXPECT_EQ(lo, hi) << "fruitlet " << f << " view " << view;
+      EXPECT_GT(lo, 0.0);
+      for (const auto& [other, instance] : instance_of) EXPECT_NE(instance, int(lo)) << other;
+      instance_of[f] = int(lo);
+    }
+    EXPECT_GE(fruitlets, 3);
+  }
+}
+
 TEST(SegmentationModel, BoundaryNoiseKeepsEachFruitletsIouInItsRange) {
   WorldConfig c = withModel();
   c.segmentation_boundary_px = 1.0;
@@ -158,8 +189,8 @@ TEST(SegmentationModel, GreenFruitletsEscapeHsvButNotTheModel) {
   const SegmentationModel model(green, 1);
   SimulatedCamera camera(renderer, clock, SimulatedErrors{nullptr, nullptr, &model});
   const host::StereoFrame frame = camera.capture(world.startCameraPose()).frame;
-  ASSERT_FALSE(frame.fruitlet_mask.empty());
-  EXPECT_EQ(cv::countNonZero(frame.fruitlet_mask != truth), 0);
+  ASSERT_EQ(frame.fruitlet_mask.type(), CV_16U);  // instance ids
+  EXPECT_EQ(cv::countNonZero((frame.fruitlet_mask != 0) != truth), 0);
 }
 
 }  // namespace

@@ -183,7 +183,7 @@ TEST(Sizing, Eq4OnAnIdealSphereViewPaperShortOursClose) {
                             z);
     pts.push_back((c + r * d).cast<float>());
   }
-  sizing::SizingView view{v.mask, v.disparity, v.in, Eigen::Isometry3d::Identity()};
+  sizing::SizingView view{v.mask, v.disparity, v.in, Eigen::Isometry3d::Identity(), {}};
   sizing::SizingConfig config;
   const auto result = sizing::sizeFruitlets({view, view}, pts, nullptr, config);
   ASSERT_EQ(result.fruitlets.size(), 1u);
@@ -214,7 +214,7 @@ TEST(Sizing, SupportRuleDropsAFragmentAndKeepsTheFruitlet) {
   for (int i = 0; i < 9; ++i)
     for (int j = 0; j < 9; ++j)
       pts.emplace_back(float(0.0003 * (i - 4)), float(0.0003 * (j - 4)), 0.315f);
-  const sizing::SizingView view{v.mask, v.disparity, v.in, Eigen::Isometry3d::Identity()};
+  const sizing::SizingView view{v.mask, v.disparity, v.in, Eigen::Isometry3d::Identity(), {}};
   sizing::SizingConfig config;
   const auto kept = sizing::sizeFruitlets({view, view}, pts, nullptr, config);
   ASSERT_EQ(kept.fruitlets.size(), 1u);
@@ -269,7 +269,7 @@ TEST(Sizing, OverlapRuleMergesAFruitletSeenTwiceAndKeepsTouchingNeighbours) {
   const Eigen::Vector3d c(0.0, 0.0, 0.3);
   const double r = 0.005;
   const SphereView v = renderSphere(c, r);
-  const sizing::SizingView view{v.mask, v.disparity, v.in, Eigen::Isometry3d::Identity()};
+  const sizing::SizingView view{v.mask, v.disparity, v.in, Eigen::Isometry3d::Identity(), {}};
   // The same fruitlet's near cap twice, 4 mm apart along the line of sight (views whose
   // poses disagree): the caps stay over 2 mm apart, so DBSCAN keeps them as two detections,
   // but their spheres overlap by 1.2 radii: no two firm fruitlets can.
@@ -306,7 +306,7 @@ TEST(Sizing, OverlapRuleMergesAFruitletSeenTwiceAndKeepsTouchingNeighbours) {
   const SphereView pair = renderSphere(left, r);
   const SphereView other = renderSphere(right, r);
   cv::Mat mask = pair.mask | other.mask, disparity = cv::max(pair.disparity, other.disparity);
-  const sizing::SizingView pair_view{mask, disparity, pair.in, Eigen::Isometry3d::Identity()};
+  const sizing::SizingView pair_view{mask, disparity, pair.in, Eigen::Isometry3d::Identity(), {}};
   std::vector<Eigen::Vector3f> neighbours = sphereCap(left, r, 70.0);
   for (const auto& p : sphereCap(right, r, 70.0)) neighbours.push_back(p);
   config.max_detection_overlap_fraction = 0.5;
@@ -325,7 +325,8 @@ TEST(Sizing, EmptyInputsAreCountedNotErrors) {
   sizing::SizingView blank{cv::Mat(1080, 1440, CV_8U, cv::Scalar(0)),
                            cv::Mat(1080, 1440, CV_32F, cv::Scalar(0)),
                            {},
-                           Eigen::Isometry3d::Identity()};
+                           Eigen::Isometry3d::Identity(),
+                           {}};
   const auto unseen = sizing::sizeFruitlets({blank}, pts, nullptr, config);
   EXPECT_TRUE(unseen.fruitlets.empty());
   EXPECT_EQ(unseen.events.unsized_clusters, 1u);
@@ -344,7 +345,7 @@ TEST(Sizing, DisparityWindowsBeyondTheSensorRangeAreInvalidAndCounted) {
   }
   // SGBM speckles: 1.4 px of disparity is 39 m away, far beyond max_depth_m.
   v.disparity.setTo(1.4f, v.mask);
-  const sizing::SizingView view{v.mask, v.disparity, v.in, Eigen::Isometry3d::Identity()};
+  const sizing::SizingView view{v.mask, v.disparity, v.in, Eigen::Isometry3d::Identity(), {}};
   const auto r = sizing::sizeFruitlets({view}, pts, nullptr, sizing::SizingConfig{});
   EXPECT_TRUE(r.fruitlets.empty());
   EXPECT_EQ(r.events.invalid_disparity_windows, 1u);

@@ -140,6 +140,7 @@ nlohmann::json sizingDetails(const sizing::SizingResult& sz) {
               {"unsized_clusters", sz.events.unsized_clusters},
               {"failed_sphere_fits", sz.events.failed_sphere_fits},
               {"clusters_split_off", sz.events.clusters_split_off},
+              {"instance_parts_split_off", sz.events.instance_parts_split_off},
               {"unsupported_detections", sz.events.unsupported_detections},
               {"overlapping_detections_merged", sz.events.overlapping_detections_merged}}}}}};
 }

@@ -238,7 +238,7 @@ void writeCapture(const fs::path& dir, const Capture& c) {
   check(c.left_bgr, CV_8UC3, "left_bgr", false);
   check(c.right_bgr, CV_8UC3, "right_bgr", false);
   check(c.disparity_px, CV_32F, "disparity_px", true);
-  check(c.fruitlet_mask, CV_8U, "fruitlet_mask", true);
+  check(c.fruitlet_mask, c.fruitlet_mask.type() == CV_16U ? CV_16U : CV_8U, "fruitlet_mask", true);
   if (!(c.disparity_scale > 0.0))
     throw std::invalid_argument("writeCapture: disparity_scale must be positive");
 
@@ -258,7 +258,9 @@ void writeCapture(const fs::path& dir, const Capture& c) {
     writePng(dir / kDisparity, encodeDisparity(c.disparity_px, c.disparity_scale));
   else
     removeIfExists(dir / kDisparity);
-  if (!c.fruitlet_mask.empty()) {
+  if (c.fruitlet_mask.type() == CV_16U) {
+    writePng(dir / kMask, c.fruitlet_mask);  // instance ids, as given
+  } else if (!c.fruitlet_mask.empty()) {
     cv::Mat mask;
     cv::compare(c.fruitlet_mask, 0, mask, cv::CMP_NE);  // 0 / 255
     writePng(dir / kMask, mask);
@@ -307,8 +309,13 @@ Capture readCapture(const fs::path& dir) {
   }
   cv::Mat mask = readImage(dir / kMask, cv::IMREAD_UNCHANGED, K, false);
   if (!mask.empty()) {
-    if (mask.type() != CV_8UC1) fail(dir / kMask, "pixel format", "a single-channel 8-bit PNG");
-    cv::compare(mask, 0, c.fruitlet_mask, cv::CMP_NE);
+    if (mask.type() == CV_16UC1)
+      c.fruitlet_mask = mask;  // instance ids
+    else if (mask.type() == CV_8UC1)
+      cv::compare(mask, 0, c.fruitlet_mask, cv::CMP_NE);
+    else
+      fail(dir / kMask, "pixel format",
+           "a single-channel 8-bit PNG (a mask) or 16-bit PNG (instance ids)");
   }
   const bool roi = fs::exists(dir / kRoiPly), other = fs::exists(dir / kOtherPly);
   if (roi != other)

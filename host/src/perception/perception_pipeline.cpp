@@ -52,7 +52,10 @@ void checkStereoFrame(const StereoFrame& frame, const std::string& source) {
   };
   check(frame.left_bgr, "left", CV_8UC3, "BGR", true);
   check(frame.right_bgr, "right", CV_8UC3, "BGR", false);
-  check(frame.fruitlet_mask, "fruitlet_mask", CV_8UC1, "CV_8U mask", false);
+  if (frame.fruitlet_mask.type() != CV_16UC1)
+    check(frame.fruitlet_mask, "fruitlet_mask", CV_8UC1, "CV_8U mask or CV_16U instance", false);
+  else
+    check(frame.fruitlet_mask, "fruitlet_mask", CV_16UC1, "CV_16U instance", false);
   check(frame.disparity_px, "disparity_px", CV_32FC1, "CV_32F disparity", false);
 }
 
@@ -64,9 +67,10 @@ PerceptionResult PerceptionPipeline::process(
   PerceptionStats timing;
 
   auto t0 = std::chrono::steady_clock::now();
-  if (!frame.fruitlet_mask.empty())
+  if (!frame.fruitlet_mask.empty()) {
     cv::compare(frame.fruitlet_mask, 0, result.fruitlet_mask, cv::CMP_NE);  // as given: 0 / 255
-  else
+    if (frame.fruitlet_mask.type() == CV_16UC1) result.fruitlet_instances = frame.fruitlet_mask;
+  } else
     result.fruitlet_mask = segmenter_.segment(frame.left_bgr);
   timing.segmentation_s = secondsSince(t0);
 

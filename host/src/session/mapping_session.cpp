@@ -81,7 +81,7 @@ ViewResult MappingSession::addView(const StereoFrame& frame, PerceptionResult* p
     // What sizing needs of the view, and the fruitlets' TSDF from its ROI depth once the
     // region bounds the TSDF (views seen before the tag are fused when it is found).
     sizing_views_.push_back({perceived.fruitlet_mask, perceived.disparity.disparity_px,
-                             frame.intrinsics, T_world_camera});
+                             frame.intrinsics, T_world_camera, perceived.fruitlet_instances});
     if (region_ && !tsdf_) {
       const Eigen::Vector3d half = Eigen::Vector3d::Constant(region_->radius_m());
       tsdf_ = std::make_unique<tsdf::TsdfVolume>(

@@ -1,6 +1,7 @@
 #include "fvp/host/sizing/fruitlet_sizer.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <map>
 #include <opencv2/imgproc.hpp>
@@ -34,6 +35,44 @@ Segments segment(const cv::Mat& mask) {
   Segments s;
   cv::Mat binary = mask != 0;
   cv::connectedComponentsWithStats(binary, s.labels, s.stats, s.centroids, 8, CV_32S);
+  return s;
+}
+
+/// An instance segmentation's segments: one per instance id (its pixels need not be
+/// connected: a stem may cross a fruitlet), numbered 1.. in order of first pixel.
+Segments segmentInstances(const cv::Mat& instances) {
+  Segments s;
+  s.labels = cv::Mat(instances.size(), CV_32S, cv::Scalar(0));
+  std::map<int, int> label_of;
+  struct Extent {
+    int x0 = INT32_MAX, y0 = INT32_MAX, x1 = -1, y1 = -1, area = 0;
+    double sum_x = 0.0, sum_y = 0.0;
+  };
+  std::vector<Extent> extents(1);
+  for (int y = 0; y < instances.rows; ++y)
+    for (int x = 0; x < instances.cols; ++x) {
+      const int id = instances.at<std::uint16_t>(y, x);
+      if (id == 0) continue;
+      auto [it, added] = label_of.emplace(id, int(extents.size()));
+      if (added) extents.emplace_back();
+      Extent& e = extents[std::size_t(it->second)];
+      e.x0 = std::min(e.x0, x), e.y0 = std::min(e.y0, y);
+      e.x1 = std::max(e.x1, x), e.y1 = std::max(e.y1, y);
+      ++e.area, e.sum_x += x, e.sum_y += y;
+      s.labels.at<int>(y, x) = it->second;
+    }
+  s.stats = cv::Mat(int(extents.size()), cv::CC_STAT_MAX, CV_32S, cv::Scalar(0));
+  s.centroids = cv::Mat(int(extents.size()), 2, CV_64F, cv::Scalar(0));
+  for (int l = 1; l < int(extents.size()); ++l) {
+    const Extent& e = extents[std::size_t(l)];
+    s.stats.at<int>(l, cv::CC_STAT_LEFT) = e.x0;
+    s.stats.at<int>(l, cv::CC_STAT_TOP) = e.y0;
+    s.stats.at<int>(l, cv::CC_STAT_WIDTH) = e.x1 - e.x0 + 1;
+    s.stats.at<int>(l, cv::CC_STAT_HEIGHT) = e.y1 - e.y0 + 1;
+    s.stats.at<int>(l, cv::CC_STAT_AREA) = e.area;
+    s.centroids.at<double>(l, 0) = e.sum_x / e.area;
+    s.centroids.at<double>(l, 1) = e.sum_y / e.area;
+  }
   return s;
 }
 
@@ -199,6 +238,7 @@ void SizingConfig::validate() const {
     throw std::invalid_argument("sizing: surface_voxel_size_m > 0");
   if (!(max_detection_overlap_fraction >= 0.0))
     throw std::invalid_argument("sizing: max_detection_overlap_fraction >= 0");
+  if (split_by_instances) instance_split.validate();
   if (split_merged_clusters && min_cluster_points < 4)
     throw std::invalid_argument("sizing: min_cluster_points >= 4 (a sphere needs 4 points)");
 }
@@ -250,6 +290,9 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
     split.min_cluster_points = config.min_cluster_points;
     result.events.clusters_split_off = splitMergedClusters(result.points, result.labels, split);
   }
+  if (config.split_by_instances)
+    result.events.instance_parts_split_off =
+        splitByInstances(result.points, result.labels, views, config.instance_split);
 
   std::map<int, std::vector<Eigen::Vector3f>> clusters;
   for (std::size_t i = 0; i < result.points.size(); ++i)
@@ -257,7 +300,9 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
 
   std::vector<Segments> segments;
   segments.reserve(views.size());
-  for (const auto& v : views) segments.push_back(segment(v.fruitlet_mask));
+  for (const auto& v : views)
+    segments.push_back(v.fruitlet_instances.empty() ? segment(v.fruitlet_mask)
+                                                    : segmentInstances(v.fruitlet_instances));
 
   // Which segment of each image every cluster falls on, first for all clusters, so that a
   // segment two clusters fall on (touching fruitlets merged in 2-D) is known.
@@ -300,8 +345,14 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
   // it is visible in. Only whether an image's segment is shared depends on which other
   // detections are kept (below).
   std::vector<FruitletEstimate> measured(sized.size());
+  const bool use_instances =
+      config.split_by_instances && std::any_of(views.begin(), views.end(), [](const auto& v) {
+        return !v.fruitlet_instances.empty();
+      });
+  std::vector<std::vector<int>> instance_of(sized.size());  // per view (dominantInstances)
   const auto measure = [&](std::size_t ci, SizingEvents& events) {
     const std::vector<Eigen::Vector3f>& pts = *sized[ci].second;
+    if (use_instances) instance_of[ci] = dominantInstances(pts, views, config.instance_split);
     FruitletEstimate& f = measured[ci];
     f = FruitletEstimate{};
     f.points = pts.size();
@@ -385,11 +436,12 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
     }
     // The overlap rule: two fruitlets are firm bodies that touch but do not interpenetrate,
     // so two kept spheres that overlap by more than half the smaller one's radius are one
-    // fruitlet seen twice (views whose poses disagree fuse its surface at two places). The
-    // pair overlapping most is merged into the better-supported one, its points added, and
-    // everything is sized again.
+    // fruitlet seen twice (views whose poses disagree fuse its surface at two places). With
+    // instance masks, two whose spheres overlap at all are one fruitlet when the views see
+    // them on one instance (sameInstance). The pair overlapping most is merged into the
+    // better-supported one, its points added, and everything is sized again.
     std::optional<std::pair<std::size_t, std::size_t>> pair;
-    double deepest = config.max_detection_overlap_fraction;
+    double deepest = 0.0;
     for (std::size_t a = 0; a < sized.size(); ++a)
       for (std::size_t b = a + 1; b < sized.size(); ++b) {
         if (dropped[a] || dropped[b]) continue;
@@ -400,7 +452,11 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
           continue;
         const double ra = 0.0005 * fa.size_ours_mm, rb = 0.0005 * fb.size_ours_mm;
         const double overlap = ra + rb - (fa.sphere_center_m - fb.sphere_center_m).norm();
-        if (const double depth = overlap / std::min(ra, rb); depth > deepest)
+        const double depth = overlap / std::min(ra, rb);
+        const bool one_instance =
+            use_instances && overlap > 0.0 && sameInstance(instance_of[a], instance_of[b]);
+        if ((depth > config.max_detection_overlap_fraction || one_instance) &&
+            (!pair || depth > deepest))
           deepest = depth, pair = {a, b};
       }
     if (!pair) break;

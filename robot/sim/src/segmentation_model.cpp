@@ -1,6 +1,8 @@
 #include "fvp/robot/sim/segmentation_model.h"
 
+#include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <vector>
@@ -56,6 +58,12 @@ cv::Mat SegmentationModel::trueMask(const cv::Mat& object_id) {
 }
 
 cv::Mat SegmentationModel::maskFor(const cv::Mat& object_id, int view) const {
+  cv::Mat mask;
+  cv::compare(instancesFor(object_id, view), 0, mask, cv::CMP_NE);
+  return mask;
+}
+
+cv::Mat SegmentationModel::instancesFor(const cv::Mat& object_id, int view) const {
   std::seed_seq seq{seed_, kSegmentationStream, static_cast<std::uint64_t>(view)};
   std::mt19937_64 rng(seq);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -82,7 +90,34 @@ cv::Mat SegmentationModel::maskFor(const cv::Mat& object_id, int view) const {
     mask = (signed_px + field) > 0.0f;
   }
 
-  // False blobs: centred on leaf pixels, a Poisson number per view.
+  // Each pixel of the mask belongs to the fruitlet whose true pixels are nearest: a
+  // network's instance boundaries follow the outline as its mask does, and touching
+  // fruitlets stay apart where they meet.
+  cv::Mat instances(object_id.size(), CV_16U, cv::Scalar(0));
+  const cv::Mat kept = fruitletPixels(object_id, missed);
+  if (cv::countNonZero(kept) > 0) {
+    cv::Mat not_kept, distance, nearest;
+    cv::bitwise_not(kept, not_kept);
+    cv::distanceTransform(not_kept, distance, nearest, cv::DIST_L2, cv::DIST_MASK_5,
+                          cv::DIST_LABEL_PIXEL);
+    std::vector<int> fruitlet_of_source(1, 0);  // DIST_LABEL_PIXEL: one label per source pixel
+    for (int v = 0; v < object_id.rows; ++v)
+      for (int u = 0; u < object_id.cols; ++u)
+        if (kept.at<std::uint8_t>(v, u)) {
+          const int source = nearest.at<int>(v, u);
+          if (source >= int(fruitlet_of_source.size())) fruitlet_of_source.resize(source + 1, 0);
+          fruitlet_of_source[source] = object_id.at<int>(v, u) - kFirstFruitletId + 1;
+        }
+    for (int v = 0; v < object_id.rows; ++v)
+      for (int u = 0; u < object_id.cols; ++u)
+        if (mask.at<std::uint8_t>(v, u)) {
+          const int source = nearest.at<int>(v, u);
+          instances.at<std::uint16_t>(v, u) = static_cast<std::uint16_t>(
+              source < int(fruitlet_of_source.size()) ? fruitlet_of_source[source] : 0);
+        }
+  }
+
+  // False blobs: centred on leaf pixels, a Poisson number per view, each an instance.
   std::vector<cv::Point> leaf_pixels;
   if (false_blobs_ > 0.0) {
     for (int v = 0; v < object_id.rows; ++v) {
@@ -98,9 +133,21 @@ cv::Mat SegmentationModel::maskFor(const cv::Mat& object_id, int view) const {
     std::uniform_real_distribution<double> radius(kMinBlobRadiusPx, kMaxBlobRadiusPx);
     const cv::Size axes(static_cast<int>(std::lround(radius(rng))),
                         static_cast<int>(std::lround(radius(rng))));
-    cv::ellipse(mask, centre, axes, 360.0 * unit(rng), 0.0, 360.0, cv::Scalar(255), cv::FILLED);
+    cv::Mat blob(mask.size(), CV_8U, cv::Scalar(0));
+    cv::ellipse(blob, centre, axes, 360.0 * unit(rng), 0.0, 360.0, cv::Scalar(255), cv::FILLED);
+    instances.setTo(kMaxFruitlets + 1 + b, blob & (instances == 0));
   }
-  return mask;
+
+  // A network numbers its instances in no particular order, and not the same way in two
+  // views: the ids are shuffled per view (drawn last, so the mask above does not change).
+  std::vector<std::uint16_t> id_of(kMaxFruitlets + 2 + blobs);
+  std::iota(id_of.begin(), id_of.end(), std::uint16_t(0));
+  std::shuffle(id_of.begin() + 1, id_of.end(), rng);
+  for (int v = 0; v < instances.rows; ++v) {
+    std::uint16_t* id = instances.ptr<std::uint16_t>(v);
+    for (int u = 0; u < instances.cols; ++u) id[u] = id_of[id[u]];
+  }
+  return instances;
 }
 
 }  // namespace fvp::robot::sim

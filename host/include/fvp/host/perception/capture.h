@@ -31,8 +31,9 @@ struct Capture {
   cv::Mat right_bgr;
   StereoIntrinsics intrinsics;
   Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();
-  cv::Mat disparity_px;                         ///< CV_32F, 0 = invalid; empty if absent
-  cv::Mat fruitlet_mask;                        ///< CV_8U, 255 = fruitlet; empty if absent
+  cv::Mat disparity_px;  ///< CV_32F, 0 = invalid; empty if absent
+  /// CV_8U, 255 = fruitlet; or CV_16U instance ids (StereoFrame::fruitlet_mask); empty if absent
+  cv::Mat fruitlet_mask;
   std::vector<Eigen::Vector3f> roi_points_m;    ///< world frame; empty if absent
   std::vector<Eigen::Vector3f> other_points_m;  ///< world frame
   bool has_clouds = false;                      ///< roi.ply and other.ply present

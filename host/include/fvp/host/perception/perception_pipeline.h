@@ -36,9 +36,10 @@ struct PerceptionConfig {
 };
 
 struct PerceptionResult {
-  cv::Mat fruitlet_mask;      ///< CV_8U, 255 = fruitlet
-  DisparityResult disparity;  ///< full-size CV_32F map, fine rect, coarse scale
-  LabeledClouds clouds;       ///< stats: all counts and timings of this view
+  cv::Mat fruitlet_mask;       ///< CV_8U, 255 = fruitlet
+  cv::Mat fruitlet_instances;  ///< CV_16U instance ids as the frame gave them; else empty
+  DisparityResult disparity;   ///< full-size CV_32F map, fine rect, coarse scale
+  LabeledClouds clouds;        ///< stats: all counts and timings of this view
   std::optional<TagDetection> tag;
   std::optional<ClusterRegion> region;  ///< the one used (given or from the tag)
 };
@@ -46,7 +47,7 @@ struct PerceptionResult {
 /// What PerceptionPipeline::process requires of a frame (any source: a robot's driver, the
 /// Python module, the simulator): a valid camera model and pose, a left image of the
 /// intrinsics' size, and a right image, mask and disparity of that size where present (the
-/// mask CV_8U, the disparity CV_32F). Throws std::invalid_argument "SOURCE: FIELD: ...".
+/// mask CV_8U or CV_16U, the disparity CV_32F). Throws std::invalid_argument "SOURCE: FIELD: ...".
 void checkStereoFrame(const StereoFrame& frame, const std::string& source);
 
 class PerceptionPipeline {

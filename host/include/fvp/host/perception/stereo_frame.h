@@ -18,8 +18,11 @@ struct StereoFrame {
   Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();  ///< left camera pose
   // Optional outside perception, used as given when present (a robot's segmentation network
   // and stereo matcher); HSV segmentation and SGBM run only when these are empty.
-  cv::Mat fruitlet_mask;  ///< CV_8U, left image size, nonzero = fruitlet
-  cv::Mat disparity_px;   ///< CV_32F, left image size, left-image disparity in pixels, 0 invalid
+  /// Left image size. CV_8U: nonzero = fruitlet (fruitlets are told apart where their
+  /// pixels are). CV_16U: an instance segmentation, 0 = background and each nonzero id one
+  /// fruitlet (ids need not agree between views): touching fruitlets stay apart.
+  cv::Mat fruitlet_mask;
+  cv::Mat disparity_px;  ///< CV_32F, left image size, left-image disparity in pixels, 0 invalid
 };
 
 }  // namespace fvp::host

@@ -26,6 +26,8 @@
 #include <vector>
 
 #include "fvp/host/core/stereo_intrinsics.h"
+#include "fvp/host/sizing/instance_split.h"
+#include "fvp/host/sizing/sizing_view.h"
 #include "fvp/host/sizing/sphere_ransac.h"
 
 namespace fvp::host::sizing {
@@ -34,14 +36,6 @@ enum class SizingEstimator { kOurs, kPaper };
 const char* toString(SizingEstimator estimator);
 /// "ours" or "paper"; throws std::invalid_argument otherwise.
 SizingEstimator parseSizingEstimator(std::string_view name);
-
-/// One captured image as sizing needs it.
-struct SizingView {
-  cv::Mat fruitlet_mask;  ///< CV_8U, nonzero = fruitlet
-  cv::Mat disparity_px;   ///< CV_32F, 0 = invalid
-  StereoIntrinsics intrinsics;
-  Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();
-};
 
 struct SizingConfig {
   SizingEstimator estimator = SizingEstimator::kOurs;
@@ -55,6 +49,10 @@ struct SizingConfig {
   /// Split DBSCAN clusters that hold more than one fruitlet (sphere_ransac.h): touching
   /// fruitlets, bridged by stereo points at the depth edges between them, merge otherwise.
   bool split_merged_clusters = true;
+  /// Split DBSCAN clusters that fall on two instances or more of the views' instance
+  /// segmentations (instance_split.h); only where the views carry instance ids.
+  bool split_by_instances = true;
+  InstanceSplitConfig instance_split;
   int disparity_window_half_px = 5;     ///< Eq. 4's square window: (2h+1)^2 pixels
   double saturated_disparity_px = 318;  ///< window maxima at or above: rejected
   /// Window maxima implying a depth beyond this are invalid (SGBM speckles where the window
@@ -146,6 +144,7 @@ struct SizingEvents {
   std::size_t unsized_clusters = 0;    ///< no image gave a size (dropped)
   std::size_t failed_sphere_fits = 0;  ///< centre fell back to the centroid
   std::size_t clusters_split_off = 0;  ///< parts of DBSCAN clusters split off (one per fruitlet)
+  std::size_t instance_parts_split_off = 0;       ///< parts split off by the views' instances
   std::size_t unsupported_detections = 0;         ///< too little surface for their size (dropped)
   std::size_t overlapping_detections_merged = 0;  ///< one fruitlet seen twice (overlap rule)
 };

@@ -27,8 +27,12 @@ class SegmentationModel {
   /// Whether the world asks for it (segmentation_model: 1).
   bool enabled() const { return enabled_; }
 
-  /// The fruitlet mask (CV_8U, 255 = fruitlet) a network would hand over for view `view`,
-  /// from the left image's object ids (CV_32S, object_ids.h).
+  /// The instance mask (CV_16U: 0 = background, each fruitlet and each false blob an id of
+  /// its own, numbered afresh in each view) a network would hand over for view `view`, from
+  /// the left image's object ids (CV_32S, object_ids.h).
+  cv::Mat instancesFor(const cv::Mat& object_id, int view) const;
+
+  /// The same mask without the instances (CV_8U, 255 = fruitlet).
   cv::Mat maskFor(const cv::Mat& object_id, int view) const;
 
   /// The exact mask: every fruitlet pixel of object_id.

@@ -1,0 +1,21 @@
+// One captured image as sizing needs it.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "fvp/host/core/stereo_intrinsics.h"
+
+namespace fvp::host::sizing {
+
+struct SizingView {
+  cv::Mat fruitlet_mask;  ///< CV_8U, nonzero = fruitlet
+  cv::Mat disparity_px;   ///< CV_32F, 0 = invalid
+  StereoIntrinsics intrinsics;
+  Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();
+  /// CV_16U instance ids when the segmentation gave them (0 = background); else empty, and
+  /// fruitlets are told apart by the mask's connected components.
+  cv::Mat fruitlet_instances;
+};
+
+}  // namespace fvp::host::sizing
