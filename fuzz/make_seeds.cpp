@@ -63,7 +63,7 @@ fs::path scratch() {
 
 // A small capture with every part (or only the required ones), as one harness input.
 std::string captureInput(int width, int height, bool all_parts, bool grey,
-                         const std::string& ground_truth) {
+                         const std::string& ground_truth, bool instances = false) {
   host::Capture c;
   c.intrinsics.width_px = width;
   c.intrinsics.height_px = height;
@@ -83,6 +83,11 @@ std::string captureInput(int width, int height, bool all_parts, bool grey,
     c.disparity_px.at<float>(0, 0) = 0.0f;
     c.fruitlet_mask = cv::Mat::zeros(height, width, CV_8U);
     c.fruitlet_mask(cv::Rect(1, 1, 3, 2)).setTo(255);
+    if (instances) {  // a 16-bit instance segmentation: two touching instances
+      c.fruitlet_mask = cv::Mat::zeros(height, width, CV_16U);
+      c.fruitlet_mask(cv::Rect(1, 1, 2, 2)).setTo(2);
+      c.fruitlet_mask(cv::Rect(3, 1, 2, 2)).setTo(40000);
+    }
     c.has_clouds = true;
     c.roi_points_m = {{0.1f, 0.2f, 1.0f}, {0.11f, 0.2f, 1.01f}, {0.12f, 0.21f, 1.0f}};
     c.other_points_m = {{-0.3f, 0.0f, 0.9f}, {0.5f, 0.1f, 1.5f}};
@@ -131,6 +136,7 @@ int main(int argc, char** argv) {
 
   // Captures: every part (ground truth of a real world), only the required parts, grey left.
   put("capture", "full_16x12", captureInput(16, 12, true, false, truth_isolated));
+  put("capture", "instances_16x12", captureInput(16, 12, true, false, truth_isolated, true));
   put("capture", "required_8x6", captureInput(8, 6, false, false, ""));
   put("capture", "grey_left_5x4", captureInput(5, 4, false, true, ""));
 

@@ -56,6 +56,22 @@ TEST(ClusterCompletion, ASizeStillMovingDoesNotStop) {
   EXPECT_FALSE(sizesSettled(h, config));
 }
 
+TEST(ClusterCompletion, ANoisyMedianMayMoveByItsStandardError) {
+  ClusterCompletionConfig config;
+  // 0.05 mm per view: 0.15 mm over three views, past the 0.1 mm floor...
+  auto h = history(6, 0.05);
+  EXPECT_FALSE(sizesSettled(h, config));
+  // ...but within the 0.2 mm standard error of medians of scattered images.
+  for (auto& f : h.back().fruitlets) f.size_stderr_mm = 0.2;
+  EXPECT_TRUE(sizesSettled(h, config));
+  config.tolerate_standard_error = false;
+  EXPECT_FALSE(sizesSettled(h, config));
+  // A precise median (0.03 mm) keeps the 0.1 mm floor.
+  config.tolerate_standard_error = true;
+  for (auto& f : h.back().fruitlets) f.size_stderr_mm = 0.03;
+  EXPECT_FALSE(sizesSettled(h, config));
+}
+
 TEST(ClusterCompletion, AFruitletFoundLateOrNotYetWellSeenDoesNotStop) {
   const ClusterCompletionConfig config;
   // A third fruitlet appears in the newest sizing (a view revealed it).

@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <regex>
 
+#include "fvp/host/perception/perception_pipeline.h"
 #include "fvp/host/perception/ply_io.h"
 #include "synthetic_scenes.h"
 
@@ -95,6 +96,37 @@ TEST(Capture, WriteReadRoundTrip) {
   EXPECT_TRUE(m.fruitlet_mask.empty());
   EXPECT_FALSE(m.has_clouds);
   EXPECT_TRUE(m.ground_truth_json.empty());
+}
+
+TEST(Capture, InstanceMaskRoundTripsAsItsIds) {
+  const fs::path dir = freshDir("instances");
+  Capture c = makeCapture();
+  c.fruitlet_mask = cv::Mat::zeros(48, 64, CV_16U);
+  c.fruitlet_mask(cv::Rect(20, 20, 10, 8)).setTo(3);
+  c.fruitlet_mask(cv::Rect(30, 20, 10, 8)).setTo(60000);  // touching the first
+  writeCapture(dir, c);
+  const Capture r = readCapture(dir);
+  ASSERT_EQ(r.fruitlet_mask.type(), CV_16U);
+  EXPECT_EQ(cv::norm(r.fruitlet_mask, c.fruitlet_mask, cv::NORM_INF), 0.0);
+  // The frame keeps the ids; the pipeline's mask is their union, its instances the ids.
+  const StereoFrame frame = toStereoFrame(r);
+  EXPECT_NO_THROW(checkStereoFrame(frame, "capture"));
+  const PerceptionResult perceived = PerceptionPipeline().process(frame);
+  EXPECT_EQ(cv::countNonZero(perceived.fruitlet_mask), 2 * 80);
+  EXPECT_EQ(cv::norm(perceived.fruitlet_instances, c.fruitlet_mask, cv::NORM_INF), 0.0);
+  // Other types are named in the error.
+  StereoFrame bad = frame;
+  bad.fruitlet_mask = cv::Mat::zeros(48, 64, CV_32S);
+  EXPECT_THROW(
+      {
+        try {
+          checkStereoFrame(bad, "capture");
+        } catch (const std::invalid_argument& e) {
+          EXPECT_NE(std::string(e.what()).find("fruitlet_mask"), std::string::npos) << e.what();
+          throw;
+        }
+      },
+      std::invalid_argument);
 }
 
 std::string readAll(const fs::path& p) {

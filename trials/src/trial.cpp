@@ -279,6 +279,7 @@ nlohmann::json sizeHistoryJson(const std::vector<host::nbv::SizingSnapshot>& his
                            {"size_mm", f.size_mm},
                            {"well_seen_images", f.well_seen_images},
                            {"view_span_deg", f.view_span_deg},
+                           {"size_stderr_mm", f.size_stderr_mm},
                            {"size_source", host::sizing::toString(f.size_source)}});
     }
     const auto m = host::eval::sizeMetrics(
@@ -540,6 +541,7 @@ nlohmann::json Trial::Impl::stopJson() const {
   return {{"rule", "auto"},
           {"stable_views", c.stable_views},
           {"size_tolerance_mm", c.size_tolerance_mm},
+          {"tolerate_standard_error", c.tolerate_standard_error},
           {"same_fruitlet_m", c.same_fruitlet_m},
           {"min_well_seen_images", c.min_well_seen_images},
           {"min_view_span_deg", c.min_view_span_deg},

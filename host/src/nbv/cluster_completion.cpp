@@ -63,7 +63,8 @@ void ClusterCompletion::onView(const ViewEvent& event) {
         span_rad =
             std::max(span_rad, std::acos(std::clamp(directions[i].dot(directions[j]), -1.0, 1.0)));
     snapshot.fruitlets.push_back({f.center_m, f.size_mm, f.support.well_seen_images,
-                                  span_rad * 180.0 / M_PI, f.size_source});
+                                  span_rad * 180.0 / M_PI, f.size_source,
+                                  f.support.size_stderr_mm});
   }
   history_.push_back(std::move(snapshot));
 }
@@ -101,9 +102,11 @@ bool sizesSettled(const std::vector<SizingSnapshot>& history,
         if (const double d = (earlier.fruitlets[g].center_m - f.center_m).norm();
             !taken[g] && d <= nearest_m)
           nearest = g, nearest_m = d;
+      const double tolerance_mm = config.tolerate_standard_error
+                                      ? std::max(config.size_tolerance_mm, f.size_stderr_mm)
+                                      : config.size_tolerance_mm;
       // A NaN size never agrees.
-      if (!nearest ||
-          !(std::abs(earlier.fruitlets[*nearest].size_mm - f.size_mm) <= config.size_tolerance_mm))
+      if (!nearest || !(std::abs(earlier.fruitlets[*nearest].size_mm - f.size_mm) <= tolerance_mm))
         return false;
       taken[*nearest] = true;
     }

@@ -26,6 +26,11 @@ struct ClusterCompletionConfig {
   /// and a third of the 0.3 mm error the sizing reaches with the paper's whole budget, so views
   /// that move estimates less than this cannot buy a better size.
   double size_tolerance_mm = 0.1;
+  /// A fruitlet whose size is a median of noisy images may move by its standard error
+  /// (FruitletSupport::size_stderr_mm) instead, when that is larger: the median cannot be
+  /// known better than its standard error, so views that move it by less re-sample noise
+  /// rather than improve it. Off: size_tolerance_mm for every fruitlet.
+  bool tolerate_standard_error = true;
   /// Detections of two sizings closer than this are one fruitlet: the smallest fruitlet's
   /// radius (3 mm; sizing keeps spheres of 1.5-12 mm radius).
   double same_fruitlet_m = 0.003;
@@ -58,6 +63,7 @@ struct FruitletSnapshot {
   int well_seen_images = 0;
   double view_span_deg = 0.0;  ///< largest angle between two well-seen views' directions
   sizing::SizeSource size_source = sizing::SizeSource::kWellSeenImages;
+  double size_stderr_mm = -1.0;  ///< the size's standard error; -1 under 2 well-seen images
 };
 
 /// The cluster sized after one view.
