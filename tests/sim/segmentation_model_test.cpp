@@ -191,6 +191,13 @@ TEST(SegmentationModel, GreenFruitletsEscapeHsvButNotTheModel) {
   const host::StereoFrame frame = camera.capture(world.startCameraPose()).frame;
   ASSERT_EQ(frame.fruitlet_mask.type(), CV_16U);  // instance ids
   EXPECT_EQ(cv::countNonZero((frame.fruitlet_mask != 0) != truth), 0);
+  // segmentation_instances: 0 hands over the same mask, binary.
+  green.segmentation_instances = 0;
+  const SegmentationModel binary(green, 1);
+  SimulatedCamera binary_camera(renderer, clock, SimulatedErrors{nullptr, nullptr, &binary});
+  const host::StereoFrame binary_frame = binary_camera.capture(world.startCameraPose()).frame;
+  ASSERT_EQ(binary_frame.fruitlet_mask.type(), CV_8U);
+  EXPECT_EQ(cv::countNonZero(binary_frame.fruitlet_mask != truth), 0);
 }
 
 }  // namespace

@@ -1,8 +1,8 @@
 #include "fvp/host/sizing/fruitlet_sizer.h"
 
 #include <algorithm>
-#include <climits>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <opencv2/imgproc.hpp>
 #include <optional>
@@ -45,7 +45,8 @@ Segments segmentInstances(const cv::Mat& instances) {
   s.labels = cv::Mat(instances.size(), CV_32S, cv::Scalar(0));
   std::map<int, int> label_of;
   struct Extent {
-    int x0 = INT32_MAX, y0 = INT32_MAX, x1 = -1, y1 = -1, area = 0;
+    int x0 = std::numeric_limits<int>::max(), y0 = std::numeric_limits<int>::max();
+    int x1 = -1, y1 = -1, area = 0;
     double sum_x = 0.0, sum_y = 0.0;
   };
   std::vector<Extent> extents(1);
@@ -238,7 +239,7 @@ void SizingConfig::validate() const {
     throw std::invalid_argument("sizing: surface_voxel_size_m > 0");
   if (!(max_detection_overlap_fraction >= 0.0))
     throw std::invalid_argument("sizing: max_detection_overlap_fraction >= 0");
-  if (split_by_instances) instance_split.validate();
+  if (use_instances) instance_split.validate();
   if (split_merged_clusters && min_cluster_points < 4)
     throw std::invalid_argument("sizing: min_cluster_points >= 4 (a sphere needs 4 points)");
 }
@@ -290,7 +291,7 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
     split.min_cluster_points = config.min_cluster_points;
     result.events.clusters_split_off = splitMergedClusters(result.points, result.labels, split);
   }
-  if (config.split_by_instances)
+  if (config.use_instances)
     result.events.instance_parts_split_off =
         splitByInstances(result.points, result.labels, views, config.instance_split);
 
@@ -345,14 +346,14 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
   // it is visible in. Only whether an image's segment is shared depends on which other
   // detections are kept (below).
   std::vector<FruitletEstimate> measured(sized.size());
-  const bool use_instances =
-      config.split_by_instances && std::any_of(views.begin(), views.end(), [](const auto& v) {
+  const bool with_instances =
+      config.use_instances && std::any_of(views.begin(), views.end(), [](const auto& v) {
         return !v.fruitlet_instances.empty();
       });
   std::vector<std::vector<int>> instance_of(sized.size());  // per view (dominantInstances)
   const auto measure = [&](std::size_t ci, SizingEvents& events) {
     const std::vector<Eigen::Vector3f>& pts = *sized[ci].second;
-    if (use_instances) instance_of[ci] = dominantInstances(pts, views, config.instance_split);
+    if (with_instances) instance_of[ci] = dominantInstances(pts, views, config.instance_split);
     FruitletEstimate& f = measured[ci];
     f = FruitletEstimate{};
     f.points = pts.size();
@@ -454,7 +455,7 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
         const double overlap = ra + rb - (fa.sphere_center_m - fb.sphere_center_m).norm();
         const double depth = overlap / std::min(ra, rb);
         const bool one_instance =
-            use_instances && overlap > 0.0 && sameInstance(instance_of[a], instance_of[b]);
+            with_instances && overlap > 0.0 && sameInstance(instance_of[a], instance_of[b]);
         if ((depth > config.max_detection_overlap_fraction || one_instance) &&
             (!pair || depth > deepest))
           deepest = depth, pair = {a, b};

@@ -48,6 +48,7 @@ cv::Mat fruitletPixels(const cv::Mat& object_id, const std::vector<bool>& missed
 
 SegmentationModel::SegmentationModel(const WorldConfig& c, std::uint64_t seed)
     : enabled_(c.segmentation_model == 1),
+      instances_(c.segmentation_instances == 1),
       seed_(seed),
       boundary_px_(c.segmentation_boundary_px),
       miss_rate_(c.segmentation_miss_rate),

@@ -26,8 +26,10 @@ host::nbv::CaptureResult SimulatedCamera::capture(const Eigen::Isometry3d& T_wor
   if (errors_.segmentation && errors_.segmentation->enabled()) {
     RenderedView rendered = renderer.renderWithGroundTruth(last_true_pose_);
     out.frame = std::move(rendered.frame);
-    out.frame.fruitlet_mask =
-        errors_.segmentation->instancesFor(rendered.ground_truth.object_id, view);
+    const cv::Mat& ids = rendered.ground_truth.object_id;
+    out.frame.fruitlet_mask = errors_.segmentation->instances()
+                                  ? errors_.segmentation->instancesFor(ids, view)
+                                  : errors_.segmentation->maskFor(ids, view);
   } else {
     out.frame = renderer.render(last_true_pose_);
   }

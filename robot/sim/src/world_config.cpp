@@ -79,6 +79,7 @@ const std::vector<KeySpec>& keySpecs() {
       {"wind_fruitlet_swing_m", &WorldConfig::wind_fruitlet_swing_m, 0.0, 0.01},
       {"fruitlet_green_fraction", &WorldConfig::fruitlet_green_fraction, 0.0, 1.0},
       {"segmentation_model", &WorldConfig::segmentation_model, 0, 1},
+      {"segmentation_instances", &WorldConfig::segmentation_instances, 0, 1},
       {"segmentation_boundary_px", &WorldConfig::segmentation_boundary_px, 0.0, 5.0},
       {"segmentation_miss_rate", &WorldConfig::segmentation_miss_rate, 0.0, 0.9},
       {"segmentation_false_blobs", &WorldConfig::segmentation_false_blobs, 0.0, 20.0},

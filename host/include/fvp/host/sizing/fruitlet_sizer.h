@@ -49,9 +49,9 @@ struct SizingConfig {
   /// Split DBSCAN clusters that hold more than one fruitlet (sphere_ransac.h): touching
   /// fruitlets, bridged by stereo points at the depth edges between them, merge otherwise.
   bool split_merged_clusters = true;
-  /// Split DBSCAN clusters that fall on two instances or more of the views' instance
-  /// segmentations (instance_split.h); only where the views carry instance ids.
-  bool split_by_instances = true;
+  /// Where the views carry instance ids (instance_split.h): split DBSCAN clusters that fall
+  /// on two instances or more, and merge overlapping detections that fall on one.
+  bool use_instances = true;
   InstanceSplitConfig instance_split;
   int disparity_window_half_px = 5;     ///< Eq. 4's square window: (2h+1)^2 pixels
   double saturated_disparity_px = 318;  ///< window maxima at or above: rejected

@@ -26,6 +26,8 @@ class SegmentationModel {
 
   /// Whether the world asks for it (segmentation_model: 1).
   bool enabled() const { return enabled_; }
+  /// Whether it hands over instances (segmentation_instances: 1) or a binary mask.
+  bool instances() const { return instances_; }
 
   /// The instance mask (CV_16U: 0 = background, each fruitlet and each false blob an id of
   /// its own, numbered afresh in each view) a network would hand over for view `view`, from
@@ -39,7 +41,7 @@ class SegmentationModel {
   static cv::Mat trueMask(const cv::Mat& object_id);
 
  private:
-  bool enabled_ = false;
+  bool enabled_ = false, instances_ = true;
   std::uint64_t seed_ = 0;
   double boundary_px_ = 0.0, miss_rate_ = 0.0, false_blobs_ = 0.0;
 };

@@ -86,6 +86,9 @@ struct WorldConfig {
   /// trained network (the renderer's instance masks with the errors below) and HSV does
   /// not run; 0: no mask (HSV segmentation, the paper's).
   int segmentation_model = 0;
+  /// 1: the model's mask is an instance segmentation (CV_16U, one id per fruitlet), as
+  /// Mask R-CNN or YOLOv8-seg hand over; 0: a binary mask (touching fruitlets merge).
+  int segmentation_instances = 1;
   /// RMS of the mask boundary's displacement, pixels (smooth along the boundary).
   double segmentation_boundary_px = 0.0;
   /// Probability that a visible fruitlet is missing from a view's mask.
