@@ -49,16 +49,26 @@ void seenInstances(const std::vector<Eigen::Vector3f>& points,
   }
 }
 
+/// How many of the seen points fall on each instance, and how many are seen.
+struct InstanceCounts {
+  std::map<int, int> per_instance;
+  int seen = 0;
+};
+
+InstanceCounts countInstances(const std::vector<int>& ids) {
+  InstanceCounts c;
+  for (int id : ids) {
+    if (id == kUnseen) continue;
+    ++c.seen;
+    if (id > 0) ++c.per_instance[id];
+  }
+  return c;
+}
+
 /// The ids holding a part's worth of the seen points, most points first; fewer than two:
 /// the view does not split the cluster.
 std::vector<int> partInstances(const std::vector<int>& ids, const InstanceSplitConfig& config) {
-  std::map<int, int> count;
-  int seen = 0;
-  for (int id : ids) {
-    if (id == kUnseen) continue;
-    ++seen;
-    if (id > 0) ++count[id];
-  }
+  const auto [count, seen] = countInstances(ids);
   const double needed = std::max<double>(config.min_part_points, config.min_part_fraction * seen);
   std::vector<std::pair<int, int>> large;
   for (const auto& [id, n] : count)
@@ -189,13 +199,7 @@ std::vector<int> dominantInstances(const std::vector<Eigen::Vector3f>& points,
   for (std::size_t v = 0; v < views.size(); ++v) {
     if (views[v].fruitlet_instances.empty()) continue;
     seenInstances(points, all, views[v], config, ids, inner);
-    std::map<int, int> count;
-    int seen = 0;
-    for (int id : ids) {
-      if (id == kUnseen) continue;
-      ++seen;
-      if (id > 0) ++count[id];
-    }
+    const auto [count, seen] = countInstances(ids);
     for (const auto& [id, n] : count)
       if (2 * n >= seen && 3 * n >= config.min_part_points) out[v] = id;
   }
