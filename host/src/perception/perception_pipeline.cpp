@@ -52,10 +52,9 @@ void checkStereoFrame(const StereoFrame& frame, const std::string& source) {
   };
   check(frame.left_bgr, "left", CV_8UC3, "BGR", true);
   check(frame.right_bgr, "right", CV_8UC3, "BGR", false);
-  if (frame.fruitlet_mask.type() != CV_16UC1)
-    check(frame.fruitlet_mask, "fruitlet_mask", CV_8UC1, "CV_8U mask or CV_16U instance", false);
-  else
-    check(frame.fruitlet_mask, "fruitlet_mask", CV_16UC1, "CV_16U instance", false);
+  check(frame.fruitlet_mask, "fruitlet_mask",
+        frame.fruitlet_mask.type() == CV_16UC1 ? CV_16UC1 : CV_8UC1,
+        "CV_8U mask or CV_16U instance", false);
   check(frame.disparity_px, "disparity_px", CV_32FC1, "CV_32F disparity", false);
 }
 

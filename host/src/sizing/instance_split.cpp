@@ -18,13 +18,14 @@ constexpr int kUnseen = -1;
 
 /// The instance id under each member as `view` sees it: kUnseen where the point is out of
 /// the image, has no valid disparity or lies off the view's surface (hidden), else the id
-/// (0: background). `inner`: whether the id is the same over the seed margin's window.
+/// (0: background). `inner`, when asked for (seeds): whether the id is the same over the
+/// seed margin's window.
 void seenInstances(const std::vector<Eigen::Vector3f>& points,
                    const std::vector<std::size_t>& members, const SizingView& view,
                    const InstanceSplitConfig& config, std::vector<int>& ids,
-                   std::vector<char>& inner) {
+                   std::vector<char>* inner = nullptr) {
   ids.assign(members.size(), kUnseen);
-  inner.assign(members.size(), 0);
+  if (inner) inner->assign(members.size(), 0);
   const cv::Mat& instances = view.fruitlet_instances;
   const cv::Mat& disparity = view.disparity_px;
   const StereoIntrinsics& K = view.intrinsics;
@@ -38,14 +39,15 @@ void seenInstances(const std::vector<Eigen::Vector3f>& points,
     if (u < 0 || v < 0 || u >= instances.cols || v >= instances.rows) continue;
     const float d = disparity.at<float>(v, u);
     if (!(d > 0.0f) || !std::isfinite(d)) continue;
-    if (std::abs(K.fx_px * K.baseline_m / d - p.z()) > config.visibility_tolerance_m) continue;
+    if (std::abs(K.depthFromDisparity(d) - p.z()) > config.visibility_tolerance_m) continue;
     const int id = instances.at<std::uint16_t>(v, u);
     ids[i] = id;
-    if (id == 0 || u < m || v < m || u + m >= instances.cols || v + m >= instances.rows) continue;
+    if (!inner || id == 0 || u < m || v < m || u + m >= instances.cols || v + m >= instances.rows)
+      continue;
     bool same = true;
     for (int y = v - m; y <= v + m && same; ++y)
       for (int x = u - m; x <= u + m && same; ++x) same = instances.at<std::uint16_t>(y, x) == id;
-    inner[i] = same;
+    (*inner)[i] = same;
   }
 }
 
@@ -135,7 +137,7 @@ void splitRecursively(const std::vector<Eigen::Vector3f>& points, std::vector<st
   if (int(members.size()) >= 2 * config.min_part_points && int(parts.size()) <= config.max_parts) {
     for (const SizingView& view : views) {
       if (view.fruitlet_instances.empty()) continue;
-      seenInstances(points, members, view, config, ids, inner);
+      seenInstances(points, members, view, config, ids, &inner);
       const std::vector<int> instances = partInstances(ids, config);
       if (instances.size() < 2) continue;
       ++splitting_views;
@@ -195,10 +197,9 @@ std::vector<int> dominantInstances(const std::vector<Eigen::Vector3f>& points,
   std::vector<std::size_t> all(points.size());
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
   std::vector<int> out(views.size(), 0), ids;
-  std::vector<char> inner;
   for (std::size_t v = 0; v < views.size(); ++v) {
     if (views[v].fruitlet_instances.empty()) continue;
-    seenInstances(points, all, views[v], config, ids, inner);
+    seenInstances(points, all, views[v], config, ids);
     const auto [count, seen] = countInstances(ids);
     for (const auto& [id, n] : count)
       if (2 * n >= seen && 3 * n >= config.min_part_points) out[v] = id;
