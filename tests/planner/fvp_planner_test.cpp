@@ -2,6 +2,7 @@
 // motion planner that fails on purpose.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -69,6 +70,117 @@ TEST(ViewpointSampler, TargetsDistancesOrientationsAndReachability) {
     EXPECT_TRUE(roi[i].T_world_camera.isApprox(roi2[i].T_world_camera, 0.0));
   // No frontiers of a kind: no candidates of it.
   EXPECT_TRUE(sampler.sampleRoi({}, 10, inShell).empty());
+}
+
+TEST(ViewpointSampler, SizingCandidatesLookAtTheirTargetFromDirectionsThatAddSpan) {
+  PlannerConfig config;
+  ViewpointSampler sampler(config, 7);
+  SizingTarget unseen, once;
+  unseen.center_m = {0.0, 0.0, 0.3};
+  once.center_m = {0.02, 0.0, 0.3};
+  once.seen_from = {Eigen::Vector3d::UnitZ()};
+  const std::vector<SizingTarget> targets = {unseen, once};
+  const auto candidates = sampler.sampleSizing(targets, 400, inShell);
+  ASSERT_EQ(candidates.size(), 400u);
+  int per_target[2] = {0, 0}, near_seen = 0;
+  for (const Candidate& c : candidates) {
+    ASSERT_EQ(c.kind, CandidateKind::kSizing);
+    ASSERT_TRUE(c.sizing_target == 0 || c.sizing_target == 1);
+    const SizingTarget& t = targets[std::size_t(c.sizing_target)];
+    ++per_target[c.sizing_target];
+    EXPECT_TRUE(c.target_m.isApprox(t.center_m, 0.0));
+    const Eigen::Vector3d to_camera = c.position_m() - t.center_m;
+    EXPECT_GE(to_camera.norm(), config.sensor_min_m - 1e-12);
+    EXPECT_LE(to_camera.norm(), config.sensor_max_m + 1e-12);
+    // Looking at the target: the optical axis (z) points from the camera to it.
+    EXPECT_NEAR(c.T_world_camera.linear().col(2).dot(-to_camera.normalized()), 1.0, 1e-9);
+    EXPECT_TRUE(addsViewSpan(t, to_camera.normalized()));
+    if (c.sizing_target == 1 && to_camera.normalized().z() > std::cos(30.0 * M_PI / 180.0))
+      ++near_seen;
+  }
+  EXPECT_GT(per_target[0], 150);
+  EXPECT_GT(per_target[1], 150);
+  EXPECT_EQ(near_seen, 0) << "within 30 degrees of its one well-seen view";
+  EXPECT_TRUE(sampler.sampleSizing({}, 10, inShell).empty());
+}
+
+TEST(SizingTarget, AddsViewSpanFromOneOfItsViews) {
+  SizingTarget t;
+  EXPECT_TRUE(addsViewSpan(t, Eigen::Vector3d::UnitX())) << "no view yet: any direction";
+  t.seen_from = {Eigen::Vector3d::UnitZ()};
+  const double a = 29.0 * M_PI / 180.0, b = 31.0 * M_PI / 180.0;
+  EXPECT_FALSE(addsViewSpan(t, Eigen::Vector3d(std::sin(a), 0.0, std::cos(a))));
+  EXPECT_TRUE(addsViewSpan(t, Eigen::Vector3d(std::sin(b), 0.0, std::cos(b))));
+  // Two views 10 degrees apart: a third 31 degrees from one of them adds the span.
+  const double c = 10.0 * M_PI / 180.0;
+  t.seen_from.push_back(Eigen::Vector3d(std::sin(c), 0.0, std::cos(c)));
+  EXPECT_TRUE(addsViewSpan(t, Eigen::Vector3d(-std::sin(a), 0.0, std::cos(a))));
+}
+
+// A fruitlet under a leaf: a camera beside it sees it whole, one above sees none of it, and
+// unknown space hides nothing.
+TEST(InfoGainEvaluator, VisibleFractionIsBlockedByOccupiedSpaceOnly) {
+  auto e = map::createMapEngine("octomap", testing::plannerTestConfig(), kRegion, nullptr);
+  const Eigen::Vector3d fruitlet = kRegion.center_m();
+  const double radius_m = 0.005;
+  const Eigen::Vector3d side(0.0, -0.3, 0.3);
+  std::vector<Eigen::Vector3f> roi, leaf;
+  // The near side of the fruitlet as the side camera sees it, and a leaf 6 cm above it.
+  for (int i = -4; i <= 4; ++i)
+    for (int k = -4; k <= 4; ++k) {
+      const Eigen::Vector3d o(0.001 * i, 0.0, 0.001 * k);
+      if (o.norm() >= radius_m) continue;
+      const double depth_m = std::sqrt(radius_m * radius_m - o.squaredNorm());
+      roi.push_back((fruitlet + o - Eigen::Vector3d(0.0, depth_m, 0.0)).cast<float>());
+    }
+  for (double x = -0.06; x <= 0.06; x += 0.003)
+    for (double y = -0.06; y <= 0.06; y += 0.003)
+      leaf.push_back(Eigen::Vector3f(float(x), float(y), float(fruitlet.z() + 0.06)));
+  e->integrate(map::testing::makeClouds(side, roi, leaf));
+  InfoGainEvaluator gain(InfoGainConfig{});
+  gain.refresh(*e);
+  EXPECT_DOUBLE_EQ(gain.visibleFraction(side, fruitlet, radius_m), 1.0);
+  EXPECT_DOUBLE_EQ(
+      gain.visibleFraction(fruitlet + Eigen::Vector3d(0.0, 0.0, 0.3), fruitlet, radius_m), 0.0);
+  // From the far side, through space no view has seen: nothing known blocks it.
+  EXPECT_DOUBLE_EQ(gain.visibleFraction(Eigen::Vector3d(0.0, 0.3, 0.3), fruitlet, radius_m), 1.0);
+  EXPECT_DOUBLE_EQ(gain.visibleFraction(fruitlet, fruitlet, radius_m), 0.0) << "inside";
+}
+
+// Sizing candidates join the heap with the predicted fraction in view as their gain.
+TEST(FvpPlanner, AimsAtSizingTargetsOnlyWhenAskedAndScoresThemByWhatIsInView) {
+  auto e = mappedEngine();
+  PlannerConfig config;
+  config.utility_threshold = 5.0;  // nothing is tried: every candidate is scored and kept
+  config.max_sampling_rounds = 1;
+  SizingTarget target;
+  target.center_m = kRegion.center_m();
+  target.radius_m = 0.006;
+  const Eigen::Isometry3d now(Eigen::Translation3d(0.0, -0.3, 0.35));
+  const auto never = [](const Eigen::Isometry3d&) { return false; };
+  FvpPlanner off(config, 3);
+  off.setSizingTargets({target});
+  for (const Candidate& c : off.planAndMove(*e, now, inShell, never).candidates)
+    EXPECT_NE(c.kind, CandidateKind::kSizing) << "sizing_samples 0: the paper's planner";
+  config.sizing_samples = 60;
+  FvpPlanner on(config, 3);
+  on.setSizingTargets({target});
+  const PlanStep step = on.planAndMove(*e, now, inShell, never);
+  std::size_t sizing = 0, scored = 0;
+  for (const Candidate& c : step.candidates) {
+    if (c.kind != CandidateKind::kSizing) continue;
+    ++sizing;
+    if (!c.reachable) continue;
+    ++scored;
+    EXPECT_TRUE(c.ig == 0.0 || c.ig >= target.min_visible_fraction) << c.ig;
+    EXPECT_NEAR(c.utility, c.ig - config.alpha_per_m * (c.position_m() - now.translation()).norm(),
+                1e-12);
+  }
+  EXPECT_EQ(sizing, 60u);
+  EXPECT_GT(scored, 0u);
+  on.setSizingTargets({});
+  for (const Candidate& c : on.planAndMove(*e, now, inShell, never).candidates)
+    EXPECT_NE(c.kind, CandidateKind::kSizing);
 }
 
 TEST(FvpPlanner, ThresholdDecaysWhenEveryMoveFailsAndResetsOnSuccess) {

@@ -24,6 +24,7 @@
 #include "fvp/host/nbv/cluster_completion.h"
 #include "fvp/host/nbv/loop_observers.h"
 #include "fvp/host/nbv/nbv_loop.h"
+#include "fvp/host/nbv/sizing_guidance.h"
 #include "fvp/host/planner/planner_registry.h"
 #include "fvp/host/planner/view_planner.h"
 #include "fvp/host/report/viewer_scene.h"
@@ -362,6 +363,8 @@ struct ClusterOutcome {
   nlohmann::json sizing;        ///< sizeAndScore's object
   nlohmann::json size_history;  ///< null unless sizes were kept after every view
   double sizing_wall_s = 0.0, sizing_during_loop_s = 0.0;
+  /// With the automatic stop: what the sizing guidance did (added to the events).
+  nlohmann::json guidance_events = nlohmann::json::object();
 };
 
 struct Trial::Impl {
@@ -508,10 +511,14 @@ ClusterOutcome Trial::Impl::runCluster(TrialParts& cluster_parts, const Fruitlet
   observers.add(&log);
   UnchargedClock observing_clock(loop_clock);  // before completion: it outlives it
   std::optional<host::nbv::ClusterCompletion> completion;
+  std::optional<host::nbv::SizingGuidance> guidance;
   if (options.stop == "auto") {
     completion.emplace(cluster_parts.session(), loop_clock, cluster_parts.sizingConfig(),
                        completion_config);
     observers.add(&*completion);
+    guidance.emplace(*completion, cluster_parts.planner(),
+                     cluster_parts.sizingConfig().well_seen_fraction);
+    observers.add(&*guidance);  // after completion: it reads completion's sizing
     stop = stop || completion->stopCondition();
   } else if (options.record_size_history) {
     completion.emplace(cluster_parts.session(), observing_clock, cluster_parts.sizingConfig(),
@@ -522,6 +529,11 @@ ClusterOutcome Trial::Impl::runCluster(TrialParts& cluster_parts, const Fruitlet
                           loop_clock);
   ClusterOutcome out;
   out.run = loop.run(stop, &observers);
+  if (guidance) {
+    out.guidance_events = {{"sizing_views", guidance->aimedViews()},
+                           {"sizing_targets_dropped", guidance->droppedTargets()}};
+    cluster_parts.planner().setSizingTargets({});  // this cluster's fruitlets
+  }
 
   const auto t_size = Clock::now();
   out.sizing = cluster_parts.sizeAndScore(*world, cluster.fruitlet_indices);
@@ -590,6 +602,7 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
                       {"trial", parts->configJson()}};
   for (auto& [key, value] : outcome.sizing.items()) result[key] = value;
   result["events"] = eventsJson(run.events);
+  result["events"].update(outcome.guidance_events);
   if (options.register_views)
     result["anchor_offset"] = anchorOffsetJson(parts->session(), log.trueAnchorShift());
   result["wall_breakdown_s"] = {{"rendering", camera->totalRenderSeconds()},
@@ -719,6 +732,7 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
     detections += outcome.sizing.value("detections", std::uint64_t{0});
     views += outcome.run.views;
     entry["events"] = eventsJson(outcome.run.events);
+    entry["events"].update(outcome.guidance_events);
     addNumbers(events, entry["events"]);
     addNumbers(wall, {{"perception", outcome.run.wall_s.perception},
                       {"mapping", outcome.run.wall_s.mapping},

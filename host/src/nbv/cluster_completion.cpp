@@ -63,8 +63,8 @@ void ClusterCompletion::onView(const ViewEvent& event) {
         span_rad =
             std::max(span_rad, std::acos(std::clamp(directions[i].dot(directions[j]), -1.0, 1.0)));
     snapshot.fruitlets.push_back({f.center_m, f.size_mm, f.support.well_seen_images,
-                                  span_rad * 180.0 / M_PI, f.size_source,
-                                  f.support.size_stderr_mm});
+                                  span_rad * 180.0 / M_PI, f.size_source, f.support.size_stderr_mm,
+                                  std::move(directions)});
   }
   history_.push_back(std::move(snapshot));
 }
@@ -78,6 +78,12 @@ StopCondition ClusterCompletion::stopCondition() const {
          StopCondition::stalled(static_cast<std::size_t>(config_.max_iterations_without_view));
 }
 
+bool lacksEvidence(const FruitletSnapshot& fruitlet, const ClusterCompletionConfig& config) {
+  return fruitlet.size_source != sizing::SizeSource::kSphereFit &&
+         (fruitlet.well_seen_images < config.min_well_seen_images ||
+          fruitlet.view_span_deg < config.min_view_span_deg);
+}
+
 bool sizesSettled(const std::vector<SizingSnapshot>& history,
                   const ClusterCompletionConfig& config) {
   if (history.size() < std::size_t(config.stable_views) + 1) return false;
@@ -86,10 +92,7 @@ bool sizesSettled(const std::vector<SizingSnapshot>& history,
   // budget ends a cluster that has none).
   if (latest.fruitlets.empty()) return false;
   for (const auto& f : latest.fruitlets)
-    if (f.size_source != sizing::SizeSource::kSphereFit &&
-        (f.well_seen_images < config.min_well_seen_images ||
-         f.view_span_deg < config.min_view_span_deg))
-      return false;
+    if (lacksEvidence(f, config)) return false;
   for (int k = 1; k <= config.stable_views; ++k) {
     const SizingSnapshot& earlier = history[history.size() - 1 - std::size_t(k)];
     // A fruitlet found or lost: the cluster is still changing.

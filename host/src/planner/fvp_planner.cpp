@@ -5,6 +5,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <numeric>
+#include <stdexcept>
 
 #include "fvp/host/map/map_engine.h"
 
@@ -49,9 +50,19 @@ void FvpPlanner::score(std::vector<Candidate>& candidates, const Eigen::Vector3d
   std::vector<ViewQuery> queries;
   std::vector<std::size_t> index;
   for (std::size_t i = 0; i < candidates.size(); ++i) {
-    candidates[i].ig = 0.0;
-    candidates[i].utility = -std::numeric_limits<double>::infinity();
-    if (!candidates[i].reachable) continue;
+    Candidate& c = candidates[i];
+    c.ig = 0.0;
+    c.utility = -std::numeric_limits<double>::infinity();
+    if (!c.reachable) continue;
+    if (c.kind == CandidateKind::kSizing) {
+      if (c.sizing_target < 0 || std::size_t(c.sizing_target) >= sizing_targets_.size())
+        throw std::logic_error("FvpPlanner::score: a sizing candidate without its target");
+      const SizingTarget& t = sizing_targets_[std::size_t(c.sizing_target)];
+      const double seen = gain_.visibleFraction(c.position_m(), t.center_m, t.radius_m);
+      c.ig = seen >= t.min_visible_fraction ? seen : 0.0;
+      c.utility = c.ig - config_.alpha_per_m * (c.position_m() - camera_m).norm();
+      continue;
+    }
     queries.push_back({candidates[i].T_world_camera, candidates[i].target_m});
     index.push_back(i);
   }
@@ -90,6 +101,11 @@ PlanStep FvpPlanner::planAndMove(map::MapEngine& map, const Eigen::Isometry3d& T
     std::vector<Candidate> exploration =
         sampler_.sampleExploration(frontiers, config_.exploration_samples, reachable);
     candidates.insert(candidates.end(), exploration.begin(), exploration.end());
+    if (config_.sizing_samples > 0 && !sizing_targets_.empty()) {
+      std::vector<Candidate> sizing =
+          sampler_.sampleSizing(sizing_targets_, config_.sizing_samples, reachable);
+      candidates.insert(candidates.end(), sizing.begin(), sizing.end());
+    }
     if (config_.camera_clearance_m > 0.0)
       for (Candidate& c : candidates)
         if (c.reachable && gain_.occupiedWithin(c.position_m(), config_.camera_clearance_m)) {

@@ -182,6 +182,34 @@ InfoGainEvaluator::RayCensus InfoGainEvaluator::census(const Eigen::Vector3d& fr
   return r;
 }
 
+double InfoGainEvaluator::visibleFraction(const Eigen::Vector3d& camera_m,
+                                          const Eigen::Vector3d& center_m, double radius_m) const {
+  const Eigen::Vector3d to_camera = camera_m - center_m;
+  const double distance_m = to_camera.norm();
+  if (!(distance_m > radius_m)) return 0.0;
+  const Eigen::Vector3d n = to_camera / distance_m;
+  const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
+  const double pullback_m = 2.0 * fine_.voxel_size_m;
+  int rays = 0, seen = 0;
+  const auto cast = [&](double along_u_m, double along_v_m) {
+    const Eigen::Vector3d offset = along_u_m * u + along_v_m * v;
+    const Eigen::Vector3d surface =
+        center_m + offset +
+        std::sqrt(std::max(0.0, radius_m * radius_m - offset.squaredNorm())) * n;
+    const Eigen::Vector3d end = surface + pullback_m * (camera_m - surface).normalized();
+    ++rays;
+    seen += !census(camera_m, end).occluded;
+  };
+  // The centre and two rings (at half and 85 % of the radius): about equal areas of the disc.
+  cast(0.0, 0.0);
+  for (const auto& [ring, count] : {std::pair{0.5, 6}, std::pair{0.85, 12}})
+    for (int k = 0; k < count; ++k) {
+      const double a = 2.0 * M_PI * k / count;
+      cast(ring * radius_m * std::cos(a), ring * radius_m * std::sin(a));
+    }
+  return static_cast<double>(seen) / rays;
+}
+
 bool InfoGainEvaluator::occupiedWithin(const Eigen::Vector3d& p_m, double radius_m) const {
   const double vs = coarse_.voxel_size_m;
   const auto lo = coarse_.latticeIndex(p_m - Eigen::Vector3d::Constant(radius_m));

@@ -27,6 +27,7 @@ const std::vector<YamlKey<C>>& yamlKeys() {
       yamlField("frustum_rays_x", &C::frustum_rays_x),
       yamlField("frustum_rays_y", &C::frustum_rays_y),
       yamlField("embree_cull", &C::embree_cull),
+      yamlField("sizing_samples", &C::sizing_samples),
   };
   return keys;
 }
@@ -67,6 +68,8 @@ void PlannerConfig::validate(const std::string& source) const {
              "1 to 256 rays");
   requireKey(frustum_rays_y >= 1 && frustum_rays_y <= 256, source, "frustum_rays_y",
              "1 to 256 rays");
+  requireKey(sizing_samples >= 0 && sizing_samples <= 10'000'000, source, "sizing_samples",
+             "0 to 10000000 candidates");
   requireKey(max_sampling_rounds >= 1 && max_sampling_rounds <= 1000, source, "max_sampling_rounds",
              "1 to 1000 rounds");
 }
@@ -86,7 +89,8 @@ std::string PlannerConfig::toJson() const {
                                     {"gain_mode", gain_mode},
                                     {"frustum_rays_x", frustum_rays_x},
                                     {"frustum_rays_y", frustum_rays_y},
-                                    {"embree_cull", embree_cull}};
+                                    {"embree_cull", embree_cull},
+                                    {"sizing_samples", sizing_samples}};
   return j.dump();
 }
 

@@ -1,11 +1,29 @@
 #include "fvp/host/planner/viewpoint_sampler.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "fvp/host/core/look_at.h"
 
 namespace fvp::host::planner {
 
 const char* toString(CandidateKind kind) {
-  return kind == CandidateKind::kRoi ? "roi" : "exploration";
+  switch (kind) {
+    case CandidateKind::kRoi:
+      return "roi";
+    case CandidateKind::kExploration:
+      return "exploration";
+    case CandidateKind::kSizing:
+      return "sizing";
+  }
+  return "unknown";
+}
+
+bool addsViewSpan(const SizingTarget& target, const Eigen::Vector3d& direction) {
+  if (target.seen_from.empty()) return true;
+  const double min_cos = std::cos(target.min_angle_deg * M_PI / 180.0);
+  return std::any_of(target.seen_from.begin(), target.seen_from.end(),
+                     [&](const Eigen::Vector3d& seen) { return seen.dot(direction) <= min_cos; });
 }
 
 ViewpointSampler::ViewpointSampler(const PlannerConfig& config, std::uint64_t seed)
@@ -40,6 +58,28 @@ std::vector<Candidate> ViewpointSampler::sampleRoi(const std::vector<map::Fronti
 std::vector<Candidate> ViewpointSampler::sampleExploration(
     const std::vector<map::FrontierVoxel>& frontiers, int count, const ReachabilityFn& reachable) {
   return sample(CandidateKind::kExploration, frontiers, count, reachable);
+}
+
+std::vector<Candidate> ViewpointSampler::sampleSizing(const std::vector<SizingTarget>& targets,
+                                                      int count, const ReachabilityFn& reachable) {
+  std::vector<Candidate> out;
+  if (targets.empty()) return out;
+  std::uniform_int_distribution<std::size_t> pick(0, targets.size() - 1);
+  out.reserve(count);
+  for (int i = 0; i < count; ++i) {
+    const std::size_t t = pick(rng_);
+    // Uniform over the directions that add span: rejection from the whole sphere, of which
+    // a 30-degree cap around a well-seen direction is 7 %, so a few draws suffice.
+    for (int attempt = 0; attempt < kSizingDirectionAttempts; ++attempt) {
+      const Eigen::Vector3d dir = randomUnitVector();
+      if (!addsViewSpan(targets[t], dir)) continue;
+      Candidate c = make(CandidateKind::kSizing, targets[t].center_m, dir, reachable);
+      c.sizing_target = static_cast<int>(t);
+      out.push_back(c);
+      break;
+    }
+  }
+  return out;
 }
 
 std::vector<Candidate> ViewpointSampler::sample(CandidateKind kind,

@@ -64,6 +64,8 @@ struct FruitletSnapshot {
   double view_span_deg = 0.0;  ///< largest angle between two well-seen views' directions
   sizing::SizeSource size_source = sizing::SizeSource::kWellSeenImages;
   double size_stderr_mm = -1.0;  ///< the size's standard error; -1 under 2 well-seen images
+  /// Unit vectors from the fruitlet towards the cameras of its well-seen images.
+  std::vector<Eigen::Vector3d> well_seen_directions;
 };
 
 /// The cluster sized after one view.
@@ -110,6 +112,10 @@ class ClusterCompletion : public LoopObserver {
   ClusterCompletionConfig config_;
   std::vector<SizingSnapshot> history_;
 };
+
+/// Whether a fruitlet still lacks the images the rule asks for: min_well_seen_images
+/// well-seen images from directions min_view_span_deg apart (sphere-fit sizes need none).
+bool lacksEvidence(const FruitletSnapshot& fruitlet, const ClusterCompletionConfig& config);
 
 /// Whether the last config.stable_views + 1 snapshots of history agree (the rule of done()).
 bool sizesSettled(const std::vector<SizingSnapshot>& history,

@@ -26,6 +26,13 @@ class FvpPlanner : public ViewPlanner {
   PlanStep planAndMove(map::MapEngine& map, const Eigen::Isometry3d& T_world_camera_now,
                        const ReachabilityFn& reachable, const MoveToPoseFn& move) override;
   std::string configJson() const override;
+  /// With sizing_samples > 0, each sampling round also aims that many candidates at these
+  /// (scored by the fraction of the fruitlet the map predicts in view, when it reaches the
+  /// target's min_visible_fraction; else 0), minus the same travel cost.
+  void setSizingTargets(std::vector<SizingTarget> targets) override {
+    sizing_targets_ = std::move(targets);
+  }
+  const std::vector<SizingTarget>& sizingTargets() const { return sizing_targets_; }
 
   /// The current threshold u_t.
   double utilityThreshold() const { return u_t_; }
@@ -53,6 +60,7 @@ class FvpPlanner : public ViewPlanner {
   std::vector<map::FrontierVoxel> frontiers_;
   const map::MapEngine* frontiers_map_ = nullptr;
   std::size_t frontiers_scans_ = 0;
+  std::vector<SizingTarget> sizing_targets_;
 };
 
 }  // namespace fvp::host::planner

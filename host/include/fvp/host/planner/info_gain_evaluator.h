@@ -117,6 +117,12 @@ class InfoGainEvaluator {
     std::uint64_t voxel_steps = 0;
   };
   RayCensus census(const Eigen::Vector3d& from_m, const Eigen::Vector3d& to_m) const;
+  /// The fraction of a sphere's near side a camera at camera_m would see: 19 rays to points
+  /// spread over its silhouette disc, each ending two fine voxels short of the surface (the
+  /// sphere's own voxels do not hide it), blocked by the first occupied voxel (census).
+  /// Unknown space does not block: optimistic, as every gain here. 0 from inside the sphere.
+  double visibleFraction(const Eigen::Vector3d& camera_m, const Eigen::Vector3d& center_m,
+                         double radius_m) const;
   /// Whether any occupied coarse voxel lies within radius_m of p (voxel centres): a camera
   /// body there would collide, so the motion planner need not be asked.
   bool occupiedWithin(const Eigen::Vector3d& p_m, double radius_m) const;

@@ -40,6 +40,9 @@ inline constexpr int kDefaultFrustumRaysY = 12;
 // Embree culling of rays blocked in the coarse map before the gain walks. Off by default:
 // measured slower than letting the walk stop at the blocking voxel (docs/planner.md).
 inline constexpr bool kDefaultEmbreeCull = false;
+// Candidates per round aimed at the fruitlets the automatic stop still waits for
+// (sizing_target.h); 0 samples none, as the paper's planner.
+inline constexpr int kDefaultSizingSamples = 0;
 
 struct PlannerConfig {
   int roi_samples = kDefaultRoiSamples;
@@ -57,6 +60,7 @@ struct PlannerConfig {
   int frustum_rays_x = kDefaultFrustumRaysX;
   int frustum_rays_y = kDefaultFrustumRaysY;
   bool embree_cull = kDefaultEmbreeCull;
+  int sizing_samples = kDefaultSizingSamples;
 
   /// Reads a YAML file; missing keys keep their defaults; unknown keys, wrong types and
   /// out-of-range values throw std::invalid_argument naming the file and the key.

@@ -14,14 +14,16 @@
 #include <string_view>
 #include <vector>
 
+#include "fvp/host/planner/sizing_target.h"
+
 namespace fvp::host::map {
 class MapEngine;
 }
 
 namespace fvp::host::planner {
 
-enum class CandidateKind { kRoi, kExploration };
-/// "roi" or "exploration" (plan.json's "kind").
+enum class CandidateKind { kRoi, kExploration, kSizing };
+/// "roi", "exploration" or "sizing" (plan.json's "kind").
 const char* toString(CandidateKind kind);
 
 /// One viewpoint candidate: a full camera pose (OpenCV optical frame of the left camera,
@@ -33,6 +35,8 @@ struct Candidate {
   double ig = 0.0;       ///< information gain (planner-specific definition)
   double utility = 0.0;  ///< ig - cost (paper Eq. 3 for FVP)
   bool reachable = false;
+  /// kSizing: which of the planner's sizing targets it looks at (-1 for the other kinds).
+  int sizing_target = -1;
   Eigen::Vector3d position_m() const { return T_world_camera.translation(); }
 };
 
@@ -76,6 +80,9 @@ class ViewPlanner {
                                const ReachabilityFn& reachable, const MoveToPoseFn& move) = 0;
   /// The planner's configuration as JSON text (printed into every result).
   virtual std::string configJson() const = 0;
+  /// The fruitlets the automatic stop still waits for, after each sizing (sizing_target.h).
+  /// Planners that cannot aim at them ignore them (the default).
+  virtual void setSizingTargets(std::vector<SizingTarget> targets) { (void)targets; }
 };
 
 }  // namespace fvp::host::planner

@@ -1,0 +1,63 @@
+// Aims the planner at what the automatic stop still waits for (docs/nbv-loop.md, "Views the
+// stop rule needs"). After each sizing, every fruitlet short of the rule's evidence (two
+// well-seen images from directions 30 degrees apart, lacksEvidence) becomes one of the
+// planner's sizing targets. A fruitlet the planner has moved to look at max_aimed_views times
+// without gaining a well-seen image is left out until it gains one: after the first such view
+// the occluders on that line of sight are in the map, so the next prediction is better
+// informed; a second miss says no reachable view shows it (a neighbour merged with it in 2-D,
+// a leaf the arm cannot see past), and the cluster must not wait on it.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <vector>
+
+#include "fvp/host/nbv/cluster_completion.h"
+#include "fvp/host/nbv/nbv_loop.h"
+#include "fvp/host/planner/view_planner.h"
+
+namespace fvp::host::nbv {
+
+class SizingGuidance : public LoopObserver {
+ public:
+  /// completion and planner must outlive this; add this observer after completion, whose
+  /// sizing it reads. min_visible_fraction: sizing's well_seen_fraction.
+  SizingGuidance(const ClusterCompletion& completion, planner::ViewPlanner& planner,
+                 double min_visible_fraction, int max_aimed_views = 2)
+      : SizingGuidance(completion.history(), completion.config(), planner, min_visible_fraction,
+                       max_aimed_views) {}
+  /// Over any sizing history (tests): history and config must outlive this.
+  SizingGuidance(const std::vector<SizingSnapshot>& history, const ClusterCompletionConfig& config,
+                 planner::ViewPlanner& planner, double min_visible_fraction,
+                 int max_aimed_views = 2);
+
+  void onView(const ViewEvent& event) override;
+  void onPlan(const PlanEvent& event) override;
+
+  /// The targets handed to the planner after the last view.
+  const std::vector<planner::SizingTarget>& targets() const { return targets_; }
+  /// Moves to a sizing candidate so far.
+  std::size_t aimedViews() const { return aimed_views_; }
+  /// Fruitlets left out after max_aimed_views aimed views without a new well-seen image.
+  std::size_t droppedTargets() const { return dropped_; }
+
+ private:
+  struct Aim {
+    Eigen::Vector3d center_m;
+    int well_seen_images = 0;  ///< when first aimed at
+    int views = 0;
+  };
+  Aim* findAim(const Eigen::Vector3d& center_m);
+
+  const std::vector<SizingSnapshot>& history_;
+  const ClusterCompletionConfig& config_;
+  planner::ViewPlanner& planner_;
+  double min_visible_fraction_;
+  int max_aimed_views_;
+  std::vector<planner::SizingTarget> targets_;
+  std::vector<int> target_well_seen_;  ///< per target, its well-seen images
+  std::vector<Aim> aims_;
+  std::size_t aimed_views_ = 0, dropped_ = 0;
+};
+
+}  // namespace fvp::host::nbv

@@ -1,0 +1,76 @@
+#include "fvp/host/nbv/sizing_guidance.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace fvp::host::nbv {
+
+SizingGuidance::SizingGuidance(const std::vector<SizingSnapshot>& history,
+                               const ClusterCompletionConfig& config, planner::ViewPlanner& planner,
+                               double min_visible_fraction, int max_aimed_views)
+    : history_(history),
+      config_(config),
+      planner_(planner),
+      min_visible_fraction_(min_visible_fraction),
+      max_aimed_views_(max_aimed_views) {
+  if (!(min_visible_fraction >= 0.0 && min_visible_fraction <= 1.0))
+    throw std::invalid_argument("SizingGuidance: min_visible_fraction: expected 0 to 1");
+  if (max_aimed_views < 1)
+    throw std::invalid_argument("SizingGuidance: max_aimed_views: expected at least 1");
+}
+
+SizingGuidance::Aim* SizingGuidance::findAim(const Eigen::Vector3d& center_m) {
+  const double same_m = config_.same_fruitlet_m;
+  for (Aim& aim : aims_)
+    if ((aim.center_m - center_m).norm() <= same_m) return &aim;
+  return nullptr;
+}
+
+void SizingGuidance::onPlan(const PlanEvent& event) {
+  if (!event.step || !event.step->moved()) return;
+  const planner::Candidate& chosen = event.step->candidates[*event.step->chosen];
+  if (chosen.kind != planner::CandidateKind::kSizing) return;
+  ++aimed_views_;
+  const std::size_t t = std::size_t(chosen.sizing_target);
+  if (t >= targets_.size()) return;
+  if (Aim* aim = findAim(targets_[t].center_m))
+    ++aim->views;
+  else
+    aims_.push_back({targets_[t].center_m, target_well_seen_[t], 1});
+}
+
+void SizingGuidance::onView(const ViewEvent& event) {
+  targets_.clear();
+  target_well_seen_.clear();
+  // No sizing for this view (no Cluster Region yet): nothing to aim at.
+  if (history_.empty() || history_.back().view != event.index) {
+    planner_.setSizingTargets({});
+    return;
+  }
+  for (const FruitletSnapshot& f : history_.back().fruitlets) {
+    if (!lacksEvidence(f, config_)) continue;
+    if (Aim* aim = findAim(f.center_m)) {
+      if (f.well_seen_images > aim->well_seen_images) {
+        *aim = aims_.back();  // a new well-seen image: the count starts again
+        aims_.pop_back();
+      } else if (aim->views >= max_aimed_views_) {
+        if (aim->views == max_aimed_views_) {
+          ++dropped_;
+          ++aim->views;  // counted once
+        }
+        continue;
+      }
+    }
+    planner::SizingTarget target;
+    target.center_m = f.center_m;
+    target.radius_m = 0.5e-3 * f.size_mm;
+    target.seen_from = f.well_seen_directions;
+    target.min_angle_deg = config_.min_view_span_deg;
+    target.min_visible_fraction = min_visible_fraction_;
+    targets_.push_back(std::move(target));
+    target_well_seen_.push_back(f.well_seen_images);
+  }
+  planner_.setSizingTargets(targets_);
+}
+
+}  // namespace fvp::host::nbv

@@ -1,0 +1,124 @@
+// The sizing guidance on constructed sizing histories: only fruitlets short of the stop's
+// evidence become targets, with their well-seen directions; a fruitlet aimed at twice without
+// a new well-seen image is dropped, and one that gains an image is aimed at again.
+#include "fvp/host/nbv/sizing_guidance.h"
+
+#include <gtest/gtest.h>
+
+namespace fvp::host::nbv {
+namespace {
+
+// Records what the guidance hands over.
+class RecordingPlanner : public planner::ViewPlanner {
+ public:
+  std::string_view name() const override { return "recording"; }
+  planner::PlanStep planAndMove(map::MapEngine&, const Eigen::Isometry3d&,
+                                const planner::ReachabilityFn&,
+                                const planner::MoveToPoseFn&) override {
+    return {};
+  }
+  std::string configJson() const override { return "{}"; }
+  void setSizingTargets(std::vector<planner::SizingTarget> targets) override {
+    targets_ = std::move(targets);
+    ++calls_;
+  }
+  std::vector<planner::SizingTarget> targets_;
+  int calls_ = 0;
+};
+
+FruitletSnapshot fruitlet(double x_m, int well_seen, double span_deg) {
+  FruitletSnapshot f;
+  f.center_m = Eigen::Vector3d(x_m, 0.0, 0.3);
+  f.size_mm = 10.0;
+  f.well_seen_images = well_seen;
+  f.view_span_deg = span_deg;
+  for (int i = 0; i < well_seen; ++i) f.well_seen_directions.push_back(Eigen::Vector3d::UnitY());
+  return f;
+}
+
+SizingSnapshot snapshot(int view, std::vector<FruitletSnapshot> fruitlets) {
+  SizingSnapshot s;
+  s.view = view;
+  s.fruitlets = std::move(fruitlets);
+  return s;
+}
+
+// A plan step that moved to a sizing candidate aimed at target t.
+planner::PlanStep aimedAt(int t) {
+  planner::PlanStep step;
+  planner::Candidate c;
+  c.kind = planner::CandidateKind::kSizing;
+  c.sizing_target = t;
+  step.candidates = {c};
+  step.chosen = 0;
+  return step;
+}
+
+TEST(SizingGuidance, TargetsOnlyFruitletsShortOfTheEvidence) {
+  const ClusterCompletionConfig config;  // 2 well-seen images, 30 degrees
+  std::vector<SizingSnapshot> history;
+  RecordingPlanner planner;
+  SizingGuidance guidance(history, config, planner, 0.6);
+  FruitletSnapshot merged = fruitlet(0.06, 0, 0.0);
+  merged.size_source = sizing::SizeSource::kSphereFit;  // sized by its sphere: needs no images
+  history.push_back(snapshot(
+      0, {fruitlet(0.0, 4, 60.0), fruitlet(0.02, 1, 0.0), fruitlet(0.04, 3, 10.0), merged}));
+  guidance.onView({.index = 0});
+  ASSERT_EQ(planner.targets_.size(), 2u);
+  EXPECT_DOUBLE_EQ(planner.targets_[0].center_m.x(), 0.02);
+  EXPECT_DOUBLE_EQ(planner.targets_[1].center_m.x(), 0.04);
+  EXPECT_DOUBLE_EQ(planner.targets_[0].radius_m, 0.005);
+  EXPECT_EQ(planner.targets_[1].seen_from.size(), 3u);
+  EXPECT_DOUBLE_EQ(planner.targets_[1].min_angle_deg, 30.0);
+  EXPECT_DOUBLE_EQ(planner.targets_[1].min_visible_fraction, 0.6);
+  // A view the completion did not size (no Cluster Region yet): nothing to aim at.
+  guidance.onView({.index = 1});
+  EXPECT_TRUE(planner.targets_.empty());
+  EXPECT_EQ(planner.calls_, 2);
+}
+
+TEST(SizingGuidance, DropsAFruitletAimedAtTwiceInVainAndReturnsToItWhenItGainsAnImage) {
+  const ClusterCompletionConfig config;
+  std::vector<SizingSnapshot> history;
+  RecordingPlanner planner;
+  SizingGuidance guidance(history, config, planner, 0.6);
+  int view = 0;
+  const auto sized = [&](int well_seen) {
+    history.push_back(snapshot(view, {fruitlet(0.0, well_seen, 0.0)}));
+    guidance.onView({.index = view++});
+  };
+  const planner::PlanStep step = aimedAt(0);
+  sized(1);
+  ASSERT_EQ(planner.targets_.size(), 1u);
+  guidance.onPlan({.step = &step});
+  sized(1);  // the aimed view showed nothing new
+  ASSERT_EQ(planner.targets_.size(), 1u) << "one miss: the map now holds that line of sight";
+  guidance.onPlan({.step = &step});
+  sized(1);
+  EXPECT_TRUE(planner.targets_.empty()) << "two misses: no reachable view shows it";
+  EXPECT_EQ(guidance.droppedTargets(), 1u);
+  sized(1);
+  EXPECT_TRUE(planner.targets_.empty());
+  EXPECT_EQ(guidance.droppedTargets(), 1u) << "counted once";
+  // An ordinary view gave it a well-seen image, still not from 30 degrees away: a target again.
+  history.push_back(snapshot(view, {fruitlet(0.0, 2, 10.0)}));
+  guidance.onView({.index = view++});
+  ASSERT_EQ(planner.targets_.size(), 1u);
+  EXPECT_EQ(guidance.aimedViews(), 2u);
+  // Moves to other kinds of candidate are not aims.
+  planner::PlanStep roi = aimedAt(0);
+  roi.candidates[0].kind = planner::CandidateKind::kRoi;
+  guidance.onPlan({.step = &roi});
+  EXPECT_EQ(guidance.aimedViews(), 2u);
+}
+
+TEST(SizingGuidance, RejectsBadSettings) {
+  const ClusterCompletionConfig config;
+  std::vector<SizingSnapshot> history;
+  RecordingPlanner planner;
+  EXPECT_THROW(SizingGuidance(history, config, planner, 1.5), std::invalid_argument);
+  EXPECT_THROW(SizingGuidance(history, config, planner, 0.6, 0), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace fvp::host::nbv
