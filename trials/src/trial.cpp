@@ -185,6 +185,9 @@ class TrialLog : public host::nbv::LoopObserver {
          {"sampling_rounds", step.sampling_rounds},
          {"chosen_utility",
           step.chosen ? nlohmann::json(step.candidates[*step.chosen].utility) : nlohmann::json()},
+         {"chosen_kind",
+          step.chosen ? nlohmann::json(host::planner::toString(step.candidates[*step.chosen].kind))
+                      : nlohmann::json()},
          {"chosen_position_m",
           step.chosen ? vec3Json(step.candidates[*step.chosen].position_m()) : nlohmann::json()},
          {"chosen_quaternion_wxyz",
