@@ -158,10 +158,11 @@ TEST(FvpPlanner, AimsAtSizingTargetsOnlyWhenAskedAndScoresThemByWhatIsInView) {
   target.radius_m = 0.006;
   const Eigen::Isometry3d now(Eigen::Translation3d(0.0, -0.3, 0.35));
   const auto never = [](const Eigen::Isometry3d&) { return false; };
+  config.sizing_samples = 0;
   FvpPlanner off(config, 3);
   off.setSizingTargets({target});
   for (const Candidate& c : off.planAndMove(*e, now, inShell, never).candidates)
-    EXPECT_NE(c.kind, CandidateKind::kSizing) << "sizing_samples 0: the paper's planner";
+    EXPECT_NE(c.kind, CandidateKind::kSizing) << "sizing_samples 0: none";
   config.sizing_samples = 60;
   FvpPlanner on(config, 3);
   on.setSizingTargets({target});

@@ -41,8 +41,9 @@ inline constexpr int kDefaultFrustumRaysY = 12;
 // measured slower than letting the walk stop at the blocking voxel (docs/planner.md).
 inline constexpr bool kDefaultEmbreeCull = false;
 // Candidates per round aimed at the fruitlets the automatic stop still waits for
-// (sizing_target.h); 0 samples none, as the paper's planner.
-inline constexpr int kDefaultSizingSamples = 0;
+// (sizing_target.h), as many as each of the paper's two kinds; only the automatic stop hands
+// targets over, so the paper's budget runs sample none. 0: never.
+inline constexpr int kDefaultSizingSamples = 100;
 
 struct PlannerConfig {
   int roi_samples = kDefaultRoiSamples;
