@@ -200,7 +200,8 @@ double InfoGainEvaluator::visibleFraction(const Eigen::Vector3d& camera_m,
     ++rays;
     seen += !census(camera_m, end).occluded;
   };
-  // The centre and two rings (at half and 85 % of the radius): about equal areas of the disc.
+  // The centre and two rings (at half and 85 % of the radius): each ray stands for about the
+  // same area of the disc.
   cast(0.0, 0.0);
   for (const auto& [ring, count] : {std::pair{0.5, 6}, std::pair{0.85, 12}})
     for (int k = 0; k < count; ++k) {
