@@ -36,12 +36,11 @@ void SizingGuidance::onPlan(const PlanEvent& event) {
   if (Aim* aim = findAim(targets_[t].center_m))
     ++aim->views;
   else
-    aims_.push_back({targets_[t].center_m, target_well_seen_[t], 1});
+    aims_.push_back({targets_[t].center_m, static_cast<int>(targets_[t].seen_from.size()), 1});
 }
 
 void SizingGuidance::onView(const ViewEvent& event) {
   targets_.clear();
-  target_well_seen_.clear();
   // No sizing for this view (no Cluster Region yet): nothing to aim at.
   if (history_.empty() || history_.back().view != event.index) {
     planner_.setSizingTargets({});
@@ -68,7 +67,6 @@ void SizingGuidance::onView(const ViewEvent& event) {
     target.min_angle_deg = config_.min_view_span_deg;
     target.min_visible_fraction = min_visible_fraction_;
     targets_.push_back(std::move(target));
-    target_well_seen_.push_back(f.well_seen_images);
   }
   planner_.setSizingTargets(targets_);
 }

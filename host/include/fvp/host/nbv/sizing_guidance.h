@@ -55,7 +55,6 @@ class SizingGuidance : public LoopObserver {
   double min_visible_fraction_;
   int max_aimed_views_;
   std::vector<planner::SizingTarget> targets_;
-  std::vector<int> target_well_seen_;  ///< per target, its well-seen images
   std::vector<Aim> aims_;
   std::size_t aimed_views_ = 0, dropped_ = 0;
 };

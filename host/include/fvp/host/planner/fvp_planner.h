@@ -32,7 +32,6 @@ class FvpPlanner : public ViewPlanner {
   void setSizingTargets(std::vector<SizingTarget> targets) override {
     sizing_targets_ = std::move(targets);
   }
-  const std::vector<SizingTarget>& sizingTargets() const { return sizing_targets_; }
 
   /// The current threshold u_t.
   double utilityThreshold() const { return u_t_; }

@@ -14,7 +14,7 @@ namespace fvp::host::planner {
 struct SizingTarget {
   Eigen::Vector3d center_m = Eigen::Vector3d::Zero();  ///< in the maps' frame
   double radius_m = 0.0;
-  /// Unit vectors from the fruitlet towards the cameras of its well-seen images.
+  /// Unit vectors from the fruitlet towards the cameras of its well-seen images, one per image.
   std::vector<Eigen::Vector3d> seen_from;
   /// A new view must lie at least this far from one of seen_from (any view when empty).
   double min_angle_deg = 30.0;
