@@ -87,6 +87,16 @@ TEST(PointFilters, DbscanEqualsBruteForce) {
   }
 }
 
+TEST(PointFilters, ClusterMembersGroupsIndicesByLabelAndLeavesNoiseOut) {
+  const std::vector<int> labels = {2, sizing::kDbscanNoise, 0, 2, 0, sizing::kDbscanNoise, 5};
+  const auto members = sizing::clusterMembers(labels);
+  ASSERT_EQ(members.size(), 3u);
+  EXPECT_EQ(members.at(0), (std::vector<std::size_t>{2, 4}));
+  EXPECT_EQ(members.at(2), (std::vector<std::size_t>{0, 3}));
+  EXPECT_EQ(members.at(5), (std::vector<std::size_t>{6}));
+  EXPECT_TRUE(sizing::clusterMembers({}).empty());
+}
+
 TEST(Matching, OneToOneWithinTheGateByHand) {
   const std::vector<Eigen::Vector3d> gt = {{0, 0, 0}, {0.004, 0, 0}, {0.1, 0, 0}};
   // d0 is 1 mm from gt0 and 3 mm from gt1; d1 is 1 mm from gt1 and 5 mm from gt0: the

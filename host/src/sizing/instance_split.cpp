@@ -228,9 +228,7 @@ std::size_t splitByInstances(const std::vector<Eigen::Vector3f>& points, std::ve
          view.disparity_px.size() != view.fruitlet_instances.size()))
       throw std::invalid_argument(
           "instance split: instance ids CV_16U and disparity CV_32F of one size expected");
-  std::map<int, std::vector<std::size_t>> clusters;
-  for (std::size_t i = 0; i < points.size(); ++i)
-    if (labels[i] != kDbscanNoise) clusters[labels[i]].push_back(i);
+  auto clusters = clusterMembers(labels);
   int next_label = clusters.empty() ? 0 : clusters.rbegin()->first + 1;
   std::size_t split_off = 0;
   for (auto& [label, members] : clusters) {

@@ -92,6 +92,13 @@ std::vector<int> dbscan(const std::vector<Eigen::Vector3f>& points, double eps_m
   return label;
 }
 
+std::map<int, std::vector<std::size_t>> clusterMembers(const std::vector<int>& labels) {
+  std::map<int, std::vector<std::size_t>> members;
+  for (std::size_t i = 0; i < labels.size(); ++i)
+    if (labels[i] != kDbscanNoise) members[labels[i]].push_back(i);
+  return members;
+}
+
 double meanNearestDistance_m(const std::vector<Eigen::Vector3f>& from,
                              const std::vector<Eigen::Vector3f>& to) {
   if (from.empty() || to.empty()) return std::numeric_limits<double>::infinity();

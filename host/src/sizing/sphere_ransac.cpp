@@ -201,9 +201,7 @@ std::size_t splitMergedClusters(const std::vector<Eigen::Vector3f>& points,
   config.validate();
   if (labels.size() != points.size())
     throw std::invalid_argument("cluster split: one label per point expected");
-  std::map<int, std::vector<std::size_t>> clusters;
-  for (std::size_t i = 0; i < points.size(); ++i)
-    if (labels[i] != kDbscanNoise) clusters[labels[i]].push_back(i);
+  auto clusters = clusterMembers(labels);
   int next_label = clusters.empty() ? 0 : clusters.rbegin()->first + 1;
   std::size_t split = 0;
   for (const auto& [label, members] : clusters)

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <map>
 #include <vector>
 
 namespace fvp::host::sizing {
@@ -23,6 +24,9 @@ inline constexpr int kDbscanNoise = -1;
 /// Cluster label of every point (0, 1, ... in order of the first core point found, scanning
 /// the points in order), kDbscanNoise for noise.
 std::vector<int> dbscan(const std::vector<Eigen::Vector3f>& points, double eps_m, int min_samples);
+
+/// The indices of each cluster's points, by label in ascending order; noise left out.
+std::map<int, std::vector<std::size_t>> clusterMembers(const std::vector<int>& labels);
 
 /// Mean distance from each point of `from` to its nearest point of `to` (k-d tree over
 /// `to`); infinity when either is empty.
