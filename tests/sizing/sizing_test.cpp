@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <set>
+#include <utility>
 
 #include "backend_test_support.h"
 #include "fvp/host/eval/fruitlet_matching.h"
@@ -323,6 +324,88 @@ TEST(Sizing, OverlapRuleMergesAFruitletSeenTwiceAndKeepsTouchingNeighbours) {
   const auto two = sizing::sizeFruitlets({pair_view}, neighbours, nullptr, config);
   EXPECT_EQ(two.fruitlets.size(), 2u);
   EXPECT_EQ(two.events.overlapping_detections_merged, 0u);
+}
+
+/// A view of the sphere (c, r) in front of a leaf: the plane z = leaf_z_m (world), from a
+/// camera at `position` looking at c. Depth, disparity and the sphere's mask.
+SphereView viewOfSphereAndLeaf(const Eigen::Vector3d& c, double r, double leaf_z_m,
+                               const Eigen::Vector3d& position) {
+  const Eigen::Vector3d z_axis = (c - position).normalized();
+  const Eigen::Vector3d x_axis = Eigen::Vector3d::UnitY().cross(z_axis).normalized();
+  Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();
+  T_world_camera.linear() << x_axis, z_axis.cross(x_axis), z_axis;
+  T_world_camera.translation() = position;
+  SphereView v;
+  static_cast<testing::SphereView&>(v) =
+      testing::renderSpheres({Eigen::Vector4d(c.x(), c.y(), c.z(), r)}, T_world_camera);
+  v.disparity = cv::Mat(v.depth.size(), CV_32F, cv::Scalar(0));
+  const Eigen::Matrix3d R = T_world_camera.linear();
+  for (int y = 0; y < v.depth.rows; ++y)
+    for (int x = 0; x < v.depth.cols; ++x) {
+      float z = v.depth.at<float>(y, x);
+      if (!(z > 0.0f)) {  // the leaf: the ray (x', y', 1) z meets the plane
+        const Eigen::Vector3d ray((x - v.in.cx_px) / v.in.fx_px, (y - v.in.cy_px) / v.in.fy_px, 1);
+        z = float((leaf_z_m - position.z()) / (R * ray).z());
+      }
+      v.disparity.at<float>(y, x) = float(v.in.fx_px * v.in.baseline_m / z);
+    }
+  return v;
+}
+
+// The views' agreement (docs/sizing.md): a patch that one view's mask calls fruitlet (mask
+// pixels bled onto the leaf beside a fruitlet's silhouette; or stereo points in the air at its
+// depth edge) is seen as leaf, or seen through, by a view from 30 degrees aside, and hidden
+// behind the fruitlet from 30 degrees the other way (no evidence). The fruitlet's surface is
+// on fruitlet pixels wherever a view sees it.
+TEST(Sizing, ViewAgreementTellsAFruitletFromAPatchOneMaskCalledFruitlet) {
+  const Eigen::Vector3d c(0.0, 0.0, 0.3);
+  const double r = 0.005, leaf_z = 0.32;
+  const Eigen::Vector3d aside(0.15, 0.0, 0.04), other_side(-0.15, 0.0, 0.04);
+  for (const double patch_z : {leaf_z, 0.31}) {  // on the leaf; in the air before it
+    SCOPED_TRACE(patch_z);
+    // 81 points, 1.6 mm square, just beside the fruitlet's silhouette as the first view sees it.
+    std::vector<Eigen::Vector3f> pts = sphereCap(c, r, 80.0);
+    const std::size_t sphere_points = pts.size();
+    for (int i = 0; i < 9; ++i)
+      for (int j = 0; j < 9; ++j)
+        pts.emplace_back(float(0.0055 + 0.0002 * i), float(0.0002 * (j - 4)), float(patch_z));
+    SphereView front = viewOfSphereAndLeaf(c, r, leaf_z, Eigen::Vector3d::Zero());
+    for (std::size_t k = sphere_points; k < pts.size(); ++k) {  // the first view's mistake
+      const auto px = front.in.project(pts[k].cast<double>());
+      ASSERT_TRUE(px);
+      const cv::Point at(int(std::lround(px->x())), int(std::lround(px->y())));
+      cv::line(front.mask, at, cv::Point(int(front.in.cx_px), int(front.in.cy_px)), 255, 3);
+      cv::circle(front.disparity, at, 1, front.in.fx_px * front.in.baseline_m / pts[k].z(), -1);
+    }
+    const SphereView side = viewOfSphereAndLeaf(c, r, leaf_z, aside);
+    const SphereView hidden = viewOfSphereAndLeaf(c, r, leaf_z, other_side);
+    std::vector<sizing::SizingView> views;
+    for (const SphereView* v : {&std::as_const(front), &side, &hidden})
+      views.push_back({v->mask, v->disparity, v->in, v->T_world_camera, {}});
+    sizing::SizingConfig config;
+    config.min_support_area_fraction = 0.0;  // keep the patch in the fruitlets, to find it
+    const auto result = sizing::sizeFruitlets(views, pts, nullptr, config);
+    ASSERT_EQ(result.fruitlets.size(), 2u);
+    const auto& fruitlet =
+        result.fruitlets[0].points > 81 ? result.fruitlets[0] : result.fruitlets[1];
+    const auto& patch = result.fruitlets[0].points > 81 ? result.fruitlets[1] : result.fruitlets[0];
+    EXPECT_EQ(patch.points, 81u);
+    EXPECT_GT(fruitlet.support.view_agreement, 0.95);
+    EXPECT_GT(fruitlet.support.view_evidence_points, sphere_points);
+    // The first view and the one aside each give all 81 points; the other side a few, those
+    // that show past the fruitlet's rim, beside its pixels.
+    EXPECT_GE(patch.support.view_evidence_points, 162u);
+    EXPECT_LE(patch.support.view_evidence_points, 190u);
+    EXPECT_GT(patch.support.view_agreement, 0.45);
+    EXPECT_LT(patch.support.view_agreement, 0.6);
+    // Without the view aside nothing contradicts the first: the statistic says so.
+    const auto two = sizing::sizeFruitlets({views[0], views[2]}, pts, nullptr, config);
+    ASSERT_EQ(two.fruitlets.size(), 2u);
+    for (const auto& f : two.fruitlets) EXPECT_GT(f.support.view_agreement, 0.95);
+  }
+  sizing::SizingConfig bad;
+  bad.view_agreement_disparity_px = 0.0;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
 }
 
 TEST(Sizing, EmptyInputsAreCountedNotErrors) {

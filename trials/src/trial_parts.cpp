@@ -118,15 +118,15 @@ host::planner::ViewPlanner& TrialParts::planner() {
 }
 
 nlohmann::json TrialParts::configJson() const {
-  return {
-      {"engine", impl_->engine},
-      {"clock", impl_->options.clock},
-      {"fine_map_extent", host::map::toString(impl_->map_config.fine_map_extent)},
-      {"stop", impl_->options.stop},
-      {"sizing",
-       {{"estimator", host::sizing::toString(impl_->sizing_config.estimator)},
-        {"min_support_area_fraction", impl_->sizing_config.min_support_area_fraction},
-        {"max_detection_overlap_fraction", impl_->sizing_config.max_detection_overlap_fraction}}}};
+  return {{"engine", impl_->engine},
+          {"clock", impl_->options.clock},
+          {"fine_map_extent", host::map::toString(impl_->map_config.fine_map_extent)},
+          {"stop", impl_->options.stop},
+          {"sizing",
+           {{"estimator", host::sizing::toString(impl_->sizing_config.estimator)},
+            {"min_support_area_fraction", impl_->sizing_config.min_support_area_fraction},
+            {"max_detection_overlap_fraction", impl_->sizing_config.max_detection_overlap_fraction},
+            {"view_agreement_disparity_px", impl_->sizing_config.view_agreement_disparity_px}}}};
 }
 
 std::vector<host::eval::GroundTruthFruitlet> groundTruthOf(const World& world,

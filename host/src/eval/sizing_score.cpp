@@ -115,7 +115,9 @@ nlohmann::json detectionJson(const sizing::FruitletEstimate& f) {
             {"sphere_rms_mm", f.support.sphere_rms_mm},
             {"required_points", f.support.required_points},
             {"size_stderr_mm", f.support.size_stderr_mm},
-            {"merged_detections", f.support.merged_detections}}},
+            {"merged_detections", f.support.merged_detections},
+            {"view_evidence_points", f.support.view_evidence_points},
+            {"view_agreement", f.support.view_agreement}}},
           {"per_image", per_image}};
 }
 

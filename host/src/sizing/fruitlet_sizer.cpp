@@ -149,6 +149,49 @@ std::optional<ImageSize> measureImage(const SizingView& view, const Segments& se
   return s;
 }
 
+/// DetectionSupport::view_evidence_points and view_agreement of one detection's points.
+void measureViewAgreement(const std::vector<Eigen::Vector3f>& points,
+                          const std::vector<SizingView>& views, const SizingConfig& config,
+                          DetectionSupport& support) {
+  std::size_t seen = 0, seen_past = 0, on_fruitlet = 0;
+  const double tolerance_px = config.view_agreement_disparity_px;
+  for (const SizingView& view : views) {
+    const cv::Mat& disparity = view.disparity_px;
+    const cv::Mat& mask = view.fruitlet_mask;
+    if (disparity.empty() || disparity.type() != CV_32F) continue;
+    const bool has_mask = mask.type() == CV_8U && mask.size() == disparity.size();
+    const Eigen::Isometry3d T_camera_world = view.T_world_camera.inverse();
+    const double fb = view.intrinsics.fx_px * view.intrinsics.baseline_m;
+    for (const auto& p_world : points) {
+      const Eigen::Vector3d p = T_camera_world * p_world.cast<double>();
+      const auto px = view.intrinsics.project(p);
+      if (!px || !(p.z() > 0.0)) continue;
+      const int u = int(std::lround(px->x())), v = int(std::lround(px->y()));
+      if (u < 0 || v < 0 || u >= disparity.cols || v >= disparity.rows) continue;
+      const double expected_px = fb / p.z();
+      bool matches = false, any_valid = false, all_farther = true, fruitlet = false;
+      for (int y = std::max(0, v - 1); y <= std::min(disparity.rows - 1, v + 1); ++y)
+        for (int x = std::max(0, u - 1); x <= std::min(disparity.cols - 1, u + 1); ++x) {
+          const float d = disparity.at<float>(y, x);
+          if (has_mask && mask.at<std::uint8_t>(y, x) != 0) fruitlet = true;
+          if (!std::isfinite(d) || !(d > 0.0f)) continue;
+          any_valid = true;
+          matches |= std::abs(d - expected_px) <= tolerance_px;
+          all_farther &= d < expected_px - tolerance_px;
+        }
+      if (matches) {
+        ++seen;
+        if (fruitlet) ++on_fruitlet;
+      } else if (any_valid && all_farther) {
+        ++seen_past;
+      }
+    }
+  }
+  support.view_evidence_points = seen + seen_past;
+  support.view_agreement =
+      support.view_evidence_points > 0 ? double(on_fruitlet) / double(seen + seen_past) : -1.0;
+}
+
 /// Both estimators, the support and the support rule's requirement from a cluster's
 /// measured images (their shared flags set); nothing for a cluster no image sized.
 void aggregate(FruitletEstimate& f, const SizingConfig& config) {
@@ -239,6 +282,8 @@ void SizingConfig::validate() const {
     throw std::invalid_argument("sizing: surface_voxel_size_m > 0");
   if (!(max_detection_overlap_fraction >= 0.0))
     throw std::invalid_argument("sizing: max_detection_overlap_fraction >= 0");
+  if (!(view_agreement_disparity_px > 0.0))
+    throw std::invalid_argument("sizing: view_agreement_disparity_px > 0");
   if (use_instances) instance_split.validate();
   if (split_merged_clusters && min_cluster_points < 4)
     throw std::invalid_argument("sizing: min_cluster_points >= 4 (a sphere needs 4 points)");
@@ -433,6 +478,7 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
       if (!worst) break;
       dropped[*worst] = true;
       marks_segments[*worst] = estimates[*worst].support.own_segment_images > 0;
+      measureViewAgreement(*sized[*worst].second, views, config, estimates[*worst].support);
       result.unsupported.push_back(std::move(estimates[*worst]));
     }
     // The overlap rule: two fruitlets are firm bodies that touch but do not interpenetrate,
@@ -484,6 +530,7 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
     }
     if (f.per_image.size() == 1) ++result.events.single_image_fruitlets;
     if (!(f.sphere_radius_m > 0.0)) ++result.events.failed_sphere_fits;
+    measureViewAgreement(*sized[ci].second, views, config, f.support);
     result.fruitlets.push_back(std::move(f));
   }
   result.events.unsupported_detections = result.unsupported.size();
