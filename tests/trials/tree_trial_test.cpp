@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <set>
 
@@ -45,17 +46,18 @@ class TreeTrial : public ::testing::Test {
   robot::sim::WorldConfig world_config_;
 };
 
-// The simulated arm, except that it cannot reach anywhere near one cluster's start view.
-class ArmWithAnUnreachableCluster : public host::nbv::Arm {
+// The simulated arm, except where `blocked` says it cannot go.
+class ArmWithABlockedRegion : public host::nbv::Arm {
  public:
-  ArmWithAnUnreachableCluster(host::nbv::Arm& arm, const Eigen::Vector3d& blocked_m)
-      : arm_(arm), blocked_m_(blocked_m) {}
+  using Blocked = std::function<bool(const Eigen::Isometry3d&)>;
+  ArmWithABlockedRegion(host::nbv::Arm& arm, Blocked blocked)
+      : arm_(arm), blocked_(std::move(blocked)) {}
   Eigen::Isometry3d cameraPose() const override { return arm_.cameraPose(); }
   bool reachable(const Eigen::Isometry3d& T) const override {
-    return !blocked(T) && arm_.reachable(T);
+    return !blocked_(T) && arm_.reachable(T);
   }
   host::nbv::MoveResult moveTo(const Eigen::Isometry3d& T) override {
-    if (blocked(T)) return {host::nbv::MoveStatus::kNoIk, 0.0};
+    if (blocked_(T)) return {host::nbv::MoveStatus::kNoIk, 0.0};
     return arm_.moveTo(T);
   }
   std::size_t updateObstacles(host::map::MapEngine& map) override {
@@ -63,12 +65,15 @@ class ArmWithAnUnreachableCluster : public host::nbv::Arm {
   }
 
  private:
-  bool blocked(const Eigen::Isometry3d& T) const {
-    return (T.translation() - blocked_m_).norm() < 0.2;
-  }
   host::nbv::Arm& arm_;
-  Eigen::Vector3d blocked_m_;
+  Blocked blocked_;
 };
+
+/// Distance from p to the line through a along the unit direction u.
+double distanceToLine(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                      const Eigen::Vector3d& u) {
+  return (p - a - (p - a).dot(u) * u).norm();
+}
 
 TEST_F(TreeTrial, VisitsEveryClusterOnceAndSkipsOneItCannotReach) {
   const auto world = robot::sim::World::generate(world_config_, kSeed);
@@ -77,8 +82,12 @@ TEST_F(TreeTrial, VisitsEveryClusterOnceAndSkipsOneItCannotReach) {
   TrialOptions o = options();
   o.out_dir = dir_ / "out";
   Trial trial(o);
-  ArmWithAnUnreachableCluster arm(trial.simulatedArm(),
-                                  world.clusters()[blocked].T_world_start_camera.translation());
+  // No view of that cluster at all: nothing within 0.6 m whose optical axis passes near it.
+  const Eigen::Vector3d centre = world.clusters()[blocked].center_m;
+  ArmWithABlockedRegion arm(trial.simulatedArm(), [centre](const Eigen::Isometry3d& T) {
+    return (T.translation() - centre).norm() < 0.6 &&
+           distanceToLine(centre, T.translation(), T.linear().col(2)) < 0.02;
+  });
   const nlohmann::json r = trial.run(trial.simulatedCamera(), arm);
 
   ASSERT_EQ(r.at("clusters").size(), 3u);
@@ -152,6 +161,38 @@ TEST_F(TreeTrial, VisitsEveryClusterOnceAndSkipsOneItCannotReach) {
     EXPECT_NE(report.find("| " + f.at("label").get<std::string>() + " |"), std::string::npos)
         << f.at("label");
   EXPECT_EQ(scene.at("cluster_regions").size(), 2u);  // the sized clusters'
+}
+
+// Where foliage stands on a cluster's axis (its start view and every view straight back from
+// it blocked), the tour reaches it from a view turned 20 degrees about the vertical.
+TEST_F(TreeTrial, ReachesAClusterFromATurnedViewWhenItsAxisIsBlocked) {
+  const auto world = robot::sim::World::generate(world_config_, kSeed);
+  const int blocked = 2;
+  const robot::sim::FruitletCluster& cluster = world.clusters()[blocked];
+  const Eigen::Vector3d centre = cluster.center_m;
+  const Eigen::Vector3d axis = -cluster.T_world_start_camera.linear().col(2);
+  TrialOptions o = options();
+  o.out_dir = dir_ / "turned";
+  Trial trial(o);
+  ArmWithABlockedRegion arm(trial.simulatedArm(), [&](const Eigen::Isometry3d& T) {
+    return (T.translation() - centre).dot(axis) > 0.1 &&
+           distanceToLine(T.translation(), centre, axis) < 0.03;
+  });
+  const nlohmann::json r = trial.run(trial.simulatedCamera(), arm);
+  EXPECT_EQ(r["tour"]["cluster_status"].value("sized", 0), 3);
+  for (const auto& c : r["clusters"]) {
+    if (c["index"] != blocked) continue;
+    EXPECT_EQ(c["status"], "sized");
+    EXPECT_EQ(c["approach_yaw_deg"], 20.0);
+    EXPECT_NEAR(c["approach_distance_m"].get<double>(),
+                (cluster.T_world_start_camera.translation() - centre).norm(), 1e-6);
+  }
+  // The others from their own axes, as before.
+  for (const auto& c : r["clusters"]) {
+    if (c["index"] != blocked && c.contains("approach_yaw_deg")) {
+      EXPECT_EQ(c["approach_yaw_deg"], 0.0);
+    }
+  }
 }
 
 TEST_F(TreeTrial, RepeatsExactlyWithAFixedClock) {

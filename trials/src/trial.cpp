@@ -1,5 +1,6 @@
 #include "fvp/trials/trial.h"
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -306,17 +307,33 @@ nlohmann::json sizeHistoryJson(const std::vector<host::nbv::SizingSnapshot>& his
 // the collision padding (1 cm) and a coarse voxel (1 cm) needs about 5 cm around it, and
 // leaves may hang that close to the start view (the generator keeps them 5 cm off the
 // camera centre), so each step backs off by that much; 0.45 m is the farthest, where the
-// 3 cm tag still spans about 70 px.
+// 3 cm tag still spans about 70 px. Where none of those can be reached (the foliage an
+// earlier cluster's views mapped may stand where the arm must), the same views turned about
+// the vertical through the cluster's centre by 20 and then 40 degrees either way: the tag,
+// tilted at most 5 degrees, is then seen 45 degrees off its axis at most, well inside what
+// AprilTag detects.
 constexpr double kApproachStepM = 0.05;
 constexpr int kApproachSteps = 3;
+constexpr std::array<double, 5> kApproachYawDeg = {0.0, 20.0, -20.0, 40.0, -40.0};
 
-std::vector<Eigen::Isometry3d> approachPoses(const FruitletCluster& cluster) {
-  std::vector<Eigen::Isometry3d> poses;
+struct ApproachPose {
+  Eigen::Isometry3d T_world_camera;
+  double yaw_deg = 0.0;  ///< turned about the vertical through the cluster's centre
+};
+
+std::vector<ApproachPose> approachPoses(const FruitletCluster& cluster) {
+  std::vector<ApproachPose> poses;
   const Eigen::Vector3d back = -cluster.T_world_start_camera.linear().col(2);
-  for (int step = 0; step <= kApproachSteps; ++step) {
-    Eigen::Isometry3d T = cluster.T_world_start_camera;
-    T.translation() += step * kApproachStepM * back;
-    poses.push_back(T);
+  for (const double yaw_deg : kApproachYawDeg) {
+    const Eigen::Isometry3d turn =
+        Eigen::Translation3d(cluster.center_m) *
+        Eigen::AngleAxisd(yaw_deg * std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ()) *
+        Eigen::Translation3d(-cluster.center_m);
+    for (int step = 0; step <= kApproachSteps; ++step) {
+      Eigen::Isometry3d T = cluster.T_world_start_camera;
+      T.translation() += step * kApproachStepM * back;
+      poses.push_back({turn * T, yaw_deg});
+    }
   }
   return poses;
 }
@@ -682,11 +699,11 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
       cluster_entries.push_back(entry);
     };
     // To its start view (the first cluster's is where the arm starts), or, where the arm
-    // cannot stand there, the same view from farther out along its axis.
+    // cannot stand there, the same view from farther out along its axis, then turned.
     if (!loop_arm.cameraPose().isApprox(cluster.T_world_start_camera, 1e-9)) {
       std::string move_status = "unreachable";
       bool arrived = false;
-      for (const Eigen::Isometry3d& T : approachPoses(cluster)) {
+      for (const auto& [T, yaw_deg] : approachPoses(cluster)) {
         if (!loop_arm.reachable(T)) continue;
         const double before_s = loop_clock.now_s();
         const host::nbv::MoveResult move = loop_arm.moveTo(T);
@@ -695,6 +712,7 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
         transit_motion[move_status] = transit_motion.value(move_status, 0) + 1;
         if ((arrived = move.ok())) {
           entry["approach_distance_m"] = (T.translation() - cluster.center_m).norm();
+          entry["approach_yaw_deg"] = yaw_deg;
           break;
         }
       }
