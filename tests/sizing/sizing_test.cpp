@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "backend_test_support.h"
+#include "fvp/host/core/look_at.h"
 #include "fvp/host/eval/fruitlet_matching.h"
 #include "fvp/host/sizing/fruitlet_sizer.h"
 #include "fvp/host/sizing/point_filters.h"
@@ -330,11 +331,7 @@ TEST(Sizing, OverlapRuleMergesAFruitletSeenTwiceAndKeepsTouchingNeighbours) {
 /// camera at `position` looking at c. Depth, disparity and the sphere's mask.
 SphereView viewOfSphereAndLeaf(const Eigen::Vector3d& c, double r, double leaf_z_m,
                                const Eigen::Vector3d& position) {
-  const Eigen::Vector3d z_axis = (c - position).normalized();
-  const Eigen::Vector3d x_axis = Eigen::Vector3d::UnitY().cross(z_axis).normalized();
-  Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();
-  T_world_camera.linear() << x_axis, z_axis.cross(x_axis), z_axis;
-  T_world_camera.translation() = position;
+  const Eigen::Isometry3d T_world_camera = lookAtPose(position, c);
   SphereView v;
   static_cast<testing::SphereView&>(v) =
       testing::renderSpheres({Eigen::Vector4d(c.x(), c.y(), c.z(), r)}, T_world_camera);
