@@ -164,8 +164,8 @@ void measureViewAgreement(const std::vector<Eigen::Vector3f>& points,
     const double fb = view.intrinsics.fx_px * view.intrinsics.baseline_m;
     for (const auto& p_world : points) {
       const Eigen::Vector3d p = T_camera_world * p_world.cast<double>();
-      const auto px = view.intrinsics.project(p);
-      if (!px || !(p.z() > 0.0)) continue;
+      const auto px = view.intrinsics.project(p);  // nothing behind the camera
+      if (!px) continue;
       const int u = int(std::lround(px->x())), v = int(std::lround(px->y()));
       if (u < 0 || v < 0 || u >= disparity.cols || v >= disparity.rows) continue;
       const double expected_px = fb / p.z();
@@ -188,8 +188,9 @@ void measureViewAgreement(const std::vector<Eigen::Vector3f>& points,
     }
   }
   support.view_evidence_points = seen + seen_past;
-  support.view_agreement =
-      support.view_evidence_points > 0 ? double(on_fruitlet) / double(seen + seen_past) : -1.0;
+  support.view_agreement = support.view_evidence_points > 0
+                               ? double(on_fruitlet) / double(support.view_evidence_points)
+                               : -1.0;
 }
 
 /// Both estimators, the support and the support rule's requirement from a cluster's
