@@ -253,6 +253,7 @@ TEST(Sizing, SupportRuleDropsAFragmentAndKeepsTheFruitlet) {
   // Without the rule the fragment is a second fruitlet, and it makes the fruitlet's
   // segment shared in every image: the rule is what drops it and restores the sizing.
   config.min_support_area_fraction = 0.0;
+  config.sphere_fit_support_area_fraction = 0.0;
   const auto all = sizing::sizeFruitlets({view, view}, pts, nullptr, config);
   ASSERT_EQ(all.fruitlets.size(), 2u);
   EXPECT_TRUE(all.unsupported.empty());
@@ -305,13 +306,24 @@ TEST(Sizing, OverlapRuleMergesAFruitletSeenTwiceAndKeepsTouchingNeighbours) {
   for (int label : merged.labels)
     if (label != sizing::kDbscanNoise) labels.insert(label);
   EXPECT_EQ(labels.size(), 1u);
-  // Without the rule the copies are two detections, each on the other's segment.
+  // Without the rule each copy is sized by its sphere fit alone (each on the other's
+  // segment) from a third of its sphere: the hemisphere rule drops one, and the other, its
+  // segment its own again, is sized from its images, its points half the merged ones.
   config.max_detection_overlap_fraction = INFINITY;
+  const auto one_copy = sizing::sizeFruitlets({view, view}, pts, nullptr, config);
+  ASSERT_EQ(one_copy.fruitlets.size(), 1u);
+  ASSERT_EQ(one_copy.unsupported.size(), 1u);
+  EXPECT_EQ(one_copy.unsupported[0].size_source, sizing::SizeSource::kSphereFit);
+  EXPECT_EQ(one_copy.fruitlets[0].size_source, sizing::SizeSource::kWellSeenImages);
+  EXPECT_EQ(f.points, one_copy.fruitlets[0].points + one_copy.unsupported[0].points);
+  // Without either, the copies are two detections.
+  config.sphere_fit_support_area_fraction = 0.0;
   const auto both = sizing::sizeFruitlets({view, view}, pts, nullptr, config);
   ASSERT_EQ(both.fruitlets.size(), 2u);
   EXPECT_EQ(both.events.overlapping_detections_merged, 0u);
   for (const auto& d : both.fruitlets) EXPECT_EQ(d.support.well_seen_images, 0);
   EXPECT_EQ(f.points, both.fruitlets[0].points + both.fruitlets[1].points);
+  config.sphere_fit_support_area_fraction = 0.5;
 
   // Two fruitlets side by side, touching: their spheres meet but do not overlap.
   const Eigen::Vector3d left(-0.005, 0.0, 0.3), right(0.005, 0.0, 0.3);
@@ -322,9 +334,82 @@ TEST(Sizing, OverlapRuleMergesAFruitletSeenTwiceAndKeepsTouchingNeighbours) {
   std::vector<Eigen::Vector3f> neighbours = sphereCap(left, r, 70.0);
   for (const auto& p : sphereCap(right, r, 70.0)) neighbours.push_back(p);
   config.max_detection_overlap_fraction = 0.5;
+  // Each shows a third of its sphere in one view: the overlap rule alone, without the
+  // hemisphere asked of their sphere-fit sizes (the hemisphere test shows that cost).
+  config.sphere_fit_support_area_fraction = 0.0;
   const auto two = sizing::sizeFruitlets({pair_view}, neighbours, nullptr, config);
   EXPECT_EQ(two.fruitlets.size(), 2u);
   EXPECT_EQ(two.events.overlapping_detections_merged, 0u);
+}
+
+// The hemisphere rule (docs/sizing.md, "Sized by its 3-D surface alone"): what the quarter
+// rule left of the spurious detections were 3.5-5 mm sphere fits on a segment a real
+// fruitlet owns, each showing 1.2-2.1 quarters of its sphere. Here a 10 mm fruitlet is seen
+// over 100 degrees of its surface (several views: 0.59 of its sphere) and behind it, within
+// its silhouette, lies a 4.5 mm cap of 75 degrees (points its mask carried onto the leaf):
+// 0.37 of its sphere, 1.5 quarters, 9 mm from the fruitlet's surface.
+TEST(Sizing, HemisphereRuleDropsASphereFitFragmentOnAFruitletsSegment) {
+  const Eigen::Vector3d c(0.0, 0.0, 0.3);
+  const double r = 0.005, fragment_r = 0.00225;
+  const Eigen::Vector3d fragment_c(0.003, 0.0, 0.312);
+  const SphereView v = renderSphere(c, r);
+  std::vector<Eigen::Vector3f> pts = sphereCap(c, r, 100.0);
+  const std::size_t fruitlet_points = pts.size();
+  for (const auto& p : sphereCap(fragment_c, fragment_r, 75.0)) pts.push_back(p);
+  const sizing::SizingView view{v.mask, v.disparity, v.in, Eigen::Isometry3d::Identity(), {}};
+  sizing::SizingConfig config;
+  const auto result = sizing::sizeFruitlets({view, view}, pts, nullptr, config);
+  ASSERT_EQ(result.fruitlets.size(), 1u);
+  ASSERT_EQ(result.unsupported.size(), 1u);
+  const auto& fragment = result.unsupported[0];
+  EXPECT_GE(fragment.points, (pts.size() - fruitlet_points) * 3 / 4);  // less outliers
+  EXPECT_EQ(fragment.size_source, sizing::SizeSource::kSphereFit);
+  EXPECT_NEAR(fragment.size_ours_mm, 4.5, 0.2);
+  EXPECT_EQ(fragment.support.required_area_fraction, 0.5);
+  EXPECT_GT(double(fragment.points), 0.5 * fragment.support.required_points);  // over a quarter
+  EXPECT_LT(double(fragment.points), fragment.support.required_points);
+  // With the fragment gone the fruitlet's images are its own: sized from them.
+  const auto& fruitlet = result.fruitlets[0];
+  EXPECT_GE(fruitlet.points, fruitlet_points * 9 / 10);
+  EXPECT_EQ(fruitlet.size_source, sizing::SizeSource::kWellSeenImages);
+  EXPECT_NEAR(fruitlet.size_ours_mm, 10.0, 0.3);
+  EXPECT_EQ(fruitlet.support.required_area_fraction, 0.25);
+
+  // The quarter alone keeps both, each sized by its sphere fit: the fruitlet right (it shows
+  // more than a hemisphere), the fragment a phantom.
+  config.sphere_fit_support_area_fraction = 0.0;
+  const auto quarter = sizing::sizeFruitlets({view, view}, pts, nullptr, config);
+  ASSERT_EQ(quarter.fruitlets.size(), 2u);
+  for (const auto& d : quarter.fruitlets) EXPECT_EQ(d.size_source, sizing::SizeSource::kSphereFit);
+
+  // Two touching fruitlets merged in 2-D, each seen over 100 degrees: sized by their sphere
+  // fits alone, each showing more than a hemisphere, both stay.
+  config.sphere_fit_support_area_fraction = 0.5;
+  const Eigen::Vector3d left(-0.005, 0.0, 0.3), right(0.005, 0.0, 0.3);
+  const SphereView pair = renderSphere(left, r), other = renderSphere(right, r);
+  cv::Mat mask = pair.mask | other.mask, disparity = cv::max(pair.disparity, other.disparity);
+  const sizing::SizingView pair_view{mask, disparity, pair.in, Eigen::Isometry3d::Identity(), {}};
+  std::vector<Eigen::Vector3f> neighbours = sphereCap(left, r, 100.0);
+  for (const auto& p : sphereCap(right, r, 100.0)) neighbours.push_back(p);
+  const auto two = sizing::sizeFruitlets({pair_view, pair_view}, neighbours, nullptr, config);
+  ASSERT_EQ(two.fruitlets.size(), 2u);
+  EXPECT_TRUE(two.unsupported.empty());
+  for (const auto& d : two.fruitlets) {
+    EXPECT_EQ(d.size_source, sizing::SizeSource::kSphereFit);
+    EXPECT_NEAR(d.size_ours_mm, 10.0, 0.3);
+  }
+  // The rule's cost: the same pair seen over 70 degrees only (a third of each sphere) is
+  // dropped, one for its sphere fit, the other then sized from the pair's merged outline
+  // (13 mm) and short of that size's quarter. Instance masks, or a view that separates their
+  // outlines, size them apart.
+  std::vector<Eigen::Vector3f> narrow = sphereCap(left, r, 70.0);
+  for (const auto& p : sphereCap(right, r, 70.0)) narrow.push_back(p);
+  const auto lost = sizing::sizeFruitlets({pair_view}, narrow, nullptr, config);
+  EXPECT_TRUE(lost.fruitlets.empty());
+  EXPECT_EQ(lost.unsupported.size(), 2u);
+  sizing::SizingConfig bad;
+  bad.sphere_fit_support_area_fraction = 1.5;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
 }
 
 /// A view of the sphere (c, r) in front of a leaf: the plane z = leaf_z_m (world), from a
@@ -381,6 +466,7 @@ TEST(Sizing, ViewAgreementTellsAFruitletFromAPatchOneMaskCalledFruitlet) {
       views.push_back({v->mask, v->disparity, v->in, v->T_world_camera, {}});
     sizing::SizingConfig config;
     config.min_support_area_fraction = 0.0;  // keep the patch in the fruitlets, to find it
+    config.sphere_fit_support_area_fraction = 0.0;
     const auto result = sizing::sizeFruitlets(views, pts, nullptr, config);
     ASSERT_EQ(result.fruitlets.size(), 2u);
     const auto& fruitlet =

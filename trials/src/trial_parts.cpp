@@ -118,15 +118,17 @@ host::planner::ViewPlanner& TrialParts::planner() {
 }
 
 nlohmann::json TrialParts::configJson() const {
-  return {{"engine", impl_->engine},
-          {"clock", impl_->options.clock},
-          {"fine_map_extent", host::map::toString(impl_->map_config.fine_map_extent)},
-          {"stop", impl_->options.stop},
-          {"sizing",
-           {{"estimator", host::sizing::toString(impl_->sizing_config.estimator)},
-            {"min_support_area_fraction", impl_->sizing_config.min_support_area_fraction},
-            {"max_detection_overlap_fraction", impl_->sizing_config.max_detection_overlap_fraction},
-            {"view_agreement_disparity_px", impl_->sizing_config.view_agreement_disparity_px}}}};
+  return {
+      {"engine", impl_->engine},
+      {"clock", impl_->options.clock},
+      {"fine_map_extent", host::map::toString(impl_->map_config.fine_map_extent)},
+      {"stop", impl_->options.stop},
+      {"sizing",
+       {{"estimator", host::sizing::toString(impl_->sizing_config.estimator)},
+        {"min_support_area_fraction", impl_->sizing_config.min_support_area_fraction},
+        {"sphere_fit_support_area_fraction", impl_->sizing_config.sphere_fit_support_area_fraction},
+        {"max_detection_overlap_fraction", impl_->sizing_config.max_detection_overlap_fraction},
+        {"view_agreement_disparity_px", impl_->sizing_config.view_agreement_disparity_px}}}};
 }
 
 std::vector<host::eval::GroundTruthFruitlet> groundTruthOf(const World& world,
@@ -585,13 +587,20 @@ void appendDetectionTable(std::ostringstream& md, const nlohmann::json& scope,
 
 /// The support rule in a sentence, with the trial's fraction.
 void appendSupportRule(std::ostringstream& md, const nlohmann::json& result) {
-  double fraction = 0.25;
+  double fraction = 0.25, sphere_fit_fraction = 0.0;
   if (result.contains("config") && result["config"].contains("trial") &&
-      result["config"]["trial"].contains("sizing"))
-    fraction = result["config"]["trial"]["sizing"].value("min_support_area_fraction", fraction);
+      result["config"]["trial"].contains("sizing")) {
+    const nlohmann::json& sizing = result["config"]["trial"]["sizing"];
+    fraction = sizing.value("min_support_area_fraction", fraction);
+    sphere_fit_fraction = sizing.value("sphere_fit_support_area_fraction", sphere_fit_fraction);
+  }
   md << "A detection of size 2r is kept only if its surface shows at least " << fmt(fraction, 2)
      << " of its sphere's area: `points` >= `required_points` (docs/sizing.md, \"Which "
-        "detections are fruitlets\"); two whose spheres overlap by more than half the smaller "
+        "detections are fruitlets\")";
+  if (sphere_fit_fraction > fraction)
+    md << ", and at least " << fmt(sphere_fit_fraction, 2)
+       << " when its size comes from its sphere fit alone (\"Sized by its 3-D surface alone\")";
+  md << "; two whose spheres overlap by more than half the smaller "
         "radius are one fruitlet seen twice and are merged (\"One fruitlet seen twice\"). A "
         "kept detection no fruitlet matched is **spurious**. "
         "± stderr is the standard error of its well-seen sizes' median; sphere RMS the "

@@ -114,6 +114,7 @@ nlohmann::json detectionJson(const sizing::FruitletEstimate& f) {
             {"well_seen_images", f.support.well_seen_images},
             {"sphere_rms_mm", f.support.sphere_rms_mm},
             {"required_points", f.support.required_points},
+            {"required_area_fraction", f.support.required_area_fraction},
             {"size_stderr_mm", f.support.size_stderr_mm},
             {"merged_detections", f.support.merged_detections},
             {"view_evidence_points", f.support.view_evidence_points},

@@ -241,7 +241,11 @@ void aggregate(FruitletEstimate& f, const SizingConfig& config) {
   // The support rule's requirement, on our size for either estimator (the paper's maximum
   // would ask more of the same points).
   const double radius_m = 0.0005 * f.size_ours_mm;
-  f.support.required_points = kSurfaceCrossingsPerVoxelFace * config.min_support_area_fraction *
+  f.support.required_area_fraction =
+      f.size_source == SizeSource::kSphereFit
+          ? std::max(config.min_support_area_fraction, config.sphere_fit_support_area_fraction)
+          : config.min_support_area_fraction;
+  f.support.required_points = kSurfaceCrossingsPerVoxelFace * f.support.required_area_fraction *
                               4.0 * M_PI * radius_m * radius_m /
                               (config.surface_voxel_size_m * config.surface_voxel_size_m);
 }
@@ -279,6 +283,8 @@ void SizingConfig::validate() const {
   if (!(max_depth_m > 0.0)) throw std::invalid_argument("sizing: max_depth_m > 0");
   if (!(min_support_area_fraction >= 0.0) || !(min_support_area_fraction <= 1.0))
     throw std::invalid_argument("sizing: min_support_area_fraction in [0, 1]");
+  if (!(sphere_fit_support_area_fraction >= 0.0) || !(sphere_fit_support_area_fraction <= 1.0))
+    throw std::invalid_argument("sizing: sphere_fit_support_area_fraction in [0, 1]");
   if (!(surface_voxel_size_m > 0.0))
     throw std::invalid_argument("sizing: surface_voxel_size_m > 0");
   if (!(max_detection_overlap_fraction >= 0.0))
@@ -457,31 +463,42 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
     return f.support.required_points > 0.0 ? double(f.points) / f.support.required_points
                                            : INFINITY;
   };
+  // Against the quarter every detection must show, whatever sized it.
+  const auto quarterRatio = [&](const FruitletEstimate& f) {
+    if (!(config.min_support_area_fraction > 0.0)) return double(INFINITY);
+    return supportRatio(f) * f.support.required_area_fraction / config.min_support_area_fraction;
+  };
   std::vector<FruitletEstimate> estimates(sized.size());
+  const auto drop = [&](std::size_t ci) {
+    dropped[ci] = true;
+    marks_segments[ci] = estimates[ci].support.own_segment_images > 0;
+    measureViewAgreement(*sized[ci].second, views, config, estimates[ci].support);
+    result.unsupported.push_back(std::move(estimates[ci]));
+  };
+  // The worst-supported kept and sized detection under `ratio` < 1, every kept one sized
+  // again first.
+  const auto worstUnder = [&](const auto& ratio) {
+    std::optional<std::size_t> worst;
+    double worst_ratio = 1.0;
+    for (std::size_t ci = 0; ci < sized.size(); ++ci) {
+      if (dropped[ci]) continue;
+      estimates[ci] = sizeKept(ci);
+      const FruitletEstimate& f = estimates[ci];
+      if (f.per_image.empty()) continue;  // unsized: dropped below, not by the rule
+      if (const double r = ratio(f); r < worst_ratio) worst = ci, worst_ratio = r;
+    }
+    return worst;
+  };
   for (;;) {
     // The support rule, one detection at a time: the worst-supported one that fails is
     // dropped and the rest are sized again, since a dropped phantom (no segment of its own:
     // it lay on a fruitlet's) no longer makes that fruitlet's images shared. A dropped
     // detection that had a segment of its own keeps marking segments: it may be a real
     // fruitlet merged in 2-D with a neighbour, whose merged outline must not size the
-    // neighbour.
-    for (;;) {
-      std::optional<std::size_t> worst;
-      double worst_ratio = 1.0;
-      for (std::size_t ci = 0; ci < sized.size(); ++ci) {
-        if (dropped[ci]) continue;
-        estimates[ci] = sizeKept(ci);
-        const FruitletEstimate& f = estimates[ci];
-        if (f.per_image.empty()) continue;  // unsized: dropped below, not by the rule
-        if (const double ratio = supportRatio(f); ratio < worst_ratio)
-          worst = ci, worst_ratio = ratio;
-      }
-      if (!worst) break;
-      dropped[*worst] = true;
-      marks_segments[*worst] = estimates[*worst].support.own_segment_images > 0;
-      measureViewAgreement(*sized[*worst].second, views, config, estimates[*worst].support);
-      result.unsupported.push_back(std::move(estimates[*worst]));
-    }
+    // neighbour. The quarter first; the hemisphere a sphere-fit size asks for only once
+    // no two detections overlap, since two shells of one fruitlet (views whose poses
+    // disagree) are each sized by their sphere fit until the overlap rule merges them.
+    while (const auto worst = worstUnder(quarterRatio)) drop(*worst);
     // The overlap rule: two fruitlets are firm bodies that touch but do not interpenetrate,
     // so two kept spheres that overlap by more than half the smaller one's radius are one
     // fruitlet seen twice (views whose poses disagree fuse its surface at two places). With
@@ -507,7 +524,14 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
             (!pair || depth > deepest))
           deepest = depth, pair = {a, b};
       }
-    if (!pair) break;
+    if (!pair) {
+      // The hemisphere rule (sphere_fit_support_area_fraction): a detection sized by its
+      // sphere fit alone must show half its sphere. One at a time, as above.
+      const auto worst = worstUnder(supportRatio);
+      if (!worst) break;
+      drop(*worst);
+      continue;
+    }
     auto [keep, gone] = *pair;
     if (supportRatio(estimates[gone]) > supportRatio(estimates[keep])) std::swap(keep, gone);
     sized[keep].second->insert(sized[keep].second->end(), sized[gone].second->begin(),

@@ -71,6 +71,13 @@ struct SizingConfig {
   /// small clusters of stereo points at depth edges) show a few percent of the sphere their
   /// size implies. 0 keeps every detection.
   double min_support_area_fraction = 0.25;
+  /// The support rule for a detection sized by its sphere fit alone (every image's segment
+  /// shared, SizeSource::kSphereFit): its size is then read off 3-D points only, and a sphere
+  /// fitted to a cap smaller than a hemisphere extrapolates its diameter from the cap's
+  /// curvature; once the points span a hemisphere they span the diameter itself. So it must
+  /// show at least half its sphere (docs/sizing.md, "Sized by its 3-D surface alone"). The
+  /// larger of the two fractions applies; 0 asks no more than min_support_area_fraction.
+  double sphere_fit_support_area_fraction = 0.5;
   /// The surface points' spacing: the TSDF voxel (MappingSession sets its own). Zero
   /// crossings between face neighbours number (|n_x| + |n_y| + |n_z|) per voxel face on a
   /// surface of normal n: 1.5 on average over a sphere.
@@ -121,6 +128,9 @@ struct DetectionSupport {
   double sphere_rms_mm = -1.0;  ///< RMS distance of its points to its sphere; -1 without one
   /// The surface points the support rule asks of a fruitlet of its size (points must reach it).
   double required_points = 0.0;
+  /// The fraction of its sphere required_points stands for: min_support_area_fraction, or
+  /// sphere_fit_support_area_fraction when its size came from the sphere fit alone.
+  double required_area_fraction = 0.0;
   /// Ours' confidence: the standard error of the median of its well-seen images' sizes
   /// (1.2533 x 1.4826 MAD / sqrt(n)); -1 with fewer than two.
   double size_stderr_mm = -1.0;
