@@ -111,6 +111,24 @@ TEST(ClusterCompletion, ImagesFromOneDirectionDoNotStopButSphereFitsDo) {
   EXPECT_TRUE(sizesSettled(merged, config));
 }
 
+// An unconfirmed detection lacks evidence until sized from directions 30 degrees apart,
+// although its size is a sphere fit's; sizesSettled leaves it to the hold (holdWhile).
+TEST(ClusterCompletion, AnUnconfirmedDetectionNeedsSizedImagesFromTwoDirections) {
+  const ClusterCompletionConfig config;
+  FruitletSnapshot u = fruitlet(0.05, 4.0, 1, 0.0);
+  u.size_source = sizing::SizeSource::kSphereFit;
+  EXPECT_FALSE(lacksEvidence(u, config)) << "a kept sphere fit needs no images";
+  u.unconfirmed = true;
+  EXPECT_TRUE(lacksEvidence(u, config));
+  u.well_seen_images = 2;
+  u.view_span_deg = 31.0;
+  EXPECT_FALSE(lacksEvidence(u, config));
+  auto h = history(6);
+  u.view_span_deg = 0.0;
+  for (auto& s : h) s.unconfirmed = {u};
+  EXPECT_TRUE(sizesSettled(h, config)) << "not compared with the kept fruitlets";
+}
+
 TEST(ClusterCompletion, NaNSizesAndTwoDetectionsOnOneEarlierFruitletNeverSettle) {
   const ClusterCompletionConfig config;
   auto nan = history(6);

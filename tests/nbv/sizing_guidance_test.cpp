@@ -112,6 +112,54 @@ TEST(SizingGuidance, DropsAFruitletAimedAtTwiceInVainAndReturnsToItWhenItGainsAn
   EXPECT_EQ(guidance.aimedViews(), 2u);
 }
 
+// An unconfirmed detection (dropped by the hemisphere rule alone) is a target until it has
+// been sized from directions 30 degrees apart; the cluster waits on it (waitingOnUnconfirmed)
+// for at most max_aimed_views views, aimed at it or not, and its new sized images do not
+// start the count again: a phantom on a fruitlet's segment is sized in every view of it.
+TEST(SizingGuidance, AnUnconfirmedDetectionHoldsTheClusterForAtMostTwoViews) {
+  ClusterCompletionConfig config;
+  config.confirm_detections = true;
+  std::vector<SizingSnapshot> history;
+  RecordingPlanner planner;
+  SizingGuidance guidance(history, config, planner, 0.6);
+  int view = 0;
+  const auto sized = [&](int sized_images, double span_deg) {
+    SizingSnapshot s = snapshot(view, {fruitlet(0.0, 4, 60.0)});
+    FruitletSnapshot u = fruitlet(0.02, sized_images, span_deg);
+    u.unconfirmed = true;
+    u.size_source = sizing::SizeSource::kSphereFit;
+    s.unconfirmed = {u};
+    history.push_back(s);
+    guidance.onView({.index = view++});
+  };
+  sized(1, 0.0);
+  ASSERT_EQ(planner.targets_.size(), 1u) << "a sphere fit, yet unconfirmed: it needs images";
+  EXPECT_DOUBLE_EQ(planner.targets_[0].center_m.x(), 0.02);
+  EXPECT_TRUE(guidance.waitingOnUnconfirmed());
+  planner::PlanStep elsewhere = aimedAt(0);
+  elsewhere.candidates[0].kind = planner::CandidateKind::kRoi;
+  guidance.onPlan({.step = &elsewhere});
+  sized(2, 10.0);  // a new sized image from near the first: the count goes on
+  EXPECT_TRUE(guidance.waitingOnUnconfirmed());
+  guidance.onPlan({.step = &elsewhere});
+  sized(3, 12.0);
+  EXPECT_FALSE(guidance.waitingOnUnconfirmed()) << "two views: the cluster no longer waits";
+  EXPECT_TRUE(planner.targets_.empty());
+  EXPECT_EQ(guidance.droppedTargets(), 1u);
+
+  // Sized from directions 30 degrees apart, it has what the rule asks: no longer a target.
+  std::vector<SizingSnapshot> seen;
+  SizingGuidance other(seen, config, planner, 0.6);
+  SizingSnapshot s = snapshot(0, {fruitlet(0.0, 4, 60.0)});
+  FruitletSnapshot u = fruitlet(0.02, 2, 35.0);
+  u.unconfirmed = true;
+  s.unconfirmed = {u};
+  seen.push_back(s);
+  other.onView({.index = 0});
+  EXPECT_TRUE(planner.targets_.empty());
+  EXPECT_FALSE(other.waitingOnUnconfirmed());
+}
+
 TEST(SizingGuidance, RejectsBadSettings) {
   const ClusterCompletionConfig config;
   std::vector<SizingSnapshot> history;

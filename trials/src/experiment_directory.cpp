@@ -232,6 +232,7 @@ nlohmann::ordered_json ExperimentManifest::toJson() const {
   j["stop"] = stop;
   j["max_views"] = max_views;
   j["register_views"] = register_views;
+  j["confirm_detections"] = confirm_detections;
   j["error_scale"] = error_scale;
   j["world_config"] = configJson(world_config);
   j["planner_config"] = configJson(planner_config);
@@ -295,6 +296,11 @@ ExperimentManifest readManifest(const std::filesystem::path& path) {
       fieldError(where, "register_views", "true or false", &j["register_views"]);
     m.register_views = j["register_views"].get<bool>();
   }
+  if (member(j, "confirm_detections")) {
+    if (!j["confirm_detections"].is_boolean())
+      fieldError(where, "confirm_detections", "true or false", &j["confirm_detections"]);
+    m.confirm_detections = j["confirm_detections"].get<bool>();
+  }
   if (member(j, "error_scale")) m.error_scale = readString(j, "error_scale", where);
   m.world_config = readConfig(j, "world_config", where);
   m.planner_config = readConfig(j, "planner_config", where);
@@ -349,6 +355,9 @@ std::optional<ManifestDifference> mergeDifference(const ExperimentManifest& a,
   if (a.register_views != b.register_views)
     return ManifestDifference{"register_views", a.register_views ? "true" : "false",
                               b.register_views ? "true" : "false"};
+  if (a.confirm_detections != b.confirm_detections)
+    return ManifestDifference{"confirm_detections", a.confirm_detections ? "true" : "false",
+                              b.confirm_detections ? "true" : "false"};
   if (a.max_views != b.max_views)
     return ManifestDifference{"max_views", shownMaxViews(a.max_views), shownMaxViews(b.max_views)};
   if (a.world_config.fnv1a64 != b.world_config.fnv1a64)

@@ -96,6 +96,9 @@ void validate(const TrialOptions& o) {
   if (o.clock != "wall" && o.clock != "fixed")
     throw std::invalid_argument("trial option 'clock': expected wall or fixed, got '" + o.clock +
                                 "'");
+  if (o.confirm_detections && o.stop != "auto")
+    throw std::invalid_argument(
+        "trial option 'confirm_detections': needs stop auto (it holds the automatic stop)");
   if (!o.engine.empty() && !host::map::MapEngineRegistry::instance().contains(o.engine))
     throw std::invalid_argument("trial option 'engine': expected one of " +
                                 host::map::MapEngineRegistry::instance().knownNames() + ", got '" +
@@ -390,6 +393,7 @@ struct ClusterOutcome {
 struct Trial::Impl {
   explicit Impl(TrialOptions opts) : options(std::move(opts)) {
     validate(options);
+    completion_config.confirm_detections = options.confirm_detections;
     if (!options.out_dir.empty()) {
       host::prepareOutputDirectory(options.out_dir, "trial output directory");
       std::vector<std::string> stale = TrialParts::outputFiles();
@@ -539,6 +543,7 @@ ClusterOutcome Trial::Impl::runCluster(TrialParts& cluster_parts, const Fruitlet
     guidance.emplace(*completion, cluster_parts.planner(),
                      cluster_parts.sizingConfig().well_seen_fraction);
     observers.add(&*guidance);  // after completion: it reads completion's sizing
+    completion->holdWhile([&g = *guidance] { return g.waitingOnUnconfirmed(); });
     stop = stop || completion->stopCondition();
   } else if (options.record_size_history) {
     completion.emplace(cluster_parts.session(), observing_clock, cluster_parts.sizingConfig(),
@@ -577,7 +582,8 @@ nlohmann::json Trial::Impl::stopJson() const {
           {"same_fruitlet_m", c.same_fruitlet_m},
           {"min_well_seen_images", c.min_well_seen_images},
           {"min_view_span_deg", c.min_view_span_deg},
-          {"max_iterations_without_view", c.max_iterations_without_view}};
+          {"max_iterations_without_view", c.max_iterations_without_view},
+          {"confirm_detections", c.confirm_detections}};
 }
 
 void Trial::Impl::describeRun(nlohmann::json& result, const TrialLog& log,

@@ -118,7 +118,8 @@ nlohmann::json detectionJson(const sizing::FruitletEstimate& f) {
             {"size_stderr_mm", f.support.size_stderr_mm},
             {"merged_detections", f.support.merged_detections},
             {"view_evidence_points", f.support.view_evidence_points},
-            {"view_agreement", f.support.view_agreement}}},
+            {"view_agreement", f.support.view_agreement},
+            {"unconfirmed", f.support.unconfirmed}}},
           {"per_image", per_image}};
 }
 

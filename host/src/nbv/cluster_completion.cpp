@@ -50,10 +50,12 @@ void ClusterCompletion::onView(const ViewEvent& event) {
   snapshot.sizing_s = sizing_s;
   if (session_.correctsAnchorOffset()) snapshot.world_shift_m = session_.anchorOffset().shift_m;
   const auto& views = session_.sizingViews();
-  for (const auto& f : sized.fruitlets) {
+  // Its images' directions (the well-seen ones, or every sized one of an unconfirmed
+  // detection) and the widest angle between two.
+  const auto snapshotOf = [&](const sizing::FruitletEstimate& f, bool unconfirmed) {
     std::vector<Eigen::Vector3d> directions;
     for (const auto& image : f.per_image)
-      if (image.well_seen)
+      if (image.well_seen || unconfirmed)
         directions.push_back(
             (views[std::size_t(image.view)].T_world_camera.translation() - f.center_m)
                 .normalized());
@@ -62,15 +64,26 @@ void ClusterCompletion::onView(const ViewEvent& event) {
       for (std::size_t j = i + 1; j < directions.size(); ++j)
         span_rad =
             std::max(span_rad, std::acos(std::clamp(directions[i].dot(directions[j]), -1.0, 1.0)));
-    snapshot.fruitlets.push_back({f.center_m, f.size_mm, f.support.well_seen_images,
-                                  span_rad * 180.0 / M_PI, f.size_source, f.support.size_stderr_mm,
-                                  std::move(directions)});
-  }
+    FruitletSnapshot out;
+    out.center_m = f.center_m;
+    out.size_mm = f.size_mm;
+    out.well_seen_images = unconfirmed ? int(directions.size()) : f.support.well_seen_images;
+    out.view_span_deg = span_rad * 180.0 / M_PI;
+    out.size_source = f.size_source;
+    out.size_stderr_mm = f.support.size_stderr_mm;
+    out.well_seen_directions = std::move(directions);
+    out.unconfirmed = unconfirmed;
+    return out;
+  };
+  for (const auto& f : sized.fruitlets) snapshot.fruitlets.push_back(snapshotOf(f, false));
+  if (config_.confirm_detections)
+    for (const auto& f : sized.unsupported)
+      if (f.support.unconfirmed) snapshot.unconfirmed.push_back(snapshotOf(f, true));
   history_.push_back(std::move(snapshot));
 }
 
 bool ClusterCompletion::done() const {
-  return sizesSettled(history_, config_);
+  return sizesSettled(history_, config_) && !(hold_ && hold_());
 }
 
 StopCondition ClusterCompletion::stopCondition() const {
@@ -79,7 +92,7 @@ StopCondition ClusterCompletion::stopCondition() const {
 }
 
 bool lacksEvidence(const FruitletSnapshot& fruitlet, const ClusterCompletionConfig& config) {
-  return fruitlet.size_source != sizing::SizeSource::kSphereFit &&
+  return (fruitlet.unconfirmed || fruitlet.size_source != sizing::SizeSource::kSphereFit) &&
          (fruitlet.well_seen_images < config.min_well_seen_images ||
           fruitlet.view_span_deg < config.min_view_span_deg);
 }

@@ -29,27 +29,40 @@ SizingGuidance::Aim* SizingGuidance::findAim(const Eigen::Vector3d& center_m) {
 void SizingGuidance::onPlan(const PlanEvent& event) {
   if (!event.step || !event.step->moved()) return;
   const planner::Candidate& chosen = event.step->candidates[*event.step->chosen];
-  if (chosen.kind != planner::CandidateKind::kSizing) return;
-  ++aimed_views_;
-  const std::size_t t = std::size_t(chosen.sizing_target);
-  if (t >= targets_.size()) return;
-  if (Aim* aim = findAim(targets_[t].center_m))
-    ++aim->views;
-  else
-    aims_.push_back({targets_[t].center_m, static_cast<int>(targets_[t].seen_from.size()), 1});
+  int aimed_target = -1;
+  if (chosen.kind == planner::CandidateKind::kSizing) {
+    ++aimed_views_;
+    aimed_target = chosen.sizing_target;
+  }
+  // The view aimed at a target counts for it; every view counts for an unconfirmed one, so
+  // that a cluster waits at most max_aimed_views views on each (the planner may find none of
+  // its candidates worth more than the others').
+  for (std::size_t t = 0; t < targets_.size(); ++t) {
+    if (int(t) != aimed_target && !target_unconfirmed_[t]) continue;
+    if (Aim* aim = findAim(targets_[t].center_m))
+      ++aim->views;
+    else
+      aims_.push_back({targets_[t].center_m, static_cast<int>(targets_[t].seen_from.size()), 1});
+  }
 }
 
 void SizingGuidance::onView(const ViewEvent& event) {
   targets_.clear();
+  target_unconfirmed_.clear();
+  unconfirmed_targets_ = 0;
   // No sizing for this view (no Cluster Region yet): nothing to aim at.
   if (history_.empty() || history_.back().view != event.index) {
     planner_.setSizingTargets({});
     return;
   }
-  for (const FruitletSnapshot& f : history_.back().fruitlets) {
+  std::vector<const FruitletSnapshot*> candidates;
+  for (const FruitletSnapshot& f : history_.back().fruitlets) candidates.push_back(&f);
+  for (const FruitletSnapshot& f : history_.back().unconfirmed) candidates.push_back(&f);
+  for (const FruitletSnapshot* candidate : candidates) {
+    const FruitletSnapshot& f = *candidate;
     if (!lacksEvidence(f, config_)) continue;
     if (Aim* aim = findAim(f.center_m)) {
-      if (f.well_seen_images > aim->well_seen_images) {
+      if (!f.unconfirmed && f.well_seen_images > aim->well_seen_images) {
         *aim = aims_.back();  // a new well-seen image: the count starts again
         aims_.pop_back();
       } else if (aim->views >= max_aimed_views_) {
@@ -67,6 +80,8 @@ void SizingGuidance::onView(const ViewEvent& event) {
     target.min_angle_deg = config_.min_view_span_deg;
     target.min_visible_fraction = min_visible_fraction_;
     targets_.push_back(std::move(target));
+    target_unconfirmed_.push_back(f.unconfirmed);
+    if (f.unconfirmed) ++unconfirmed_targets_;
   }
   planner_.setSizingTargets(targets_);
 }

@@ -469,7 +469,8 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
     return supportRatio(f) * f.support.required_area_fraction / config.min_support_area_fraction;
   };
   std::vector<FruitletEstimate> estimates(sized.size());
-  const auto drop = [&](std::size_t ci) {
+  const auto drop = [&](std::size_t ci, bool unconfirmed) {
+    estimates[ci].support.unconfirmed = unconfirmed;
     dropped[ci] = true;
     marks_segments[ci] = estimates[ci].support.own_segment_images > 0;
     measureViewAgreement(*sized[ci].second, views, config, estimates[ci].support);
@@ -498,7 +499,7 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
     // neighbour. The quarter first; the hemisphere a sphere-fit size asks for only once
     // no two detections overlap, since two shells of one fruitlet (views whose poses
     // disagree) are each sized by their sphere fit until the overlap rule merges them.
-    while (const auto worst = worstUnder(quarterRatio)) drop(*worst);
+    while (const auto worst = worstUnder(quarterRatio)) drop(*worst, false);
     // The overlap rule: two fruitlets are firm bodies that touch but do not interpenetrate,
     // so two kept spheres that overlap by more than half the smaller one's radius are one
     // fruitlet seen twice (views whose poses disagree fuse its surface at two places). With
@@ -529,7 +530,7 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
       // sphere fit alone must show half its sphere. One at a time, as above.
       const auto worst = worstUnder(supportRatio);
       if (!worst) break;
-      drop(*worst);
+      drop(*worst, true);
       continue;
     }
     auto [keep, gone] = *pair;

@@ -63,9 +63,10 @@ struct ExperimentManifest {
   // Row-defining: resume and merge refuse a difference.
   double budget_s = 0;
   std::string clock;
-  std::string stop = "budget";  ///< budget | auto (absent in a manifest: budget)
-  int max_views = 0;            ///< 0: no limit
-  bool register_views = false;  ///< --register-views (absent in a manifest: false)
+  std::string stop = "budget";      ///< budget | auto (absent in a manifest: budget)
+  int max_views = 0;                ///< 0: no limit
+  bool register_views = false;      ///< --register-views (absent in a manifest: false)
+  bool confirm_detections = false;  ///< --confirm-detections (absent in a manifest: false)
   /// --error-scale GROUP=FACTOR, or empty; the world config's hash already tells runs apart,
   /// this names the sweep point (absent in a manifest: empty).
   std::string error_scale;

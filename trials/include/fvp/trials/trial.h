@@ -50,6 +50,9 @@ struct TrialOptions {
   /// enableViewRegistration; docs/sizing.md "Registering views"): the counter-measure to
   /// pose errors. Off: the paper's fusion at the told poses.
   bool register_views = false;
+  /// With stop auto: look again at unconfirmed detections (dropped by the hemisphere rule
+  /// alone) before a cluster is done (host::nbv::ClusterCompletionConfig::confirm_detections).
+  bool confirm_detections = false;
   /// Where result.json, the maps, the TSDF surface, the clusters and report.md go; empty:
   /// nothing is written (the result is only returned).
   std::filesystem::path out_dir;

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -52,6 +53,13 @@ struct ClusterCompletionConfig {
   /// candidates those iterations sampled with a gain above its travel cost was then tried
   /// and none could be reached: more planning here only spends the clock.
   int max_iterations_without_view = 3;
+  /// Look again at unconfirmed detections (DetectionSupport::unconfirmed: dropped by the
+  /// hemisphere rule alone) before the cluster is done. Such a detection is a real fruitlet
+  /// seen from one side with its outline merged with a neighbour's, or a phantom; its evidence
+  /// is its sized images from directions min_view_span_deg apart, and SizingGuidance aims at
+  /// it like a fruitlet short of well-seen images (holdWhile: the stop waits while it does).
+  /// Off: the stop rule and the planner see the kept detections only.
+  bool confirm_detections = false;
   /// Throws std::invalid_argument naming the bad field.
   void validate() const;
 };
@@ -66,6 +74,9 @@ struct FruitletSnapshot {
   double size_stderr_mm = -1.0;  ///< the size's standard error; -1 under 2 well-seen images
   /// Unit vectors from the fruitlet towards the cameras of its well-seen images.
   std::vector<Eigen::Vector3d> well_seen_directions;
+  /// An unconfirmed detection (ClusterCompletionConfig::confirm_detections): well_seen_images,
+  /// view_span_deg and well_seen_directions then count every image that sized it.
+  bool unconfirmed = false;
 };
 
 /// The cluster sized after one view.
@@ -77,6 +88,8 @@ struct SizingSnapshot {
   /// final sizing reports them (MappingSession::anchorOffset; zero without the correction).
   Eigen::Vector3d world_shift_m = Eigen::Vector3d::Zero();
   std::vector<FruitletSnapshot> fruitlets;
+  /// The unconfirmed detections, with confirm_detections (not compared by sizesSettled).
+  std::vector<FruitletSnapshot> unconfirmed;
 };
 
 /// A loop observer that sizes the session's cluster after every view and a stop condition
@@ -94,8 +107,11 @@ class ClusterCompletion : public LoopObserver {
 
   void onView(const ViewEvent& event) override;
 
-  /// Whether the sizes have settled (see ClusterCompletionConfig).
+  /// Whether the sizes have settled (see ClusterCompletionConfig) and no hold holds.
   bool done() const;
+  /// The cluster is not done while `pending` returns true (SizingGuidance::
+  /// waitingOnUnconfirmed): `pending` must outlive this.
+  void holdWhile(std::function<bool()> pending) { hold_ = std::move(pending); }
   /// Holds when done(); its reason is "cluster_done".
   /// "cluster_done" once the sizes have settled, "no_reachable_view" once the planner is
   /// stuck (max_iterations_without_view).
@@ -111,10 +127,12 @@ class ClusterCompletion : public LoopObserver {
   sizing::SizingConfig sizing_config_;
   ClusterCompletionConfig config_;
   std::vector<SizingSnapshot> history_;
+  std::function<bool()> hold_;
 };
 
 /// Whether a fruitlet still lacks the images the rule asks for: min_well_seen_images
-/// well-seen images from directions min_view_span_deg apart (sphere-fit sizes need none).
+/// well-seen images from directions min_view_span_deg apart (sphere-fit sizes need none; an
+/// unconfirmed detection needs as many sized images, as far apart).
 bool lacksEvidence(const FruitletSnapshot& fruitlet, const ClusterCompletionConfig& config);
 
 /// Whether the last config.stable_views + 1 snapshots of history agree (the rule of done()).

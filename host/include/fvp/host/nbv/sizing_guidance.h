@@ -40,6 +40,11 @@ class SizingGuidance : public LoopObserver {
   std::size_t aimedViews() const { return aimed_views_; }
   /// Fruitlets left out after max_aimed_views aimed views without a new well-seen image.
   std::size_t droppedTargets() const { return dropped_; }
+  /// Whether an unconfirmed detection (SizingSnapshot::unconfirmed) is still a target: not
+  /// yet sized from directions the rule asks, and the loop has not yet taken max_aimed_views
+  /// views since it became one. ClusterCompletion::holdWhile takes it: a cluster is not done
+  /// while the planner may still confirm one.
+  bool waitingOnUnconfirmed() const { return unconfirmed_targets_ > 0; }
 
  private:
   struct Aim {
@@ -55,8 +60,9 @@ class SizingGuidance : public LoopObserver {
   double min_visible_fraction_;
   int max_aimed_views_;
   std::vector<planner::SizingTarget> targets_;
+  std::vector<bool> target_unconfirmed_;  ///< per target: an unconfirmed detection
   std::vector<Aim> aims_;
-  std::size_t aimed_views_ = 0, dropped_ = 0;
+  std::size_t aimed_views_ = 0, dropped_ = 0, unconfirmed_targets_ = 0;
 };
 
 }  // namespace fvp::host::nbv

@@ -145,6 +145,10 @@ struct DetectionSupport {
   /// air at a depth edge, are seen as leaf or seen through from other directions.
   std::size_t view_evidence_points = 0;  ///< (point, view) pairs seen or seen past
   double view_agreement = -1.0;
+  /// Dropped by the hemisphere rule alone: it shows the quarter, but its size is a sphere fit
+  /// to less than a hemisphere. A view from another side confirms a real fruitlet (more of its
+  /// surface, or its outline apart from the neighbour's); the loop may look for one.
+  bool unconfirmed = false;
 };
 
 struct FruitletEstimate {
