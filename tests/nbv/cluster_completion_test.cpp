@@ -100,6 +100,13 @@ TEST(ClusterCompletion, ImagesFromOneDirectionDoNotStopButSphereFitsDo) {
   auto narrow = history(6);
   for (auto& s : narrow) s.fruitlets[0].view_span_deg = 12.0;
   EXPECT_FALSE(sizesSettled(narrow, config));
+  // Released (release_left_out: the planner looked for it twice in vain), its stable size
+  // is enough; a size still moving is not.
+  const auto first = [](const FruitletSnapshot& f) { return f.center_m.x() == 0.0; };
+  EXPECT_TRUE(sizesSettled(narrow, config, first));
+  auto moving = history(6, 0.04);
+  for (auto& s : moving) s.fruitlets[0].view_span_deg = 12.0;
+  EXPECT_FALSE(sizesSettled(moving, config, first));
   // A fruitlet merged with a neighbour in every image has no well-seen image: its sphere
   // fit is its size, and it counts once that is stable.
   auto merged = history(6);

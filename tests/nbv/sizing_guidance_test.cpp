@@ -97,6 +97,8 @@ TEST(SizingGuidance, DropsAFruitletAimedAtTwiceInVainAndReturnsToItWhenItGainsAn
   sized(1);
   EXPECT_TRUE(planner.targets_.empty()) << "two misses: no reachable view shows it";
   EXPECT_EQ(guidance.droppedTargets(), 1u);
+  EXPECT_TRUE(guidance.leftOut(Eigen::Vector3d(0.001, 0.0, 0.3)));
+  EXPECT_FALSE(guidance.leftOut(Eigen::Vector3d(0.02, 0.0, 0.3)));
   sized(1);
   EXPECT_TRUE(planner.targets_.empty());
   EXPECT_EQ(guidance.droppedTargets(), 1u) << "counted once";
@@ -104,6 +106,7 @@ TEST(SizingGuidance, DropsAFruitletAimedAtTwiceInVainAndReturnsToItWhenItGainsAn
   history.push_back(snapshot(view, {fruitlet(0.0, 2, 10.0)}));
   guidance.onView({.index = view++});
   ASSERT_EQ(planner.targets_.size(), 1u);
+  EXPECT_FALSE(guidance.leftOut(Eigen::Vector3d(0.0, 0.0, 0.3)));
   EXPECT_EQ(guidance.aimedViews(), 2u);
   // Moves to other kinds of candidate are not aims.
   planner::PlanStep roi = aimedAt(0);

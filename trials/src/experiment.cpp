@@ -109,6 +109,7 @@ ExperimentManifest manifestOf(const ExperimentOptions& o) {
   m.max_views = o.trial.max_views.value_or(0);
   m.register_views = o.trial.register_views;
   m.confirm_detections = o.trial.confirm_detections;
+  m.release_left_out = o.trial.release_left_out;
   m.error_scale = o.error_scale;
   m.world_config = stampOf(o.trial.world_config, "world config");
   m.planner_config = stampOf(o.trial.planner_config, "planner config");

@@ -233,6 +233,7 @@ nlohmann::ordered_json ExperimentManifest::toJson() const {
   j["max_views"] = max_views;
   j["register_views"] = register_views;
   j["confirm_detections"] = confirm_detections;
+  j["release_left_out"] = release_left_out;
   j["error_scale"] = error_scale;
   j["world_config"] = configJson(world_config);
   j["planner_config"] = configJson(planner_config);
@@ -301,6 +302,11 @@ ExperimentManifest readManifest(const std::filesystem::path& path) {
       fieldError(where, "confirm_detections", "true or false", &j["confirm_detections"]);
     m.confirm_detections = j["confirm_detections"].get<bool>();
   }
+  if (member(j, "release_left_out")) {
+    if (!j["release_left_out"].is_boolean())
+      fieldError(where, "release_left_out", "true or false", &j["release_left_out"]);
+    m.release_left_out = j["release_left_out"].get<bool>();
+  }
   if (member(j, "error_scale")) m.error_scale = readString(j, "error_scale", where);
   m.world_config = readConfig(j, "world_config", where);
   m.planner_config = readConfig(j, "planner_config", where);
@@ -358,6 +364,9 @@ std::optional<ManifestDifference> mergeDifference(const ExperimentManifest& a,
   if (a.confirm_detections != b.confirm_detections)
     return ManifestDifference{"confirm_detections", a.confirm_detections ? "true" : "false",
                               b.confirm_detections ? "true" : "false"};
+  if (a.release_left_out != b.release_left_out)
+    return ManifestDifference{"release_left_out", a.release_left_out ? "true" : "false",
+                              b.release_left_out ? "true" : "false"};
   if (a.max_views != b.max_views)
     return ManifestDifference{"max_views", shownMaxViews(a.max_views), shownMaxViews(b.max_views)};
   if (a.world_config.fnv1a64 != b.world_config.fnv1a64)

@@ -99,6 +99,9 @@ void validate(const TrialOptions& o) {
   if (o.confirm_detections && o.stop != "auto")
     throw std::invalid_argument(
         "trial option 'confirm_detections': needs stop auto (it holds the automatic stop)");
+  if (o.release_left_out && o.stop != "auto")
+    throw std::invalid_argument(
+        "trial option 'release_left_out': needs stop auto (it releases the automatic stop)");
   if (!o.engine.empty() && !host::map::MapEngineRegistry::instance().contains(o.engine))
     throw std::invalid_argument("trial option 'engine': expected one of " +
                                 host::map::MapEngineRegistry::instance().knownNames() + ", got '" +
@@ -394,6 +397,7 @@ struct Trial::Impl {
   explicit Impl(TrialOptions opts) : options(std::move(opts)) {
     validate(options);
     completion_config.confirm_detections = options.confirm_detections;
+    completion_config.release_left_out = options.release_left_out;
     if (!options.out_dir.empty()) {
       host::prepareOutputDirectory(options.out_dir, "trial output directory");
       std::vector<std::string> stale = TrialParts::outputFiles();
@@ -544,6 +548,9 @@ ClusterOutcome Trial::Impl::runCluster(TrialParts& cluster_parts, const Fruitlet
                      cluster_parts.sizingConfig().well_seen_fraction);
     observers.add(&*guidance);  // after completion: it reads completion's sizing
     completion->holdWhile([&g = *guidance] { return g.waitingOnUnconfirmed(); });
+    if (completion_config.release_left_out)
+      completion->releaseWhen(
+          [&g = *guidance](const host::nbv::FruitletSnapshot& f) { return g.leftOut(f.center_m); });
     stop = stop || completion->stopCondition();
   } else if (options.record_size_history) {
     completion.emplace(cluster_parts.session(), observing_clock, cluster_parts.sizingConfig(),
@@ -583,7 +590,8 @@ nlohmann::json Trial::Impl::stopJson() const {
           {"min_well_seen_images", c.min_well_seen_images},
           {"min_view_span_deg", c.min_view_span_deg},
           {"max_iterations_without_view", c.max_iterations_without_view},
-          {"confirm_detections", c.confirm_detections}};
+          {"confirm_detections", c.confirm_detections},
+          {"release_left_out", c.release_left_out}};
 }
 
 void Trial::Impl::describeRun(nlohmann::json& result, const TrialLog& log,

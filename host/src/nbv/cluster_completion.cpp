@@ -83,7 +83,7 @@ void ClusterCompletion::onView(const ViewEvent& event) {
 }
 
 bool ClusterCompletion::done() const {
-  return sizesSettled(history_, config_) && !(hold_ && hold_());
+  return sizesSettled(history_, config_, released_) && !(hold_ && hold_());
 }
 
 StopCondition ClusterCompletion::stopCondition() const {
@@ -97,15 +97,15 @@ bool lacksEvidence(const FruitletSnapshot& fruitlet, const ClusterCompletionConf
           fruitlet.view_span_deg < config.min_view_span_deg);
 }
 
-bool sizesSettled(const std::vector<SizingSnapshot>& history,
-                  const ClusterCompletionConfig& config) {
+bool sizesSettled(const std::vector<SizingSnapshot>& history, const ClusterCompletionConfig& config,
+                  const std::function<bool(const FruitletSnapshot&)>& released) {
   if (history.size() < std::size_t(config.stable_views) + 1) return false;
   const SizingSnapshot& latest = history.back();
   // A cluster with nothing sized is not done: its fruitlets are still to be found (the
   // budget ends a cluster that has none).
   if (latest.fruitlets.empty()) return false;
   for (const auto& f : latest.fruitlets)
-    if (lacksEvidence(f, config)) return false;
+    if (lacksEvidence(f, config) && !(released && released(f))) return false;
   for (int k = 1; k <= config.stable_views; ++k) {
     const SizingSnapshot& earlier = history[history.size() - 1 - std::size_t(k)];
     // A fruitlet found or lost: the cluster is still changing.

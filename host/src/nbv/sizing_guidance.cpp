@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <utility>
 
 namespace fvp::host::nbv {
 
@@ -19,11 +20,20 @@ SizingGuidance::SizingGuidance(const std::vector<SizingSnapshot>& history,
     throw std::invalid_argument("SizingGuidance: max_aimed_views: expected at least 1");
 }
 
-SizingGuidance::Aim* SizingGuidance::findAim(const Eigen::Vector3d& center_m) {
+const SizingGuidance::Aim* SizingGuidance::findAim(const Eigen::Vector3d& center_m) const {
   const double same_m = config_.same_fruitlet_m;
-  for (Aim& aim : aims_)
+  for (const Aim& aim : aims_)
     if ((aim.center_m - center_m).norm() <= same_m) return &aim;
   return nullptr;
+}
+
+SizingGuidance::Aim* SizingGuidance::findAim(const Eigen::Vector3d& center_m) {
+  return const_cast<Aim*>(std::as_const(*this).findAim(center_m));
+}
+
+bool SizingGuidance::leftOut(const Eigen::Vector3d& center_m) const {
+  const Aim* aim = findAim(center_m);
+  return aim && aim->views >= max_aimed_views_;
 }
 
 void SizingGuidance::onPlan(const PlanEvent& event) {

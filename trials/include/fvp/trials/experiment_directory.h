@@ -67,6 +67,7 @@ struct ExperimentManifest {
   int max_views = 0;                ///< 0: no limit
   bool register_views = false;      ///< --register-views (absent in a manifest: false)
   bool confirm_detections = false;  ///< --confirm-detections (absent in a manifest: false)
+  bool release_left_out = false;    ///< --release-left-out (absent in a manifest: false)
   /// --error-scale GROUP=FACTOR, or empty; the world config's hash already tells runs apart,
   /// this names the sweep point (absent in a manifest: empty).
   std::string error_scale;

@@ -60,6 +60,11 @@ struct ClusterCompletionConfig {
   /// it like a fruitlet short of well-seen images (holdWhile: the stop waits while it does).
   /// Off: the stop rule and the planner see the kept detections only.
   bool confirm_detections = false;
+  /// A kept fruitlet that lacks the evidence (lacksEvidence) no longer holds the stop once
+  /// the planner has looked for it max_aimed_views times in vain (SizingGuidance::leftOut,
+  /// handed over by releaseWhen): no reachable view shows it as the rule asks, so waiting on
+  /// it only spends the cap. Its size must still be stable. Off: it holds the stop to the cap.
+  bool release_left_out = false;
   /// Throws std::invalid_argument naming the bad field.
   void validate() const;
 };
@@ -112,6 +117,11 @@ class ClusterCompletion : public LoopObserver {
   /// The cluster is not done while `pending` returns true (SizingGuidance::
   /// waitingOnUnconfirmed): `pending` must outlive this.
   void holdWhile(std::function<bool()> pending) { hold_ = std::move(pending); }
+  /// A fruitlet for which `released` returns true does not need the evidence
+  /// (SizingGuidance::leftOut, with release_left_out): `released` must outlive this.
+  void releaseWhen(std::function<bool(const FruitletSnapshot&)> released) {
+    released_ = std::move(released);
+  }
   /// Holds when done(); its reason is "cluster_done".
   /// "cluster_done" once the sizes have settled, "no_reachable_view" once the planner is
   /// stuck (max_iterations_without_view).
@@ -128,6 +138,7 @@ class ClusterCompletion : public LoopObserver {
   ClusterCompletionConfig config_;
   std::vector<SizingSnapshot> history_;
   std::function<bool()> hold_;
+  std::function<bool(const FruitletSnapshot&)> released_;
 };
 
 /// Whether a fruitlet still lacks the images the rule asks for: min_well_seen_images
@@ -136,7 +147,8 @@ class ClusterCompletion : public LoopObserver {
 bool lacksEvidence(const FruitletSnapshot& fruitlet, const ClusterCompletionConfig& config);
 
 /// Whether the last config.stable_views + 1 snapshots of history agree (the rule of done()).
-bool sizesSettled(const std::vector<SizingSnapshot>& history,
-                  const ClusterCompletionConfig& config);
+/// `released` (optional): fruitlets that need not show the evidence.
+bool sizesSettled(const std::vector<SizingSnapshot>& history, const ClusterCompletionConfig& config,
+                  const std::function<bool(const FruitletSnapshot&)>& released = {});
 
 }  // namespace fvp::host::nbv

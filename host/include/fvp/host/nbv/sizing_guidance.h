@@ -45,6 +45,9 @@ class SizingGuidance : public LoopObserver {
   /// views since it became one. ClusterCompletion::holdWhile takes it: a cluster is not done
   /// while the planner may still confirm one.
   bool waitingOnUnconfirmed() const { return unconfirmed_targets_ > 0; }
+  /// Whether the fruitlet at center_m was left out: looked at max_aimed_views times without a
+  /// new well-seen image (ClusterCompletion::releaseWhen takes it, with release_left_out).
+  bool leftOut(const Eigen::Vector3d& center_m) const;
 
  private:
   struct Aim {
@@ -53,6 +56,7 @@ class SizingGuidance : public LoopObserver {
     int views = 0;
   };
   Aim* findAim(const Eigen::Vector3d& center_m);
+  const Aim* findAim(const Eigen::Vector3d& center_m) const;
 
   const std::vector<SizingSnapshot>& history_;
   const ClusterCompletionConfig& config_;
