@@ -12,6 +12,7 @@
 #include <set>
 
 #include "fvp/host/nbv/arm.h"
+#include "fvp/host/nbv/camera.h"
 #include "fvp/robot/sim/world.h"
 #include "fvp/trials/trial.h"
 
@@ -67,6 +68,28 @@ class ArmWithABlockedRegion : public host::nbv::Arm {
  private:
   host::nbv::Arm& arm_;
   Blocked blocked_;
+};
+
+// The simulated camera, except that from the poses `hidden` names the tag is not seen: the
+// left image is blacked out (a leaf before the tag from there).
+class CameraWithAHiddenTag : public host::nbv::Camera {
+ public:
+  using Hidden = std::function<bool(const Eigen::Isometry3d&)>;
+  CameraWithAHiddenTag(host::nbv::Camera& camera, Hidden hidden)
+      : camera_(camera), hidden_(std::move(hidden)) {}
+  host::nbv::CaptureResult capture(const Eigen::Isometry3d& T_world_camera) override {
+    host::nbv::CaptureResult r = camera_.capture(T_world_camera);
+    if (r.ok() && hidden_(T_world_camera)) {
+      r.frame.left_bgr.setTo(cv::Scalar::all(0));
+      ++hidden_captures;
+    }
+    return r;
+  }
+  int hidden_captures = 0;
+
+ private:
+  host::nbv::Camera& camera_;
+  Hidden hidden_;
 };
 
 /// Distance from p to the line through a along the unit direction u.
@@ -192,6 +215,36 @@ TEST_F(TreeTrial, ReachesAClusterFromATurnedViewWhenItsAxisIsBlocked) {
     if (c["index"] != blocked && c.contains("approach_yaw_deg")) {
       EXPECT_EQ(c["approach_yaw_deg"], 0.0);
     }
+  }
+}
+
+// A cluster whose tag its start view does not show is mapped from the next approach view
+// (5 cm farther out along its axis), not given up.
+TEST_F(TreeTrial, TriesTheNextApproachViewWhenTheTagIsNotSeen) {
+  const auto world = robot::sim::World::generate(world_config_, kSeed);
+  const int hidden = 2;
+  const robot::sim::FruitletCluster& cluster = world.clusters()[hidden];
+  TrialOptions o = options();
+  o.out_dir = dir_ / "hidden";
+  Trial trial(o);
+  CameraWithAHiddenTag camera(trial.simulatedCamera(), [&](const Eigen::Isometry3d& T) {
+    return (T.translation() - cluster.T_world_start_camera.translation()).norm() < 1e-3;
+  });
+  const nlohmann::json r = trial.run(camera, trial.simulatedArm());
+  EXPECT_EQ(camera.hidden_captures, 1);
+  EXPECT_EQ(r["tour"]["cluster_status"].value("sized", 0), 3);
+  for (const auto& c : r["clusters"]) {
+    if (c["index"] != hidden) {
+      EXPECT_EQ(c.value("approaches_without_tag", -1), 0);
+      continue;
+    }
+    EXPECT_EQ(c["status"], "sized");
+    EXPECT_EQ(c["approaches_without_tag"], 1);
+    EXPECT_EQ(c["approach_yaw_deg"], 0.0);
+    EXPECT_NEAR(c["approach_distance_m"].get<double>(),
+                (cluster.T_world_start_camera.translation() - cluster.center_m).norm() + 0.05,
+                1e-6);
+    EXPECT_EQ(c["views"], 3) << "the untagged view, then the cluster's two";
   }
 }
 

@@ -714,34 +714,55 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
     };
     // To its start view (the first cluster's is where the arm starts), or, where the arm
     // cannot stand there, the same view from farther out along its axis, then turned.
-    if (!loop_arm.cameraPose().isApprox(cluster.T_world_start_camera, 1e-9)) {
-      std::string move_status = "unreachable";
-      bool arrived = false;
-      for (const auto& [T, yaw_deg] : approachPoses(cluster)) {
-        if (!loop_arm.reachable(T)) continue;
+    const std::vector<ApproachPose> approaches = approachPoses(cluster);
+    std::size_t next_approach = 0;
+    std::string move_status = "unreachable";
+    const auto approach = [&] {
+      for (; next_approach < approaches.size(); ++next_approach) {
+        const auto& [T, yaw_deg] = approaches[next_approach];
+        if (loop_arm.cameraPose().isApprox(T, 1e-9) || !loop_arm.reachable(T)) continue;
         const double before_s = loop_clock.now_s();
         const host::nbv::MoveResult move = loop_arm.moveTo(T);
         transit_s += loop_clock.now_s() - before_s;
         move_status = host::nbv::toString(move.status);
         transit_motion[move_status] = transit_motion.value(move_status, 0) + 1;
-        if ((arrived = move.ok())) {
+        if (move.ok()) {
           entry["approach_distance_m"] = (T.translation() - cluster.center_m).norm();
           entry["approach_yaw_deg"] = yaw_deg;
-          break;
+          ++next_approach;
+          return true;
         }
       }
-      if (!arrived) {
-        entry["move_status"] = move_status;
-        skip(move_status == "unreachable" ? "unreachable" : "move_failed");
-        continue;
-      }
+      return false;
+    };
+    if (!loop_arm.cameraPose().isApprox(cluster.T_world_start_camera, 1e-9) && !approach()) {
+      entry["move_status"] = move_status;
+      skip(move_status == "unreachable" ? "unreachable" : "move_failed");
+      continue;
     }
     if (!cluster_parts) cluster_parts = makeParts(k);
     if (carried_map) cluster_parts->session().carryOnWith(std::move(carried_map));
     const double t0_s = loop_clock.now_s();
     log.startCluster(static_cast<int>(k), cluster.center_m);
-    const ClusterOutcome outcome =
+    ClusterOutcome outcome =
         runCluster(*cluster_parts, cluster, loop_camera, loop_arm, loop_clock, log);
+    // A view that shows no tag (a leaf before it from there, foliage an earlier cluster's
+    // views put on the way) places no Cluster Region: the next approach view may show it.
+    // The views taken on the way are the cluster's too.
+    std::size_t untagged_views = 0;
+    std::vector<Eigen::Isometry3d> untagged_poses;
+    int retried_approaches = 0;
+    while (!cluster_parts->map() && outcome.run.stop_reason == "no_region" && approach()) {
+      untagged_views += outcome.run.views;
+      untagged_poses.insert(untagged_poses.end(), outcome.run.camera_poses.begin(),
+                            outcome.run.camera_poses.end());
+      ++retried_approaches;
+      outcome = runCluster(*cluster_parts, cluster, loop_camera, loop_arm, loop_clock, log);
+    }
+    outcome.run.views += untagged_views;
+    outcome.run.camera_poses.insert(outcome.run.camera_poses.begin(), untagged_poses.begin(),
+                                    untagged_poses.end());
+    entry["approaches_without_tag"] = retried_approaches;
     const bool mapped = cluster_parts->map() != nullptr;
     if (options.register_views)
       entry["anchor_offset"] = anchorOffsetJson(cluster_parts->session(), log.trueAnchorShift());
