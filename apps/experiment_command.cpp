@@ -57,12 +57,13 @@ void addExperimentCommands(CLI::App& app) {
          "settled, the budget being the cap")
       ->check(CLI::IsMember({"budget", "auto"}))
       ->capture_default_str();
-  cmd->add_flag("--confirm-detections", opt->experiment.trial.confirm_detections,
+  cmd->add_flag("--confirm-detections,!--no-confirm-detections",
+                opt->experiment.trial.confirm_detections,
                 "with --stop auto: look again at detections sized by a sphere fit to less than "
-                "a hemisphere before a cluster is done (docs/nbv-loop.md)");
-  cmd->add_flag("--release-left-out", opt->experiment.trial.release_left_out,
+                "a hemisphere before a cluster is done (the default; docs/nbv-loop.md)");
+  cmd->add_flag("--release-left-out,!--no-release-left-out", opt->experiment.trial.release_left_out,
                 "with --stop auto: a fruitlet the planner has looked for twice in vain no longer "
-                "holds the stop (docs/nbv-loop.md)");
+                "holds the stop (the default; docs/nbv-loop.md)");
   cmd->add_flag("--register-views", opt->experiment.trial.register_views,
                 "align each view to the earlier ones before fusing it (a counter-measure to "
                 "pose errors)");

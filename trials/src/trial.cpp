@@ -96,12 +96,6 @@ void validate(const TrialOptions& o) {
   if (o.clock != "wall" && o.clock != "fixed")
     throw std::invalid_argument("trial option 'clock': expected wall or fixed, got '" + o.clock +
                                 "'");
-  if (o.confirm_detections && o.stop != "auto")
-    throw std::invalid_argument(
-        "trial option 'confirm_detections': needs stop auto (it holds the automatic stop)");
-  if (o.release_left_out && o.stop != "auto")
-    throw std::invalid_argument(
-        "trial option 'release_left_out': needs stop auto (it releases the automatic stop)");
   if (!o.engine.empty() && !host::map::MapEngineRegistry::instance().contains(o.engine))
     throw std::invalid_argument("trial option 'engine': expected one of " +
                                 host::map::MapEngineRegistry::instance().knownNames() + ", got '" +

@@ -52,10 +52,10 @@ struct TrialOptions {
   bool register_views = false;
   /// With stop auto: look again at unconfirmed detections (dropped by the hemisphere rule
   /// alone) before a cluster is done (host::nbv::ClusterCompletionConfig::confirm_detections).
-  bool confirm_detections = false;
+  bool confirm_detections = true;
   /// With stop auto: a fruitlet the planner looked for twice in vain no longer holds the stop
   /// (host::nbv::ClusterCompletionConfig::release_left_out).
-  bool release_left_out = false;
+  bool release_left_out = true;
   /// Where result.json, the maps, the TSDF surface, the clusters and report.md go; empty:
   /// nothing is written (the result is only returned).
   std::filesystem::path out_dir;

@@ -58,13 +58,13 @@ struct ClusterCompletionConfig {
   /// seen from one side with its outline merged with a neighbour's, or a phantom; its evidence
   /// is its sized images from directions min_view_span_deg apart, and SizingGuidance aims at
   /// it like a fruitlet short of well-seen images (holdWhile: the stop waits while it does).
-  /// Off: the stop rule and the planner see the kept detections only.
-  bool confirm_detections = false;
+  /// Off (the rule before 8c37611): the stop rule and the planner see the kept detections only.
+  bool confirm_detections = true;
   /// A kept fruitlet that lacks the evidence (lacksEvidence) no longer holds the stop once
   /// the planner has looked for it max_aimed_views times in vain (SizingGuidance::leftOut,
   /// handed over by releaseWhen): no reachable view shows it as the rule asks, so waiting on
-  /// it only spends the cap. Its size must still be stable. Off: it holds the stop to the cap.
-  bool release_left_out = false;
+  /// it only spends the cap. Its size must still be stable. Off (before 8c37611): it holds the stop to the cap.
+  bool release_left_out = true;
   /// Throws std::invalid_argument naming the bad field.
   void validate() const;
 };
