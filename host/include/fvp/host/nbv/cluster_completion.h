@@ -63,7 +63,8 @@ struct ClusterCompletionConfig {
   /// A kept fruitlet that lacks the evidence (lacksEvidence) no longer holds the stop once
   /// the planner has looked for it max_aimed_views times in vain (SizingGuidance::leftOut,
   /// handed over by releaseWhen): no reachable view shows it as the rule asks, so waiting on
-  /// it only spends the cap. Its size must still be stable. Off (before 8c37611): it holds the stop to the cap.
+  /// it only spends the cap. Its size must still be stable. Off (before 8c37611): it holds the stop
+  /// to the cap.
   bool release_left_out = true;
   /// Throws std::invalid_argument naming the bad field.
   void validate() const;
