@@ -104,8 +104,8 @@ TEST(ClusterCompletion, ImagesFromOneDirectionDoNotStopButSphereFitsDo) {
   // is enough; a size still moving is not.
   const auto first = [](const FruitletSnapshot& f) { return f.center_m.x() == 0.0; };
   EXPECT_TRUE(sizesSettled(narrow, config, first));
-  auto moving = history(6, 0.04);
-  for (auto& s : moving) s.fruitlets[0].view_span_deg = 12.0;
+  auto moving = narrow;  // only the released fruitlet's size moves
+  for (std::size_t v = 0; v < moving.size(); ++v) moving[v].fruitlets[0].size_mm += 0.2 * double(v);
   EXPECT_FALSE(sizesSettled(moving, config, first));
   // A fruitlet merged with a neighbour in every image has no well-seen image: its sphere
   // fit is its size, and it counts once that is stable.

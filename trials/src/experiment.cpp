@@ -108,8 +108,10 @@ ExperimentManifest manifestOf(const ExperimentOptions& o) {
   m.stop = o.trial.stop;
   m.max_views = o.trial.max_views.value_or(0);
   m.register_views = o.trial.register_views;
-  m.confirm_detections = o.trial.confirm_detections;
-  m.release_left_out = o.trial.release_left_out;
+  // Switches of the automatic stop: nothing under the budget stop, recorded as off there so
+  // that budget experiments from before they existed still resume and merge.
+  m.confirm_detections = o.trial.stop == "auto" && o.trial.confirm_detections;
+  m.release_left_out = o.trial.stop == "auto" && o.trial.release_left_out;
   m.error_scale = o.error_scale;
   m.world_config = stampOf(o.trial.world_config, "world config");
   m.planner_config = stampOf(o.trial.planner_config, "planner config");
