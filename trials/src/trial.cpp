@@ -743,17 +743,15 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
     // A view that shows no tag (a leaf before it from there, foliage an earlier cluster's
     // views put on the way) places no Cluster Region: the next approach view may show it.
     // The views taken on the way are the cluster's too.
-    std::size_t untagged_views = 0;
-    std::vector<Eigen::Isometry3d> untagged_poses;
+    std::vector<Eigen::Isometry3d> untagged_poses;  // one per untagged view
     int retried_approaches = 0;
     while (!cluster_parts->map() && outcome.run.stop_reason == "no_region" && approach()) {
-      untagged_views += outcome.run.views;
       untagged_poses.insert(untagged_poses.end(), outcome.run.camera_poses.begin(),
                             outcome.run.camera_poses.end());
       ++retried_approaches;
       outcome = runCluster(*cluster_parts, cluster, loop_camera, loop_arm, loop_clock, log);
     }
-    outcome.run.views += untagged_views;
+    outcome.run.views += untagged_poses.size();
     outcome.run.camera_poses.insert(outcome.run.camera_poses.begin(), untagged_poses.begin(),
                                     untagged_poses.end());
     entry["approaches_without_tag"] = retried_approaches;

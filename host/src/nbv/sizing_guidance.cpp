@@ -59,7 +59,6 @@ void SizingGuidance::onPlan(const PlanEvent& event) {
 void SizingGuidance::onView(const ViewEvent& event) {
   targets_.clear();
   target_unconfirmed_.clear();
-  unconfirmed_targets_ = 0;
   // No sizing for this view (no Cluster Region yet): nothing to aim at.
   if (history_.empty() || history_.back().view != event.index) {
     planner_.setSizingTargets({});
@@ -91,7 +90,6 @@ void SizingGuidance::onView(const ViewEvent& event) {
     target.min_visible_fraction = min_visible_fraction_;
     targets_.push_back(std::move(target));
     target_unconfirmed_.push_back(f.unconfirmed);
-    if (f.unconfirmed) ++unconfirmed_targets_;
   }
   planner_.setSizingTargets(targets_);
 }

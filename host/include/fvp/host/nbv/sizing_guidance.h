@@ -9,6 +9,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cstddef>
 #include <vector>
 
@@ -44,7 +45,10 @@ class SizingGuidance : public LoopObserver {
   /// yet sized from directions the rule asks, and the loop has not yet taken max_aimed_views
   /// views since it became one. ClusterCompletion::holdWhile takes it: a cluster is not done
   /// while the planner may still confirm one.
-  bool waitingOnUnconfirmed() const { return unconfirmed_targets_ > 0; }
+  bool waitingOnUnconfirmed() const {
+    return std::find(target_unconfirmed_.begin(), target_unconfirmed_.end(), true) !=
+           target_unconfirmed_.end();
+  }
   /// Whether the fruitlet at center_m was left out: looked at max_aimed_views times without a
   /// new well-seen image (ClusterCompletion::releaseWhen takes it, with release_left_out).
   bool leftOut(const Eigen::Vector3d& center_m) const;
@@ -66,7 +70,7 @@ class SizingGuidance : public LoopObserver {
   std::vector<planner::SizingTarget> targets_;
   std::vector<bool> target_unconfirmed_;  ///< per target: an unconfirmed detection
   std::vector<Aim> aims_;
-  std::size_t aimed_views_ = 0, dropped_ = 0, unconfirmed_targets_ = 0;
+  std::size_t aimed_views_ = 0, dropped_ = 0;
 };
 
 }  // namespace fvp::host::nbv
