@@ -28,7 +28,6 @@ typedef long fvp_i64;
 #define FVP_FN static inline
 #define FVP_GLOBAL __global
 #define FVP_FLOORF floor
-#define FVP_SQRTF sqrt
 #else
 #include <math.h>
 #include <stdint.h>
@@ -36,7 +35,6 @@ typedef int64_t fvp_i64;
 #define FVP_FN static inline
 #define FVP_GLOBAL
 #define FVP_FLOORF floorf
-#define FVP_SQRTF sqrtf
 #endif
 
 /* Fixed point: 16 fractional bits per voxel. */

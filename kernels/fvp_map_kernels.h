@@ -14,6 +14,7 @@
 #define FVP_MAP_KERNELS_H
 
 #include "fvp_dda.h"
+#include "fvp_exact.h"
 #include "fvp_map.h"
 
 #ifdef __OPENCL_VERSION__
@@ -22,7 +23,6 @@
 #define FVP_ATOMIC_INC(ptr) atomic_inc(ptr)
 #define FVP_LOAD(ptr) (*(ptr))
 #define FVP_FLAG(ptr) (*(ptr) = 1u)
-#define FVP_SQRTF sqrt
 #else
 #define FVP_ATOMIC_OR(ptr, v) __atomic_fetch_or((ptr), (v), __ATOMIC_RELAXED)
 #define FVP_ATOMIC_ADD(ptr, v) __atomic_fetch_add((ptr), (v), __ATOMIC_RELAXED)
@@ -30,7 +30,6 @@
 #define FVP_LOAD(ptr) __atomic_load_n((ptr), __ATOMIC_RELAXED)
 /* Racing stores of the same constant: relaxed atomics keep them well defined in C++. */
 #define FVP_FLAG(ptr) __atomic_store_n((ptr), 1u, __ATOMIC_RELAXED)
-#define FVP_SQRTF sqrtf
 #endif
 
 /* Point flags */
@@ -228,10 +227,11 @@ FVP_FN unsigned int fvp_edt_pass_voxel(const fvp_edt_params* p, int x, int y, in
   return best;
 }
 
-/* Distance in voxels from a squared distance, capped at the radius. */
+/* Distance in voxels from a squared distance, capped at the radius; correctly rounded
+ * (fvp_exact.h), since the gain's weights are read from it. */
 FVP_FN float fvp_edt_distance_vox(unsigned int sq, int radius_vox) {
   if (sq >= (unsigned int)(radius_vox * radius_vox)) return (float)radius_vox;
-  return FVP_SQRTF((float)sq);
+  return fvp_sqrt_rn((float)sq);
 }
 
 FVP_FN int fvp_voxel_unknown(const fvp_bricked_grid* m, FVP_GLOBAL const int* table,

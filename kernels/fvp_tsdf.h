@@ -7,11 +7,13 @@
  * along the viewing ray, truncated, is averaged into the voxel with weight 1 / z^2, which
  * drops linearly to 0 from one voxel behind the surface to the truncation distance. Every
  * voxel is written by exactly one item, so the result does not depend on scheduling.
- * Floats throughout: a GPU's division and sqrt are not correctly rounded, so backends agree
- * to a tolerance, not bit for bit (tests/tsdf). */
+ * Floats throughout, rounded the same on every device: no contraction, and division and
+ * square root correctly rounded by fvp_exact.h (a GPU's own are not), so every backend
+ * gives the cpu backend's voxels bit for bit (tests/tsdf, docs/kernels.md). */
 #ifndef FVP_TSDF_H
 #define FVP_TSDF_H
 
+#include "fvp_exact.h"
 #include "fvp_map.h"
 
 typedef struct fvp_tsdf_params {
@@ -51,8 +53,8 @@ FVP_FN void fvp_tsdf_update_voxel(const fvp_tsdf_params* p, FVP_GLOBAL const int
   float u_f, v_f, depth, sdf, w, tsdf, w_old;
   int u, v;
   if (!(z > 0.0f)) return;
-  u_f = FVP_FLOORF(p->fx_px * x / z + p->cx_px + 0.5f);
-  v_f = FVP_FLOORF(p->fy_px * y / z + p->cy_px + 0.5f);
+  u_f = FVP_FLOORF(fvp_div_rn(p->fx_px * x, z) + p->cx_px + 0.5f);
+  v_f = FVP_FLOORF(fvp_div_rn(p->fy_px * y, z) + p->cy_px + 0.5f);
   if (!(u_f >= 0.0f && v_f >= 0.0f && u_f < (float)p->width_px && v_f < (float)p->height_px))
     return;
   u = (int)u_f;
@@ -60,14 +62,15 @@ FVP_FN void fvp_tsdf_update_voxel(const fvp_tsdf_params* p, FVP_GLOBAL const int
   depth = depth_m[v * p->width_px + u];
   if (!(depth > 0.0f)) return; /* not ROI, no depth, or NaN */
   /* Projective distance along the viewing ray, in metres. */
-  sdf = (depth - z) * FVP_SQRTF(x * x + y * y + z * z) / z;
+  sdf = fvp_div_rn((depth - z) * fvp_sqrt_rn(x * x + y * y + z * z), z);
   if (sdf < -p->truncation_m) return;
-  w = 1.0f / (z * z);
-  if (sdf < -p->voxel_size_m) w *= (p->truncation_m + sdf) / (p->truncation_m - p->voxel_size_m);
+  w = fvp_div_rn(1.0f, z * z);
+  if (sdf < -p->voxel_size_m)
+    w = w * fvp_div_rn(p->truncation_m + sdf, p->truncation_m - p->voxel_size_m);
   if (!(w > 0.0f)) return;
   tsdf = sdf < p->truncation_m ? sdf : p->truncation_m;
   w_old = tsdf_weight[slot];
-  tsdf_distance[slot] = (tsdf_distance[slot] * w_old + tsdf * w) / (w_old + w);
+  tsdf_distance[slot] = fvp_div_rn(tsdf_distance[slot] * w_old + tsdf * w, w_old + w);
   tsdf_weight[slot] = w_old + w < p->max_weight ? w_old + w : p->max_weight;
 }
 

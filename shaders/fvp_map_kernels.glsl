@@ -2,6 +2,7 @@
 // name for each C function there; the C versions' buffer pointers are the shader's storage
 // buffers of the same names. Include after fvp_map.glsl for the types; include again after
 // declaring the buffers and defining FVP_HAS_<BUFFER> for each, for the functions over them.
+#include "fvp_exact.glsl"
 #ifndef FVP_MAP_KERNELS_GLSL
 #define FVP_MAP_KERNELS_GLSL
 
@@ -58,7 +59,7 @@ struct FvpFrontier {
 
 float fvp_edt_distance_vox(uint sq, int radius_vox) {
   if (sq >= uint(radius_vox * radius_vox)) return float(radius_vox);
-  return sqrt(float(sq));
+  return fvp_sqrt_rn(float(sq));
 }
 
 #endif  // FVP_MAP_KERNELS_GLSL

@@ -9,7 +9,7 @@
 // - then the work-item count (OpenCL: second argument; GLSL: FVP_ITEM_COUNT);
 // - then the buffers, in binding order (OpenCL: arguments 2.., whose names the OpenCL
 //   backend checks against the binding names; GLSL: set 0, bindings 0..).
-// Adding a kernel: README.md, "Adding a kernel".
+// Adding a kernel: docs/kernels.md, "Adding a kernel".
 #pragma once
 
 #include <cstddef>
