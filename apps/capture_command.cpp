@@ -15,6 +15,7 @@
 #include "cli_checks.h"
 #include "commands.h"
 #include "fvp/host/core/input_checks.h"
+#include "fvp/host/core/interrupt.h"
 #include "fvp/host/core/output_directory.h"
 #include "fvp/host/perception/capture.h"
 #include "fvp/host/perception/perception_pipeline.h"
@@ -59,6 +60,17 @@ std::string vec(const Eigen::Vector3d& p) {
 
 }  // namespace
 
+// A single view written into a capture set would leave a camera.yaml beside its views, and
+// fvp size would refuse the set: refused before anything is rendered or written.
+static void refuseCaptureSet(const std::filesystem::path& out) {
+  for (const auto& entry : std::filesystem::directory_iterator(out))
+    if (entry.is_directory() && std::filesystem::exists(entry.path() / "camera.yaml"))
+      throw std::runtime_error("--out '" + out.string() + "' holds a capture set (" +
+                               entry.path().filename().string() +
+                               "/camera.yaml): a single view there would hide its views from "
+                               "fvp size; write it to a new directory, or use --views");
+}
+
 // K views orbiting the cluster, each rendered, perceived and written as out/NNN.
 static void writeCaptureSet(std::uint64_t seed, const std::string& world_file, int views,
                             double arc_deg, const std::filesystem::path& out) {
@@ -84,6 +96,7 @@ static void writeCaptureSet(std::uint64_t seed, const std::string& world_file, i
   std::optional<host::ClusterRegion> region;
   const auto poses = robot::sim::orbitViews(world, views, arc_deg);
   for (std::size_t i = 0; i < poses.size(); ++i) {
+    host::throwIfInterrupted();  // the views written so far are complete captures
     const host::StereoFrame frame = renderer.render(poses[i]);
     const host::PerceptionResult result = pipeline.process(frame, region);
     if (!region && result.region) region = result.region;
@@ -137,9 +150,13 @@ void addCaptureCommand(CLI::App& app) {
       ->check(finiteNumber())
       ->check(CLI::Range(0.0, 360.0))
       ->capture_default_str();
-  cmd->add_option("--out", opt->out, "capture directory (created)")->required();
+  cmd->add_option("--out", opt->out, "capture directory (created)")
+      ->required()
+      ->check(nonEmptyPath());
   cmd->callback([opt] {
     host::prepareOutputDirectory(opt->out, "--out");
+    const host::OutputDirectoryLock lock(opt->out, "--out");
+    if (opt->views == 1) refuseCaptureSet(opt->out);
     if (opt->views > 1) {
       if (!opt->pose.empty()) throw std::invalid_argument("--pose and --views exclude each other");
       writeCaptureSet(opt->seed, opt->world_file, opt->views, opt->arc_deg, opt->out);

@@ -61,4 +61,15 @@ inline CLI::Validator positiveNumber() {
       "POSITIVE", "positiveNumber");
 }
 
+/// A path that is not empty: `--out ""` would write nowhere (the libraries take an empty
+/// directory to mean "no files") and report success.
+inline CLI::Validator nonEmptyPath() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        if (text.empty()) return "expected a directory, got an empty path";
+        return {};
+      },
+      "PATH", "nonEmptyPath");
+}
+
 }  // namespace fvp::apps

@@ -4,11 +4,13 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <tuple>
 
 #include "cli_checks.h"
 #include "commands.h"
+#include "fvp/host/core/output_directory.h"
 #include "fvp/host/map/map_engine_registry.h"
 #include "fvp/trials/experiment.h"
 #include "fvp/trials/sensitivity_report.h"
@@ -78,7 +80,7 @@ void addExperimentCommands(CLI::App& app) {
       ->check(decimalUnsigned());
   cmd->add_option("--shard", opt->shard, "run shard i of n (0-based, 0 <= i < n), e.g. 0/4");
   cmd->add_flag("--resume", opt->experiment.resume, "skip trials already in trials.jsonl");
-  cmd->add_option("--out", opt->out, "output directory")->required();
+  cmd->add_option("--out", opt->out, "output directory")->required()->check(nonEmptyPath());
   cmd->callback([opt] {
     trials::ExperimentOptions o = opt->experiment;
     // Every comma-separated name, empty ones too: the runner rejects empty, unknown and
@@ -94,6 +96,14 @@ void addExperimentCommands(CLI::App& app) {
     if (!opt->shard.empty())
       std::tie(o.shard_index, o.shard_count) = trials::parseShard(opt->shard);
     o.error_scale = opt->error_scale;
+    // One writer from the first file on: --error-scale writes OUT/world.yaml before the
+    // runner (which takes the same lock, shared within this process) starts.
+    std::optional<host::OutputDirectoryLock> lock;
+    if (!opt->error_scale.empty()) {
+      (void)trials::parseErrorScale(opt->error_scale);  // a bad one fails before --out is made
+      host::prepareOutputDirectory(opt->out, "experiment: --out");
+      lock.emplace(opt->out, "experiment: --out");
+    }
     o.trial.world_config = opt->error_scale.empty() ? std::filesystem::path(opt->world)
                                                     : trials::writeScaledWorldConfig(
                                                           opt->world, opt->error_scale, opt->out);
@@ -122,7 +132,9 @@ void addExperimentCommands(CLI::App& app) {
   auto shards = std::make_shared<std::vector<std::string>>();
   auto* merge = app.add_subcommand("merge", "Combine experiment shards into one experiment");
   merge->add_option("shards", *shards, "shard output directories")->required();
-  merge->add_option("--out", *merge_out, "merged output directory")->required();
+  merge->add_option("--out", *merge_out, "merged output directory")
+      ->required()
+      ->check(nonEmptyPath());
   merge->callback([merge_out, shards] {
     std::vector<std::filesystem::path> dirs(shards->begin(), shards->end());
     trials::mergeExperiments(dirs, *merge_out, [](const std::string& line) {
@@ -140,7 +152,9 @@ void addExperimentCommands(CLI::App& app) {
                          "sensitivity.json, sensitivity.md and sensitivity.png to --out");
   sensitivity->add_option("experiments", *points, "experiment directories (the sweep's points)")
       ->required();
-  sensitivity->add_option("--out", *sweep_out, "output directory")->required();
+  sensitivity->add_option("--out", *sweep_out, "output directory")
+      ->required()
+      ->check(nonEmptyPath());
   sensitivity->callback([sweep_out, points] {
     std::vector<std::filesystem::path> dirs(points->begin(), points->end());
     const bool drawn = trials::writeSensitivityReport(

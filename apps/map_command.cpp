@@ -55,10 +55,11 @@ void addMapCommand(CLI::App& app) {
   cmd->add_option("--backend", opt->backend,
                   "compute backend for the grid engine: cpu | opencl | vulkan | auto")
       ->capture_default_str();
-  cmd->add_option("--out", opt->out, "output directory")->required();
+  cmd->add_option("--out", opt->out, "output directory")->required()->check(nonEmptyPath());
   cmd->callback([opt] {
     using robot::sim::WorldConfig;
     host::prepareOutputDirectory(opt->out, "--out");
+    const host::OutputDirectoryLock lock(opt->out, "--out");
     host::removeStaleOutputs(opt->out, {"coarse.bt", "fine.ot", "map.json"});
     const WorldConfig config =
         opt->world_file.empty() ? WorldConfig{} : WorldConfig::fromYamlFile(opt->world_file);

@@ -42,7 +42,7 @@ void addPlanCommand(CLI::App& app) {
   cmd->add_option("--perception-config", *perception,
                   "perception config YAML for --captures (tag, Cluster Region, HSV)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--out", *out, "output directory")->required();
+  cmd->add_option("--out", *out, "output directory")->required()->check(nonEmptyPath());
   cmd->callback([opt, world, config, out, captures, perception] {
     trials::PlanOnceOptions o = *opt;
     o.captures_dir = *captures;

@@ -70,7 +70,7 @@ void addRunCommand(CLI::App& app) {
                   "simulated clock: wall (charge measured compute time) | fixed (a constant)")
       ->check(CLI::IsMember({"wall", "fixed"}))
       ->capture_default_str();
-  cmd->add_option("--out", opt->out, "output directory")->required();
+  cmd->add_option("--out", opt->out, "output directory")->required()->check(nonEmptyPath());
   cmd->callback([opt] {
     trials::TrialOptions trial = opt->trial;
     trial.world_config = opt->world;
@@ -93,6 +93,12 @@ void addRunCommand(CLI::App& app) {
               << "report: " << (std::filesystem::path(opt->out) / "report.md").string() << "\n"
               << "3-D viewer: " << (std::filesystem::path(opt->out) / "viewer.html").string()
               << " (open it in a browser)\n";
+    // The result is kept; an extra that could not be written (a full disk) still fails the
+    // command, so that a script notices.
+    if (const auto it = result.find("unwritten_outputs"); it != result.end())
+      throw std::runtime_error(std::to_string(it->size()) + " of the trial's files not written (" +
+                               it->dump() + "; see the warnings above); result.json holds " +
+                               "the trial");
   });
 }
 

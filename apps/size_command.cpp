@@ -3,6 +3,7 @@
 #include <iostream>
 #include <memory>
 
+#include "cli_checks.h"
 #include "commands.h"
 #include "fvp/accel/backend.h"
 #include "fvp/host/map/map_engine_registry.h"
@@ -35,7 +36,7 @@ void addSizeCommand(CLI::App& app) {
                   "(offset and radius, or an explicit centre) and HSV thresholds "
                   "(docs/capture-format.md)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--out", opt->out, "output directory")->required();
+  cmd->add_option("--out", opt->out, "output directory")->required()->check(nonEmptyPath());
   cmd->callback([opt] {
     host::PerceptionConfig perception;  // read first: a bad file fails before any work
     if (!opt->config.empty()) perception = host::PerceptionConfig::fromYamlFile(opt->config);

@@ -5,6 +5,7 @@
 #include "cli_checks.h"
 #include "commands.h"
 #include "fvp/accel/ray_workload.h"
+#include "fvp/host/core/memory_budget.h"
 
 namespace fvp::apps {
 
@@ -47,6 +48,13 @@ void addTraverseCommand(CLI::App& app) {
   cmd->add_flag("!--no-check", opt->check, "skip the comparison with the cpu reference");
   cmd->callback([opt] {
     using Clock = std::chrono::steady_clock;
+    // The grid (two floats a voxel) on the host and the device, and the rays with their
+    // results (twice with the check): 1024^3 voxels asked for 17 GiB.
+    const std::uint64_t side = static_cast<std::uint64_t>(opt->side_voxels);
+    host::checkMemoryFor(
+        side * side * side * 2 * sizeof(float) * 2 + std::uint64_t(opt->rays) * 3 * 64,
+        "traverse --side-voxels " + std::to_string(opt->side_voxels) + " --rays " +
+            std::to_string(opt->rays));
     auto backend = accel::createBackend(opt->backend);
     const accel::DenseGrid grid =
         accel::makeCanopyGrid(opt->side_voxels, opt->voxel_size_m, opt->seed);

@@ -4,6 +4,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -123,6 +125,28 @@ void ArmConfig::validate(const std::string& source) const {
   if (trajectory_timing != "rest_to_rest" && trajectory_timing != "blended")
     throw std::invalid_argument(source + ": key 'trajectory_timing' = '" + trajectory_timing +
                                 "' is not a timing; expected rest_to_rest or blended");
+  if (const std::uint64_t bytes = workspaceTreeBytes(); bytes > kMaxWorkspaceTreeBytes)
+    throw std::invalid_argument(
+        source + ": keys 'workspace_resolution_m' = " + formatNumber(workspace_resolution_m) +
+        ", 'workspace_direction_bins' = " + std::to_string(workspace_direction_bins) +
+        " and 'workspace_samples' = " + std::to_string(workspace_samples) +
+        " ask for a workspace tree of " + formatNumber(double(bytes) / double(1 << 30)) +
+        " GiB; expected at most " + std::to_string(kMaxWorkspaceTreeBytes >> 30) +
+        " GiB (a coarser resolution or fewer bins)");
+}
+
+std::uint64_t ArmConfig::workspaceTreeBytes() const {
+  // As WorkspaceTree::build lays it out: one slot a sample, counts over the arm grid, then
+  // the grid swept along the slider (16-bit counts) and a flag a cell.
+  const double reach = kUr5ReachM + hand_eye_translation_m.norm() + camera_body_radius_m;
+  const double arm_cells = std::ceil(2.0 * reach / workspace_resolution_m);
+  const double shifts = std::round(slider_travel_m / workspace_resolution_m);
+  const double bins = 6.0 * workspace_direction_bins * workspace_direction_bins;
+  const double arm_total = arm_cells * arm_cells * arm_cells;
+  const double cells = (arm_cells + shifts) * arm_cells * arm_cells;
+  const double bytes =
+      4.0 * double(workspace_samples) + 4.0 * arm_total * bins + 2.0 * cells * bins + cells;
+  return bytes >= 1.8e19 ? UINT64_MAX : static_cast<std::uint64_t>(bytes);
 }
 
 ArmConfig ArmConfig::fromYamlFile(const std::filesystem::path& path) {

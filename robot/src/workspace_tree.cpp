@@ -22,9 +22,6 @@ namespace {
 
 constexpr char kMagic[8] = {'F', 'V', 'P', 'W', 'S', 'T', '0', '2'};
 constexpr std::int64_t kChunk = 1 << 16;  // samples per random stream
-// The farthest a camera gets from the shoulder: the UR5's reach (shoulder to flange, with
-// every offset) plus the hand-eye offset, and a margin.
-constexpr double kUr5ReachM = 0.425 + 0.39225 + 0.10915 + 0.09465 + 0.0823 + 0.089159;
 
 std::uint64_t fnv1a(const void* data, std::size_t size, std::uint64_t h = 1469598103934665603ull) {
   const auto* bytes = static_cast<const unsigned char*>(data);

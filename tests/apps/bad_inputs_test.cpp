@@ -2,8 +2,18 @@
 // each case must end with exit code 1 (a bad file or value) or 2 (a usage error), never a
 // signal, with a message naming the file and field or the option, and leave no half-written
 // (*.tmp-*) or result file behind. A second group checks the documented warnings.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/file.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <chrono>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +22,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "fvp/host/core/subprocess.h"
@@ -328,6 +339,154 @@ const std::vector<BadInput>& cases() {
        1,
        {"no manifest.json"},
        {"PWNED"}},
+      // --out "" wrote nowhere and exited 0: every --out is a usage error when empty.
+      {"RunOutEmpty",
+       [](const fs::path&) {
+         return std::vector<std::string>{"run", "--seed", "1", "--out", ""};
+       },
+       2,
+       {"--out: expected a directory, got an empty path"},
+       {}},
+      {"SizeOutEmpty",
+       [](const fs::path& d) {
+         writeGreyCapture(d / "cap");
+         return std::vector<std::string>{"size", "--captures", p(d / "cap"), "--out", ""};
+       },
+       2,
+       {"--out: expected a directory, got an empty path"},
+       {}},
+      {"PlanOutEmpty",
+       [](const fs::path&) {
+         return std::vector<std::string>{"plan", "--seed", "1", "--out", ""};
+       },
+       2,
+       {"--out: expected a directory, got an empty path"},
+       {}},
+      // Output paths checked before the work: a `views` that is a file fails before the trial.
+      {"RunViewsIsAFile",
+       [](const fs::path& d) {
+         writeText(d / "out" / "views", "a file where the trial writes its views");
+         return std::vector<std::string>{"run",       "--seed", "3",     "--max-views", "1",
+                                         "--backend", "cpu",    "--out", p(d / "out")};
+       },
+       1,
+       {"views exists and is not a directory"},
+       {"out/result.json"}},
+      {"RunResultIsADirectory",
+       [](const fs::path& d) {
+         fs::create_directories(d / "out" / "result.json");
+         return std::vector<std::string>{"run", "--seed", "3",         "--backend",
+                                         "cpu", "--out",  p(d / "out")};
+       },
+       1,
+       {"result.json is a directory"},
+       {"out/report.md"}},
+      // The capture reader opens regular files of a bounded size only: a FIFO hung it, and
+      // /dev/zero or a sparse 30 GB file were read until memory ran out. A stale temporary of
+      // a dead process in --out is removed (the table checks that none is left).
+      {"SizeMaskIsAFifo",
+       [](const fs::path& d) {
+         writeGreyCapture(d / "cap");
+         ::mkfifo((d / "cap" / "mask.png").c_str(), 0600);
+         writeText(d / "out" / "fruitlets.json.tmp-2147483-0", "left by a killed run");
+         return std::vector<std::string>{"size", "--captures", p(d / "cap"), "--out", p(d / "out")};
+       },
+       1,
+       {"mask.png: expected a regular file (the PNG image), got a FIFO"},
+       {"out/fruitlets.json"}},
+      {"SizeCameraYamlIsAFifo",
+       [](const fs::path& d) {
+         writeGreyCapture(d / "cap");
+         fs::remove(d / "cap" / "camera.yaml");
+         ::mkfifo((d / "cap" / "camera.yaml").c_str(), 0600);
+         return std::vector<std::string>{"size", "--captures", p(d / "cap"), "--out", p(d / "out")};
+       },
+       1,
+       {"camera.yaml: expected a regular file (the camera model), got a FIFO"},
+       {"out/fruitlets.json"}},
+      {"SizeLeftImageIsDevZero",
+       [](const fs::path& d) {
+         writeGreyCapture(d / "cap");
+         fs::remove(d / "cap" / "left.png");
+         fs::create_symlink("/dev/zero", d / "cap" / "left.png");
+         return std::vector<std::string>{"size", "--captures", p(d / "cap"), "--out", p(d / "out")};
+       },
+       1,
+       {"left.png: expected a regular file (the PNG image), got a character device"},
+       {"out/fruitlets.json"}},
+      {"SizeLeftImageIsHugeAndSparse",
+       [](const fs::path& d) {
+         writeGreyCapture(d / "cap");
+         fs::resize_file(d / "cap" / "left.png", std::uintmax_t{30} << 30);
+         return std::vector<std::string>{"size", "--captures", p(d / "cap"), "--out", p(d / "out")};
+       },
+       1,
+       {"left.png: 32212254720 bytes, more than the 17391616 bytes a PNG image may have"},
+       {"out/fruitlets.json"}},
+      // Memory bounds: what a setting may ask for follows from what it means.
+      {"WorldConfigOfTwoMegabytes",
+       [](const fs::path& d) {
+         std::string list = "fruitlet_count: [";
+         while (list.size() < (std::size_t{2} << 20)) list += "1, ";
+         writeText(d / "world.yaml", list + "1]\n");
+         return std::vector<std::string>{"run",   "--seed",    "1", "--world", p(d / "world.yaml"),
+                                         "--out", p(d / "out")};
+       },
+       1,
+       {"world.yaml", "bytes a config file may have"},
+       {"out/result.json"}},
+      {"ArmWorkspaceTreeOfTerabytes",
+       [](const fs::path& d) {
+         writeText(d / "arm.yaml", "workspace_resolution_m: 0.005\nworkspace_direction_bins: 16\n");
+         return std::vector<std::string>{"run",   "--seed",          "1",
+                                         "--arm", p(d / "arm.yaml"), "--backend",
+                                         "cpu",   "--out",           p(d / "out")};
+       },
+       1,
+       {"arm.yaml", "'workspace_resolution_m' = 0.005", "workspace tree of", "at most 4 GiB"},
+       {"out/result.json"}},
+      {"PlannerTenMillionSamples",
+       [](const fs::path& d) {
+         writeText(d / "planner.yaml", "roi_samples: 10000000\n");
+         return std::vector<std::string>{
+             "run",       "--seed", "1",     "--config",  p(d / "planner.yaml"),
+             "--backend", "cpu",    "--out", p(d / "out")};
+       },
+       1,
+       {"roi_samples", "0 to 100000 candidates"},
+       {"out/result.json"}},
+      {"ExperimentTwoBillionTrials",
+       [](const fs::path& d) {
+         return std::vector<std::string>{"experiment", "--planners", "fvp",       "--trials",
+                                         "2147483647", "--out",      p(d / "exp")};
+       },
+       1,
+       {"--trials 2147483647: expected at most 100000"},
+       {"exp/manifest.json", "exp/trials.jsonl"}},
+      // merge --out: new, empty or an earlier merge, nothing else.
+      {"MergeIntoADirectoryWithAUsersFile",
+       [](const fs::path& d) {
+         // An empty shard: a valid experiment made without running a trial.
+         const auto made =
+             fvp::host::runProgram({kFvp, "experiment", "--planners", "fvp", "--trials", "2",
+                                    "--shard", "3/4", "--out", p(d / "shard")},
+                                   "");
+         EXPECT_EQ(made.exit_code, 0) << made.stderr_text;
+         writeText(d / "merged" / "table1.md", "the user's own table");
+         return std::vector<std::string>{"merge", "--out", p(d / "merged"), p(d / "shard")};
+       },
+       1,
+       {"is not empty (it holds table1.md) and is not an earlier merge"},
+       {"merged/manifest.json", "merged/trials.jsonl"}},
+      // A single view into a capture set left a stray camera.yaml that broke the set.
+      {"CaptureOneViewIntoASet",
+       [](const fs::path& d) {
+         writeGreyCapture(d / "set" / "000");
+         return std::vector<std::string>{"capture", "--seed", "1", "--out", p(d / "set")};
+       },
+       1,
+       {"holds a capture set (000/camera.yaml)"},
+       {"set/camera.yaml", "set/left.png"}},
   };
   return table;
 }
@@ -408,6 +567,194 @@ TEST(Warnings, ATrialWithoutGnuplotKeepsItsResultAndClearsAnEarlierRun) {
   EXPECT_FALSE(fs::exists(dir / "out" / "views" / "099.png"));
   EXPECT_FALSE(fs::exists(dir / "out" / "path.png"));
   EXPECT_TRUE(fs::exists(dir / "out" / "notes.txt"));
+}
+
+/// Runs fvp with a resource limit set for it (and restored here after): the limit is
+/// inherited by the child. SIGXFSZ is ignored as fvp ignores it, so an over-size write fails
+/// with EFBIG ("File too large"), the way a full disk fails it with ENOSPC.
+fvp::host::SubprocessResult runLimited(const std::vector<std::string>& argv, int resource,
+                                       rlim_t limit) {
+  struct rlimit saved {};
+  ::getrlimit(resource, &saved);
+  struct rlimit lowered = saved;
+  lowered.rlim_cur = limit;
+  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  ::setrlimit(resource, &lowered);
+  fvp::host::SubprocessResult run = fvp::host::runProgram(argv, "");
+  ::setrlimit(resource, &saved);
+  std::signal(SIGXFSZ, old_handler);
+  return run;
+}
+
+std::vector<std::string> lines(const fs::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> out;
+  for (std::string line; std::getline(in, line);) out.push_back(line);
+  return out;
+}
+
+// One writer per output directory: while another process holds the lock, every writer
+// fails at once, naming the directory and the holder, and writes nothing.
+TEST(Outputs, ASecondWriterIsRefusedNamingTheFirst) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "fvp_bad_inputs_locked";
+  fs::remove_all(dir);
+  writeGreyCapture(dir / "cap");
+  const auto shard = fvp::host::runProgram({kFvp, "experiment", "--planners", "fvp", "--trials",
+                                            "2", "--shard", "3/4", "--out", p(dir / "shard")},
+                                           "");
+  ASSERT_EQ(shard.exit_code, 0) << shard.stderr_text;
+  fs::create_directories(dir / "out");
+  const int fd = ::open((dir / "out" / ".fvp.lock").c_str(), O_RDWR | O_CREAT, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+  const std::string holder = "pid 4242: fvp experiment --out out";
+  ASSERT_EQ(::write(fd, holder.data(), holder.size()), ssize_t(holder.size()));
+  const std::string out = p(dir / "out");
+  const std::vector<std::vector<std::string>> writers = {
+      {"experiment", "--planners", "fvp", "--trials", "1", "--out", out},
+      {"experiment", "--planners", "fvp", "--trials", "1", "--error-scale", "wind=2", "--out", out},
+      {"run", "--seed", "1", "--backend", "cpu", "--out", out},
+      {"size", "--captures", p(dir / "cap"), "--backend", "cpu", "--out", out},
+      {"capture", "--seed", "1", "--out", out},
+      {"map", "--seed", "1", "--views", "1", "--out", out},
+      {"plan", "--seed", "1", "--backend", "cpu", "--out", out},
+      {"merge", "--out", out, p(dir / "shard")}};
+  for (const auto& args : writers) {
+    std::vector<std::string> argv = {kFvp};
+    argv.insert(argv.end(), args.begin(), args.end());
+    const auto run = fvp::host::runProgram(argv, "");
+    SCOPED_TRACE(args.front() + ": " + run.stderr_text);
+    EXPECT_EQ(run.exit_code, 1);
+    EXPECT_NE(run.stderr_text.find("'" + out + "': in use by another fvp (" + holder + ")"),
+              std::string::npos);
+    std::vector<std::string> written;
+    for (const auto& e : fs::directory_iterator(dir / "out"))
+      if (e.path().filename() != ".fvp.lock") written.push_back(e.path().string());
+    EXPECT_EQ(written, std::vector<std::string>{});
+  }
+  ::close(fd);
+  // Released: the next writer takes the lock, and removes the lock file when it is done.
+  const auto run = fvp::host::runProgram(
+      {kFvp, "experiment", "--planners", "fvp", "--trials", "2", "--shard", "3/4", "--out", out},
+      "");
+  EXPECT_EQ(run.exit_code, 0) << run.stderr_text;
+  EXPECT_FALSE(fs::exists(dir / "out" / ".fvp.lock"));
+}
+
+// A write failure after the trial ran costs extras only: result.json (written first) and
+// the experiment's trials.jsonl line are kept, the cause is named (here EFBIG from a file
+// size limit, as ENOSPC from a full disk: "File too large", not "the writer reported an
+// error"), and the command fails, so that a script notices.
+TEST(Outputs, AFailedWriteOfAnExtraKeepsTheTrial) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "fvp_bad_inputs_file_limit";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  // 192 KiB: result.json of a one-view trial fits, fine.ot and the clouds do not.
+  const rlim_t limit = 192 << 10;
+  const auto run = runLimited({kFvp, "run", "--seed", "3", "--max-views", "1", "--clock", "fixed",
+                               "--backend", "cpu", "--out", p(dir / "run")},
+                              RLIMIT_FSIZE, limit);
+  SCOPED_TRACE(run.stderr_text);
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.stderr_text.find("File too large"), std::string::npos);
+  EXPECT_EQ(run.stderr_text.find("the writer reported an error"), std::string::npos);
+  EXPECT_NE(run.stderr_text.find("result.json holds the trial"), std::string::npos);
+  std::ifstream in(dir / "run" / "result.json");
+  const nlohmann::json result = nlohmann::json::parse(in);
+  ASSERT_TRUE(result.contains("unwritten_outputs"));
+  EXPECT_FALSE(result["unwritten_outputs"].empty());
+  EXPECT_TRUE(result.contains("fruitlets"));
+  EXPECT_EQ(temporaries(dir), std::vector<std::string>{});
+
+  const auto exp =
+      runLimited({kFvp, "experiment", "--planners", "fvp", "--trials", "1", "--max-views", "1",
+                  "--clock", "fixed", "--backend", "cpu", "--out", p(dir / "exp")},
+                 RLIMIT_FSIZE, limit);
+  SCOPED_TRACE(exp.stderr_text);
+  EXPECT_EQ(exp.exit_code, 0);
+  EXPECT_NE(exp.stderr_text.find("not written"), std::string::npos);
+  EXPECT_EQ(lines(dir / "exp" / "trials.jsonl").size(), 1u);
+  EXPECT_EQ(temporaries(dir), std::vector<std::string>{});
+}
+
+// Memory asked for by a setting is estimated before it is allocated, against what the
+// process may have (here an address-space limit of 4 GiB): the message names the setting.
+TEST(Outputs, MemoryASettingAsksForIsCheckedFirst) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "fvp_bad_inputs_memory";
+  fs::remove_all(dir);
+  // Ten views of 8192 x 8192 keep ~5 GiB for sizing: refused from camera.yaml alone.
+  const std::string big = cameraYaml({{"width", "8192"},
+                                      {"height", "8192"},
+                                      {"fx", "7000"},
+                                      {"fy", "7000"},
+                                      {"cx", "4095.5"},
+                                      {"cy", "4095.5"}});
+  for (int i = 0; i < 10; ++i)
+    writeText(dir / "set" / ("00" + std::to_string(i)) / "camera.yaml", big);
+  const rlim_t limit = rlim_t{4} << 30;
+  const auto size = runLimited(
+      {kFvp, "size", "--captures", p(dir / "set"), "--backend", "cpu", "--out", p(dir / "out")},
+      RLIMIT_AS, limit);
+  EXPECT_EQ(size.exit_code, 1) << size.stderr_text;
+  EXPECT_NE(size.stderr_text.find("10 captures (--captures"), std::string::npos)
+      << size.stderr_text;
+  EXPECT_NE(size.stderr_text.find("more than the 4.0 GiB available"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir / "out" / "fruitlets.json"));
+  const auto traverse =
+      runLimited({kFvp, "traverse", "--side-voxels", "1024", "--backend", "cpu"}, RLIMIT_AS, limit);
+  EXPECT_EQ(traverse.exit_code, 1) << traverse.stderr_text;
+  EXPECT_NE(traverse.stderr_text.find("traverse --side-voxels 1024"), std::string::npos)
+      << traverse.stderr_text;
+}
+
+/// Starts fvp with stdout and stderr to log; returns its PID.
+pid_t spawnFvp(const std::vector<std::string>& args, const fs::path& log) {
+  std::vector<std::string> argv = {kFvp};
+  argv.insert(argv.end(), args.begin(), args.end());
+  std::vector<char*> cargv;
+  for (auto& a : argv) cargv.push_back(a.data());
+  cargv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  pid_t pid = -1;
+  if (posix_spawn(&pid, kFvp, &actions, nullptr, cargv.data(), environ) != 0) pid = -1;
+  posix_spawn_file_actions_destroy(&actions);
+  return pid;
+}
+
+// SIGTERM ends an experiment cleanly: the trials that finished stay in trials.jsonl, no
+// temporary is left, and the exit status is 128 + 15.
+TEST(Signals, SigtermKeepsFinishedTrialsAndRemovesTemporaries) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "fvp_bad_inputs_sigterm";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  // A temporary a killed run left: removed by the next writer of the directory.
+  writeText(dir / "exp" / "trials" / "fvp-1" / "fine.ot.tmp-2147483-7", "stale");
+  const pid_t pid = spawnFvp({"experiment", "--planners", "fvp", "--trials", "3", "--max-views",
+                              "1", "--clock", "fixed", "--backend", "cpu", "--out", p(dir / "exp")},
+                             dir / "log.txt");
+  ASSERT_GT(pid, 0);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(5);
+  while (lines(dir / "exp" / "trials.jsonl").empty() && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ::kill(pid, SIGTERM);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  std::ifstream log_in(dir / "log.txt");
+  const std::string log((std::istreambuf_iterator<char>(log_in)), std::istreambuf_iterator<char>());
+  SCOPED_TRACE(log);
+  ASSERT_TRUE(WIFEXITED(status)) << "a signal ended fvp";
+  const std::vector<std::string> done = lines(dir / "exp" / "trials.jsonl");
+  if (done.size() < 3) {  // stopped before the end (the usual case)
+    EXPECT_EQ(WEXITSTATUS(status), 143);
+    EXPECT_NE(log.find("interrupted by SIGTERM"), std::string::npos);
+  }
+  EXPECT_GE(done.size(), 1u);
+  for (const std::string& line : done) EXPECT_TRUE(nlohmann::json::accept(line)) << line;
+  EXPECT_EQ(temporaries(dir), std::vector<std::string>{});
+  EXPECT_FALSE(fs::exists(dir / "exp" / ".fvp.lock"));
 }
 
 }  // namespace

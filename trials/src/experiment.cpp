@@ -20,6 +20,7 @@
 #include "experiment_index.h"
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/host/core/gnuplot.h"
+#include "fvp/host/core/interrupt.h"
 #include "fvp/host/core/output_directory.h"
 #include "fvp/host/map/map_engine_registry.h"
 #include "fvp/robot/sim/world_config.h"
@@ -128,6 +129,12 @@ ExperimentManifest manifestOf(const ExperimentOptions& o) {
 
 void checkOptions(const ExperimentOptions& o) {
   if (o.trials < 1) throw std::invalid_argument("experiment: --trials must be at least 1");
+  // A trial takes minutes: more than this is a typo, and its trial list alone (2^31 worlds)
+  // exhausted memory before a trial ran.
+  if (o.trials > kMaxExperimentTrials)
+    throw std::invalid_argument("experiment: --trials " + std::to_string(o.trials) +
+                                ": expected at most " + std::to_string(kMaxExperimentTrials) +
+                                " worlds (split a larger run into experiments and merge them)");
   if (o.shard_count < 1 || o.shard_index < 0 || o.shard_index >= o.shard_count)
     throw std::invalid_argument("experiment: --shard i/n needs 0 <= i < n");
   if (o.planners.empty())
@@ -506,14 +513,39 @@ bool writeReports(const fs::path& dir, const std::vector<nlohmann::json>& unsort
   return false;
 }
 
-void runExperiment(const ExperimentOptions& o, const TrialRunner& run_trial,
-                   const MessageSink& progress, const MessageSink& warning_sink) {
-  const MessageSink& warning = warning_sink ? warning_sink : progress;
-  checkOptions(o);
-  const ExperimentManifest manifest = manifestOf(o);
-  host::prepareOutputDirectory(o.out_dir, "experiment: --out");
-  const fs::path jsonl = o.out_dir / "trials.jsonl";
-  const fs::path manifest_path = o.out_dir / "manifest.json";
+namespace {
+
+/// What an experiment directory holds at its top (checked before the first trial).
+const std::vector<std::string>& experimentOutputFiles() {
+  static const std::vector<std::string> files = {
+      "manifest.json", "trials.jsonl",          "summary.json",         "table1.md", "sizes.png",
+      "index.html",    "accuracy_vs_time.json", "accuracy_vs_time.png", "world.yaml"};
+  return files;
+}
+
+/// merge --out must be new, empty or an earlier merge: anything else (a user's table1.md, a
+/// trial's directory) would be overwritten.
+void refuseForeignMergeOut(const fs::path& out_dir) {
+  const fs::path manifest = out_dir / "manifest.json";
+  if (fs::exists(manifest) && readManifest(manifest).kind == "merged") return;
+  for (const auto& entry : fs::directory_iterator(out_dir)) {
+    const std::string name = entry.path().filename().string();
+    if (name == host::kOutputLockFile) continue;
+    throw std::runtime_error("merge: --out " + out_dir.string() + " is not empty (it holds " +
+                             name +
+                             ") and is not an earlier merge; merge into a new or empty "
+                             "directory");
+  }
+}
+
+/// The run's manifest in the directory: written for a new experiment (or over one that never
+/// finished a trial), else compared with the one there (a difference is an error).
+void adoptManifest(const ExperimentManifest& manifest, const fs::path& manifest_path,
+                   const fs::path& jsonl) {
+  // A manifest without a finished trial (a start that failed) binds nothing: the next run
+  // writes its own instead of refusing the directory.
+  std::error_code size_ec;
+  const bool no_trials = !fs::exists(jsonl) || fs::file_size(jsonl, size_ec) == 0;
 
   if (fs::exists(manifest_path)) {
     const ExperimentManifest old = readManifest(manifest_path);
@@ -521,7 +553,10 @@ void runExperiment(const ExperimentOptions& o, const TrialRunner& run_trial,
       throw std::runtime_error(manifest_path.string() +
                                ": a merged experiment (kind \"merged\"), not a run: it cannot be "
                                "resumed or run into; use another --out");
-    if (const auto d = resumeDifference(old, manifest))
+    if (no_trials)
+      host::writeFileAtomically(manifest_path, "experiment manifest",
+                                manifest.toJson().dump(2) + "\n");
+    else if (const auto d = resumeDifference(old, manifest))
       throw std::runtime_error(manifest_path.string() + ": this experiment was made with " +
                                d->setting + " " + d->old_value + ", this run asks for " +
                                d->new_value +
@@ -536,6 +571,22 @@ void runExperiment(const ExperimentOptions& o, const TrialRunner& run_trial,
     host::writeFileAtomically(manifest_path, "experiment manifest",
                               manifest.toJson().dump(2) + "\n");
   }
+}
+
+}  // namespace
+
+void runExperiment(const ExperimentOptions& o, const TrialRunner& run_trial,
+                   const MessageSink& progress, const MessageSink& warning_sink) {
+  const MessageSink& warning = warning_sink ? warning_sink : progress;
+  checkOptions(o);
+  const ExperimentManifest manifest = manifestOf(o);
+  host::prepareOutputDirectory(o.out_dir, "experiment: --out");
+  // One writer: a second experiment into the same directory appended its trials beside the
+  // first's. Held until the reports are written.
+  const host::OutputDirectoryLock lock(o.out_dir, "experiment: --out");
+  host::checkOutputPaths(o.out_dir, "experiment: --out", experimentOutputFiles(), {"trials"});
+  const fs::path jsonl = o.out_dir / "trials.jsonl";
+  adoptManifest(manifest, o.out_dir / "manifest.json", jsonl);
   if (!fs::exists(jsonl)) host::writeFileAtomically(jsonl, "trials", "");
 
   std::vector<nlohmann::json> done = readTrials(jsonl, warning);
@@ -574,6 +625,7 @@ void runExperiment(const ExperimentOptions& o, const TrialRunner& run_trial,
   for (const auto& [p, s] : mine) todo += !finished.count(trialKey(p, s));
   for (const auto& [planner, seed] : mine) {
     if (finished.count(trialKey(planner, seed))) continue;
+    host::throwIfInterrupted();  // a signal stops between trials; finished lines are kept
     TrialOptions t = o.trial;
     t.planner = planner;
     t.seed = seed;
@@ -672,6 +724,8 @@ void mergeExperiments(const std::vector<fs::path>& shard_dirs, const fs::path& o
                                "earlier merge's)");
   }
   host::prepareOutputDirectory(out_dir, "merge: --out");
+  const host::OutputDirectoryLock lock(out_dir, "merge: --out");
+  refuseForeignMergeOut(out_dir);
   ExperimentManifest merged = manifests.front();
   merged.kind = "merged";
   merged.sources.clear();

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -47,8 +48,11 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
                                 host::planner::PlannerRegistry::instance().knownNames() +
                                 ", got '" + o.planner + "'");
   if (o.views < 1) throw std::invalid_argument("plan: --views: expected at least 1");
+  std::optional<host::OutputDirectoryLock> lock;  // one writer, for the whole command
   if (!o.out_dir.empty()) {
     host::prepareOutputDirectory(o.out_dir, "plan output directory");
+    lock.emplace(o.out_dir, "plan output directory");
+    host::checkOutputPaths(o.out_dir, "plan output directory", {"plan.json", "candidates.ply"}, {});
     host::removeStaleOutputs(o.out_dir, {"plan.json", "candidates.ply"});
   }
   const std::string engine = o.engine.empty() ? defaultEngine(o.planner) : o.engine;

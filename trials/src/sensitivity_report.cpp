@@ -10,6 +10,7 @@
 
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/host/core/gnuplot.h"
+#include "fvp/host/core/output_directory.h"
 #include "fvp/trials/experiment.h"
 #include "fvp/trials/experiment_directory.h"
 #include "number_text.h"
@@ -122,7 +123,8 @@ std::vector<SensitivityPoint> readSensitivityPoints(const std::vector<fs::path>&
 bool writeSensitivityReport(const std::vector<fs::path>& experiments, const fs::path& out_dir,
                             const std::function<void(const std::string&)>& warning) {
   const std::vector<SensitivityPoint> points = readSensitivityPoints(experiments);
-  fs::create_directories(out_dir);
+  host::prepareOutputDirectory(out_dir, "sensitivity: --out");
+  const host::OutputDirectoryLock lock(out_dir, "sensitivity: --out");
   nlohmann::json json = nlohmann::json::array();
   std::ostringstream md;
   md << "# Sensitivity to the simulated errors\n\n"

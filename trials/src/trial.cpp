@@ -18,6 +18,7 @@
 
 #include "fvp/accel/backend.h"
 #include "fvp/host/core/atomic_file.h"
+#include "fvp/host/core/interrupt.h"
 #include "fvp/host/core/output_directory.h"
 #include "fvp/host/eval/fruitlet_matching.h"
 #include "fvp/host/eval/sizing_score.h"
@@ -166,15 +167,17 @@ class TrialLog : public host::nbv::LoopObserver {
           {"pairs", r.pairs}};
     }
     if (!options_.out_dir.empty()) {
-      keepViewImage(options_.out_dir, index, *e.frame);
+      view_pngs_.emplace_back(index, encodeViewImage(index, *e.frame));
       images_.add(index, e.frame->left_bgr);
       if (!intrinsics_) intrinsics_ = e.frame->intrinsics;
     }
     if (options_.on_progress)
       options_.on_progress({index + 1, e.now_s, options_.budget_s, secondsSince(wall_start_)});
+    host::throwIfInterrupted();  // a signal ends the loop after the view
   }
 
   void onPlan(const host::nbv::PlanEvent& e) override {
+    host::throwIfInterrupted();
     const host::planner::PlanStep& step = *e.step;
     nlohmann::json timings = nlohmann::json::object();
     for (const auto& [stage, s] : step.timings_s) timings[stage] = s;
@@ -212,6 +215,8 @@ class TrialLog : public host::nbv::LoopObserver {
   }
   /// The views' images for the overlays (kept only with an output directory).
   const ViewImages& images() const { return images_; }
+  /// views/NNN.png of each view so far (index, PNG bytes), written after result.json.
+  const std::vector<std::pair<int, std::string>>& viewPngs() const { return view_pngs_; }
   const std::optional<host::StereoIntrinsics>& intrinsics() const { return intrinsics_; }
   /// The run's number of this cluster's first view.
   int firstView() const { return first_view_; }
@@ -220,6 +225,7 @@ class TrialLog : public host::nbv::LoopObserver {
   const SimulatedCamera& camera_;
   const TrialOptions& options_;
   ViewImages images_;
+  std::vector<std::pair<int, std::string>> view_pngs_;
   std::optional<host::StereoIntrinsics> intrinsics_;
   Clock::time_point wall_start_;
   int cluster_ = -1, first_view_ = 0;  ///< -1: a one-cluster world
@@ -394,11 +400,18 @@ struct Trial::Impl {
     completion_config.release_left_out = options.release_left_out;
     if (!options.out_dir.empty()) {
       host::prepareOutputDirectory(options.out_dir, "trial output directory");
+      lock.emplace(options.out_dir, "trial output directory");
       std::vector<std::string> stale = TrialParts::outputFiles();
-      for (int k = 0; k < kMaxClusterDirs; ++k)
+      std::vector<std::string> subdirs = {"views", "overlays"};
+      for (int k = 0; k < kMaxClusterDirs; ++k) {
+        subdirs.push_back(clusterDirName(k));
         for (const std::string& file : TrialParts::clusterFiles())
           stale.push_back(clusterDirName(k) + "/" + file);
+      }
       stale.push_back("viewer.html");
+      // Every path the trial writes, before it runs: a `views` that is a file must not fail
+      // the trial at its end.
+      host::checkOutputPaths(options.out_dir, "trial output directory", stale, subdirs);
       host::removeStaleOutputs(options.out_dir, stale, {"views", "overlays"});
     }
     engine = options.engine.empty() ? defaultEngine(options.planner) : options.engine;
@@ -481,17 +494,43 @@ struct Trial::Impl {
       return nlohmann::json::array();
     }
   }
-  /// viewer.html by write(), after result.json: a failure becomes a warning in result.json
-  /// (written again), as a figure's does.
-  void viewerOrWarning(nlohmann::json& result, const std::function<void()>& write) {
+  /// The writer of the extras after result.json: a failure (a full disk) becomes a warning
+  /// in result["warnings"] and the file's name in result["unwritten_outputs"]; a signal's stop
+  /// is not caught. finishExtras writes result.json again with them.
+  ExtraWriter extraWriter(nlohmann::json& result) {
+    return [this, &result](const std::string& file, const std::function<void()>& write) {
+      try {
+        write();
+      } catch (const host::Interrupted&) {
+        throw;
+      } catch (const std::exception& e) {
+        const std::string text = file + " not written: " + e.what();
+        result["warnings"].push_back(text);
+        result["unwritten_outputs"].push_back(file);
+        if (options.on_warning) options.on_warning(text);
+      }
+    };
+  }
+  /// views/NNN.png, viewer.html, then result.json again when an extra failed (best effort:
+  /// the result written first stands when this fails too).
+  void finishExtras(nlohmann::json& result, const TrialLog& log,
+                    const std::function<void()>& write_viewer) {
+    const ExtraWriter extra = extraWriter(result);
+    extra("views", [&] {
+      if (!log.viewPngs().empty()) std::filesystem::create_directories(options.out_dir / "views");
+      for (const auto& [index, png] : log.viewPngs())
+        if (!png.empty())
+          host::writeFileAtomically(options.out_dir / host::numberedFileName("views", index, "png"),
+                                    "view image", png);
+    });
+    extra("viewer.html", write_viewer);
+    if (!result.contains("unwritten_outputs")) return;
     try {
-      write();
-    } catch (const std::exception& e) {
-      const std::string text = std::string("viewer.html not written: ") + e.what();
-      result["warnings"].push_back(text);
-      if (options.on_warning) options.on_warning(text);
       host::writeFileAtomically(options.out_dir / "result.json", "trial result",
                                 result.dump(2) + "\n");
+    } catch (const std::exception& e) {
+      if (options.on_warning)
+        options.on_warning(std::string("result.json kept without these warnings: ") + e.what());
     }
   }
   std::string viewerTitle() const {
@@ -500,6 +539,8 @@ struct Trial::Impl {
   }
 
   TrialOptions options;
+  /// One writer per output directory, for the trial's life.
+  std::optional<host::OutputDirectoryLock> lock;
   /// The automatic stop's parameters, for every cluster (and the record of them).
   host::nbv::ClusterCompletionConfig completion_config;
   Clock::time_point wall_start = Clock::now();
@@ -651,8 +692,9 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
   describeRun(result, log, camera_path);
   markSizedViews(result["view_log"], outcome.sizing, 0, std::nullopt);
   if (!options.out_dir.empty()) {
-    parts->writeOutputs(result, *world, camera_path, options.out_dir, options.on_warning);
-    viewerOrWarning(result, [&] {
+    parts->writeOutputs(result, *world, camera_path, options.out_dir, options.on_warning,
+                        extraWriter(result));
+    finishExtras(result, log, [&] {
       host::report::ViewerScene scene(viewerTitle(), "");
       host::addSessionToScene(scene, parts->session(), outcome.sizing, 0, std::nullopt);
       writeTrialViewer(scene, result, log.intrinsics(), options.out_dir);
@@ -678,6 +720,7 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
   nlohmann::json transit_motion = nlohmann::json::object();
   std::map<std::string, int> cluster_status;
   std::vector<Eigen::Vector3d> camera_path;
+  nlohmann::json cluster_write_failures = nlohmann::json::object();  // as extraWriter records
   std::uint64_t detections = 0;
   int views = 0;
   double transit_s = 0.0;
@@ -794,7 +837,14 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
     planner_config = nlohmann::json::parse(cluster_parts->planner().configJson());
     trial_config = cluster_parts->configJson();
     if (!options.out_dir.empty()) {
-      cluster_parts->writeClusterFiles(options.out_dir / clusterDirName(k));
+      // Written as the tour goes (the map moves on); a failure is recorded with the tree's
+      // result, not the end of the tour.
+      const ExtraWriter record = extraWriter(cluster_write_failures);
+      cluster_parts->writeClusterFiles(
+          options.out_dir / clusterDirName(k),
+          [&](const std::string& file, const std::function<void()>& write) {
+            record(clusterDirName(k) + "/" + file, write);
+          });
       const int cluster = static_cast<int>(k);
       // The scene's part of this cluster now: its map moves on to the next cluster.
       try {
@@ -870,13 +920,16 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
   result["stop"] = stopJson();
   if (!options.out_dir.empty()) result["overlays"] = overlays;
   describeRun(result, log, camera_path);
+  for (const char* key : {"warnings", "unwritten_outputs"})
+    for (const auto& item : cluster_write_failures.value(key, nlohmann::json::array()))
+      result[key].push_back(item);
   for (const auto& c : result["clusters"])
     if (c.contains("first_view"))
       markSizedViews(result["view_log"], c, c["first_view"].get<int>(), c["index"].get<int>());
   if (!options.out_dir.empty()) {
     writeTreeOutputs(result, *world, carried_map.get(), camera_path, options.out_dir,
-                     options.on_warning);
-    viewerOrWarning(result, [&] {
+                     options.on_warning, extraWriter(result));
+    finishExtras(result, log, [&] {
       if (!scene_error.empty()) throw std::runtime_error(scene_error);
       writeTrialViewer(scene, result, log.intrinsics(), options.out_dir);
     });

@@ -141,20 +141,15 @@ std::vector<host::eval::GroundTruthFruitlet> groundTruthOf(const World& world,
   return truth;
 }
 
-void keepViewImage(const std::filesystem::path& out_dir, int index,
-                   const host::StereoFrame& frame) {
-  if (frame.left_bgr.empty()) return;
-  const std::filesystem::path dir = out_dir / "views";
-  std::filesystem::create_directories(dir);
+std::string encodeViewImage(int index, const host::StereoFrame& frame) {
+  if (frame.left_bgr.empty()) return {};
   cv::Mat small;
   const double scale = double(kReportImageWidthPx) / frame.left_bgr.cols;
   cv::resize(frame.left_bgr, small, cv::Size(), scale, scale, cv::INTER_AREA);
   std::vector<unsigned char> png;
   if (!cv::imencode(".png", small, png))
     throw std::runtime_error("view image " + std::to_string(index) + ": PNG encoding failed");
-  host::writeFileAtomically(
-      out_dir / host::numberedFileName("views", index, "png"), "view image",
-      std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
+  return std::string(reinterpret_cast<const char*>(png.data()), png.size());
 }
 
 }  // namespace fvp::trials
@@ -348,19 +343,17 @@ namespace {
 /// the coarse map and the figures: path.png (with the regions) and sizes.png (left out,
 /// without a warning, when no fruitlet matched). A figure that cannot be drawn becomes a
 /// warning in result (written again). Returns the figures drawn.
-ReportFigures writeResultMapAndPath(nlohmann::json& result, const World& world,
-                                    const host::map::MapEngine* map,
-                                    const std::vector<Eigen::Vector3d>& camera_path,
-                                    const std::vector<PathRegion>& regions,
-                                    const std::string& region_title,
-                                    const std::filesystem::path& out_dir,
-                                    const std::function<void(const std::string&)>& warn) {
+ReportFigures writeResultMapAndPath(
+    nlohmann::json& result, const World& world, const host::map::MapEngine* map,
+    const std::vector<Eigen::Vector3d>& camera_path, const std::vector<PathRegion>& regions,
+    const std::string& region_title, const std::filesystem::path& out_dir,
+    const std::function<void(const std::string&)>& warn, const ExtraWriter& extra) {
   std::filesystem::create_directories(out_dir);
   const auto write_result = [&] {
     host::writeFileAtomically(out_dir / "result.json", "trial result", result.dump(2) + "\n");
   };
   write_result();
-  if (map) map->exportCoarse(out_dir / "coarse.bt");
+  if (map) extra("coarse.bt", [&] { map->exportCoarse(out_dir / "coarse.bt"); });
   ReportFigures drawn;
   // One warning a cause: a missing gnuplot loses both figures, and says so once.
   std::vector<std::pair<std::string, std::string>> failed;  // warning text, cause
@@ -768,17 +761,25 @@ const std::vector<std::string>& TrialParts::clusterFiles() {
   return files;
 }
 
-void TrialParts::writeClusterFiles(const std::filesystem::path& dir) const {
-  std::filesystem::create_directories(dir);
-  if (const host::map::MapEngine* map = impl_->session.map()) map->exportFine(dir / "fine.ot");
+void TrialParts::writeClusterFiles(const std::filesystem::path& dir,
+                                   const ExtraWriter& extra) const {
+  std::error_code ignored;  // a directory that cannot be made fails each file's write below
+  std::filesystem::create_directories(dir, ignored);
+  if (const host::map::MapEngine* map = impl_->session.map())
+    extra("fine.ot", [&] { map->exportFine(dir / "fine.ot"); });
   const auto& sz = impl_->sizing;
-  host::writePlyPoints(dir / "surface.ply", impl_->session.surfacePoints());
-  const host::tsdf::TriangleMesh mesh = impl_->session.surfaceMesh();
-  host::writePlyMesh(dir / "mesh.ply", mesh.vertices_m, mesh.triangles,
-                     "fvp TSDF mesh (marching cubes), world frame, metres");
-  host::writePlyColoredPoints(dir / "clusters.ply", sz.points,
-                              host::sizing::clusterColours(sz.labels),
-                              "fvp clusters, world frame, metres; grey = noise");
+  extra("surface.ply",
+        [&] { host::writePlyPoints(dir / "surface.ply", impl_->session.surfacePoints()); });
+  extra("mesh.ply", [&] {
+    const host::tsdf::TriangleMesh mesh = impl_->session.surfaceMesh();
+    host::writePlyMesh(dir / "mesh.ply", mesh.vertices_m, mesh.triangles,
+                       "fvp TSDF mesh (marching cubes), world frame, metres");
+  });
+  extra("clusters.ply", [&] {
+    host::writePlyColoredPoints(dir / "clusters.ply", sz.points,
+                                host::sizing::clusterColours(sz.labels),
+                                "fvp clusters, world frame, metres; grey = noise");
+  });
 }
 
 const std::vector<std::string>& TrialParts::outputFiles() {
@@ -791,21 +792,26 @@ const std::vector<std::string>& TrialParts::outputFiles() {
 void TrialParts::writeOutputs(nlohmann::json& result, const World& world,
                               const std::vector<Eigen::Vector3d>& camera_path,
                               const std::filesystem::path& out_dir,
-                              const std::function<void(const std::string&)>& warn) const {
+                              const std::function<void(const std::string&)>& warn,
+                              const ExtraWriter& extra) const {
   std::vector<PathRegion> regions;
   if (const auto& region = impl_->session.region())
     regions.push_back({region->center_m(), region->radius_m()});
-  const ReportFigures figures = writeResultMapAndPath(
-      result, world, impl_->session.map(), camera_path, regions, "Cluster Region", out_dir, warn);
-  writeClusterFiles(out_dir);
-  host::writeFileAtomically(out_dir / "report.md", "trial report",
-                            trialReportMarkdown(result, figures));
+  const ReportFigures figures =
+      writeResultMapAndPath(result, world, impl_->session.map(), camera_path, regions,
+                            "Cluster Region", out_dir, warn, extra);
+  writeClusterFiles(out_dir, extra);
+  extra("report.md", [&] {
+    host::writeFileAtomically(out_dir / "report.md", "trial report",
+                              trialReportMarkdown(result, figures));
+  });
 }
 
 void writeTreeOutputs(nlohmann::json& result, const World& world, const host::map::MapEngine* map,
                       const std::vector<Eigen::Vector3d>& camera_path,
                       const std::filesystem::path& out_dir,
-                      const std::function<void(const std::string&)>& warn) {
+                      const std::function<void(const std::string&)>& warn,
+                      const ExtraWriter& extra) {
   // Each sized cluster's region where its tag is (the regions its session placed were
   // handed on with the map).
   std::vector<PathRegion> regions;
@@ -816,10 +822,13 @@ void writeTreeOutputs(nlohmann::json& result, const World& world, const host::ma
         host::ClusterRegion::fromTag(world.clusters()[k].tag.T_world_tag);
     regions.push_back({region.center_m(), region.radius_m()});
   }
-  const ReportFigures figures = writeResultMapAndPath(
-      result, world, map, camera_path, regions, "Cluster Regions (at the tags)", out_dir, warn);
-  host::writeFileAtomically(out_dir / "report.md", "trial report",
-                            treeReportMarkdown(result, figures));
+  const ReportFigures figures =
+      writeResultMapAndPath(result, world, map, camera_path, regions,
+                            "Cluster Regions (at the tags)", out_dir, warn, extra);
+  extra("report.md", [&] {
+    host::writeFileAtomically(out_dir / "report.md", "trial report",
+                              treeReportMarkdown(result, figures));
+  });
 }
 
 }  // namespace fvp::trials

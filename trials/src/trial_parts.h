@@ -39,6 +39,11 @@ std::string defaultCacheDir();
 robot::WorkspaceTree loadWorkspaceTree(const robot::ArmModel& arm,
                                        const std::function<void(const std::string&)>& warn);
 
+/// Writes an extra (a map, a cloud, the report, the view images) after result.json: the
+/// caller's writer turns a failure into a warning naming `file`, so the result stands.
+using ExtraWriter =
+    std::function<void(const std::string& file, const std::function<void()>& write)>;
+
 /// A tree trial's files into out_dir, each atomically: result.json first, then the shared
 /// coarse map (coarse.bt, when a cluster was mapped), the camera path over the tree and
 /// report.md. The clusters' own files were written as each was finished (cluster_K/).
@@ -46,10 +51,12 @@ void writeTreeOutputs(nlohmann::json& result, const robot::sim::World& world,
                       const host::map::MapEngine* map,
                       const std::vector<Eigen::Vector3d>& camera_path,
                       const std::filesystem::path& out_dir,
-                      const std::function<void(const std::string&)>& warn);
+                      const std::function<void(const std::string&)>& warn,
+                      const ExtraWriter& extra);
 
-/// Writes a small PNG of the view's left image for the report: out_dir/views/NNN.png.
-void keepViewImage(const std::filesystem::path& out_dir, int index, const host::StereoFrame& frame);
+/// The view's left image as the small PNG of the report (views/NNN.png), encoded: kept in
+/// memory during the loop and written after result.json, so a full disk cannot cost the trial.
+std::string encodeViewImage(int index, const host::StereoFrame& frame);
 
 /// The ground truth of the world's fruitlets with these indices (a cluster's).
 std::vector<host::eval::GroundTruthFruitlet> groundTruthOf(const robot::sim::World& world,
@@ -85,7 +92,7 @@ class TrialParts {
                               const std::vector<int>& fruitlet_indices);
   /// The cluster's files from the last sizeAndScore, each atomically, into dir: fine.ot (while
   /// the session holds its map), surface.ply, mesh.ply and clusters.ply.
-  void writeClusterFiles(const std::filesystem::path& dir) const;
+  void writeClusterFiles(const std::filesystem::path& dir, const ExtraWriter& extra) const;
   /// Those files' names.
   static const std::vector<std::string>& clusterFiles();
   /// result.json first, then the maps, surface, clusters, the camera-path figure and
@@ -94,7 +101,8 @@ class TrialParts {
   void writeOutputs(nlohmann::json& result, const robot::sim::World& world,
                     const std::vector<Eigen::Vector3d>& camera_path,
                     const std::filesystem::path& out_dir,
-                    const std::function<void(const std::string&)>& warn) const;
+                    const std::function<void(const std::string&)>& warn,
+                    const ExtraWriter& extra) const;
   /// The files writeOutputs writes (relative to out_dir), besides views/NNN.png.
   static const std::vector<std::string>& outputFiles();
 

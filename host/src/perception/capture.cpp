@@ -16,6 +16,7 @@
 
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/host/core/input_checks.h"
+#include "fvp/host/core/regular_file.h"
 #include "fvp/host/perception/ply_io.h"
 
 namespace fvp::host {
@@ -106,11 +107,14 @@ int readInt(const YAML::Node& root, const fs::path& file, const std::string& key
 }
 
 void readCameraYaml(const fs::path& file, Capture& c) {
+  std::error_code ec;
+  if (!fs::exists(file, ec))
+    fail(file, "file", "a readable camera model (required), cannot open it");
+  // A regular file of bounded size: a FIFO hung the reader, a huge file exhausted memory.
+  const std::string text = readRegularFile(file, "camera model", kMaxCameraYamlBytes);
   YAML::Node root;
   try {
-    root = YAML::LoadFile(file.string());
-  } catch (const YAML::BadFile&) {
-    fail(file, "file", "a readable camera model (required), cannot open it");
+    root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(file.string() + ": YAML syntax error: " + e.what());
   }
@@ -182,24 +186,27 @@ void readCameraYaml(const fs::path& file, Capture& c) {
 }
 
 cv::Mat readImage(const fs::path& file, int flags, const StereoIntrinsics& K, bool required) {
-  if (!fs::exists(file)) {
+  std::error_code ec;
+  if (!fs::exists(file, ec)) {
     if (required) fail(file, "file", "an image (required), it is missing");
     return {};
   }
-  std::ifstream in(file, std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (!in.good() && !in.eof()) fail(file, "file", "a readable image, cannot read it");
+  // A regular file no larger than an image of camera.yaml's size can be (a FIFO would hang
+  // the reader, /dev/zero or a sparse 30 GB file would be read until memory ran out), and
+  // only its header is read before the header is checked.
+  const std::uint64_t max_bytes = maxCaptureImageBytes(K);
+  const std::string head = readRegularFileHead(file, "PNG image", max_bytes, 24);
   // Only a PNG of camera.yaml's size reaches the decoder: OpenCV picks its decoder from the
   // content (a PPM or TIFF named left.png would be decoded too) and allocates the image its
   // header claims before it reads a pixel, so 100 bytes could ask for gigabytes. A PNG opens
   // with its 8-byte signature and the IHDR chunk: length, "IHDR", width, height (big-endian).
   static constexpr unsigned char kPngSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  if (bytes.size() < 24 || bytes.size() > std::size_t{INT_MAX} ||
-      std::memcmp(bytes.data(), kPngSignature, 8) != 0 || bytes.compare(12, 4, "IHDR") != 0)
+  if (head.size() < 24 || std::memcmp(head.data(), kPngSignature, 8) != 0 ||
+      head.compare(12, 4, "IHDR") != 0)
     fail(file, "image", "a PNG file (signature and IHDR header)");
   const auto be32 = [&](std::size_t at) {
     std::uint32_t v = 0;
-    for (std::size_t i = 0; i < 4; ++i) v = (v << 8) | static_cast<unsigned char>(bytes[at + i]);
+    for (std::size_t i = 0; i < 4; ++i) v = (v << 8) | static_cast<unsigned char>(head[at + i]);
     return v;
   };
   const std::uint32_t png_width = be32(16), png_height = be32(20);
@@ -211,6 +218,8 @@ cv::Mat readImage(const fs::path& file, int flags, const StereoIntrinsics& K, bo
   if (png_width != static_cast<std::uint32_t>(K.width_px) ||
       png_height != static_cast<std::uint32_t>(K.height_px))
     sizeError(png_width, png_height);
+  const std::string bytes = readRegularFile(file, "PNG image", max_bytes);
+  if (bytes.size() > std::size_t{INT_MAX}) fail(file, "image", "a PNG file below 2 GiB");
   cv::Mat im = cv::imdecode(
       cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, const_cast<char*>(bytes.data())), flags);
   if (im.empty()) fail(file, "image", "a readable PNG");
@@ -293,6 +302,12 @@ StereoFrame toStereoFrame(const Capture& c) {
   return frame;
 }
 
+StereoIntrinsics readCaptureIntrinsics(const fs::path& dir) {
+  Capture c;
+  readCameraYaml(dir / kCamera, c);
+  return c.intrinsics;
+}
+
 Capture readCapture(const fs::path& dir) {
   if (!fs::is_directory(dir)) throw std::runtime_error(dir.string() + ": not a capture directory");
   Capture c;
@@ -322,16 +337,16 @@ Capture readCapture(const fs::path& dir) {
     throw std::runtime_error((dir / (roi ? kOtherPly : kRoiPly)).string() +
                              ": missing (roi.ply and other.ply come together)");
   if (roi) {
+    // Bounded before the PLY reader opens them (a FIFO would hang it).
+    for (const char* name : {kRoiPly, kOtherPly})
+      checkRegularFile(dir / name, "point cloud (PLY)", maxCaptureCloudBytes(K));
     c.roi_points_m = readPlyPoints(dir / kRoiPly);
     c.other_points_m = readPlyPoints(dir / kOtherPly);
     c.has_clouds = true;
   }
   const fs::path gt = dir / kGroundTruth;
   if (fs::exists(gt)) {
-    std::ifstream in(gt);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    c.ground_truth_json = ss.str();
+    c.ground_truth_json = readRegularFile(gt, "ground truth (JSON)", kMaxGroundTruthBytes);
     try {
       const auto j = nlohmann::json::parse(c.ground_truth_json);
       if (!j.is_object()) fail(gt, "document", "a JSON object");

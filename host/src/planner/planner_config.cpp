@@ -43,10 +43,11 @@ PlannerConfig PlannerConfig::fromYamlFile(const std::filesystem::path& path) {
 }
 
 void PlannerConfig::validate(const std::string& source) const {
-  requireKey(roi_samples >= 0 && roi_samples <= 10'000'000, source, "roi_samples",
-             "0 to 10000000 candidates");
-  requireKey(exploration_samples >= 0 && exploration_samples <= 10'000'000, source,
-             "exploration_samples", "0 to 10000000 candidates");
+  requireKey(roi_samples >= 0 && roi_samples <= kMaxCandidateSamples, source, "roi_samples",
+             "0 to 100000 candidates a round (each is ray cast every round)");
+  requireKey(exploration_samples >= 0 && exploration_samples <= kMaxCandidateSamples, source,
+             "exploration_samples",
+             "0 to 100000 candidates a round (each is ray cast every round)");
   requireKey(roi_samples + exploration_samples > 0, source, "roi_samples",
              "at least one candidate per round (roi_samples + exploration_samples > 0)");
   requireKey(sensor_min_m > 0.0 && sensor_min_m < 5.0, source, "sensor_min_m",
@@ -68,8 +69,8 @@ void PlannerConfig::validate(const std::string& source) const {
              "1 to 256 rays");
   requireKey(frustum_rays_y >= 1 && frustum_rays_y <= 256, source, "frustum_rays_y",
              "1 to 256 rays");
-  requireKey(sizing_samples >= 0 && sizing_samples <= 10'000'000, source, "sizing_samples",
-             "0 to 10000000 candidates");
+  requireKey(sizing_samples >= 0 && sizing_samples <= kMaxCandidateSamples, source,
+             "sizing_samples", "0 to 100000 candidates a round (each is ray cast every round)");
   requireKey(max_sampling_rounds >= 1 && max_sampling_rounds <= 1000, source, "max_sampling_rounds",
              "1 to 1000 rounds");
 }

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "fvp/host/core/yaml_config.h"
+#include "fvp/host/planner/planner_config.h"
 
 namespace fvp::host::planner {
 namespace {
@@ -41,10 +42,11 @@ RvpConfig RvpConfig::fromYamlFile(const std::filesystem::path& path) {
 void RvpConfig::validate(const std::string& source) const {
   // Each count bounded before they are added (two large ints overflow), the rays so that
   // nx * ny stays an int; every double in a finite range (`!(x >= lo)` style: NaN fails).
-  requireKey(roi_samples >= 0 && roi_samples <= 10'000'000, source, "roi_samples",
-             "0 to 10000000 candidates");
-  requireKey(exploration_samples >= 0 && exploration_samples <= 10'000'000, source,
-             "exploration_samples", "0 to 10000000 candidates");
+  requireKey(roi_samples >= 0 && roi_samples <= kMaxCandidateSamples, source, "roi_samples",
+             "0 to 100000 candidates a round (each is ray cast every round)");
+  requireKey(exploration_samples >= 0 && exploration_samples <= kMaxCandidateSamples, source,
+             "exploration_samples",
+             "0 to 100000 candidates a round (each is ray cast every round)");
   requireKey(roi_samples + exploration_samples > 0, source, "roi_samples",
              "non-negative sample counts, not both 0");
   requireKey(sensor_min_m > 0.0 && sensor_max_m >= sensor_min_m && sensor_max_m < 5.0, source,

@@ -55,6 +55,13 @@ inline constexpr int kDefaultWorkspaceDirectionBins = 3;
 inline constexpr int kDefaultWorkspaceMinCount = 1;
 inline constexpr std::int64_t kDefaultWorkspaceSeed = 1;
 inline constexpr const char* kDefaultWorkspaceCacheDir = "";
+// The farthest a camera gets from the shoulder: the UR5's reach (shoulder to flange, with
+// every offset); the workspace tree adds the hand-eye offset and the camera body.
+inline constexpr double kUr5ReachM = 0.425 + 0.39225 + 0.10915 + 0.09465 + 0.0823 + 0.089159;
+// The most memory building the workspace tree may take (ArmConfig::workspaceTreeBytes): the
+// resolution, direction bins and samples are each in range, but 5 mm with 16 bins asked for
+// terabytes.
+inline constexpr std::uint64_t kMaxWorkspaceTreeBytes = std::uint64_t{4} << 30;
 
 struct ArmConfig {
   // Slider (joint 0, prismatic) and the UR5's mount on its carriage.
@@ -103,6 +110,8 @@ struct ArmConfig {
   static ArmConfig fromYamlFile(const std::filesystem::path& path);
   /// Throws std::invalid_argument naming the first bad key and its expected range.
   void validate(const std::string& source = "arm config") const;
+  /// The memory WorkspaceTree::build takes for this config (its grids and samples), bytes.
+  std::uint64_t workspaceTreeBytes() const;
   static const std::vector<std::string>& keyNames();
   /// The config as a JSON object text (for result.json).
   std::string toJson() const;

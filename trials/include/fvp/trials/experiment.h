@@ -21,6 +21,9 @@
 
 namespace fvp::trials {
 
+/// The most worlds (--trials) an experiment runs: at minutes a trial, more is a typo.
+inline constexpr int kMaxExperimentTrials = 100'000;
+
 struct ExperimentOptions {
   std::vector<std::string> planners{"fvp", "rvp"};
   int trials = 35;

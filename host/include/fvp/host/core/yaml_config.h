@@ -18,7 +18,12 @@
 #include <type_traits>
 #include <vector>
 
+#include "fvp/host/core/regular_file.h"
+
 namespace fvp::host {
+
+/// The largest config file read (docs/reliability.md, "Memory bounds").
+inline constexpr std::uint64_t kMaxConfigFileBytes = std::uint64_t{1} << 20;
 
 /// The file's top-level node: null for an empty file, else a mapping. Throws
 /// std::invalid_argument when the file cannot be read as YAML or is not a mapping.
@@ -28,9 +33,17 @@ inline YAML::Node readYamlMapping(const std::filesystem::path& path, const std::
   if (!std::filesystem::is_regular_file(path, ec))
     throw std::invalid_argument(source + ": not a readable file" +
                                 (std::filesystem::is_directory(path, ec) ? " (a directory)" : ""));
+  // Configs are a page of keys: a bound keeps a 100 MB list from exhausting memory in the
+  // YAML parser (whose nodes take ~50 times the text).
+  std::string text;
+  try {
+    text = readRegularFile(path, "config file", kMaxConfigFileBytes);
+  } catch (const std::runtime_error& e) {
+    throw std::invalid_argument(source + ": " + e.what());
+  }
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path.string());
+    root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw std::invalid_argument(source + ": cannot read YAML: " + e.what());
   }

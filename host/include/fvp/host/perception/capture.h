@@ -25,6 +25,18 @@ inline constexpr double kDefaultDisparityScale = 16.0;  ///< OpenCV's fixed poin
 /// Largest image readCapture accepts, width x height (64 Mi pixels, e.g. 8192 x 8192): the
 /// images and their per-pixel working copies must fit in memory.
 inline constexpr std::int64_t kMaxCapturePixels = std::int64_t{1} << 26;
+/// What a capture's files may weigh, checked before they are read (docs/capture-format.md,
+/// "Size limits"): camera.yaml 64 KiB; ground_truth.json 16 MiB; a PNG 8 bytes a pixel (a
+/// 16-bit RGBA image stored without compression) plus 16 MiB of other chunks; a PLY 32 bytes
+/// a pixel (a point per pixel with extra properties) plus 1 MiB.
+inline constexpr std::uint64_t kMaxCameraYamlBytes = std::uint64_t{64} << 10;
+inline constexpr std::uint64_t kMaxGroundTruthBytes = std::uint64_t{16} << 20;
+inline std::uint64_t maxCaptureImageBytes(const StereoIntrinsics& K) {
+  return std::uint64_t(K.width_px) * std::uint64_t(K.height_px) * 8 + (std::uint64_t{16} << 20);
+}
+inline std::uint64_t maxCaptureCloudBytes(const StereoIntrinsics& K) {
+  return std::uint64_t(K.width_px) * std::uint64_t(K.height_px) * 32 + (std::uint64_t{1} << 20);
+}
 
 struct Capture {
   cv::Mat left_bgr;  ///< CV_8UC3 (a grey PNG is read as CV_8UC3 too)
@@ -53,5 +65,9 @@ StereoFrame toStereoFrame(const Capture& capture);
 /// Reads and validates a capture; throws std::runtime_error whose message names the file,
 /// the field and what was expected.
 Capture readCapture(const std::filesystem::path& dir);
+
+/// Only dir/camera.yaml's intrinsics, checked as readCapture checks them (to size a set's
+/// needs before its images are read).
+StereoIntrinsics readCaptureIntrinsics(const std::filesystem::path& dir);
 
 }  // namespace fvp::host

@@ -9,6 +9,11 @@
 
 namespace fvp::host::planner {
 
+/// The most candidates a round may sample (roi_samples, exploration_samples, sizing_samples;
+/// the RVP config's too): each is ray cast every round, so 10^7 exhausted memory where the
+/// paper samples 200.
+inline constexpr int kMaxCandidateSamples = 100'000;
+
 // Paper's protocol: 100 ROI-targeted + 100 exploration candidates per iteration.
 inline constexpr int kDefaultRoiSamples = 100;
 inline constexpr int kDefaultExplorationSamples = 100;
