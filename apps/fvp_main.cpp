@@ -1,43 +1,6 @@
-// fvp: command-line entry point. Options are parsed here; the work is in the libraries.
-#include <exception>
-#include <iostream>
-#include <string>
-
+// fvp: command-line entry point. Options are parsed in cli.cpp; the work is in the libraries.
 #include "commands.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"fvp: apple-fruitlet sizing with next-best-view planning"};
-  app.require_subcommand(1);
-  fvp::apps::addBackendsCommand(app);
-  fvp::apps::addCaptureCommand(app);
-  fvp::apps::addTraverseCommand(app);
-  fvp::apps::addMapCommand(app);
-  fvp::apps::addRunCommand(app);
-  fvp::apps::addPlanCommand(app);
-  fvp::apps::addSizeCommand(app);
-  fvp::apps::addExperimentCommands(app);
-  // CLI11 reports a mistyped subcommand as "A subcommand is required"; name it instead.
-  if (argc > 1 && argv[1][0] != '-') {
-    std::string known;
-    bool found = false;
-    for (const CLI::App* sub : app.get_subcommands({})) {
-      found |= sub->get_name() == argv[1];
-      known += (known.empty() ? "" : ", ") + sub->get_name();
-    }
-    if (!found) {
-      std::cerr << "fvp: error: unknown subcommand '" << argv[1] << "' (known: " << known
-                << "; see fvp --help)\n";
-      return 2;
-    }
-  }
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    // Usage errors exit 2 (CLI11's own codes are 100+); --help exits 0.
-    return app.exit(e) == 0 ? 0 : 2;
-  } catch (const std::exception& e) {
-    std::cerr << "fvp: error: " << e.what() << "\n";
-    return 1;
-  }
-  return 0;
+  return fvp::apps::runFvp(argc, argv, fvp::apps::CliMode::kRun);
 }

@@ -50,13 +50,13 @@ void addMapCommand(CLI::App& app) {
       ->check(CLI::Range(0.0, 360.0))
       ->capture_default_str();
   cmd->add_option("--engine", opt->engine, "map engine: grid | octomap")
-      ->check(CLI::IsMember(host::map::MapEngineRegistry::instance().names()))
+      ->check(CLI::IsMember(mapEngineNames()))
       ->capture_default_str();
   cmd->add_option("--backend", opt->backend,
                   "compute backend for the grid engine: cpu | opencl | vulkan | auto")
       ->capture_default_str();
   cmd->add_option("--out", opt->out, "output directory")->required();
-  cmd->callback([opt] {
+  FVP_ON_RUN(cmd, [opt] {
     using robot::sim::WorldConfig;
     host::prepareOutputDirectory(opt->out, "--out");
     host::removeStaleOutputs(opt->out, {"coarse.bt", "fine.ot", "map.json"});

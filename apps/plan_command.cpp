@@ -20,7 +20,7 @@ void addPlanCommand(CLI::App& app) {
       "One planning iteration on a map of K simulated views; write plan.json and "
       "candidates.ply to --out");
   cmd->add_option("--planner", opt->planner, "fvp | rvp")
-      ->check(CLI::IsMember(host::planner::PlannerRegistry::instance().names()))
+      ->check(CLI::IsMember(plannerNames()))
       ->capture_default_str();
   cmd->add_option("--seed", opt->seed, "world seed")
       ->check(decimalUnsigned())
@@ -31,7 +31,7 @@ void addPlanCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--backend", opt->backend, "cpu | opencl | vulkan | auto")->capture_default_str();
   cmd->add_option("--engine", opt->engine, "grid | octomap (default: the planner's)")
-      ->check(CLI::IsMember(host::map::MapEngineRegistry::instance().names()));
+      ->check(CLI::IsMember(mapEngineNames()));
   cmd->add_option("--world", *world, "world config YAML")->check(CLI::ExistingFile);
   cmd->add_option("--config", *config, "planner config YAML")->check(CLI::ExistingFile);
   auto captures = std::make_shared<std::string>(), perception = std::make_shared<std::string>();
@@ -43,7 +43,7 @@ void addPlanCommand(CLI::App& app) {
                   "perception config YAML for --captures (tag, Cluster Region, HSV)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", *out, "output directory")->required();
-  cmd->callback([opt, world, config, out, captures, perception] {
+  FVP_ON_RUN(cmd, [opt, world, config, out, captures, perception] {
     trials::PlanOnceOptions o = *opt;
     o.captures_dir = *captures;
     o.perception_config = *perception;

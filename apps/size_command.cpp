@@ -27,7 +27,7 @@ void addSizeCommand(CLI::App& app) {
       ->check(CLI::IsMember({"ours", "paper"}))
       ->capture_default_str();
   cmd->add_option("--engine", opt->engine, "map engine: grid | octomap")
-      ->check(CLI::IsMember(host::map::MapEngineRegistry::instance().names()))
+      ->check(CLI::IsMember(mapEngineNames()))
       ->capture_default_str();
   cmd->add_option("--backend", opt->backend, "cpu | opencl | vulkan | auto")->capture_default_str();
   cmd->add_option("--config", opt->config,
@@ -36,7 +36,7 @@ void addSizeCommand(CLI::App& app) {
                   "(docs/capture-format.md)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", opt->out, "output directory")->required();
-  cmd->callback([opt] {
+  FVP_ON_RUN(cmd, [opt] {
     host::PerceptionConfig perception;  // read first: a bad file fails before any work
     if (!opt->config.empty()) perception = host::PerceptionConfig::fromYamlFile(opt->config);
     std::unique_ptr<accel::Backend> backend;

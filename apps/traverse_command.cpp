@@ -45,7 +45,7 @@ void addTraverseCommand(CLI::App& app) {
       ->check(decimalUnsigned())
       ->capture_default_str();
   cmd->add_flag("!--no-check", opt->check, "skip the comparison with the cpu reference");
-  cmd->callback([opt] {
+  FVP_ON_RUN(cmd, [opt] {
     using Clock = std::chrono::steady_clock;
     auto backend = accel::createBackend(opt->backend);
     const accel::DenseGrid grid =

@@ -16,6 +16,7 @@
 
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/host/core/input_checks.h"
+#include "fvp/host/core/yaml_config.h"
 #include "fvp/host/perception/ply_io.h"
 
 namespace fvp::host {
@@ -90,6 +91,9 @@ double readNumber(const YAML::Node& root, const fs::path& file, const std::strin
   const YAML::Node n = root[key];
   if (!n) fail(file, "field '" + key + "'", expected + " (missing)");
   if (!n.IsScalar()) fail(file, "field '" + key + "'", expected + ", got a non-scalar");
+  // Decimal only, as in every config (yaml-cpp alone reads 012 as 10 for an integer).
+  if (!isDecimalNumberText(n.Scalar(), false))
+    fail(file, "field '" + key + "'", expected + " (a decimal number), got '" + n.Scalar() + "'");
   try {
     return n.as<double>();
   } catch (const YAML::Exception&) {
@@ -108,11 +112,11 @@ int readInt(const YAML::Node& root, const fs::path& file, const std::string& key
 void readCameraYaml(const fs::path& file, Capture& c) {
   YAML::Node root;
   try {
-    root = YAML::LoadFile(file.string());
-  } catch (const YAML::BadFile&) {
-    fail(file, "file", "a readable camera model (required), cannot open it");
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(file.string() + ": YAML syntax error: " + e.what());
+    // One document, no key twice (yaml-cpp keeps both and root[key] took the first).
+    root = loadOneYamlDocument(file, file.string());
+  } catch (const std::invalid_argument& e) {
+    if (!fs::exists(file)) fail(file, "file", "a readable camera model (required), it is missing");
+    throw std::runtime_error(e.what());
   }
   if (!root.IsMap()) fail(file, "document", "a mapping of camera fields");
   if (root["format_version"]) {
@@ -154,6 +158,8 @@ void readCameraYaml(const fs::path& file, Capture& c) {
       fail(file, tkey, texp + " (row " + std::to_string(r) + ")");
     for (int col = 0; col < 4; ++col) {
       try {
+        if (!T[r][col].IsScalar() || !isDecimalNumberText(T[r][col].Scalar(), false))
+          throw YAML::Exception(YAML::Mark::null_mark(), "not a decimal number");
         M(r, col) = T[r][col].as<double>();
       } catch (const YAML::Exception&) {
         fail(file, tkey,
@@ -186,6 +192,8 @@ cv::Mat readImage(const fs::path& file, int flags, const StereoIntrinsics& K, bo
     if (required) fail(file, "file", "an image (required), it is missing");
     return {};
   }
+  // Reading a directory fails inside the stream with a message that names no file.
+  if (fs::is_directory(file)) fail(file, "file", "a PNG image, got a directory");
   std::ifstream in(file, std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (!in.good() && !in.eof()) fail(file, "file", "a readable image, cannot read it");

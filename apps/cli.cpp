@@ -1,0 +1,49 @@
+// The command line: every subcommand's options on one CLI11 app, and the exit codes.
+#include <exception>
+#include <iostream>
+#include <string>
+
+#include "commands.h"
+
+namespace fvp::apps {
+
+int runFvp(int argc, const char* const* argv, CliMode mode) {
+  CLI::App app{"fvp: apple-fruitlet sizing with next-best-view planning"};
+  app.require_subcommand(1);
+  addBackendsCommand(app);
+  addCaptureCommand(app);
+  addTraverseCommand(app);
+  addMapCommand(app);
+  addRunCommand(app);
+  addPlanCommand(app);
+  addSizeCommand(app);
+  addExperimentCommands(app);
+  if (mode == CliMode::kParseOnly)
+    for (CLI::App* sub : app.get_subcommands({})) sub->callback([] {});
+  // CLI11 reports a mistyped subcommand as "A subcommand is required"; name it instead.
+  if (argc > 1 && argv[1][0] != '-') {
+    std::string known;
+    bool found = false;
+    for (const CLI::App* sub : app.get_subcommands({})) {
+      found |= sub->get_name() == argv[1];
+      known += (known.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!found) {
+      std::cerr << "fvp: error: unknown subcommand '" << argv[1] << "' (known: " << known
+                << "; see fvp --help)\n";
+      return 2;
+    }
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // Usage errors exit 2 (CLI11's own codes are 100+); --help exits 0.
+    return app.exit(e) == 0 ? 0 : 2;
+  } catch (const std::exception& e) {
+    std::cerr << "fvp: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace fvp::apps
