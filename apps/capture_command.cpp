@@ -37,8 +37,8 @@ Eigen::Isometry3d parsePose(const std::string& text) {
   std::stringstream ss(text);
   for (std::string item; std::getline(ss, item, ',');) {
     // Decimal text, as every number fvp reads (stod alone takes " 5", hex and inf).
-    const double x = host::isDecimalNumberText(item, false) ? std::strtod(item.c_str(), nullptr)
-                                                            : std::nan("");
+    const double x =
+        host::isDecimalNumberText(item, false) ? std::strtod(item.c_str(), nullptr) : std::nan("");
     if (!std::isfinite(x))
       throw std::invalid_argument("--pose: '" + item.substr(0, 40) + "' is not a finite number");
     v.push_back(x);

@@ -42,9 +42,8 @@ inline CLI::Validator finiteNumber() {
       [](std::string& text) -> std::string {
         // Decimal text first: strtod alone takes " 5" (not "5 "), hex floats, inf and nan.
         errno = 0;
-        const double v = host::isDecimalNumberText(text, false)
-                             ? std::strtod(text.c_str(), nullptr)
-                             : std::nan("");
+        const double v = host::isDecimalNumberText(text, false) ? std::strtod(text.c_str(), nullptr)
+                                                                : std::nan("");
         if (!std::isfinite(v) || errno == ERANGE)
           return "expected a finite decimal number, got '" + text + "'";
         return {};

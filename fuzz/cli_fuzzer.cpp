@@ -37,8 +37,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::vector<const char*> argv;
   for (const std::string& a : args) argv.push_back(a.c_str());
   argv.push_back(nullptr);
-  const int code = fvp::apps::runFvp(static_cast<int>(args.size()), argv.data(),
-                                     fvp::apps::CliMode::kParseOnly);
+  const int code =
+      fvp::apps::runFvp(static_cast<int>(args.size()), argv.data(), fvp::apps::CliMode::kParseOnly);
   if (code < 0 || code > 2) {
     std::fprintf(stderr, "fvp fuzz: the command line ended with exit code %d\n", code);
     std::abort();

@@ -324,8 +324,7 @@ PYBIND11_MODULE(fvp, m) {
                              })
       .def(
           "next_best_view",
-          [](Planner& p, Session& s, const py::handle& T_now,
-             const py::object& reachable) {
+          [](Planner& p, Session& s, const py::handle& T_now, const py::object& reachable) {
             const Eigen::Isometry3d T = poseFromArray(T_now, "next_best_view T_world_camera");
             std::optional<Eigen::Isometry3d> chosen;
             host::planner::PlanStep step;

@@ -388,9 +388,9 @@ const std::vector<BadInput>& cases() {
        [](const fs::path& d) {
          writeExperiment(d / "exp", "", injection(d, "octomap"));
          return std::vector<std::string>{
-             "experiment", "--planners", "fvp",    "--trials",   "1",          "--first-seed",
-             "1",          "--clock",    "fixed",  "--max-views", "1",         "--backend",
-             "cpu",        "--budget-s", "180",    "--resume",   "--out",      p(d / "exp")};
+             "experiment", "--planners", "fvp",   "--trials",    "1",     "--first-seed",
+             "1",          "--clock",    "fixed", "--max-views", "1",     "--backend",
+             "cpu",        "--budget-s", "180",   "--resume",    "--out", p(d / "exp")};
        },
        1,
        {"trials.jsonl: line 1: field 'engine'"},
@@ -399,9 +399,9 @@ const std::vector<BadInput>& cases() {
       {"ErrorScaleBeyondTheWorldConfig",
        [](const fs::path& d) {
          writeText(d / "world.yaml", "hand_eye_translation_sigma_m: 0.0015\n");
-         return std::vector<std::string>{"experiment", "--planners", "fvp", "--trials", "1",
-                                         "--world", p(d / "world.yaml"), "--error-scale",
-                                         "pose=20", "--out", p(d / "exp")};
+         return std::vector<std::string>{
+             "experiment",        "--planners",    "fvp",     "--trials", "1",         "--world",
+             p(d / "world.yaml"), "--error-scale", "pose=20", "--out",    p(d / "exp")};
        },
        1,
        {"--error-scale: error scale pose=20: hand_eye_translation_sigma_m would be 0.03",
@@ -464,8 +464,8 @@ const std::vector<BadInput>& cases() {
       {"CameraYamlDuplicateKey",
        [](const fs::path& d) {
          writeGreyCapture(d / "set" / "000", 320, 240, cameraYaml() + "fx: 3000\n");
-         return std::vector<std::string>{"size", "--captures", p(d / "set"), "--backend", "cpu",
-                                         "--out", p(d / "out")};
+         return std::vector<std::string>{"size", "--captures", p(d / "set"), "--backend",
+                                         "cpu",  "--out",      p(d / "out")};
        },
        1,
        {"camera.yaml: key 'fx' appears twice"},
@@ -473,8 +473,8 @@ const std::vector<BadInput>& cases() {
       {"CameraYamlOctalWidth",
        [](const fs::path& d) {
          writeGreyCapture(d / "set" / "000", 320, 240, cameraYaml({{"width", "0320"}}));
-         return std::vector<std::string>{"size", "--captures", p(d / "set"), "--backend", "cpu",
-                                         "--out", p(d / "out")};
+         return std::vector<std::string>{"size", "--captures", p(d / "set"), "--backend",
+                                         "cpu",  "--out",      p(d / "out")};
        },
        1,
        {"camera.yaml: field 'width'", "got '0320'"},
@@ -503,8 +503,8 @@ const std::vector<BadInput>& cases() {
          writeGreyCapture(d / "set" / "000");
          fs::remove(d / "set" / "000" / "left.png");
          fs::create_directories(d / "set" / "000" / "left.png");
-         return std::vector<std::string>{"size", "--captures", p(d / "set"), "--backend", "cpu",
-                                         "--out", p(d / "out")};
+         return std::vector<std::string>{"size", "--captures", p(d / "set"), "--backend",
+                                         "cpu",  "--out",      p(d / "out")};
        },
        1,
        {"left.png: file: expected a PNG image, got a directory"},
@@ -513,9 +513,9 @@ const std::vector<BadInput>& cases() {
        [](const fs::path& d) {
          writeGreyCapture(d / "set" / "000");
          writeText(d / "perception.yaml", "region_radius_m: 1e9\n");
-         return std::vector<std::string>{"size",  "--captures", p(d / "set"), "--config",
-                                         p(d / "perception.yaml"), "--backend", "cpu",
-                                         "--out", p(d / "out")};
+         return std::vector<std::string>{
+             "size",      "--captures", p(d / "set"), "--config",  p(d / "perception.yaml"),
+             "--backend", "cpu",        "--out",      p(d / "out")};
        },
        1,
        {"perception.yaml': key 'region_radius_m': expected a radius above 0 and at most 0.5 m"},

@@ -383,9 +383,9 @@ TEST(Experiment, AnErrorScaleWritesTheScaledWorldConfigTheTrialsRead) {
   const auto base = robot::sim::WorldConfig::fromYamlFile(world);
   EXPECT_DOUBLE_EQ(scaled.hand_eye_translation_sigma_m, 2.0 * base.hand_eye_translation_sigma_m);
   EXPECT_EQ(scaled.wind_leaf_tip_m, base.wind_leaf_tip_m);
-  for (const char* bad : {"pose", "pose=", "pose=x", "pose=1x", "=1", "sun=1", "pose=-1",
-                          "pose=012", "pose=0x2", "pose= 2", "pose=2 ", "pose=+2", "pose=1e308",
-                          "pose=inf", "pose=20"})
+  for (const char* bad :
+       {"pose", "pose=", "pose=x", "pose=1x", "=1", "sun=1", "pose=-1", "pose=012", "pose=0x2",
+        "pose= 2", "pose=2 ", "pose=+2", "pose=1e308", "pose=inf", "pose=20"})
     EXPECT_THROW(writeScaledWorldConfig(world, bad, out), std::invalid_argument) << bad;
   fs::remove_all(out);
 }
@@ -399,8 +399,8 @@ TEST(Experiment, TheVocabulariesOfExperimentFilesAreTheRegistriesAndTheWorldConf
   // Every name the schema accepts is figure text as it is (gnuplotQuoted takes it).
   for (const auto& p : experimentPlanners())
     for (const auto& e : experimentEngines())
-      EXPECT_TRUE(host::isGnuplotSafeText(
-          trialRowKey({{"planner", p}, {"engine", e}}) + "-paper-sizing: median automatic stop"));
+      EXPECT_TRUE(host::isGnuplotSafeText(trialRowKey({{"planner", p}, {"engine", e}}) +
+                                          "-paper-sizing: median automatic stop"));
   for (const auto& g : errorScaleGroups()) EXPECT_TRUE(host::isGnuplotSafeText(g));
 }
 
@@ -412,9 +412,11 @@ TEST(Experiment, TextFromExperimentFilesIsCheckedAgainstItsSchema) {
       {"seed", 1},
       {"engine", injection},
       {"fruitlets", nlohmann::json::array({{{"gt_size_mm", 10.0}, {"matched", false}}})}};
-  EXPECT_NE(errorOf([&] { checkTrial(trial, "t.jsonl: line 1"); })
-                .find("t.jsonl: line 1: field 'engine': expected \"\" or a map engine (grid,octomap)"),
-            std::string::npos);
+  EXPECT_NE(
+      errorOf([&] {
+        checkTrial(trial, "t.jsonl: line 1");
+      }).find("t.jsonl: line 1: field 'engine': expected \"\" or a map engine (grid,octomap)"),
+      std::string::npos);
   nlohmann::json reason = trial;
   reason["engine"] = "octomap";
   EXPECT_NO_THROW(checkTrial(reason, "t"));

@@ -83,9 +83,9 @@ fs::path writeScaledWorldConfig(const fs::path& world, const std::string& error_
   try {
     scaled = base.withErrorsScaled(group, factor);
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument("--error-scale: " + std::string(e.what()) +
-                                (world.empty() ? " (built-in world config)"
-                                               : " (world config " + world.string() + ")"));
+    throw std::invalid_argument(
+        "--error-scale: " + std::string(e.what()) +
+        (world.empty() ? " (built-in world config)" : " (world config " + world.string() + ")"));
   }
   fs::create_directories(out_dir);
   const fs::path path = out_dir / "world.yaml";
@@ -377,7 +377,6 @@ std::string accuracyTimeFigureScript(const std::map<std::string, std::vector<Acc
 }
 
 }  // namespace
-
 
 nlohmann::json summarize(const std::vector<nlohmann::json>& trials) {
   std::map<std::string, std::vector<const nlohmann::json*>> by_key;

@@ -186,19 +186,17 @@ std::pair<std::string, double> parseErrorScale(const std::string& error_scale) {
     std::string shown = error_scale.size() > 60 ? error_scale.substr(0, 57) + "..." : error_scale;
     for (char& c : shown)
       if (c < 0x20 || c == 0x7f) c = '?';  // the message is printed: no control bytes
-    return std::invalid_argument("--error-scale '" + shown +
-                                 "': expected GROUP=FACTOR with GROUP one of " +
-                                 joined(errorScaleGroups()) +
-                                 " and FACTOR a decimal number from 0 to " +
-                                 std::to_string(int(kMaxErrorScaleFactor)) + ", e.g. wind=0.5" +
-                                 (why.empty() ? "" : " (" + why + ")"));
+    return std::invalid_argument(
+        "--error-scale '" + shown + "': expected GROUP=FACTOR with GROUP one of " +
+        joined(errorScaleGroups()) + " and FACTOR a decimal number from 0 to " +
+        std::to_string(int(kMaxErrorScaleFactor)) + ", e.g. wind=0.5" +
+        (why.empty() ? "" : " (" + why + ")"));
   };
   const std::size_t eq = error_scale.find('=');
   if (eq == std::string::npos) throw bad("no '='");
   const std::string group = error_scale.substr(0, eq), text = error_scale.substr(eq + 1);
   const auto& groups = errorScaleGroups();
-  if (std::find(groups.begin(), groups.end(), group) == groups.end())
-    throw bad("unknown group");
+  if (std::find(groups.begin(), groups.end(), group) == groups.end()) throw bad("unknown group");
   // Decimal only, as every other number fvp reads: no sign, hex, inf, nan or spaces.
   static const std::regex decimal(R"((0|[1-9][0-9]*)(\.[0-9]+)?([eE][+-]?[0-9]{1,3})?)");
   if (!std::regex_match(text, decimal)) throw bad("'" + text + "' is not a decimal number");

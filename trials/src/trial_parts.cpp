@@ -262,8 +262,7 @@ std::string cameraPathScript(const std::vector<Eigen::Vector3d>& fruitlets,
       const double dx = (p - centre).x() >= 0 ? 1.0 : -1.0;
       const double dy = flip * ((p - centre).y() >= 0 ? 1.0 : -1.0);
       s << "set label " << tag << " " << host::gnuplotQuoted(text) << " at " << p.x() << ","
-        << p.y()
-        << " offset char " << 2.0 * dx << "," << 1.4 * dy << (dx > 0 ? " left" : " right")
+        << p.y() << " offset char " << 2.0 * dx << "," << 1.4 * dy << (dx > 0 ? " left" : " right")
         << " front boxed font ',9'\n";
     };
     if (last >= 0) label(1, "start (view 0)", 0, 1.0);

@@ -233,11 +233,11 @@ WorldConfig WorldConfig::withErrorsScaled(const std::string& group, double facto
   if (factor > limit) {
     const double value = this->*std::get<double WorldConfig::*>(limiting->member);
     throw std::invalid_argument(
-        "error scale " + group + "=" + formatNumber(factor) + ": " + limiting->name +
-        " would be " + formatNumber(value * factor) + " (" + formatNumber(value) + " x " +
-        formatNumber(factor) + "), outside its range " + formatNumber(limiting->lo) + " to " +
-        formatNumber(limiting->hi) + "; the largest factor this world config allows for " +
-        group + " is " + formatNumber(limit));
+        "error scale " + group + "=" + formatNumber(factor) + ": " + limiting->name + " would be " +
+        formatNumber(value * factor) + " (" + formatNumber(value) + " x " + formatNumber(factor) +
+        "), outside its range " + formatNumber(limiting->lo) + " to " + formatNumber(limiting->hi) +
+        "; the largest factor this world config allows for " + group + " is " +
+        formatNumber(limit));
   }
   WorldConfig out = *this;
   // The clamp only absorbs rounding at factor == limit.
