@@ -130,7 +130,7 @@ void addCaptureCommand(CLI::App& app) {
     int views = 1;
     double arc_deg = 90.0;
   };
-  auto opt = std::make_shared<Options>();
+  auto opt = optionStorage<Options>();
   auto* cmd = app.add_subcommand(
       "capture",
       "Render one view of a simulated world (default: the start view), run the "

@@ -6,8 +6,24 @@
 #include "commands.h"
 
 namespace fvp::apps {
+namespace {
+
+// The running runFvp's option storage (optionStorage); null outside runFvp.
+thread_local std::vector<std::shared_ptr<void>>* kept = nullptr;
+
+}  // namespace
+
+void keepForRun(std::shared_ptr<void> p) {
+  if (kept) kept->push_back(std::move(p));
+}
 
 int runFvp(int argc, const char* const* argv, CliMode mode) {
+  // Declared before the app: the app (which refers to the storage) goes first.
+  std::vector<std::shared_ptr<void>> storage;
+  struct Keeping {
+    explicit Keeping(std::vector<std::shared_ptr<void>>* s) { kept = s; }
+    ~Keeping() { kept = nullptr; }
+  } keeping(&storage);
   CLI::App app{"fvp: apple-fruitlet sizing with next-best-view planning"};
   app.require_subcommand(1);
   addBackendsCommand(app);

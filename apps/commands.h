@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,19 @@ void addRunCommand(CLI::App& app);
 void addPlanCommand(CLI::App& app);
 void addSizeCommand(CLI::App& app);
 void addExperimentCommands(CLI::App& app);
+
+/// Keeps p alive until the running runFvp returns (no-op outside runFvp).
+void keepForRun(std::shared_ptr<void> p);
+
+/// What a subcommand's options are read into. CLI11 holds references to it, so it lives as
+/// long as the command line, not only as long as the subcommand's work holds it: the
+/// parse-only mode and build run no work.
+template <typename T>
+std::shared_ptr<T> optionStorage() {
+  auto p = std::make_shared<T>();
+  keepForRun(p);
+  return p;
+}
 
 /// The names --planner and --engine take: the registries' (cli_vocabulary.cpp).
 std::vector<std::string> plannerNames();

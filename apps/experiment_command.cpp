@@ -21,7 +21,7 @@ void addExperimentCommands(CLI::App& app) {
     std::string planners = "fvp,rvp", shard, world, config, arm, out, error_scale;
     int max_views = 0;
   };
-  auto opt = std::make_shared<Options>();
+  auto opt = optionStorage<Options>();
   auto* cmd =
       app.add_subcommand("experiment",
                          "Run every planner on the same simulated worlds; write trials.jsonl, "
@@ -120,8 +120,8 @@ void addExperimentCommands(CLI::App& app) {
               << " for Table 1, the figures and every trial's 3-D viewer\n";
   });
 
-  auto merge_out = std::make_shared<std::string>();
-  auto shards = std::make_shared<std::vector<std::string>>();
+  auto merge_out = optionStorage<std::string>();
+  auto shards = optionStorage<std::vector<std::string>>();
   auto* merge = app.add_subcommand("merge", "Combine experiment shards into one experiment");
   merge->add_option("shards", *shards, "shard output directories")->required();
   merge->add_option("--out", *merge_out, "merged output directory")->required();
@@ -134,8 +134,8 @@ void addExperimentCommands(CLI::App& app) {
               << "Table 1, the figures and every trial's viewer)\n";
   });
 
-  auto sweep_out = std::make_shared<std::string>();
-  auto points = std::make_shared<std::vector<std::string>>();
+  auto sweep_out = optionStorage<std::string>();
+  auto points = optionStorage<std::vector<std::string>>();
   auto* sensitivity =
       app.add_subcommand("sensitivity",
                          "Tabulate and plot a sweep of experiments made with --error-scale; write "

@@ -28,7 +28,7 @@ void addMapCommand(CLI::App& app) {
     std::string backend = "auto";
     std::string out;
   };
-  auto opt = std::make_shared<Options>();
+  auto opt = optionStorage<Options>();
   auto* cmd = app.add_subcommand(
       "map",
       "Map a simulated world from views orbiting the cluster; write coarse.bt, fine.ot "

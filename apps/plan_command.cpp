@@ -12,9 +12,9 @@
 namespace fvp::apps {
 
 void addPlanCommand(CLI::App& app) {
-  auto opt = std::make_shared<trials::PlanOnceOptions>();
-  auto world = std::make_shared<std::string>(), config = std::make_shared<std::string>(),
-       out = std::make_shared<std::string>();
+  auto opt = optionStorage<trials::PlanOnceOptions>();
+  auto world = optionStorage<std::string>(), config = optionStorage<std::string>(),
+       out = optionStorage<std::string>();
   auto* cmd = app.add_subcommand(
       "plan",
       "One planning iteration on a map of K simulated views; write plan.json and "
@@ -34,7 +34,7 @@ void addPlanCommand(CLI::App& app) {
       ->check(CLI::IsMember(mapEngineNames()));
   cmd->add_option("--world", *world, "world config YAML")->check(CLI::ExistingFile);
   cmd->add_option("--config", *config, "planner config YAML")->check(CLI::ExistingFile);
-  auto captures = std::make_shared<std::string>(), perception = std::make_shared<std::string>();
+  auto captures = optionStorage<std::string>(), perception = optionStorage<std::string>();
   cmd->add_option("--captures", *captures,
                   "plan from a robot's capture set (docs/capture-format.md) instead of "
                   "simulated views: the next best view from where the last capture was taken")

@@ -20,7 +20,7 @@ void addRunCommand(CLI::App& app) {
     std::string world, config, arm, out;
     int max_views = 0;
   };
-  auto opt = std::make_shared<Options>();
+  auto opt = optionStorage<Options>();
   auto* cmd = app.add_subcommand("run",
                                  "Run one simulated trial; write result.json, report.md and "
                                  "viewer.html (the trial in 3-D) to --out");

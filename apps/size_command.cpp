@@ -14,7 +14,7 @@ void addSizeCommand(CLI::App& app) {
   struct Options {
     std::string captures, out, sizing = "ours", engine = "grid", backend = "auto", config;
   };
-  auto opt = std::make_shared<Options>();
+  auto opt = optionStorage<Options>();
   auto* cmd =
       app.add_subcommand("size",
                          "Size the fruitlets of a set of stored captures; write fruitlets.json, "

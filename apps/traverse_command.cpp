@@ -18,7 +18,7 @@ void addTraverseCommand(CLI::App& app) {
     std::uint64_t seed = 1;
     bool check = true;
   };
-  auto opt = std::make_shared<Options>();
+  auto opt = optionStorage<Options>();
   auto* cmd =
       app.add_subcommand("traverse",
                          "Run the batched voxel ray traversal kernel on a synthetic canopy grid, "
