@@ -330,6 +330,22 @@ nlohmann::ordered_json ExperimentManifest::toJson() const {
   return j;
 }
 
+/// The manifest's error_scale: "" or a GROUP=FACTOR that --error-scale takes (its group is
+/// written into a figure's title).
+static std::string readErrorScale(const nlohmann::json& j, const std::string& where) {
+  const std::string text = readString(j, "error_scale", where);
+  try {
+    if (!text.empty()) parseErrorScale(text);
+  } catch (const std::invalid_argument&) {
+    fieldError(where, "error_scale",
+               "\"\" or GROUP=FACTOR (GROUP one of " + joined(errorScaleGroups()) +
+                   ", FACTOR a decimal number from 0 to " +
+                   std::to_string(int(kMaxErrorScaleFactor)) + ")",
+               &j.at("error_scale"));
+  }
+  return text;
+}
+
 ExperimentManifest readManifest(const std::filesystem::path& path) {
   const std::string where = path.string();
   const std::optional<std::string> bytes = readFileBytes(path);
@@ -388,18 +404,7 @@ ExperimentManifest readManifest(const std::filesystem::path& path) {
       fieldError(where, "release_left_out", "true or false", &j["release_left_out"]);
     m.release_left_out = j["release_left_out"].get<bool>();
   }
-  if (member(j, "error_scale")) {
-    m.error_scale = readString(j, "error_scale", where);
-    try {
-      if (!m.error_scale.empty()) parseErrorScale(m.error_scale);
-    } catch (const std::invalid_argument&) {
-      fieldError(where, "error_scale",
-                 "\"\" or GROUP=FACTOR (GROUP one of " + joined(errorScaleGroups()) +
-                     ", FACTOR a decimal number from 0 to " +
-                     std::to_string(int(kMaxErrorScaleFactor)) + ")",
-                 &j["error_scale"]);
-    }
-  }
+  if (member(j, "error_scale")) m.error_scale = readErrorScale(j, where);
   m.world_config = readConfig(j, "world_config", where);
   m.planner_config = readConfig(j, "planner_config", where);
   // Manifests written before --arm existed ran the built-in arm.
