@@ -8,7 +8,7 @@ namespace fvp::apps {
 
 void addBackendsCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("backends", "List the compute backends and their devices");
-  cmd->callback([] {
+  FVP_ON_RUN(cmd, [] {
     for (const auto& info : accel::probeBackends()) {
       std::cout << std::left << std::setw(8) << accel::toString(info.kind)
                 << (info.available ? "available    " : "unavailable  ")

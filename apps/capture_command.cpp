@@ -28,23 +28,37 @@
 namespace fvp::apps {
 namespace {
 
+// How far a --pose quaternion's norm may be from 1: rounding as people type rotations
+// (0.707 for 1/sqrt 2 is off by 3e-4), not a typo's missing or doubled component.
+constexpr double kQuaternionNormTolerance = 0.01;
+
 // "x,y,z,qx,qy,qz,qw" -> the left camera's optical-frame pose in the world.
 Eigen::Isometry3d parsePose(const std::string& text) {
   std::vector<double> v;
   std::stringstream ss(text);
   for (std::string item; std::getline(ss, item, ',');) {
-    try {
-      std::size_t used = 0;
-      v.push_back(std::stod(item, &used));
-      if (used != item.size() || !std::isfinite(v.back())) throw std::invalid_argument(item);
-    } catch (const std::exception&) {
-      throw std::invalid_argument("--pose: '" + item + "' is not a finite number");
-    }
+    // Decimal text, as every number fvp reads (stod alone takes " 5", hex and inf).
+    const double x =
+        host::isDecimalNumberText(item, false) ? std::strtod(item.c_str(), nullptr) : std::nan("");
+    if (!std::isfinite(x))
+      throw std::invalid_argument("--pose: '" + item.substr(0, 40) + "' is not a finite number");
+    v.push_back(x);
   }
   if (v.size() != 7)
     throw std::invalid_argument("--pose: expected 7 comma-separated numbers x,y,z,qx,qy,qz,qw");
+  // A unit quaternion as typed (rounded): its norm within kQuaternionNormTolerance of 1. A
+  // component beyond 2 is checked first, so the norm cannot overflow (1e308 normalised to
+  // an identity rotation).
   Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
-  if (!(q.norm() > 1e-9)) throw std::invalid_argument("--pose: the quaternion is zero");
+  const bool bounded = q.coeffs().cwiseAbs().maxCoeff() <= 2.0;
+  if (!bounded || std::abs(q.norm() - 1.0) > kQuaternionNormTolerance) {
+    std::ostringstream norm;
+    norm << (bounded ? q.norm() : q.coeffs().cwiseAbs().maxCoeff());
+    throw std::invalid_argument(
+        "--pose: field 'qx,qy,qz,qw': expected a unit quaternion (norm within " +
+        std::to_string(kQuaternionNormTolerance).substr(0, 4) + " of 1), got " +
+        (bounded ? "norm " : "a component of ") + norm.str());
+  }
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = q.normalized().toRotationMatrix();
   T.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
@@ -129,7 +143,7 @@ void addCaptureCommand(CLI::App& app) {
     int views = 1;
     double arc_deg = 90.0;
   };
-  auto opt = std::make_shared<Options>();
+  auto opt = optionStorage<Options>();
   auto* cmd = app.add_subcommand(
       "capture",
       "Render one view of a simulated world (default: the start view), run the "
@@ -153,7 +167,7 @@ void addCaptureCommand(CLI::App& app) {
   cmd->add_option("--out", opt->out, "capture directory (created)")
       ->required()
       ->check(nonEmptyPath());
-  cmd->callback([opt] {
+  FVP_ON_RUN(cmd, [opt] {
     host::prepareOutputDirectory(opt->out, "--out");
     const host::OutputDirectoryLock lock(opt->out, "--out");
     if (opt->views == 1) refuseCaptureSet(opt->out);

@@ -10,7 +10,11 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <stdexcept>
 #include <string>
+
+#include "fvp/host/core/number_text.h"
+#include "fvp/trials/experiment_directory.h"
 
 namespace fvp::apps {
 
@@ -36,11 +40,11 @@ inline CLI::Validator decimalUnsigned() {
 inline CLI::Validator finiteNumber() {
   return CLI::Validator(
       [](std::string& text) -> std::string {
-        char* end = nullptr;
+        // Decimal text first: strtod alone takes " 5" (not "5 "), hex floats, inf and nan.
         errno = 0;
-        const double v = std::strtod(text.c_str(), &end);
-        if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v) ||
-            errno == ERANGE || text.find_first_of("xXpP") != std::string::npos)
+        const double v = host::isDecimalNumberText(text, false) ? std::strtod(text.c_str(), nullptr)
+                                                                : std::nan("");
+        if (!std::isfinite(v) || errno == ERANGE)
           return "expected a finite decimal number, got '" + text + "'";
         return {};
       },
@@ -70,6 +74,40 @@ inline CLI::Validator nonEmptyPath() {
         return {};
       },
       "PATH", "nonEmptyPath");
+}
+
+/// Wraps a parser that throws std::invalid_argument (with the option's name in its message)
+/// as a validator: a malformed value is a usage error (exit 2) like any other option's.
+template <typename Parse>
+CLI::Validator parsedBy(Parse parse, const char* name) {
+  return CLI::Validator(
+      [parse](std::string& text) -> std::string {
+        try {
+          parse(text);
+        } catch (const std::invalid_argument& e) {
+          // CLI11 puts the option's name in front; the parser's own "--name: " goes.
+          std::string message = e.what();
+          const std::size_t colon = message.find(": ");
+          if (message.rfind("--", 0) == 0 && colon != std::string::npos &&
+              message.find(' ') > colon)
+            message.erase(0, colon + 2);
+          return message;
+        }
+        return {};
+      },
+      "", name);
+}
+
+/// --shard i/n (trials::parseShard).
+inline CLI::Validator shardText() {
+  return parsedBy([](const std::string& t) { trials::parseShard(t); }, "shard");
+}
+
+/// --error-scale GROUP=FACTOR: a known group, a decimal factor from 0 to 1000
+/// (trials::parseErrorScale). Whether the world config can take the factor is checked
+/// with the config (exit 1).
+inline CLI::Validator errorScaleText() {
+  return parsedBy([](const std::string& t) { trials::parseErrorScale(t); }, "error scale");
 }
 
 }  // namespace fvp::apps

@@ -23,7 +23,7 @@ void addExperimentCommands(CLI::App& app) {
     std::string planners = "fvp,rvp", shard, world, config, arm, out, error_scale;
     int max_views = 0;
   };
-  auto opt = std::make_shared<Options>();
+  auto opt = optionStorage<Options>();
   auto* cmd =
       app.add_subcommand("experiment",
                          "Run every planner on the same simulated worlds; write trials.jsonl, "
@@ -43,7 +43,8 @@ void addExperimentCommands(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--error-scale", opt->error_scale,
                   "GROUP=FACTOR: the world's pose, stereo, wind, segmentation, light or all errors "
-                  "times FACTOR (a sweep point; written to OUT/world.yaml)");
+                  "times FACTOR (a sweep point; written to OUT/world.yaml)")
+      ->check(errorScaleText());
   cmd->add_option("--budget-s", opt->experiment.trial.budget_s, "simulated budget per trial, s")
       ->check(finiteNumber())
       ->check(positiveNumber())
@@ -52,7 +53,7 @@ void addExperimentCommands(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--engine", opt->experiment.trial.engine,
                   "map engine for every planner (default: each planner's own)")
-      ->check(CLI::IsMember(host::map::MapEngineRegistry::instance().names()));
+      ->check(CLI::IsMember(mapEngineNames()));
   cmd->add_option(
          "--stop", opt->experiment.trial.stop,
          "budget: run the whole budget (the paper) | auto: stop once the cluster's sizes have "
@@ -78,10 +79,11 @@ void addExperimentCommands(CLI::App& app) {
   cmd->add_option("--max-views", opt->max_views,
                   "stop each trial after this many views (0: no limit)")
       ->check(decimalUnsigned());
-  cmd->add_option("--shard", opt->shard, "run shard i of n (0-based, 0 <= i < n), e.g. 0/4");
+  cmd->add_option("--shard", opt->shard, "run shard i of n (0-based, 0 <= i < n), e.g. 0/4")
+      ->check(shardText());
   cmd->add_flag("--resume", opt->experiment.resume, "skip trials already in trials.jsonl");
   cmd->add_option("--out", opt->out, "output directory")->required()->check(nonEmptyPath());
-  cmd->callback([opt] {
+  FVP_ON_RUN(cmd, [opt] {
     trials::ExperimentOptions o = opt->experiment;
     // Every comma-separated name, empty ones too: the runner rejects empty, unknown and
     // repeated planners with a message.
@@ -128,14 +130,14 @@ void addExperimentCommands(CLI::App& app) {
               << " for Table 1, the figures and every trial's 3-D viewer\n";
   });
 
-  auto merge_out = std::make_shared<std::string>();
-  auto shards = std::make_shared<std::vector<std::string>>();
+  auto merge_out = optionStorage<std::string>();
+  auto shards = optionStorage<std::vector<std::string>>();
   auto* merge = app.add_subcommand("merge", "Combine experiment shards into one experiment");
   merge->add_option("shards", *shards, "shard output directories")->required();
   merge->add_option("--out", *merge_out, "merged output directory")
       ->required()
       ->check(nonEmptyPath());
-  merge->callback([merge_out, shards] {
+  FVP_ON_RUN(merge, [merge_out, shards] {
     std::vector<std::filesystem::path> dirs(shards->begin(), shards->end());
     trials::mergeExperiments(dirs, *merge_out, [](const std::string& line) {
       std::cerr << "fvp: warning: " << line << "\n";
@@ -144,8 +146,8 @@ void addExperimentCommands(CLI::App& app) {
               << "Table 1, the figures and every trial's viewer)\n";
   });
 
-  auto sweep_out = std::make_shared<std::string>();
-  auto points = std::make_shared<std::vector<std::string>>();
+  auto sweep_out = optionStorage<std::string>();
+  auto points = optionStorage<std::vector<std::string>>();
   auto* sensitivity =
       app.add_subcommand("sensitivity",
                          "Tabulate and plot a sweep of experiments made with --error-scale; write "
@@ -155,7 +157,7 @@ void addExperimentCommands(CLI::App& app) {
   sensitivity->add_option("--out", *sweep_out, "output directory")
       ->required()
       ->check(nonEmptyPath());
-  sensitivity->callback([sweep_out, points] {
+  FVP_ON_RUN(sensitivity, [sweep_out, points] {
     std::vector<std::filesystem::path> dirs(points->begin(), points->end());
     const bool drawn = trials::writeSensitivityReport(
         dirs, *sweep_out,

@@ -1,70 +1,13 @@
-// fvp: command-line entry point. Options are parsed here; the work is in the libraries.
+// fvp: command-line entry point. Options are parsed in cli.cpp; the work is in the libraries.
 #include <csignal>
-#include <exception>
-#include <iostream>
-#include <new>
-#include <string>
 
 #include "commands.h"
 #include "fvp/host/core/interrupt.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"fvp: apple-fruitlet sizing with next-best-view planning"};
-  app.require_subcommand(1);
-  fvp::apps::addBackendsCommand(app);
-  fvp::apps::addCaptureCommand(app);
-  fvp::apps::addTraverseCommand(app);
-  fvp::apps::addMapCommand(app);
-  fvp::apps::addRunCommand(app);
-  fvp::apps::addPlanCommand(app);
-  fvp::apps::addSizeCommand(app);
-  fvp::apps::addExperimentCommands(app);
-  // CLI11 reports a mistyped subcommand as "A subcommand is required"; name it instead.
-  if (argc > 1 && argv[1][0] != '-') {
-    std::string known;
-    bool found = false;
-    for (const CLI::App* sub : app.get_subcommands({})) {
-      found |= sub->get_name() == argv[1];
-      known += (known.empty() ? "" : ", ") + sub->get_name();
-    }
-    if (!found) {
-      std::cerr << "fvp: error: unknown subcommand '" << argv[1] << "' (known: " << known
-                << "; see fvp --help)\n";
-      return 2;
-    }
-  }
   // SIGINT/SIGTERM stop the run cleanly (docs/reliability.md, "Signals"); a file size limit
   // (ulimit -f) fails the write with EFBIG instead of killing fvp with SIGXFSZ.
   fvp::host::installInterruptHandlers();
   std::signal(SIGXFSZ, SIG_IGN);
-  const auto command = [&app] {
-    const auto used = app.get_subcommands();
-    return used.empty() ? std::string("fvp") : "fvp " + used.front()->get_name();
-  };
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    // Usage errors exit 2 (CLI11's own codes are 100+); --help exits 0.
-    return app.exit(e) == 0 ? 0 : 2;
-  } catch (const std::bad_alloc&) {
-    // A setting's memory is estimated before the large allocations; one that got past them
-    // still ends with a message naming the command, not a bare std::bad_alloc.
-    std::cerr << "fvp: error: " << command()
-              << ": out of memory (a setting, a config or an input asked for more memory than "
-                 "there is; see docs/reliability.md, \"Memory bounds\")\n";
-    return 1;
-  } catch (const std::exception& e) {
-    if (const int sig = fvp::host::interruptSignal()) {
-      std::cerr << "fvp: " << command() << ": " << e.what()
-                << "; files that were complete are kept\n";
-      return 128 + sig;
-    }
-    std::cerr << "fvp: error: " << e.what() << "\n";
-    return 1;
-  }
-  if (const int sig = fvp::host::interruptSignal()) {
-    std::cerr << "fvp: " << command() << ": interrupted by signal " << sig << " at its end\n";
-    return 128 + sig;
-  }
-  return 0;
+  return fvp::apps::runFvp(argc, argv, fvp::apps::CliMode::kRun);
 }

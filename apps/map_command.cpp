@@ -28,7 +28,7 @@ void addMapCommand(CLI::App& app) {
     std::string backend = "auto";
     std::string out;
   };
-  auto opt = std::make_shared<Options>();
+  auto opt = optionStorage<Options>();
   auto* cmd = app.add_subcommand(
       "map",
       "Map a simulated world from views orbiting the cluster; write coarse.bt, fine.ot "
@@ -50,13 +50,13 @@ void addMapCommand(CLI::App& app) {
       ->check(CLI::Range(0.0, 360.0))
       ->capture_default_str();
   cmd->add_option("--engine", opt->engine, "map engine: grid | octomap")
-      ->check(CLI::IsMember(host::map::MapEngineRegistry::instance().names()))
+      ->check(CLI::IsMember(mapEngineNames()))
       ->capture_default_str();
   cmd->add_option("--backend", opt->backend,
                   "compute backend for the grid engine: cpu | opencl | vulkan | auto")
       ->capture_default_str();
   cmd->add_option("--out", opt->out, "output directory")->required()->check(nonEmptyPath());
-  cmd->callback([opt] {
+  FVP_ON_RUN(cmd, [opt] {
     using robot::sim::WorldConfig;
     host::prepareOutputDirectory(opt->out, "--out");
     const host::OutputDirectoryLock lock(opt->out, "--out");

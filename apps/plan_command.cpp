@@ -12,15 +12,15 @@
 namespace fvp::apps {
 
 void addPlanCommand(CLI::App& app) {
-  auto opt = std::make_shared<trials::PlanOnceOptions>();
-  auto world = std::make_shared<std::string>(), config = std::make_shared<std::string>(),
-       out = std::make_shared<std::string>();
+  auto opt = optionStorage<trials::PlanOnceOptions>();
+  auto world = optionStorage<std::string>(), config = optionStorage<std::string>(),
+       out = optionStorage<std::string>();
   auto* cmd = app.add_subcommand(
       "plan",
       "One planning iteration on a map of K simulated views; write plan.json and "
       "candidates.ply to --out");
   cmd->add_option("--planner", opt->planner, "fvp | rvp")
-      ->check(CLI::IsMember(host::planner::PlannerRegistry::instance().names()))
+      ->check(CLI::IsMember(plannerNames()))
       ->capture_default_str();
   cmd->add_option("--seed", opt->seed, "world seed")
       ->check(decimalUnsigned())
@@ -31,10 +31,10 @@ void addPlanCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--backend", opt->backend, "cpu | opencl | vulkan | auto")->capture_default_str();
   cmd->add_option("--engine", opt->engine, "grid | octomap (default: the planner's)")
-      ->check(CLI::IsMember(host::map::MapEngineRegistry::instance().names()));
+      ->check(CLI::IsMember(mapEngineNames()));
   cmd->add_option("--world", *world, "world config YAML")->check(CLI::ExistingFile);
   cmd->add_option("--config", *config, "planner config YAML")->check(CLI::ExistingFile);
-  auto captures = std::make_shared<std::string>(), perception = std::make_shared<std::string>();
+  auto captures = optionStorage<std::string>(), perception = optionStorage<std::string>();
   cmd->add_option("--captures", *captures,
                   "plan from a robot's capture set (docs/capture-format.md) instead of "
                   "simulated views: the next best view from where the last capture was taken")
@@ -43,7 +43,7 @@ void addPlanCommand(CLI::App& app) {
                   "perception config YAML for --captures (tag, Cluster Region, HSV)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", *out, "output directory")->required()->check(nonEmptyPath());
-  cmd->callback([opt, world, config, out, captures, perception] {
+  FVP_ON_RUN(cmd, [opt, world, config, out, captures, perception] {
     trials::PlanOnceOptions o = *opt;
     o.captures_dir = *captures;
     o.perception_config = *perception;

@@ -20,12 +20,12 @@ void addRunCommand(CLI::App& app) {
     std::string world, config, arm, out;
     int max_views = 0;
   };
-  auto opt = std::make_shared<Options>();
+  auto opt = optionStorage<Options>();
   auto* cmd = app.add_subcommand("run",
                                  "Run one simulated trial; write result.json, report.md and "
                                  "viewer.html (the trial in 3-D) to --out");
   cmd->add_option("--planner", opt->trial.planner, "viewpoint planner: fvp | rvp")
-      ->check(CLI::IsMember(host::planner::PlannerRegistry::instance().names()))
+      ->check(CLI::IsMember(plannerNames()))
       ->capture_default_str();
   cmd->add_option("--seed", opt->trial.seed, "world seed")
       ->check(decimalUnsigned())
@@ -45,7 +45,7 @@ void addRunCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--engine", opt->trial.engine,
                   "map engine: grid | octomap (default: grid for fvp, octomap for rvp)")
-      ->check(CLI::IsMember(host::map::MapEngineRegistry::instance().names()));
+      ->check(CLI::IsMember(mapEngineNames()));
   cmd->add_option("--max-views", opt->max_views, "stop after this many views (0: no limit)")
       ->check(decimalUnsigned());
   cmd->add_option(
@@ -71,7 +71,7 @@ void addRunCommand(CLI::App& app) {
       ->check(CLI::IsMember({"wall", "fixed"}))
       ->capture_default_str();
   cmd->add_option("--out", opt->out, "output directory")->required()->check(nonEmptyPath());
-  cmd->callback([opt] {
+  FVP_ON_RUN(cmd, [opt] {
     trials::TrialOptions trial = opt->trial;
     trial.world_config = opt->world;
     trial.planner_config = opt->config;

@@ -15,7 +15,7 @@ void addSizeCommand(CLI::App& app) {
   struct Options {
     std::string captures, out, sizing = "ours", engine = "grid", backend = "auto", config;
   };
-  auto opt = std::make_shared<Options>();
+  auto opt = optionStorage<Options>();
   auto* cmd =
       app.add_subcommand("size",
                          "Size the fruitlets of a set of stored captures; write fruitlets.json, "
@@ -28,7 +28,7 @@ void addSizeCommand(CLI::App& app) {
       ->check(CLI::IsMember({"ours", "paper"}))
       ->capture_default_str();
   cmd->add_option("--engine", opt->engine, "map engine: grid | octomap")
-      ->check(CLI::IsMember(host::map::MapEngineRegistry::instance().names()))
+      ->check(CLI::IsMember(mapEngineNames()))
       ->capture_default_str();
   cmd->add_option("--backend", opt->backend, "cpu | opencl | vulkan | auto")->capture_default_str();
   cmd->add_option("--config", opt->config,
@@ -37,7 +37,7 @@ void addSizeCommand(CLI::App& app) {
                   "(docs/capture-format.md)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", opt->out, "output directory")->required()->check(nonEmptyPath());
-  cmd->callback([opt] {
+  FVP_ON_RUN(cmd, [opt] {
     host::PerceptionConfig perception;  // read first: a bad file fails before any work
     if (!opt->config.empty()) perception = host::PerceptionConfig::fromYamlFile(opt->config);
     std::unique_ptr<accel::Backend> backend;

@@ -19,7 +19,7 @@ void addTraverseCommand(CLI::App& app) {
     std::uint64_t seed = 1;
     bool check = true;
   };
-  auto opt = std::make_shared<Options>();
+  auto opt = optionStorage<Options>();
   auto* cmd =
       app.add_subcommand("traverse",
                          "Run the batched voxel ray traversal kernel on a synthetic canopy grid, "
@@ -46,7 +46,7 @@ void addTraverseCommand(CLI::App& app) {
       ->check(decimalUnsigned())
       ->capture_default_str();
   cmd->add_flag("!--no-check", opt->check, "skip the comparison with the cpu reference");
-  cmd->callback([opt] {
+  FVP_ON_RUN(cmd, [opt] {
     using Clock = std::chrono::steady_clock;
     // The grid (two floats a voxel) on the host and the device, and the rays with their
     // results (twice with the check): 1024^3 voxels asked for 17 GiB.

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fuzz_support.h"
+#include "fvp/host/core/gnuplot.h"
 #include "fvp/trials/experiment_directory.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -23,6 +24,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         std::fprintf(stderr, "fvp fuzz: an accepted trial fails checkTrial: %s\n", e.what());
         std::abort();
       }
+      // The figures title a row by its key: what the schema accepts, gnuplot text takes.
+      if (!fvp::host::isGnuplotSafeText(sim::trialRowKey(t) + ": median automatic stop")) {
+        std::fprintf(stderr, "fvp fuzz: an accepted trial's row key is no gnuplot text\n");
+        std::abort();
+      }
     }
   } catch (const nlohmann::json::exception& e) {
     fz::reportEscapedException("nlohmann_json", e);
@@ -33,6 +39,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   fz::writeFile(manifest_path, data, size);
   try {
     const sim::ExperimentManifest manifest = sim::readManifest(manifest_path);
+    if (!manifest.error_scale.empty() &&
+        !fvp::host::isGnuplotSafeText(sim::parseErrorScale(manifest.error_scale).first)) {
+      std::fprintf(stderr, "fvp fuzz: an accepted manifest's error group is no gnuplot text\n");
+      std::abort();
+    }
     const std::string text = manifest.toJson().dump();
     fz::writeFile(manifest_path, text);
     if (sim::readManifest(manifest_path).toJson().dump() != text) {

@@ -58,10 +58,8 @@ class PyArm : public host::nbv::Arm {
   }
   bool reachable(const Eigen::Isometry3d& T_world_camera) const override {
     py::gil_scoped_acquire gil;
-    const py::object out = method("reachable")(poseToArray(T_world_camera));
     // None is a forgotten return, not "unreachable".
-    if (out.is_none()) throw std::invalid_argument("fvp.Arm.reachable: expected a bool, got None");
-    return out.cast<bool>();
+    return boolFromPython(method("reachable")(poseToArray(T_world_camera)), "fvp.Arm.reachable");
   }
   MoveResult moveTo(const Eigen::Isometry3d& T_world_camera) override {
     py::gil_scoped_acquire gil;
@@ -226,14 +224,30 @@ void bindNbv(py::module_& m) {
           py::arg("map"));
 
   py::class_<host::nbv::LoopState>(m, "LoopState", "What a stop condition sees.")
+      .def(py::init<>(), "An empty state (no views yet): for trying a condition's check().")
       .def_readonly("views", &host::nbv::LoopState::views)
       .def_readonly("iterations", &host::nbv::LoopState::iterations)
       .def_readonly("now_s", &host::nbv::LoopState::now_s)
       .def_readonly("dropped_frames", &host::nbv::LoopState::dropped_frames);
 
   py::class_<host::nbv::StopCondition>(m, "StopCondition", "When the loop stops; combine with |.")
-      .def(py::init<host::nbv::StopCondition::Predicate, std::string>(), py::arg("predicate"),
-           py::arg("reason"), "predicate(LoopState) -> bool; reason names it in the result.")
+      .def(py::init([](py::function predicate, std::string reason) {
+             // The function is released with the GIL held, whichever thread drops the last
+             // copy of the condition.
+             std::shared_ptr<py::function> held(new py::function(std::move(predicate)),
+                                                [](py::function* f) {
+                                                  py::gil_scoped_acquire gil;
+                                                  delete f;
+                                                });
+             return host::nbv::StopCondition(
+                 [held](const host::nbv::LoopState& state) {
+                   py::gil_scoped_acquire gil;
+                   return boolFromPython((*held)(state), "fvp.StopCondition predicate");
+                 },
+                 std::move(reason));
+           }),
+           py::arg("predicate"), py::arg("reason"),
+           "predicate(LoopState) -> bool; reason names it in the result.")
       .def_static("budget", &host::nbv::StopCondition::budget, py::arg("budget_s"))
       .def_static("views", &host::nbv::StopCondition::views, py::arg("max_views"))
       .def("__or__", &host::nbv::StopCondition::operator||)

@@ -163,4 +163,11 @@ py::object jsonToPython(const nlohmann::json& value) {
   return py::module_::import("json").attr("loads")(value.dump());
 }
 
+bool boolFromPython(const py::handle& value, const std::string& what) {
+  const std::string type = Py_TYPE(value.ptr())->tp_name;
+  if (py::isinstance<py::bool_>(value) || type == "numpy.bool_") return value.cast<bool>();
+  throw std::invalid_argument(what + ": expected a bool (True or False), got " +
+                              (value.is_none() ? std::string("None") : type));
+}
+
 }  // namespace fvp::python

@@ -18,6 +18,13 @@ namespace py = pybind11;
 
 /// A (4, 4) array -> a checked pose (host::checkPose); `what` names the argument.
 Eigen::Isometry3d poseFromArray(const py::handle& array, const std::string& what);
+
+/// What a Python callback returned where a bool belongs: True/False or a numpy bool (what
+/// an array comparison gives). Anything else, None included (a forgotten return), throws
+/// std::invalid_argument (ValueError) "WHAT: expected a bool (True or False), got TYPE": one
+/// rule for every callback, where pybind11 alone took None as False and refused a str with
+/// "Unable to cast Python instance".
+bool boolFromPython(const py::handle& value, const std::string& what);
 /// A pose -> a new (4, 4) float64 array.
 py::array_t<double> poseToArray(const Eigen::Isometry3d& T);
 /// A (3,) array -> a finite vector.

@@ -324,8 +324,7 @@ PYBIND11_MODULE(fvp, m) {
                              })
       .def(
           "next_best_view",
-          [](Planner& p, Session& s, const py::handle& T_now,
-             const std::function<bool(py::array_t<double>)>& reachable) {
+          [](Planner& p, Session& s, const py::handle& T_now, const py::object& reachable) {
             const Eigen::Isometry3d T = poseFromArray(T_now, "next_best_view T_world_camera");
             std::optional<Eigen::Isometry3d> chosen;
             host::planner::PlanStep step;
@@ -337,9 +336,9 @@ PYBIND11_MODULE(fvp, m) {
               step = p.planner->planAndMove(
                   map, T,
                   [&](const Eigen::Isometry3d& pose) {
-                    if (!reachable) return true;
+                    if (reachable.is_none()) return true;
                     py::gil_scoped_acquire gil;
-                    return reachable(poseToArray(pose));
+                    return boolFromPython(reachable(poseToArray(pose)), "next_best_view reachable");
                   },
                   [&](const Eigen::Isometry3d& pose) {
                     chosen = pose;
@@ -355,7 +354,7 @@ PYBIND11_MODULE(fvp, m) {
             d["timings_s"] = timings;
             return d;
           },
-          py::arg("session"), py::arg("T_world_camera"), py::arg("reachable") = nullptr,
+          py::arg("session"), py::arg("T_world_camera"), py::arg("reachable") = py::none(),
           "One planning iteration on the session's maps from the camera pose: the best "
           "candidate's pose (None when none is worth a view), its index and every candidate "
           "scored. reachable(T) -> bool filters candidates (default: all reachable).");

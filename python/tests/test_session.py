@@ -190,3 +190,14 @@ def test_size_captures_is_fvp_size_as_a_function(capture_set, tmp_path):
     assert len(result["sized_fruitlets"]) >= 1
     assert result["metrics"]["match_percent"] > 0  # the set carries ground_truth.json
     assert (tmp_path / "sized" / "fruitlets.json").exists()
+
+
+def test_callbacks_that_answer_yes_or_no_take_a_bool_only():
+    # One rule for every such callback: True/False (or a numpy bool); None, a str or an int
+    # is an error naming the callback, never taken as False.
+    state = fvp.LoopState()
+    assert fvp.StopCondition(lambda s: True, "t").check(state)
+    assert not fvp.StopCondition(lambda s: np.bool_(False), "f").check(state)
+    for bad, shown in [(None, "None"), ("yes", "str"), (1, "int")]:
+        with pytest.raises(ValueError, match="StopCondition predicate: expected a bool .*got " + shown):
+            fvp.StopCondition(lambda s, v=bad: v, "x").check(state)

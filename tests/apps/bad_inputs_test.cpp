@@ -63,6 +63,45 @@ void writeGreyCapture(const fs::path& dir, int width = 320, int height = 240,
   writeText(dir / "camera.yaml", yaml);
 }
 
+/// An experiment directory of one fvp trial (seed 1, --clock fixed --max-views 1 --backend
+/// cpu --budget-s 180 --stop budget) whose manifest's error_scale and trial's engine are
+/// given: what `fvp experiment` writes, edited.
+void writeExperiment(const fs::path& dir, const std::string& error_scale,
+                     const std::string& engine) {
+  nlohmann::ordered_json m = {{"format", "fvp-experiment-manifest"},
+                              {"version", 1},
+                              {"kind", "run"},
+                              {"budget_s", 180.0},
+                              {"clock", "fixed"},
+                              {"stop", "budget"},
+                              {"max_views", 1},
+                              {"register_views", false},
+                              {"confirm_detections", false},
+                              {"release_left_out", false},
+                              {"error_scale", error_scale},
+                              {"world_config", {{"path", ""}, {"fnv1a64", ""}}},
+                              {"planner_config", {{"path", ""}, {"fnv1a64", ""}}},
+                              {"arm_config", {{"path", ""}, {"fnv1a64", ""}}},
+                              {"engine", ""},
+                              {"backend", "cpu"},
+                              {"planners", {"fvp"}},
+                              {"trials", 1},
+                              {"first_seed", 1},
+                              {"shard", {{"index", 0}, {"count", 1}}}};
+  writeText(dir / "manifest.json", m.dump(2) + "\n");
+  const nlohmann::json trial = {
+      {"planner", "fvp"},
+      {"seed", 1},
+      {"engine", engine},
+      {"fruitlets", nlohmann::json::array({{{"gt_size_mm", 10.0}, {"matched", false}}})}};
+  writeText(dir / "trials.jsonl", trial.dump() + "\n");
+}
+
+/// Issue 38's gnuplot injection, touching dir/PWNED if it ever ran.
+std::string injection(const fs::path& dir, const std::string& before) {
+  return before + "'\nsystem \"touch " + (dir / "PWNED").string() + "\"\n#";
+}
+
 struct BadInput {
   std::string name;
   /// Makes the case's files under dir and returns the command line (without the program).
@@ -319,7 +358,7 @@ const std::vector<BadInput>& cases() {
        [](const fs::path& d) {
          return std::vector<std::string>{"experiment", "--shard", "1/2/3", "--out", p(d / "exp")};
        },
-       1,
+       2,
        {"--shard: expected i/n", "'1/2/3'"},
        {"exp/trials.jsonl"}},
       {"MergeADirectoryWithoutManifest",
@@ -487,6 +526,189 @@ const std::vector<BadInput>& cases() {
        1,
        {"holds a capture set (000/camera.yaml)"},
        {"set/camera.yaml", "set/left.png"}},
+
+      // Issue 38, 1: text from experiment files never reaches a gnuplot script.
+      {"SensitivityErrorGroupInjection",
+       [](const fs::path& d) {
+         writeExperiment(d / "exp", injection(d, "wind") + "=1", "");
+         return std::vector<std::string>{"sensitivity", "--out", p(d / "sens"), p(d / "exp")};
+       },
+       1,
+       {"manifest.json: field 'error_scale': expected \"\" or GROUP=FACTOR"},
+       {"PWNED", "sens/sensitivity.png", "sens/sensitivity.json"}},
+      {"MergeTrialEngineInjection",
+       [](const fs::path& d) {
+         writeExperiment(d / "exp", "", injection(d, "grid"));
+         return std::vector<std::string>{"merge", "--out", p(d / "merged"), p(d / "exp")};
+       },
+       1,
+       {"trials.jsonl: line 1: field 'engine': expected \"\" or a map engine (grid,octomap)"},
+       {"PWNED", "merged/trials.jsonl", "merged/accuracy_vs_time.png"}},
+      {"ResumeTrialEngineInjection",
+       [](const fs::path& d) {
+         writeExperiment(d / "exp", "", injection(d, "octomap"));
+         return std::vector<std::string>{
+             "experiment", "--planners", "fvp",   "--trials",    "1",     "--first-seed",
+             "1",          "--clock",    "fixed", "--max-views", "1",     "--backend",
+             "cpu",        "--budget-s", "180",   "--resume",    "--out", p(d / "exp")};
+       },
+       1,
+       {"trials.jsonl: line 1: field 'engine'"},
+       {"PWNED", "exp/summary.json"}},
+      // 5: a factor the world config cannot take is refused, not clamped.
+      {"ErrorScaleBeyondTheWorldConfig",
+       [](const fs::path& d) {
+         writeText(d / "world.yaml", "hand_eye_translation_sigma_m: 0.0015\n");
+         return std::vector<std::string>{
+             "experiment",        "--planners",    "fvp",     "--trials", "1",         "--world",
+             p(d / "world.yaml"), "--error-scale", "pose=20", "--out",    p(d / "exp")};
+       },
+       1,
+       {"--error-scale: error scale pose=20: hand_eye_translation_sigma_m would be 0.03",
+        "the largest factor this world config allows for pose is 13.3333", "world.yaml"},
+       {"exp/manifest.json", "exp/world.yaml"}},
+      {"ErrorScaleHuge",
+       [](const fs::path& d) {
+         return std::vector<std::string>{"experiment", "--error-scale", "pose=1e308", "--out",
+                                         p(d / "exp")};
+       },
+       2,
+       {"--error-scale", "FACTOR a decimal number from 0 to 1000"},
+       {"exp"}},
+      // 6: one rule for numbers and keys in every YAML file.
+      {"WorldConfigOctalInteger",
+       [](const fs::path& d) {
+         writeText(d / "world.yaml", "max_fruitlets: 012\n");
+         return std::vector<std::string>{"capture", "--world", p(d / "world.yaml"), "--seed",
+                                         "1",       "--out",   p(d / "out")};
+       },
+       1,
+       {"world.yaml': key 'max_fruitlets': expected an integer (decimal", "got '012'"},
+       {"out/camera.yaml"}},
+      {"WorldConfigHexInteger",
+       [](const fs::path& d) {
+         writeText(d / "world.yaml", "max_fruitlets: 0x05\n");
+         return std::vector<std::string>{"capture", "--world", p(d / "world.yaml"), "--seed",
+                                         "1",       "--out",   p(d / "out")};
+       },
+       1,
+       {"key 'max_fruitlets': expected an integer", "got '0x05'"},
+       {"out/camera.yaml"}},
+      {"WorldConfigDuplicateKey",
+       [](const fs::path& d) {
+         writeText(d / "world.yaml", "max_fruitlets: 5\nmin_fruitlets: 2\nmax_fruitlets: 6\n");
+         return std::vector<std::string>{"capture", "--world", p(d / "world.yaml"), "--seed",
+                                         "1",       "--out",   p(d / "out")};
+       },
+       1,
+       {"world.yaml': key 'max_fruitlets' appears twice (lines 1 and 3)"},
+       {"out/camera.yaml"}},
+      {"WorldConfigTwoDocuments",
+       [](const fs::path& d) {
+         writeText(d / "world.yaml", "max_fruitlets: 5\n---\nmax_fruitlets: 6\n");
+         return std::vector<std::string>{"capture", "--world", p(d / "world.yaml"), "--seed",
+                                         "1",       "--out",   p(d / "out")};
+       },
+       1,
+       {"world.yaml': expected one YAML document, got 2"},
+       {"out/camera.yaml"}},
+      {"WorldConfigNestedTooDeeply",
+       [](const fs::path& d) {
+         writeText(d / "world.yaml", "max_fruitlets: " + std::string(5000, '[') + "\n");
+         return std::vector<std::string>{"capture", "--world", p(d / "world.yaml"), "--seed",
+                                         "1",       "--out",   p(d / "out")};
+       },
+       1,
+       {"world.yaml': cannot read YAML: lists or mappings nested too deeply"},
+       {"out/camera.yaml"}},
+      {"CameraYamlDuplicateKey",
+       [](const fs::path& d) {
+         writeGreyCapture(d / "set" / "000", 320, 240, cameraYaml() + "fx: 3000\n");
+         return std::vector<std::string>{"size", "--captures", p(d / "set"), "--backend",
+                                         "cpu",  "--out",      p(d / "out")};
+       },
+       1,
+       {"camera.yaml: key 'fx' appears twice"},
+       {"out/fruitlets.json"}},
+      {"CameraYamlOctalWidth",
+       [](const fs::path& d) {
+         writeGreyCapture(d / "set" / "000", 320, 240, cameraYaml({{"width", "0320"}}));
+         return std::vector<std::string>{"size", "--captures", p(d / "set"), "--backend",
+                                         "cpu",  "--out",      p(d / "out")};
+       },
+       1,
+       {"camera.yaml: field 'width'", "got '0320'"},
+       {"out/fruitlets.json"}},
+      // 7: a quaternion whose norm overflows or is far from 1.
+      {"CapturePoseQuaternionOverflow",
+       [](const fs::path& d) {
+         return std::vector<std::string>{"capture",           "--seed", "1",         "--pose",
+                                         "0,0,0,1e308,0,0,1", "--out",  p(d / "out")};
+       },
+       1,
+       {"--pose: field 'qx,qy,qz,qw': expected a unit quaternion (norm within 0.01 of 1), got "
+        "a component of 1e+308"},
+       {"out/camera.yaml"}},
+      {"CapturePoseQuaternionNotUnit",
+       [](const fs::path& d) {
+         return std::vector<std::string>{"capture",         "--seed", "1",         "--pose",
+                                         "0,0,1,0,0,0,0.5", "--out",  p(d / "out")};
+       },
+       1,
+       {"expected a unit quaternion (norm within 0.01 of 1), got norm 0.5"},
+       {"out/camera.yaml"}},
+      // 13: clear messages.
+      {"SizeLeftPngIsADirectory",
+       [](const fs::path& d) {
+         writeGreyCapture(d / "set" / "000");
+         fs::remove(d / "set" / "000" / "left.png");
+         fs::create_directories(d / "set" / "000" / "left.png");
+         return std::vector<std::string>{"size", "--captures", p(d / "set"), "--backend",
+                                         "cpu",  "--out",      p(d / "out")};
+       },
+       1,
+       {"left.png: file: expected a PNG image, got a directory"},
+       {"out/fruitlets.json"}},
+      {"PerceptionRegionRadiusHuge",
+       [](const fs::path& d) {
+         writeGreyCapture(d / "set" / "000");
+         writeText(d / "perception.yaml", "region_radius_m: 1e9\n");
+         return std::vector<std::string>{
+             "size",      "--captures", p(d / "set"), "--config",  p(d / "perception.yaml"),
+             "--backend", "cpu",        "--out",      p(d / "out")};
+       },
+       1,
+       {"perception.yaml': key 'region_radius_m': expected a radius above 0 and at most 0.5 m"},
+       {"out/fruitlets.json"}},
+      {"OutIsADanglingSymlink",
+       [](const fs::path& d) {
+         fs::create_directory_symlink(d / "gone", d / "out");
+         return std::vector<std::string>{"capture", "--seed", "1", "--out", p(d / "out")};
+       },
+       1,
+       {"a symbolic link to '", "gone', which does not exist"},
+       {"gone"}},
+      {"ShardNotANumber",
+       [](const fs::path& d) {
+         return std::vector<std::string>{"experiment", "--shard", "0/4x", "--out", p(d / "exp")};
+       },
+       2,
+       {"--shard: expected i/n", "'4x' is not a decimal integer"},
+       {"exp"}},
+      {"BudgetLeadingSpace",
+       [](const fs::path& d) {
+         return std::vector<std::string>{"run", "--budget-s", " 5", "--out", p(d / "out")};
+       },
+       2,
+       {"--budget-s", "expected a finite decimal number, got ' 5'"},
+       {"out"}},
+      {"BudgetTrailingSpace",
+       [](const fs::path& d) {
+         return std::vector<std::string>{"run", "--budget-s", "5 ", "--out", p(d / "out")};
+       },
+       2,
+       {"--budget-s", "expected a finite decimal number, got '5 '"},
+       {"out"}},
   };
   return table;
 }

@@ -97,6 +97,48 @@ TEST(Gnuplot, DrawsIntoADirectoryWhoseNameHoldsShellAndGnuplotQuotes) {
   EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
 }
 
+TEST(GnuplotText, AcceptsTheSafeSetQuotedAndRefusesEverythingElse) {
+  EXPECT_EQ(gnuplotQuoted("fvp-octomap MAE"), "'fvp-octomap MAE'");
+  EXPECT_EQ(gnuplotQuoted("a.b_c-d+e=f%g/h(i)[j]:k, 0 9 Z"), "'a.b_c-d+e=f%g/h(i)[j]:k, 0 9 Z'");
+  EXPECT_EQ(gnuplotQuoted(""), "''");
+  // Every byte outside the set, alone and inside an otherwise fine title.
+  const std::string safe =
+      "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789 ._-+=%/()[]:,";
+  for (int b = 0; b < 256; ++b) {
+    const std::string one(1, char(b));
+    const bool expected = safe.find(char(b)) != std::string::npos;
+    EXPECT_EQ(isGnuplotSafeText(one), expected) << "byte " << b;
+    if (!expected) {
+      EXPECT_THROW(gnuplotQuoted("wind" + one + "x"), std::invalid_argument) << b;
+    }
+  }
+  EXPECT_TRUE(isGnuplotSafeText(std::string(kGnuplotTextMax, 'a')));
+  EXPECT_FALSE(isGnuplotSafeText(std::string(kGnuplotTextMax + 1, 'a')));
+  // The issue's injection: refused, and the message shows it without a newline or a quote
+  // that could close anything.
+  try {
+    gnuplotQuoted("wind'\nsystem \"touch PWNED\"\n#");
+    FAIL() << "expected the title to be refused";
+  } catch (const std::invalid_argument& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    EXPECT_NE(m.find("wind'\\x0asystem"), std::string::npos) << m;
+  }
+}
+
+TEST(Gnuplot, AQuotedTitleIsTextEvenWhenItReadsLikeACommand) {
+  // Characters of the safe set only, in gnuplot's command forms: inside single quotes they
+  // are a title, so gnuplot draws it and runs nothing.
+  const fs::path dir = freshDir("fvp_gnuplot_inert_title");
+  const std::string text = "system(touch " + (dir / "PWNED").string() + ") load(x) [1:2]";
+  ASSERT_TRUE(isGnuplotSafeText(text)) << text;
+  const std::string script = "set terminal pngcairo size 200,150\nset title " +
+                             gnuplotQuoted(text) + "\nplot x title " + gnuplotQuoted(text) + "\n";
+  plotWithGnuplot(script, dir / "f.png", "test figure");
+  EXPECT_TRUE(fs::exists(dir / "f.png"));
+  EXPECT_FALSE(fs::exists(dir / "PWNED"));
+}
+
 TEST(Gnuplot, MissingGnuplotIsAnErrorAndWritesNothing) {
   const fs::path dir = freshDir("fvp_gnuplot_missing");
   const ScopedEnv path("PATH", "/nonexistent");

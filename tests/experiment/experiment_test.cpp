@@ -11,6 +11,9 @@
 #include <optional>
 #include <sstream>
 
+#include "fvp/host/core/gnuplot.h"
+#include "fvp/host/map/map_engine_registry.h"
+#include "fvp/host/planner/planner_registry.h"
 #include "fvp/robot/sim/world_config.h"
 #include "fvp/trials/experiment.h"
 #include "fvp/trials/sensitivity_report.h"
@@ -380,9 +383,72 @@ TEST(Experiment, AnErrorScaleWritesTheScaledWorldConfigTheTrialsRead) {
   const auto base = robot::sim::WorldConfig::fromYamlFile(world);
   EXPECT_DOUBLE_EQ(scaled.hand_eye_translation_sigma_m, 2.0 * base.hand_eye_translation_sigma_m);
   EXPECT_EQ(scaled.wind_leaf_tip_m, base.wind_leaf_tip_m);
-  for (const char* bad : {"pose", "pose=", "pose=x", "pose=1x", "=1", "sun=1", "pose=-1"})
+  for (const char* bad :
+       {"pose", "pose=", "pose=x", "pose=1x", "=1", "sun=1", "pose=-1", "pose=012", "pose=0x2",
+        "pose= 2", "pose=2 ", "pose=+2", "pose=1e308", "pose=inf", "pose=20"})
     EXPECT_THROW(writeScaledWorldConfig(world, bad, out), std::invalid_argument) << bad;
   fs::remove_all(out);
+}
+
+TEST(Experiment, TheVocabulariesOfExperimentFilesAreTheRegistriesAndTheWorldConfigs) {
+  // The readers of trials.jsonl and manifest.json (and the CLI's parse-only build, fuzz/)
+  // keep their own copy, so that they need no planner, engine or simulator code.
+  EXPECT_EQ(host::map::MapEngineRegistry::instance().names(), experimentEngines());
+  EXPECT_EQ(host::planner::PlannerRegistry::instance().names(), experimentPlanners());
+  EXPECT_EQ(robot::sim::WorldConfig::errorGroups(), errorScaleGroups());
+  // Every name the schema accepts is figure text as it is (gnuplotQuoted takes it).
+  for (const auto& p : experimentPlanners())
+    for (const auto& e : experimentEngines())
+      EXPECT_TRUE(host::isGnuplotSafeText(trialRowKey({{"planner", p}, {"engine", e}}) +
+                                          "-paper-sizing: median automatic stop"));
+  for (const auto& g : errorScaleGroups()) EXPECT_TRUE(host::isGnuplotSafeText(g));
+}
+
+TEST(Experiment, TextFromExperimentFilesIsCheckedAgainstItsSchema) {
+  // Issue 38: an engine or an error group that would have been written into a gnuplot title.
+  const std::string injection = "grid'\nsystem \"touch PWNED\"\n#";
+  const nlohmann::json trial = {
+      {"planner", "fvp"},
+      {"seed", 1},
+      {"engine", injection},
+      {"fruitlets", nlohmann::json::array({{{"gt_size_mm", 10.0}, {"matched", false}}})}};
+  EXPECT_NE(
+      errorOf([&] {
+        checkTrial(trial, "t.jsonl: line 1");
+      }).find("t.jsonl: line 1: field 'engine': expected \"\" or a map engine (grid,octomap)"),
+      std::string::npos);
+  nlohmann::json reason = trial;
+  reason["engine"] = "octomap";
+  EXPECT_NO_THROW(checkTrial(reason, "t"));
+  reason["stop_reason"] = "budget'`id`";
+  EXPECT_NE(errorOf([&] { checkTrial(reason, "t"); }).find("field 'stop_reason'"),
+            std::string::npos);
+  // The manifest's strings: each from its vocabulary.
+  const fs::path dir = freshDir("manifest_schema");
+  fs::create_directories(dir);
+  ExperimentManifest m;
+  m.kind = "run";
+  m.budget_s = 180;
+  m.clock = "fixed";
+  m.backend = "cpu";
+  m.planners = {"fvp"};
+  m.trials = 1;
+  const auto refused = [&](const char* field, const nlohmann::json& value) {
+    nlohmann::ordered_json j = m.toJson();
+    j[field] = value;
+    std::ofstream(dir / "manifest.json") << j.dump();
+    return errorOf([&] { readManifest(dir / "manifest.json"); });
+  };
+  EXPECT_EQ(refused("error_scale", "wind=0.5"), "");
+  EXPECT_NE(refused("error_scale", "wind'\nsystem \"id\"\n#=1").find("field 'error_scale'"),
+            std::string::npos);
+  EXPECT_NE(refused("error_scale", "pose=1e308").find("field 'error_scale'"), std::string::npos);
+  EXPECT_NE(refused("engine", injection).find("field 'engine'"), std::string::npos);
+  EXPECT_NE(refused("backend", "gpu;id").find("field 'backend'"), std::string::npos);
+  EXPECT_NE(refused("clock", "sundial").find("field 'clock'"), std::string::npos);
+  EXPECT_NE(refused("world_config", {{"path", "rel.yaml"}, {"fnv1a64", "0123456789abcdef"}})
+                .find("field 'world_config'"),
+            std::string::npos);
 }
 
 TEST(Experiment, TheSensitivityReportHasAPointPerExperimentAndPlannerSortedByFactor) {
@@ -634,7 +700,8 @@ TEST(Experiment, SchemaErrorsNameTheFileTheLineAndTheField) {
        "field 'seed': expected an unsigned integer"},
       {with("/planner", "nbv"), "field 'planner': expected one of fvp,rvp, got \"nbv\""},
       {without("/planner"), "field 'planner': expected one of fvp,rvp, but it is missing"},
-      {with("/engine", 3), "field 'engine': expected a string"},
+      {with("/engine", 3), "field 'engine': expected \"\" or a map engine (grid,octomap), got 3"},
+      {with("/engine", "gpu"), "field 'engine': expected \"\" or a map engine"},
       {with("/views", -3), "field 'views': expected a non-negative integer"},
       {with("/detections", "2"), "field 'detections': expected a non-negative integer"},
       {with("/wall_time_s", nullptr), "field 'wall_time_s': expected a finite non-negative"},

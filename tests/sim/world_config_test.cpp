@@ -109,7 +109,7 @@ TEST(WorldConfig, ToJsonHasEveryKey) {
   }
 }
 
-TEST(WorldConfig, ErrorGroupsScaleTheirOwnKeysAndClampToTheirRanges) {
+TEST(WorldConfig, ErrorGroupsScaleTheirOwnKeysAndRefuseToLeaveTheirRanges) {
   const WorldConfig field =
       WorldConfig::fromYamlFile(std::string(FVP_SOURCE_DIR) + "/robot/sim/config/world_field.yaml");
   const WorldConfig half = field.withErrorsScaled("wind", 0.5);
@@ -124,10 +124,30 @@ TEST(WorldConfig, ErrorGroupsScaleTheirOwnKeysAndClampToTheirRanges) {
   EXPECT_EQ(none.segmentation_false_blobs, 0.0);
   EXPECT_EQ(none.segmentation_model, 1);
   EXPECT_EQ(none.fruitlet_green_fraction, 1.0);
-  // Clamped: a miss rate of 0.05 times 100 is the key's maximum, and the result validates.
-  const WorldConfig many = field.withErrorsScaled("segmentation", 100.0);
-  EXPECT_EQ(many.segmentation_miss_rate, 0.9);
-  EXPECT_NO_THROW(many.validate());
+  // Refused, not clamped (issue 38: a clamped point would be plotted at the wrong factor):
+  // the message names the key, the value, the range and the largest factor that fits.
+  try {
+    field.withErrorsScaled("pose", 20.0);
+    FAIL() << "expected pose=20 to be refused on the field preset";
+  } catch (const std::invalid_argument& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("error scale pose=20: hand_eye_translation_sigma_m would be 0.03"),
+              std::string::npos)
+        << m;
+    EXPECT_NE(m.find("outside its range 0 to 0.02"), std::string::npos) << m;
+    EXPECT_NE(m.find("the largest factor this world config allows for pose is 13.3333"),
+              std::string::npos)
+        << m;
+  }
+  EXPECT_THROW(field.withErrorsScaled("pose", 1e308), std::invalid_argument);
+  EXPECT_THROW(field.withErrorsScaled("all", 100.0), std::invalid_argument);
+  // Up to the limit the factor holds exactly, and the result validates.
+  const double limit = 0.02 / field.hand_eye_translation_sigma_m;
+  const WorldConfig most = field.withErrorsScaled("pose", limit);
+  EXPECT_DOUBLE_EQ(most.hand_eye_translation_sigma_m, 0.02);
+  EXPECT_NO_THROW(most.validate());
+  EXPECT_EQ(WorldConfig::errorGroups(),
+            (std::vector<std::string>{"pose", "stereo", "wind", "segmentation", "light", "all"}));
   EXPECT_THROW(field.withErrorsScaled("sun", 1.0), std::invalid_argument);
   EXPECT_THROW(field.withErrorsScaled("pose", -1.0), std::invalid_argument);
   EXPECT_THROW(field.withErrorsScaled("pose", std::nan("")), std::invalid_argument);

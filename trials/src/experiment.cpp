@@ -75,23 +75,19 @@ ConfigFileStamp stampOf(const fs::path& path, const std::string& what) {
 /// The manifest an experiment with these options has.
 }  // namespace
 
-std::pair<std::string, double> parseErrorScale(const std::string& error_scale) {
-  const std::size_t eq = error_scale.find('=');
-  const std::string factor_text = eq == std::string::npos ? "" : error_scale.substr(eq + 1);
-  char* end = nullptr;
-  const double factor = std::strtod(factor_text.c_str(), &end);
-  if (eq == std::string::npos || factor_text.empty() || *end != '\0' || !std::isfinite(factor))
-    throw std::invalid_argument("--error-scale '" + error_scale +
-                                "': expected GROUP=FACTOR, e.g. wind=0.5");
-  return {error_scale.substr(0, eq), factor};
-}
-
 fs::path writeScaledWorldConfig(const fs::path& world, const std::string& error_scale,
                                 const fs::path& out_dir) {
   const auto [group, factor] = parseErrorScale(error_scale);
   const robot::sim::WorldConfig base =
       world.empty() ? robot::sim::WorldConfig{} : robot::sim::WorldConfig::fromYamlFile(world);
-  const robot::sim::WorldConfig scaled = base.withErrorsScaled(group, factor);
+  robot::sim::WorldConfig scaled;
+  try {
+    scaled = base.withErrorsScaled(group, factor);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(
+        "--error-scale: " + std::string(e.what()) +
+        (world.empty() ? " (built-in world config)" : " (world config " + world.string() + ")"));
+  }
   fs::create_directories(out_dir);
   const fs::path path = out_dir / "world.yaml";
   // JSON is YAML: the config's keys and values, read back by WorldConfig::fromYamlFile.
@@ -364,8 +360,9 @@ std::string accuracyTimeFigureScript(const std::map<std::string, std::vector<Acc
   int mark = 1;
   for (const auto& [key, times] : stops) {
     gp << "set arrow " << mark << " from " << median(times) << ", graph 0 to " << median(times)
-       << ", graph 1 nohead dt 2 lc rgb 'black'\nset label " << mark << " '" << key
-       << ": median automatic stop' at " << median(times) << ", graph 0.95 offset 0.5,0\n";
+       << ", graph 1 nohead dt 2 lc rgb 'black'\nset label " << mark << " "
+       << host::gnuplotQuoted(key + ": median automatic stop") << " at " << median(times)
+       << ", graph 0.95 offset 0.5,0\n";
     ++mark;
   }
   std::string plot = "plot ";
@@ -377,8 +374,9 @@ std::string accuracyTimeFigureScript(const std::map<std::string, std::vector<Acc
          << "\n";
     gp << "EOD\n";
     plot += (i ? ", " : "") + std::string("$r") + std::to_string(i) +
-            " using 1:2 with lines lw 2 title '" + key + " MAE', $r" + std::to_string(i) +
-            " using 1:3 axes x1y2 with lines dt 3 lw 2 title '" + key + " MP'";
+            " using 1:2 with lines lw 2 title " + host::gnuplotQuoted(key + " MAE") + ", $r" +
+            std::to_string(i) + " using 1:3 axes x1y2 with lines dt 3 lw 2 title " +
+            host::gnuplotQuoted(key + " MP");
     ++i;
   }
   gp << plot << "\n";
@@ -386,25 +384,6 @@ std::string accuracyTimeFigureScript(const std::map<std::string, std::vector<Acc
 }
 
 }  // namespace
-
-std::pair<int, int> parseShard(const std::string& text) {
-  const auto bad = [&text](const std::string& why) {
-    return std::invalid_argument("--shard: expected i/n with 0 <= i < n (e.g. 0/4), got '" + text +
-                                 "': " + why);
-  };
-  const auto number = [&](const std::string& part) {
-    if (part.empty() || part.find_first_not_of("0123456789") != std::string::npos)
-      throw bad("'" + part + "' is not a decimal integer");
-    if (part.size() > 1 && part[0] == '0') throw bad("'" + part + "' has a leading zero");
-    if (part.size() > 9) throw bad("'" + part + "' is too large");
-    return std::stoi(part);
-  };
-  const std::size_t slash = text.find('/');
-  if (slash == std::string::npos) throw bad("no '/'");
-  const int i = number(text.substr(0, slash)), n = number(text.substr(slash + 1));
-  if (n < 1 || i >= n) throw bad("needs 0 <= i < n");
-  return {i, n};
-}
 
 nlohmann::json summarize(const std::vector<nlohmann::json>& trials) {
   std::map<std::string, std::vector<const nlohmann::json*>> by_key;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -65,6 +66,17 @@ void checkFruitlets(const nlohmann::json& trial, const char* key, const std::str
   }
 }
 
+bool knownOrEmpty(const std::vector<std::string>& known, const nlohmann::json& v) {
+  const std::string& s = v.get_ref<const std::string&>();
+  return s.empty() || std::find(known.begin(), known.end(), s) != known.end();
+}
+
+bool isIdentifier(const nlohmann::json& v) {
+  if (!v.is_string() || v.get_ref<const std::string&>().empty()) return false;
+  const std::string& s = v.get_ref<const std::string&>();
+  return s.size() <= 64 && s.find_first_not_of("abcdefghijklmnopqrstuvwxyz_") == std::string::npos;
+}
+
 std::string defaultEngineOf(const std::string& planner) {
   // As trial_parts.cpp's defaultEngine, which the trial runs on.
   return planner == "rvp" ? "octomap" : "grid";
@@ -86,6 +98,14 @@ std::string shownMaxViews(int v) {
 
 nlohmann::ordered_json configJson(const ConfigFileStamp& c) {
   return {{"path", c.path}, {"fnv1a64", c.fnv1a64}};
+}
+
+/// The manifest's paths are written absolute (and one line: no control bytes).
+bool isAbsolutePath(const std::string& path) {
+  if (path.empty() || path[0] != '/') return false;
+  for (const char c : path)
+    if ((unsigned char)c < 0x20 || c == 0x7f) return false;
+  return true;
 }
 
 // Manifest field readers: `where` is the file.
@@ -119,7 +139,8 @@ ConfigFileStamp readConfig(const nlohmann::json& o, const char* key, const std::
   ConfigFileStamp c{path->get<std::string>(), hash->get<std::string>()};
   const bool hex = c.fnv1a64.size() == 16 &&
                    c.fnv1a64.find_first_not_of("0123456789abcdef") == std::string::npos;
-  if (c.path.empty() ? !c.fnv1a64.empty() : !hex) fieldError(where, key, expected, &v);
+  if (c.path.empty() ? !c.fnv1a64.empty() : !hex || !isAbsolutePath(c.path))
+    fieldError(where, key, expected + " (an absolute path)", &v);
   return c;
 }
 
@@ -128,6 +149,60 @@ ConfigFileStamp readConfig(const nlohmann::json& o, const char* key, const std::
 const std::vector<std::string>& experimentPlanners() {
   static const std::vector<std::string> planners{"fvp", "rvp"};
   return planners;
+}
+
+const std::vector<std::string>& experimentEngines() {
+  static const std::vector<std::string> engines{"grid", "octomap"};
+  return engines;
+}
+
+const std::vector<std::string>& errorScaleGroups() {
+  static const std::vector<std::string> groups{"pose",         "stereo", "wind",
+                                               "segmentation", "light",  "all"};
+  return groups;
+}
+
+std::pair<int, int> parseShard(const std::string& text) {
+  const auto bad = [&text](const std::string& why) {
+    return std::invalid_argument("--shard: expected i/n with 0 <= i < n (e.g. 0/4), got '" + text +
+                                 "': " + why);
+  };
+  const auto number = [&](const std::string& part) {
+    if (part.empty() || part.find_first_not_of("0123456789") != std::string::npos)
+      throw bad("'" + part + "' is not a decimal integer");
+    if (part.size() > 1 && part[0] == '0') throw bad("'" + part + "' has a leading zero");
+    if (part.size() > 9) throw bad("'" + part + "' is too large");
+    return std::stoi(part);
+  };
+  const std::size_t slash = text.find('/');
+  if (slash == std::string::npos) throw bad("no '/'");
+  const int i = number(text.substr(0, slash)), n = number(text.substr(slash + 1));
+  if (n < 1 || i >= n) throw bad("needs 0 <= i < n");
+  return {i, n};
+}
+
+std::pair<std::string, double> parseErrorScale(const std::string& error_scale) {
+  const auto bad = [&](const std::string& why) {
+    std::string shown = error_scale.size() > 60 ? error_scale.substr(0, 57) + "..." : error_scale;
+    for (char& c : shown)
+      if (c < 0x20 || c == 0x7f) c = '?';  // the message is printed: no control bytes
+    return std::invalid_argument(
+        "--error-scale '" + shown + "': expected GROUP=FACTOR with GROUP one of " +
+        joined(errorScaleGroups()) + " and FACTOR a decimal number from 0 to " +
+        std::to_string(int(kMaxErrorScaleFactor)) + ", e.g. wind=0.5" +
+        (why.empty() ? "" : " (" + why + ")"));
+  };
+  const std::size_t eq = error_scale.find('=');
+  if (eq == std::string::npos) throw bad("no '='");
+  const std::string group = error_scale.substr(0, eq), text = error_scale.substr(eq + 1);
+  const auto& groups = errorScaleGroups();
+  if (std::find(groups.begin(), groups.end(), group) == groups.end()) throw bad("unknown group");
+  // Decimal only, as every other number fvp reads: no sign, hex, inf, nan or spaces.
+  static const std::regex decimal(R"((0|[1-9][0-9]*)(\.[0-9]+)?([eE][+-]?[0-9]{1,3})?)");
+  if (!std::regex_match(text, decimal)) throw bad("'" + text + "' is not a decimal number");
+  const double factor = std::strtod(text.c_str(), nullptr);
+  if (!(factor <= kMaxErrorScaleFactor)) throw bad("the factor is too large");
+  return {group, factor};
 }
 
 void checkTrial(const nlohmann::json& trial, const std::string& where) {
@@ -141,8 +216,12 @@ void checkTrial(const nlohmann::json& trial, const std::string& where) {
     fieldError(where, "planner", "one of " + joined(known), planner);
   const nlohmann::json* seed = member(trial, "seed");
   if (!seed || !isUnsigned(*seed)) fieldError(where, "seed", "an unsigned integer", seed);
-  if (const nlohmann::json* engine = member(trial, "engine"); engine && !engine->is_string())
-    fieldError(where, "engine", "a string", engine);
+  if (const nlohmann::json* engine = member(trial, "engine");
+      engine && (!engine->is_string() || !knownOrEmpty(experimentEngines(), *engine)))
+    fieldError(where, "engine", "\"\" or a map engine (" + joined(experimentEngines()) + ")",
+               engine);
+  if (const nlohmann::json* reason = member(trial, "stop_reason"); reason && !isIdentifier(*reason))
+    fieldError(where, "stop_reason", "a stop reason (lower-case letters and _)", reason);
   for (const char* key : {"views", "detections"})
     if (const nlohmann::json* v = member(trial, key); v && !isUnsigned(*v))
       fieldError(where, key, "a non-negative integer", v);
@@ -251,6 +330,22 @@ nlohmann::ordered_json ExperimentManifest::toJson() const {
   return j;
 }
 
+/// The manifest's error_scale: "" or a GROUP=FACTOR that --error-scale takes (its group is
+/// written into a figure's title).
+static std::string readErrorScale(const nlohmann::json& j, const std::string& where) {
+  const std::string text = readString(j, "error_scale", where);
+  try {
+    if (!text.empty()) parseErrorScale(text);
+  } catch (const std::invalid_argument&) {
+    fieldError(where, "error_scale",
+               "\"\" or GROUP=FACTOR (GROUP one of " + joined(errorScaleGroups()) +
+                   ", FACTOR a decimal number from 0 to " +
+                   std::to_string(int(kMaxErrorScaleFactor)) + ")",
+               &j.at("error_scale"));
+  }
+  return text;
+}
+
 ExperimentManifest readManifest(const std::filesystem::path& path) {
   const std::string where = path.string();
   const std::optional<std::string> bytes = readFileBytes(path);
@@ -283,6 +378,8 @@ ExperimentManifest readManifest(const std::filesystem::path& path) {
     fieldError(where, "budget_s", "a finite positive number", &budget);
   m.budget_s = budget.get<double>();
   m.clock = readString(j, "clock", where);
+  if (m.clock != "wall" && m.clock != "fixed")
+    fieldError(where, "clock", "\"wall\" or \"fixed\"", &j["clock"]);
   // Manifests written before the automatic stop existed ran on the budget alone.
   if (member(j, "stop")) {
     m.stop = readString(j, "stop", where);
@@ -307,7 +404,7 @@ ExperimentManifest readManifest(const std::filesystem::path& path) {
       fieldError(where, "release_left_out", "true or false", &j["release_left_out"]);
     m.release_left_out = j["release_left_out"].get<bool>();
   }
-  if (member(j, "error_scale")) m.error_scale = readString(j, "error_scale", where);
+  if (member(j, "error_scale")) m.error_scale = readErrorScale(j, where);
   m.world_config = readConfig(j, "world_config", where);
   m.planner_config = readConfig(j, "planner_config", where);
   // Manifests written before --arm existed ran the built-in arm.
@@ -316,13 +413,20 @@ ExperimentManifest readManifest(const std::filesystem::path& path) {
     const nlohmann::json& sources = required(j, "sources", where, "an array of directories");
     if (!sources.is_array()) fieldError(where, "sources", "an array of directories", &sources);
     for (const auto& s : sources) {
-      if (!s.is_string()) fieldError(where, "sources", "an array of directories", &s);
+      if (!s.is_string() || !isAbsolutePath(s.get<std::string>()))
+        fieldError(where, "sources", "an array of absolute directory paths", &s);
       m.sources.push_back(s.get<std::string>());
     }
     return m;
   }
   m.engine = readString(j, "engine", where);
+  if (!knownOrEmpty(experimentEngines(), j["engine"]))
+    fieldError(where, "engine",
+               "\"\" (each planner's own) or a map engine (" + joined(experimentEngines()) + ")",
+               &j["engine"]);
   m.backend = readString(j, "backend", where);
+  if (m.backend != "auto" && m.backend != "cpu" && m.backend != "opencl" && m.backend != "vulkan")
+    fieldError(where, "backend", "one of auto, cpu, opencl, vulkan", &j["backend"]);
   const std::string planners_expected = "a non-empty array of distinct planners (fvp, rvp)";
   const nlohmann::json& planners = required(j, "planners", where, planners_expected);
   if (!planners.is_array() || planners.empty())

@@ -52,12 +52,12 @@ std::string figureScript(const std::vector<SensitivityPoint>& points) {
     }
   for (const auto& [column, label] : {std::pair{2, "MAE (mm)"}, std::pair{3, "MP (%)"}})
     for (const auto& [group, series] : groups) {
-      gp << "set title '" << group << "'\nset ylabel '" << label
-         << "'\nset xlabel 'x the world config'\nplot ";
+      gp << "set title " << host::gnuplotQuoted(group) << "\nset ylabel "
+         << host::gnuplotQuoted(label) << "\nset xlabel 'x the world config'\nplot ";
       int i = 0;
       for (const auto& [name, ps] : series) {
         gp << (i ? ", " : "") << "$s" << blocks[group][std::size_t(i)] << " using 1:" << column
-           << " with linespoints lw 2 title '" << name << "'";
+           << " with linespoints lw 2 title " << host::gnuplotQuoted(name);
         ++i;
       }
       gp << "\n";

@@ -211,9 +211,11 @@ std::string cameraPathScript(const std::vector<Eigen::Vector3d>& fruitlets,
   const int last = static_cast<int>(path.size()) - 1;
   std::ostringstream s;
   s << "set terminal pngcairo size 1500,660 font 'DejaVu Sans,11'\nset encoding utf8\n"
-    << "set multiplot layout 1,2 title 'Camera path: " << path.size()
-    << " views coloured by capture order"
-    << (directions.empty() ? "" : ", arrows: viewing directions (3 cm)") << "'\n"
+    << "set multiplot layout 1,2 title "
+    << host::gnuplotQuoted("Camera path: " + std::to_string(path.size()) +
+                           " views coloured by capture order" +
+                           (directions.empty() ? "" : ", arrows: viewing directions (3 cm)"))
+    << "\n"
     << "set size ratio -1\nset grid\nset key outside bottom center horizontal\n"
     << "set style textbox opaque noborder margins 1,1\n"
     // Room inside the axes for the labels of views at the edge.
@@ -240,8 +242,9 @@ std::string cameraPathScript(const std::vector<Eigen::Vector3d>& fruitlets,
     for (const auto& r : regions)
       s << r.center_m[a] << " " << r.center_m[b] << " " << r.radius_m << "\n";
     s << "EOD\n";
-    s << "set title '" << title << "'\nset xlabel '" << axis[a] << "'\nset ylabel '" << axis[b]
-      << "'\nunset label\n"
+    s << "set title " << host::gnuplotQuoted(title) << "\nset xlabel "
+      << host::gnuplotQuoted(axis[a]) << "\nset ylabel " << host::gnuplotQuoted(axis[b])
+      << "\nunset label\n"
       << (first_panel ? "unset colorbox\n" : "set colorbox\n");
     // The start's and the last view's labels point away from the cluster (off the fruitlets
     // and the region), on an opaque box; two views close together get opposite sides.
@@ -253,8 +256,8 @@ std::string cameraPathScript(const std::vector<Eigen::Vector3d>& fruitlets,
       const Eigen::Vector2d p(path[view][a], path[view][b]);
       const double dx = (p - centre).x() >= 0 ? 1.0 : -1.0;
       const double dy = flip * ((p - centre).y() >= 0 ? 1.0 : -1.0);
-      s << "set label " << tag << " '" << text << "' at " << p.x() << "," << p.y()
-        << " offset char " << 2.0 * dx << "," << 1.4 * dy << (dx > 0 ? " left" : " right")
+      s << "set label " << tag << " " << host::gnuplotQuoted(text) << " at " << p.x() << ","
+        << p.y() << " offset char " << 2.0 * dx << "," << 1.4 * dy << (dx > 0 ? " left" : " right")
         << " front boxed font ',9'\n";
     };
     if (last >= 0) label(1, "start (view 0)", 0, 1.0);
@@ -266,8 +269,8 @@ std::string cameraPathScript(const std::vector<Eigen::Vector3d>& fruitlets,
     if (!regions.empty())
       clauses.push_back(
           "$region using 1:2:3 with circles lc rgb '#2ca02c' dt 2 lw 1.5 "
-          "fs empty title '" +
-          region_title + "'");
+          "fs empty title " +
+          host::gnuplotQuoted(region_title));
     clauses.push_back("$path using 1:2 with lines lc rgb '#b0b0b0' lw 1 title 'path'");
     if (!directions.empty())
       clauses.push_back(
@@ -315,8 +318,10 @@ bool plotSizeScatter(const nlohmann::json& result, const std::filesystem::path& 
   hi = std::ceil(hi + 1.0);
   std::ostringstream s;
   s << "set terminal pngcairo size 760,720 font 'DejaVu Sans,11'\nset encoding utf8\n"
-    << "set title 'Estimated against true size (our estimator): " << n << " matched, MAE "
-    << fmt(abs_error / n, 2) << " mm'\n"
+    << "set title "
+    << host::gnuplotQuoted("Estimated against true size (our estimator): " + std::to_string(n) +
+                           " matched, MAE " + fmt(abs_error / n, 2) + " mm")
+    << "\n"
     << "set xlabel 'true size (mm)'\nset ylabel 'estimated size (mm)'\nset size ratio -1\n"
     << "set grid\nset key top left\nset xrange [" << lo << ":" << hi << "]\nset yrange [" << lo
     << ":" << hi << "]\nset samples 2\n";
@@ -331,7 +336,8 @@ bool plotSizeScatter(const nlohmann::json& result, const std::filesystem::path& 
   int colour = 0;
   for (const auto& [cluster, points] : by_cluster)
     s << ", $c" << (cluster + 1) << " using 1:2 with points pt 7 ps 1.3 lc " << ++colour
-      << " title '" << (cluster < 0 ? "fruitlet" : "cluster " + std::to_string(cluster)) << "'";
+      << " title "
+      << host::gnuplotQuoted(cluster < 0 ? "fruitlet" : "cluster " + std::to_string(cluster));
   s << "\n";
   host::plotWithGnuplot(s.str(), png, "size figure");
   return true;

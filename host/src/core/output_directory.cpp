@@ -28,6 +28,10 @@ void prepareOutputDirectory(const fs::path& dir, const std::string& what) {
   const fs::file_status status = fs::status(dir, ec);
   if (fs::exists(status) && !fs::is_directory(status))
     throw std::runtime_error(where + ": exists and is not a directory");
+  // A dangling link: create_directories would say only "File exists".
+  if (!fs::exists(status) && fs::is_symlink(fs::symlink_status(dir, ec)))
+    throw std::runtime_error(where + ": a symbolic link to '" + fs::read_symlink(dir, ec).string() +
+                             "', which does not exist; create that directory or name another");
   fs::create_directories(dir, ec);
   if (ec) throw std::runtime_error(where + ": cannot create the directory: " + ec.message());
   try {

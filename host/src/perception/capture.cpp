@@ -17,6 +17,7 @@
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/host/core/input_checks.h"
 #include "fvp/host/core/regular_file.h"
+#include "fvp/host/core/yaml_config.h"
 #include "fvp/host/perception/ply_io.h"
 
 namespace fvp::host {
@@ -91,6 +92,9 @@ double readNumber(const YAML::Node& root, const fs::path& file, const std::strin
   const YAML::Node n = root[key];
   if (!n) fail(file, "field '" + key + "'", expected + " (missing)");
   if (!n.IsScalar()) fail(file, "field '" + key + "'", expected + ", got a non-scalar");
+  // Decimal only, as in every config (yaml-cpp alone reads 012 as 10 for an integer).
+  if (!isDecimalNumberText(n.Scalar(), false))
+    fail(file, "field '" + key + "'", expected + " (a decimal number), got '" + n.Scalar() + "'");
   try {
     return n.as<double>();
   } catch (const YAML::Exception&) {
@@ -110,13 +114,13 @@ void readCameraYaml(const fs::path& file, Capture& c) {
   std::error_code ec;
   if (!fs::exists(file, ec))
     fail(file, "file", "a readable camera model (required), cannot open it");
-  // A regular file of bounded size: a FIFO hung the reader, a huge file exhausted memory.
-  const std::string text = readRegularFile(file, "camera model", kMaxCameraYamlBytes);
   YAML::Node root;
   try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(file.string() + ": YAML syntax error: " + e.what());
+    // A regular file of bounded size (a FIFO hung the reader, a huge file exhausted memory),
+    // one document, no key twice (yaml-cpp keeps both and root[key] took the first).
+    root = loadOneYamlDocument(file, file.string(), "camera model", kMaxCameraYamlBytes);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(e.what());
   }
   if (!root.IsMap()) fail(file, "document", "a mapping of camera fields");
   if (root["format_version"]) {
@@ -158,6 +162,8 @@ void readCameraYaml(const fs::path& file, Capture& c) {
       fail(file, tkey, texp + " (row " + std::to_string(r) + ")");
     for (int col = 0; col < 4; ++col) {
       try {
+        if (!T[r][col].IsScalar() || !isDecimalNumberText(T[r][col].Scalar(), false))
+          throw YAML::Exception(YAML::Mark::null_mark(), "not a decimal number");
         M(r, col) = T[r][col].as<double>();
       } catch (const YAML::Exception&) {
         fail(file, tkey,

@@ -30,6 +30,10 @@ std::vector<HueRange> hueRanges(const YAML::Node& node, const std::string& where
   return out;
 }
 
+// The largest Cluster Region a config may ask for: a fruitlet cluster is ~0.1 m across (the
+// default radius is 0.065 m); half a metre already holds a branch.
+constexpr double kMaxRegionRadiusM = 0.5;
+
 const std::vector<YamlKey<C>>& yamlKeys() {
   static const std::vector<YamlKey<C>> keys = {
       yamlField<C>(
@@ -64,6 +68,12 @@ PerceptionConfig PerceptionConfig::fromYamlFile(const std::filesystem::path& pat
   const std::string source = "perception config '" + path.string() + "'";
   PerceptionConfig config;
   readYamlConfig(path, source, yamlKeys(), config);
+  // Here, by its key: the maps size themselves from the region, and a radius of 1e9 m
+  // failed later with a voxel count naming neither the key nor the file.
+  const double radius = config.region.radius_m;
+  requireKey(radius > 0.0 && radius <= kMaxRegionRadiusM, source, "region_radius_m",
+             "a radius above 0 and at most " + formatNumber(kMaxRegionRadiusM) +
+                 " m (one fruitlet cluster), got " + formatNumber(radius));
   try {
     config.validate();
   } catch (const std::invalid_argument& e) {

@@ -170,7 +170,9 @@ WorldConfig WorldConfig::fromYamlFile(const std::filesystem::path& path) {
   return config;
 }
 
-WorldConfig WorldConfig::withErrorsScaled(const std::string& group, double factor) const {
+namespace {
+
+const std::vector<std::pair<std::string, std::vector<std::string>>>& errorGroupMembers() {
   static const std::vector<std::pair<std::string, std::vector<std::string>>> members = {
       {"pose",
        {"hand_eye_translation_sigma_m", "hand_eye_rotation_sigma_deg", "arm_position_error_m",
@@ -180,27 +182,67 @@ WorldConfig WorldConfig::withErrorsScaled(const std::string& group, double facto
       {"segmentation",
        {"segmentation_boundary_px", "segmentation_miss_rate", "segmentation_false_blobs"}},
       {"light", {"sun_strength"}}};
+  return members;
+}
+
+/// The largest factor that keeps `value` x factor within [lo, hi] (value != 0).
+double largestFactor(double value, double lo, double hi) {
+  return value > 0 ? hi / value : lo / value;
+}
+
+}  // namespace
+
+const std::vector<std::string>& WorldConfig::errorGroups() {
+  static const std::vector<std::string> groups = [] {
+    std::vector<std::string> out;
+    for (const auto& [name, keys] : errorGroupMembers()) out.push_back(name);
+    out.push_back("all");
+    return out;
+  }();
+  return groups;
+}
+
+WorldConfig WorldConfig::withErrorsScaled(const std::string& group, double factor) const {
   if (!(factor >= 0.0) || !std::isfinite(factor))
     throw std::invalid_argument("error scale: expected a factor >= 0, got " + formatNumber(factor));
   const bool all = group == "all";
   bool known = all;
-  WorldConfig out = *this;
-  for (const auto& [name, keys] : members) {
+  // First the largest factor every magnitude of the group allows: a clamped magnitude
+  // would make the sweep point another factor than the one the manifest records.
+  std::vector<std::pair<double WorldConfig::*, const KeySpec*>> scaled;
+  double limit = HUGE_VAL;
+  const KeySpec* limiting = nullptr;
+  for (const auto& [name, keys] : errorGroupMembers()) {
     if (!all && name != group) continue;
     known = true;
     for (const std::string& key : keys) {
       const KeySpec& spec = specNamed(key);
-      std::visit(
-          [&](auto field) {
-            if constexpr (std::is_same_v<std::remove_reference_t<decltype(out.*field)>, double>)
-              out.*field = std::clamp(out.*field * factor, spec.lo, spec.hi);
-          },
-          spec.member);
+      const auto* field = std::get_if<double WorldConfig::*>(&spec.member);
+      if (!field) continue;
+      scaled.emplace_back(*field, &spec);
+      const double value = this->**field;
+      if (value != 0.0 && largestFactor(value, spec.lo, spec.hi) < limit) {
+        limit = largestFactor(value, spec.lo, spec.hi);
+        limiting = &spec;
+      }
     }
   }
   if (!known)
     throw std::invalid_argument("error scale: unknown error group '" + group +
                                 "'; expected pose, stereo, wind, segmentation, light or all");
+  if (factor > limit) {
+    const double value = this->*std::get<double WorldConfig::*>(limiting->member);
+    throw std::invalid_argument(
+        "error scale " + group + "=" + formatNumber(factor) + ": " + limiting->name + " would be " +
+        formatNumber(value * factor) + " (" + formatNumber(value) + " x " + formatNumber(factor) +
+        "), outside its range " + formatNumber(limiting->lo) + " to " + formatNumber(limiting->hi) +
+        "; the largest factor this world config allows for " + group + " is " +
+        formatNumber(limit));
+  }
+  WorldConfig out = *this;
+  // The clamp only absorbs rounding at factor == limit.
+  for (const auto& [field, spec] : scaled)
+    out.*field = std::clamp(this->*field * factor, spec->lo, spec->hi);
   return out;
 }
 

@@ -40,10 +40,6 @@ struct ExperimentOptions {
 using TrialRunner = std::function<nlohmann::json(const TrialOptions&)>;
 using MessageSink = std::function<void(const std::string&)>;
 
-/// --error-scale's GROUP=FACTOR split into its group and factor; throws
-/// std::invalid_argument naming the text when it is not of that form (a finite FACTOR).
-std::pair<std::string, double> parseErrorScale(const std::string& error_scale);
-
 /// --error-scale GROUP=FACTOR (docs/simulation.md "Sweeping an error"): the world config
 /// (world, or the default when empty) with that error group's magnitudes times FACTOR,
 /// written to out_dir/world.yaml (out_dir created) for the trials to read and the manifest
@@ -51,10 +47,6 @@ std::pair<std::string, double> parseErrorScale(const std::string& error_scale);
 std::filesystem::path writeScaledWorldConfig(const std::filesystem::path& world,
                                              const std::string& error_scale,
                                              const std::filesystem::path& out_dir);
-
-/// Parses --shard's "i/n": two decimal integers (no sign, no leading zeros), 0 <= i < n.
-/// Throws std::invalid_argument.
-std::pair<int, int> parseShard(const std::string& text);
 
 /// Runs the experiment's trials of this shard (skipping finished ones with resume) and
 /// writes the reports. Before the first trial: the options are checked, out_dir is made (an

@@ -38,6 +38,26 @@ void checkTrial(const nlohmann::json& trial, const std::string& where);
 
 /// The planners an experiment knows ("fvp", "rvp").
 const std::vector<std::string>& experimentPlanners();
+/// The map engines a trial line or a manifest may name ("grid", "octomap": the built-in
+/// entries of host::map::MapEngineRegistry, which a test holds equal).
+const std::vector<std::string>& experimentEngines();
+/// The error groups of --error-scale (robot::sim::WorldConfig::errorGroups(), held equal by
+/// a test): pose, stereo, wind, segmentation, light, all.
+const std::vector<std::string>& errorScaleGroups();
+/// The largest --error-scale factor (a sweep point is a multiple of the world config's
+/// errors; beyond this it is no longer a magnitude the model means).
+inline constexpr double kMaxErrorScaleFactor = 1000.0;
+
+/// Parses --shard's "i/n": two decimal integers (no sign, no leading zeros), 0 <= i < n.
+/// Throws std::invalid_argument. (Here, with the other readers of experiment text, so that
+/// the option checks need no trial code.)
+std::pair<int, int> parseShard(const std::string& text);
+
+/// --error-scale's GROUP=FACTOR split into its group and factor: GROUP one of
+/// errorScaleGroups(), FACTOR a decimal number from 0 to kMaxErrorScaleFactor (no sign,
+/// exponent-free forms and exponents both fine, no hex, inf or nan). Throws
+/// std::invalid_argument naming the text and what was expected.
+std::pair<std::string, double> parseErrorScale(const std::string& error_scale);
 
 /// A trial's summary row: its planner, plus "-<engine>" when that is not the planner's
 /// default engine (fvp: grid, rvp: octomap), so the octomap ablation of FVP is its own row.

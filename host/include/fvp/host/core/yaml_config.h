@@ -5,6 +5,7 @@
 // own validate().
 #pragma once
 
+#include <yaml-cpp/depthguard.h>  // YAML::DeepRecursion
 #include <yaml-cpp/yaml.h>
 
 #include <Eigen/Core>
@@ -18,6 +19,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "fvp/host/core/number_text.h"
 #include "fvp/host/core/regular_file.h"
 
 namespace fvp::host {
@@ -25,28 +27,79 @@ namespace fvp::host {
 /// The largest config file read (docs/reliability.md, "Memory bounds").
 inline constexpr std::uint64_t kMaxConfigFileBytes = std::uint64_t{1} << 20;
 
+/// Throws std::invalid_argument "SOURCE: key 'K' appears twice (lines A and B)" for a mapping,
+/// at any depth, that holds a key twice: yaml-cpp keeps both, and a reader would silently
+/// take the first or the last.
+inline void checkNoDuplicateKeys(const YAML::Node& node, const std::string& source) {
+  if (node.IsSequence())
+    for (const auto& item : node) checkNoDuplicateKeys(item, source);
+  if (!node.IsMap()) return;
+  std::vector<std::pair<std::string, int>> seen;  // scalar keys and their lines
+  for (const auto& item : node) {
+    if (item.first.IsScalar()) {
+      const std::string key = item.first.Scalar();
+      const int line = item.first.Mark().line + 1;
+      for (const auto& [k, l] : seen)
+        if (k == key)
+          throw std::invalid_argument(source + ": key '" + key + "' appears twice (lines " +
+                                      std::to_string(l) + " and " + std::to_string(line) +
+                                      "); expected each key once");
+      seen.emplace_back(key, line);
+    }
+    checkNoDuplicateKeys(item.second, source);
+  }
+}
+
+/// The one YAML document of a file (null when the file is empty), with no key twice in any
+/// mapping. Throws std::invalid_argument naming source when the file is not a regular file
+/// of at most max_bytes (a bound keeps a 100 MB list from exhausting memory in the parser,
+/// whose nodes take ~50 times the text), cannot be read as YAML, holds more than one
+/// document (a later `---` document would be ignored), or nests deeper than yaml-cpp reads
+/// (whose own message is "bad file").
+inline YAML::Node loadOneYamlDocument(const std::filesystem::path& path, const std::string& source,
+                                      const std::string& what = "config file",
+                                      std::uint64_t max_bytes = kMaxConfigFileBytes) {
+  std::string text;
+  try {
+    text = readRegularFile(path, what, max_bytes);
+  } catch (const std::runtime_error& e) {
+    // The reader's message starts with the path; source names the file already.
+    std::string why = e.what();
+    const std::string path_prefix = path.string() + ": ";
+    if (why.rfind(path_prefix, 0) == 0) why.erase(0, path_prefix.size());
+    throw std::invalid_argument(source + ": " + why);
+  }
+  std::vector<YAML::Node> docs;
+  try {
+    docs = YAML::LoadAll(text);
+  } catch (const YAML::DeepRecursion&) {
+    throw std::invalid_argument(source +
+                                ": cannot read YAML: lists or mappings nested too deeply "
+                                "(expected a flat file of key: value)");
+  } catch (const YAML::BadFile&) {
+    throw std::invalid_argument(source + ": cannot open the file");
+  } catch (const YAML::Exception& e) {
+    throw std::invalid_argument(source + ": cannot read YAML: " + e.what());
+  }
+  if (docs.size() > 1)
+    throw std::invalid_argument(source + ": expected one YAML document, got " +
+                                std::to_string(docs.size()) +
+                                " (a '---' line starts another; remove it or the later ones)");
+  const YAML::Node root = docs.empty() ? YAML::Node() : docs[0];
+  checkNoDuplicateKeys(root, source);
+  return root;
+}
+
 /// The file's top-level node: null for an empty file, else a mapping. Throws
-/// std::invalid_argument when the file cannot be read as YAML or is not a mapping.
+/// std::invalid_argument when the file cannot be read as YAML (loadOneYamlDocument) or is
+/// not a mapping.
 inline YAML::Node readYamlMapping(const std::filesystem::path& path, const std::string& source) {
   // yaml-cpp reads a directory as an empty document, which would mean "all defaults".
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     throw std::invalid_argument(source + ": not a readable file" +
                                 (std::filesystem::is_directory(path, ec) ? " (a directory)" : ""));
-  // Configs are a page of keys: a bound keeps a 100 MB list from exhausting memory in the
-  // YAML parser (whose nodes take ~50 times the text).
-  std::string text;
-  try {
-    text = readRegularFile(path, "config file", kMaxConfigFileBytes);
-  } catch (const std::runtime_error& e) {
-    throw std::invalid_argument(source + ": " + e.what());
-  }
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw std::invalid_argument(source + ": cannot read YAML: " + e.what());
-  }
+  const YAML::Node root = loadOneYamlDocument(path, source);
   if (!root.IsNull() && !root.IsMap())
     throw std::invalid_argument(source + ": expected a mapping of key: value");
   return root;
@@ -75,6 +128,13 @@ T readScalar(const YAML::Node& node, const std::string& where, const std::string
   if constexpr (std::is_floating_point_v<T>) {
     if (!std::isfinite(value))
       throw std::invalid_argument(where + ": expected " + expected + " (finite), got '" +
+                                  node.Scalar() + "'");
+  }
+  if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>) {
+    // yaml-cpp reads 012 as 10 and 0x05 as 5; fvp's numbers are decimal, as on the CLI.
+    if (!isDecimalNumberText(node.Scalar(), std::is_integral_v<T>))
+      throw std::invalid_argument(where + ": expected " + expected +
+                                  " (decimal, without a leading zero, '+' or 0x), got '" +
                                   node.Scalar() + "'");
   }
   return value;

@@ -106,12 +106,16 @@ struct WorldConfig {
   /// Throws std::invalid_argument naming the first bad key and its expected range.
   void validate(const std::string& source = "world config") const;
   /// This config with the magnitudes of one group of simulated errors times factor (>= 0),
-  /// each clamped to its key's range, for sweeps (docs/simulation.md "Sweeping an error"):
-  /// pose (hand_eye_*, arm_position_error_m, view_*), stereo (stereo_*), wind (wind_*),
-  /// segmentation (segmentation_boundary_px, _miss_rate, _false_blobs; not the switches
-  /// segmentation_model and fruitlet_green_fraction), light (sun_strength), or all. Throws
-  /// std::invalid_argument for an unknown group or a bad factor.
+  /// for sweeps (docs/simulation.md "Sweeping an error"): pose (hand_eye_*,
+  /// arm_position_error_m, view_*), stereo (stereo_*), wind (wind_*), segmentation
+  /// (segmentation_boundary_px, _miss_rate, _false_blobs; not the switches segmentation_model
+  /// and fruitlet_green_fraction), light (sun_strength), or all. Throws std::invalid_argument
+  /// for an unknown group, a bad factor, or a factor that takes a magnitude out of its key's
+  /// range (naming the key, the value, the limit and the largest factor that fits): a
+  /// clamped magnitude would be a sweep point at another factor than the one recorded.
   WorldConfig withErrorsScaled(const std::string& group, double factor) const;
+  /// The groups withErrorsScaled takes, "all" last.
+  static const std::vector<std::string>& errorGroups();
   /// Every YAML key, in declaration order (the same names as the fields).
   static const std::vector<std::string>& keyNames();
   /// The config as a JSON object text {key: value, ...} (for ground truth and results).
