@@ -22,7 +22,7 @@ float fvp_exact_pack(uint sign, int biased_exponent, uint64_t significand, uint6
   return uintBitsToFloat(sign | (uint(biased_exponent) << 23) | (uint(significand) & 0x7fffffu));
 }
 
-float fvp_div_rn(float a, float b) {
+float fvp_div_rn_bits(float a, float b) {
   uint ua = floatBitsToUint(a), ub = floatBitsToUint(b);
   uint sign = (ua ^ ub) & FVP_EXACT_SIGN;
   int ea = int((ua >> 23) & 0xffu), eb = int((ub >> 23) & 0xffu);
@@ -49,7 +49,7 @@ uint64_t fvp_exact_isqrt(uint64_t n) {
   return s;
 }
 
-float fvp_sqrt_rn(float x) {
+float fvp_sqrt_rn_bits(float x) {
   uint ux = floatBitsToUint(x);
   int ex = int((ux >> 23) & 0xffu);
   uint mx = ux & 0x7fffffu;
@@ -64,5 +64,9 @@ float fvp_sqrt_rn(float x) {
   return fvp_exact_pack(0u, (unbiased - 23 - scale) / 2 + 151, root >> 1, root & 1ul, 1,
                         root * root != n);
 }
+
+// What the kernels call (the host twin uses its IEEE hardware; fvp_exact.h says why).
+float fvp_div_rn(float a, float b) { return fvp_div_rn_bits(a, b); }
+float fvp_sqrt_rn(float x) { return fvp_sqrt_rn_bits(x); }
 
 #endif  // FVP_EXACT_GLSL

@@ -1,7 +1,8 @@
 // kernels/fvp_exact.h against the host's IEEE 754 division and square root: the integer forms
-// (what OpenCL and Vulkan devices run) must be correctly rounded (round to nearest, ties to even) wherever neither an operand nor
-// the result is subnormal, and handle zeros, infinities and NaN as IEEE does. The kernels'
-// cross-backend tests (tsdf_test, grid_engine_test) then check the devices run them alike.
+// (what OpenCL and Vulkan devices run) must be correctly rounded (round to nearest, ties to even)
+// wherever neither an operand nor the result is subnormal, and handle zeros, infinities and NaN as
+// IEEE does. The kernels' cross-backend tests (tsdf_test, grid_engine_test) then check the devices
+// run them alike.
 #include <gtest/gtest.h>
 
 #include <cmath>
