@@ -667,7 +667,7 @@ const std::vector<BadInput>& cases() {
                                          "cpu",  "--out",      p(d / "out")};
        },
        1,
-       {"left.png: file: expected a PNG image, got a directory"},
+       {"left.png: expected a regular file (the PNG image), got a directory"},
        {"out/fruitlets.json"}},
       {"PerceptionRegionRadiusHuge",
        [](const fs::path& d) {

@@ -34,7 +34,10 @@ std::string gnuplotQuoted(std::string_view text) {
                                 "and ._-+=%/()[]:, (at most " +
                                 std::to_string(kGnuplotTextMax) + " characters)");
   }
-  return "'" + std::string(text) + "'";
+  std::string quoted;
+  quoted.reserve(text.size() + 2);
+  quoted.append(1, '\'').append(text).append(1, '\'');
+  return quoted;
 }
 
 void plotWithGnuplot(const std::string& script, const std::filesystem::path& png_path,
