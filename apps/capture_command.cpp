@@ -134,16 +134,138 @@ static void writeCaptureSet(std::uint64_t seed, const std::string& world_file, i
   }
 }
 
+namespace {
+
+/// `fvp capture`'s options.
+struct CaptureCommandOptions {
+  std::uint64_t seed = 1;
+  std::string world_file;
+  std::string pose;
+  std::string out;
+  int views = 1;
+  double arc_deg = 90.0;
+};
+
+// What the tag detection and the Cluster Region came to, against the world's ground truth.
+void printTagAndRegion(const robot::sim::World& world, const host::PerceptionResult& result,
+                       const host::PerceptionConfig& config) {
+  const host::PerceptionStats& st = result.clouds.stats;
+  if (result.tag) {
+    const auto& tag = *result.tag;
+    const Eigen::Isometry3d& gt = world.tag().T_world_tag;
+    std::cout << std::setprecision(2) << "tag            detected id " << tag.tag_id << " (hamming "
+              << tag.hamming << ", margin " << tag.decision_margin << "), error vs ground truth "
+              << (tag.T_world_tag.translation() - gt.translation()).norm() * 1e3 << " mm, "
+              << Eigen::AngleAxisd(tag.T_world_tag.linear().transpose() * gt.linear()).angle() *
+                     180.0 / M_PI
+              << " deg, in " << st.tag_s * 1e3 << " ms\n";
+  } else {
+    std::cout << "tag            NOT detected (id " << config.tag.tag_id
+              << "): no Cluster Region; full resolution only around segmented fruitlets\n";
+  }
+  if (result.region)
+    std::cout << std::setprecision(3) << "cluster region centre " << vec(result.region->center_m())
+              << ", radius " << result.region->radius_m() << " m; true cluster centre "
+              << (world.clusterCenter_m() - result.region->center_m()).norm() * 1e3
+              << " mm from it\n";
+}
+
+// The stereo matcher's, the segmentation's and the point clouds' numbers.
+void printPerceptionStats(const host::PerceptionResult& result) {
+  const host::PerceptionStats& st = result.clouds.stats;
+  const cv::Rect fine = result.disparity.fine_rect;
+  std::cout << std::setprecision(1) << "SGBM           " << st.sgbm_s * 1e3
+            << " ms (full resolution " << fine.width << "x" << fine.height << " px at (" << fine.x
+            << ", " << fine.y << "), 1/" << result.disparity.coarse_scale
+            << " resolution elsewhere)\n"
+            << "segmentation   " << cv::countNonZero(result.fruitlet_mask) << " fruitlet px in "
+            << st.segmentation_s * 1e3 << " ms\n"
+            << "points         " << st.roi_points << " ROI, " << st.other_points << " other\n"
+            << "disparities    " << st.fine_samples << " full-res + " << st.coarse_samples
+            << " coarse samples; dropped " << st.droppedDisparities() << ": SGBM invalid "
+            << st.sgbm_invalid << ", saturated (too near) " << st.saturated << ", blind left band "
+            << st.blind_band << ", dark (no signal) " << st.no_signal << ", non-finite "
+            << st.nonfinite << ", zero/negative " << st.nonpositive << ", out of range "
+            << st.out_of_range << "\n";
+}
+
+// Unused in the parse-only build of the CLI fuzz harness (FVP_ON_RUN).
+[[maybe_unused]] void runCaptureCommand(const CaptureCommandOptions* opt) {
+  host::prepareOutputDirectory(opt->out, "--out");
+  const host::OutputDirectoryLock lock(opt->out, "--out");
+  if (opt->views == 1) refuseCaptureSet(opt->out);
+  if (opt->views > 1) {
+    if (!opt->pose.empty()) throw std::invalid_argument("--pose and --views exclude each other");
+    writeCaptureSet(opt->seed, opt->world_file, opt->views, opt->arc_deg, opt->out);
+    return;
+  }
+  const robot::sim::WorldConfig world_config =
+      opt->world_file.empty() ? robot::sim::WorldConfig{}
+                              : robot::sim::WorldConfig::fromYamlFile(opt->world_file);
+  const auto world = robot::sim::World::generate(world_config, opt->seed);
+  const Eigen::Isometry3d T_world_camera =
+      opt->pose.empty() ? world.startCameraPose() : parsePose(opt->pose);
+
+  robot::sim::StereoRenderer renderer(world);
+  const robot::sim::RenderedView view = renderer.renderWithGroundTruth(T_world_camera);
+  const host::StereoFrame& frame = view.frame;
+  const double render_s = renderer.lastRenderSeconds();
+  robot::sim::RenderOptions no_leaves;  // ids only: for the occlusion statistic
+  no_leaves.with_leaves = false;
+  no_leaves.images = false;
+  const robot::sim::RenderedView bare = renderer.renderWithGroundTruth(T_world_camera, no_leaves);
+  const double bare_render_s = renderer.lastRenderSeconds();
+
+  host::PerceptionConfig config;
+  config.tag.tag_id = world.tag().tag_id;
+  config.tag.tag_size_m = world.tag().tag_size_m;
+  const host::PerceptionPipeline pipeline(config);
+  const host::PerceptionResult result = pipeline.process(frame);
+
+  host::Capture capture;
+  capture.left_bgr = frame.left_bgr;
+  capture.right_bgr = frame.right_bgr;
+  capture.intrinsics = frame.intrinsics;
+  capture.T_world_camera = frame.T_world_camera;
+  capture.disparity_px = result.disparity.disparity_px;
+  capture.fruitlet_mask = result.fruitlet_mask;
+  capture.roi_points_m = result.clouds.roi_points_m;
+  capture.other_points_m = result.clouds.other_points_m;
+  capture.has_clouds = true;
+  capture.ground_truth_json = world.groundTruthJson();
+  host::writeCapture(opt->out, capture);
+
+  const auto occlusion = robot::sim::OcclusionStatistic::compute(view.ground_truth.object_id,
+                                                                 bare.ground_truth.object_id);
+  const auto& K = frame.intrinsics;
+  std::cout << std::fixed << std::setprecision(1);
+  std::cout << "world          seed " << world.seed() << ": " << world.fruitlets().size()
+            << " fruitlets, " << world.leaves().size() << " leaves, tag36h11 id "
+            << world.tag().tag_id << "\n"
+            << "camera         " << K.width_px << "x" << K.height_px << " at "
+            << vec(T_world_camera.translation()) << (opt->pose.empty() ? " (start view)" : "")
+            << "\n"
+            << "render         " << render_s * 1e3 << " ms per pair (+ " << bare_render_s * 1e3
+            << " ms for the leafless render of the occlusion statistic)\n";
+  printTagAndRegion(world, result, config);
+  printPerceptionStats(result);
+  std::cout << std::setprecision(3)
+            << "occlusion      visible fraction of each fruitlet's "
+               "silhouette vs a render without leaves:\n";
+  for (const auto& f : occlusion.fruitlets())
+    std::cout << "  fruitlet " << f.object_id - robot::sim::kFirstFruitletId << "   "
+              << (f.unoccluded_px > 0 ? std::to_string(f.visible_fraction).substr(0, 5)
+                                      : std::string("out of view"))
+              << "  (" << f.visible_px << " of " << f.unoccluded_px << " px)\n";
+  std::cout << "  mean         " << occlusion.meanVisibleFraction() << " over "
+            << occlusion.fruitletsInView() << " fruitlets in view\n"
+            << "capture        " << opt->out << "\n";
+}
+
+}  // namespace
+
 void addCaptureCommand(CLI::App& app) {
-  struct Options {
-    std::uint64_t seed = 1;
-    std::string world_file;
-    std::string pose;
-    std::string out;
-    int views = 1;
-    double arc_deg = 90.0;
-  };
-  auto opt = optionStorage<Options>();
+  auto opt = optionStorage<CaptureCommandOptions>();
   auto* cmd = app.add_subcommand(
       "capture",
       "Render one view of a simulated world (default: the start view), run the "
@@ -167,110 +289,7 @@ void addCaptureCommand(CLI::App& app) {
   cmd->add_option("--out", opt->out, "capture directory (created)")
       ->required()
       ->check(nonEmptyPath());
-  FVP_ON_RUN(cmd, [opt] {
-    host::prepareOutputDirectory(opt->out, "--out");
-    const host::OutputDirectoryLock lock(opt->out, "--out");
-    if (opt->views == 1) refuseCaptureSet(opt->out);
-    if (opt->views > 1) {
-      if (!opt->pose.empty()) throw std::invalid_argument("--pose and --views exclude each other");
-      writeCaptureSet(opt->seed, opt->world_file, opt->views, opt->arc_deg, opt->out);
-      return;
-    }
-    const robot::sim::WorldConfig world_config =
-        opt->world_file.empty() ? robot::sim::WorldConfig{}
-                                : robot::sim::WorldConfig::fromYamlFile(opt->world_file);
-    const auto world = robot::sim::World::generate(world_config, opt->seed);
-    const Eigen::Isometry3d T_world_camera =
-        opt->pose.empty() ? world.startCameraPose() : parsePose(opt->pose);
-
-    robot::sim::StereoRenderer renderer(world);
-    const robot::sim::RenderedView view = renderer.renderWithGroundTruth(T_world_camera);
-    const host::StereoFrame& frame = view.frame;
-    const double render_s = renderer.lastRenderSeconds();
-    robot::sim::RenderOptions no_leaves;  // ids only: for the occlusion statistic
-    no_leaves.with_leaves = false;
-    no_leaves.images = false;
-    const robot::sim::RenderedView bare = renderer.renderWithGroundTruth(T_world_camera, no_leaves);
-    const double bare_render_s = renderer.lastRenderSeconds();
-
-    host::PerceptionConfig config;
-    config.tag.tag_id = world.tag().tag_id;
-    config.tag.tag_size_m = world.tag().tag_size_m;
-    const host::PerceptionPipeline pipeline(config);
-    const host::PerceptionResult result = pipeline.process(frame);
-    const host::PerceptionStats& st = result.clouds.stats;
-
-    host::Capture capture;
-    capture.left_bgr = frame.left_bgr;
-    capture.right_bgr = frame.right_bgr;
-    capture.intrinsics = frame.intrinsics;
-    capture.T_world_camera = frame.T_world_camera;
-    capture.disparity_px = result.disparity.disparity_px;
-    capture.fruitlet_mask = result.fruitlet_mask;
-    capture.roi_points_m = result.clouds.roi_points_m;
-    capture.other_points_m = result.clouds.other_points_m;
-    capture.has_clouds = true;
-    capture.ground_truth_json = world.groundTruthJson();
-    host::writeCapture(opt->out, capture);
-
-    const auto occlusion = robot::sim::OcclusionStatistic::compute(view.ground_truth.object_id,
-                                                                   bare.ground_truth.object_id);
-    const auto& K = frame.intrinsics;
-    const cv::Rect fine = result.disparity.fine_rect;
-    std::cout << std::fixed << std::setprecision(1);
-    std::cout << "world          seed " << world.seed() << ": " << world.fruitlets().size()
-              << " fruitlets, " << world.leaves().size() << " leaves, tag36h11 id "
-              << world.tag().tag_id << "\n"
-              << "camera         " << K.width_px << "x" << K.height_px << " at "
-              << vec(T_world_camera.translation()) << (opt->pose.empty() ? " (start view)" : "")
-              << "\n"
-              << "render         " << render_s * 1e3 << " ms per pair (+ " << bare_render_s * 1e3
-              << " ms for the leafless render of the occlusion statistic)\n";
-    if (result.tag) {
-      const auto& tag = *result.tag;
-      const Eigen::Isometry3d& gt = world.tag().T_world_tag;
-      std::cout << std::setprecision(2) << "tag            detected id " << tag.tag_id
-                << " (hamming " << tag.hamming << ", margin " << tag.decision_margin
-                << "), error vs ground truth "
-                << (tag.T_world_tag.translation() - gt.translation()).norm() * 1e3 << " mm, "
-                << Eigen::AngleAxisd(tag.T_world_tag.linear().transpose() * gt.linear()).angle() *
-                       180.0 / M_PI
-                << " deg, in " << st.tag_s * 1e3 << " ms\n";
-    } else {
-      std::cout << "tag            NOT detected (id " << config.tag.tag_id
-                << "): no Cluster Region; full resolution only around segmented fruitlets\n";
-    }
-    if (result.region)
-      std::cout << std::setprecision(3) << "cluster region centre "
-                << vec(result.region->center_m()) << ", radius " << result.region->radius_m()
-                << " m; true cluster centre "
-                << (world.clusterCenter_m() - result.region->center_m()).norm() * 1e3
-                << " mm from it\n";
-    std::cout << std::setprecision(1) << "SGBM           " << st.sgbm_s * 1e3
-              << " ms (full resolution " << fine.width << "x" << fine.height << " px at (" << fine.x
-              << ", " << fine.y << "), 1/" << result.disparity.coarse_scale
-              << " resolution elsewhere)\n"
-              << "segmentation   " << cv::countNonZero(result.fruitlet_mask) << " fruitlet px in "
-              << st.segmentation_s * 1e3 << " ms\n"
-              << "points         " << st.roi_points << " ROI, " << st.other_points << " other\n"
-              << "disparities    " << st.fine_samples << " full-res + " << st.coarse_samples
-              << " coarse samples; dropped " << st.droppedDisparities() << ": SGBM invalid "
-              << st.sgbm_invalid << ", saturated (too near) " << st.saturated
-              << ", blind left band " << st.blind_band << ", dark (no signal) " << st.no_signal
-              << ", non-finite " << st.nonfinite << ", zero/negative " << st.nonpositive
-              << ", out of range " << st.out_of_range << "\n";
-    std::cout << std::setprecision(3)
-              << "occlusion      visible fraction of each fruitlet's "
-                 "silhouette vs a render without leaves:\n";
-    for (const auto& f : occlusion.fruitlets())
-      std::cout << "  fruitlet " << f.object_id - robot::sim::kFirstFruitletId << "   "
-                << (f.unoccluded_px > 0 ? std::to_string(f.visible_fraction).substr(0, 5)
-                                        : std::string("out of view"))
-                << "  (" << f.visible_px << " of " << f.unoccluded_px << " px)\n";
-    std::cout << "  mean         " << occlusion.meanVisibleFraction() << " over "
-              << occlusion.fruitletsInView() << " fruitlets in view\n"
-              << "capture        " << opt->out << "\n";
-  });
+  FVP_ON_RUN(cmd, [opt] { runCaptureCommand(opt.get()); });
 }
 
 }  // namespace fvp::apps

@@ -17,13 +17,64 @@
 
 namespace fvp::apps {
 
-void addExperimentCommands(CLI::App& app) {
-  struct Options {
-    trials::ExperimentOptions experiment;
-    std::string planners = "fvp,rvp", shard, world, config, arm, out, error_scale;
-    int max_views = 0;
+namespace {
+
+/// `fvp experiment`'s options: the runner's, and those the command turns into them.
+struct ExperimentCommandOptions {
+  trials::ExperimentOptions experiment;
+  std::string planners = "fvp,rvp", shard, world, config, arm, out, error_scale;
+  int max_views = 0;
+};
+
+// Unused in the parse-only build of the CLI fuzz harness (FVP_ON_RUN).
+[[maybe_unused]] void runExperimentCommand(const ExperimentCommandOptions* opt) {
+  trials::ExperimentOptions o = opt->experiment;
+  // Every comma-separated name, empty ones too: the runner rejects empty, unknown and
+  // repeated planners with a message.
+  o.planners.clear();
+  for (std::size_t from = 0;;) {
+    const std::size_t comma = opt->planners.find(',', from);
+    o.planners.push_back(opt->planners.substr(from, comma - from));
+    if (comma == std::string::npos) break;
+    from = comma + 1;
+  }
+  if (opt->planners.empty()) o.planners.clear();
+  if (!opt->shard.empty()) std::tie(o.shard_index, o.shard_count) = trials::parseShard(opt->shard);
+  o.error_scale = opt->error_scale;
+  // One writer from the first file on: --error-scale writes OUT/world.yaml before the
+  // runner (which takes the same lock, shared within this process) starts.
+  std::optional<host::OutputDirectoryLock> lock;
+  if (!opt->error_scale.empty()) {
+    (void)trials::parseErrorScale(opt->error_scale);  // a bad one fails before --out is made
+    host::prepareOutputDirectory(opt->out, "experiment: --out");
+    lock.emplace(opt->out, "experiment: --out");
+  }
+  o.trial.world_config = opt->error_scale.empty() ? std::filesystem::path(opt->world)
+                                                  : trials::writeScaledWorldConfig(
+                                                        opt->world, opt->error_scale, opt->out);
+  o.trial.planner_config = opt->config;
+  o.trial.arm_config = opt->arm;
+  if (opt->max_views > 0) o.trial.max_views = opt->max_views;
+  o.out_dir = opt->out;
+  const bool tty = isatty(STDERR_FILENO);
+  const auto progress = [tty](const std::string& line) {
+    std::cerr << (tty ? "\r\033[K" : "") << line << (tty ? "" : "\n") << std::flush;
   };
-  auto opt = optionStorage<Options>();
+  // A warning on a line of its own: the next progress line must not overwrite it.
+  const auto warning = [tty](const std::string& line) {
+    std::cerr << (tty ? "\r\033[K" : "") << "fvp: warning: " << line << "\n" << std::flush;
+  };
+  trials::runExperiment(o, trials::runTrial, progress, warning);
+  if (tty) std::cerr << "\n";
+  std::cout << "wrote " << opt->out << "/{manifest.json, trials.jsonl, summary.json, table1.md"
+            << (std::filesystem::exists(o.out_dir / "sizes.png") ? ", sizes.png" : "")
+            << ", index.html}\n"
+            << "open " << (o.out_dir / "index.html").string()
+            << " for Table 1, the figures and every trial's 3-D viewer\n";
+}
+
+void addExperimentCommand(CLI::App& app) {
+  auto opt = optionStorage<ExperimentCommandOptions>();
   auto* cmd =
       app.add_subcommand("experiment",
                          "Run every planner on the same simulated worlds; write trials.jsonl, "
@@ -83,53 +134,10 @@ void addExperimentCommands(CLI::App& app) {
       ->check(shardText());
   cmd->add_flag("--resume", opt->experiment.resume, "skip trials already in trials.jsonl");
   cmd->add_option("--out", opt->out, "output directory")->required()->check(nonEmptyPath());
-  FVP_ON_RUN(cmd, [opt] {
-    trials::ExperimentOptions o = opt->experiment;
-    // Every comma-separated name, empty ones too: the runner rejects empty, unknown and
-    // repeated planners with a message.
-    o.planners.clear();
-    for (std::size_t from = 0;;) {
-      const std::size_t comma = opt->planners.find(',', from);
-      o.planners.push_back(opt->planners.substr(from, comma - from));
-      if (comma == std::string::npos) break;
-      from = comma + 1;
-    }
-    if (opt->planners.empty()) o.planners.clear();
-    if (!opt->shard.empty())
-      std::tie(o.shard_index, o.shard_count) = trials::parseShard(opt->shard);
-    o.error_scale = opt->error_scale;
-    // One writer from the first file on: --error-scale writes OUT/world.yaml before the
-    // runner (which takes the same lock, shared within this process) starts.
-    std::optional<host::OutputDirectoryLock> lock;
-    if (!opt->error_scale.empty()) {
-      (void)trials::parseErrorScale(opt->error_scale);  // a bad one fails before --out is made
-      host::prepareOutputDirectory(opt->out, "experiment: --out");
-      lock.emplace(opt->out, "experiment: --out");
-    }
-    o.trial.world_config = opt->error_scale.empty() ? std::filesystem::path(opt->world)
-                                                    : trials::writeScaledWorldConfig(
-                                                          opt->world, opt->error_scale, opt->out);
-    o.trial.planner_config = opt->config;
-    o.trial.arm_config = opt->arm;
-    if (opt->max_views > 0) o.trial.max_views = opt->max_views;
-    o.out_dir = opt->out;
-    const bool tty = isatty(STDERR_FILENO);
-    const auto progress = [tty](const std::string& line) {
-      std::cerr << (tty ? "\r\033[K" : "") << line << (tty ? "" : "\n") << std::flush;
-    };
-    // A warning on a line of its own: the next progress line must not overwrite it.
-    const auto warning = [tty](const std::string& line) {
-      std::cerr << (tty ? "\r\033[K" : "") << "fvp: warning: " << line << "\n" << std::flush;
-    };
-    trials::runExperiment(o, trials::runTrial, progress, warning);
-    if (tty) std::cerr << "\n";
-    std::cout << "wrote " << opt->out << "/{manifest.json, trials.jsonl, summary.json, table1.md"
-              << (std::filesystem::exists(o.out_dir / "sizes.png") ? ", sizes.png" : "")
-              << ", index.html}\n"
-              << "open " << (o.out_dir / "index.html").string()
-              << " for Table 1, the figures and every trial's 3-D viewer\n";
-  });
+  FVP_ON_RUN(cmd, [opt] { runExperimentCommand(opt.get()); });
+}
 
+void addMergeCommand(CLI::App& app) {
   auto merge_out = optionStorage<std::string>();
   auto shards = optionStorage<std::vector<std::string>>();
   auto* merge = app.add_subcommand("merge", "Combine experiment shards into one experiment");
@@ -145,7 +153,9 @@ void addExperimentCommands(CLI::App& app) {
     std::cout << "merged " << dirs.size() << " shards into " << *merge_out << " (index.html: "
               << "Table 1, the figures and every trial's viewer)\n";
   });
+}
 
+void addSensitivityCommand(CLI::App& app) {
   auto sweep_out = optionStorage<std::string>();
   auto points = optionStorage<std::vector<std::string>>();
   auto* sensitivity =
@@ -165,6 +175,14 @@ void addExperimentCommands(CLI::App& app) {
     std::cout << "wrote " << *sweep_out << "/{sensitivity.json, sensitivity.md"
               << (drawn ? ", sensitivity.png" : "") << "}\n";
   });
+}
+
+}  // namespace
+
+void addExperimentCommands(CLI::App& app) {
+  addExperimentCommand(app);
+  addMergeCommand(app);
+  addSensitivityCommand(app);
 }
 
 }  // namespace fvp::apps

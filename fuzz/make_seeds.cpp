@@ -115,6 +115,85 @@ std::string plyFile(const std::function<void(const fs::path&)>& write) {
   return slurp(path);
 }
 
+void putConfigSeeds() {
+  // Configs: the committed defaults, the built-in defaults as JSON (YAML's flow form).
+  copySource("world_config", "world_default.yaml", "robot/sim/config/world_default.yaml");
+  copySource("world_config", "world_isolated.yaml", "robot/sim/config/world_isolated.yaml");
+  copySource("world_config", "world_unoccluded.yaml", "robot/sim/config/world_unoccluded.yaml");
+  put("world_config", "defaults.json", robot::sim::WorldConfig{}.toJson());
+  copySource("arm_config", "arm_default.yaml", "robot/config/arm_default.yaml");
+  put("arm_config", "defaults.json", robot::ArmConfig{}.toJson());
+  copySource("map_config", "map_default.yaml", "host/config/map_default.yaml");
+  copySource("map_config", "map_unknown_key.yaml", "tests/apps/data/map_unknown_key.yaml");
+  put("map_config", "vectors.yaml",
+      "observation_min_m: [-0.5, -0.5, 0.0]\nobservation_max_m: [0.5, 0.5, 1.5]\n"
+      "fine_map_extent: observation_box\nprob_hit: 0.7\n");
+  copySource("planner_config", "planner_default.yaml", "host/config/planner_default.yaml");
+  put("planner_config", "defaults.json", host::planner::PlannerConfig{}.toJson());
+  copySource("rvp_config", "rvp_default.yaml", "host/config/rvp_default.yaml");
+  put("rvp_config", "defaults.json", host::planner::RvpConfig{}.toJson());
+  for (const std::string name :
+       {"world_config", "arm_config", "map_config", "planner_config", "rvp_config"})
+    put(name, "empty.yaml", "");
+}
+
+void putMapSeeds() {
+  // Coarse maps: empty, a few voxels, a ray's free voxels ending in an occupied one.
+  auto bt = [&](const std::string& file, const std::function<void(octomap::OcTree&)>& fill) {
+    octomap::OcTree tree(0.1);
+    fill(tree);
+    const fs::path path = scratch() / "seed.bt";
+    host::map::writeCoarseBt(tree, path);
+    put("coarse_bt", file, slurp(path));
+  };
+  bt("empty.bt", [](octomap::OcTree&) {});
+  bt("voxels.bt", [](octomap::OcTree& t) {
+    t.updateNode(octomap::point3d(0.05f, 0.05f, 0.05f), true);
+    t.updateNode(octomap::point3d(-0.35f, 0.2f, 1.0f), false);
+    t.updateNode(octomap::point3d(0.4f, -0.1f, 0.6f), true);
+  });
+  bt("ray.bt", [](octomap::OcTree& t) {
+    t.insertRay(octomap::point3d(0, 0, 0), octomap::point3d(0.6f, 0.3f, 0.4f));
+  });
+
+  // A workspace-tree cache of a coarse grid (0.5 m cells, one direction bin per face).
+  {
+    robot::ArmConfig arm;
+    arm.workspace_samples = 2000;
+    arm.workspace_resolution_m = 0.5;
+    arm.workspace_direction_bins = 1;
+    arm.slider_travel_m = 1.0;
+    arm.workspace_cache_dir = "";
+    const robot::ArmModel model(arm);
+    const fs::path path = scratch() / "workspace.bin";
+    robot::WorkspaceTree::build(model).save(path);
+    put("workspace_tree", "coarse_0.5m.bin", slurp(path));
+  }
+}
+
+void putTrialsSeeds() {
+  // trials.jsonl: finished trials as the runner appends them, and one cut short.
+  {
+    const nlohmann::json f0 = {{"gt_center_m", {0, 0, 1}},
+                               {"gt_size_mm", 6.0},
+                               {"matched", true},
+                               {"est_center_m", {0, 0, 1}},
+                               {"est_size_mm", 6.5}};
+    const nlohmann::json f1 = {
+        {"gt_center_m", {0.02, 0, 1}}, {"gt_size_mm", 8.0}, {"matched", false}};
+    const nlohmann::json fvp_trial = {
+        {"planner", "fvp"},      {"seed", 10},
+        {"engine", "grid"},      {"views", 30},
+        {"wall_time_s", 100.0},  {"detections", 2},
+        {"fruitlets", {f0, f1}}, {"fruitlets_paper_sizing", {f0, f1}}};
+    nlohmann::json rvp_trial = fvp_trial;
+    rvp_trial["planner"] = "rvp";
+    rvp_trial["engine"] = "octomap";
+    put("trials", "two_trials.jsonl", fvp_trial.dump() + "\n" + rvp_trial.dump() + "\n");
+    put("trials", "cut_short.jsonl", fvp_trial.dump() + "\n\n" + rvp_trial.dump().substr(0, 40));
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -159,82 +238,15 @@ int main(int argc, char** argv) {
     put("ply", "extra_properties_crlf", ply);
   }
 
-  // Configs: the committed defaults, the built-in defaults as JSON (YAML's flow form).
-  copySource("world_config", "world_default.yaml", "robot/sim/config/world_default.yaml");
-  copySource("world_config", "world_isolated.yaml", "robot/sim/config/world_isolated.yaml");
-  copySource("world_config", "world_unoccluded.yaml", "robot/sim/config/world_unoccluded.yaml");
-  put("world_config", "defaults.json", robot::sim::WorldConfig{}.toJson());
-  copySource("arm_config", "arm_default.yaml", "robot/config/arm_default.yaml");
-  put("arm_config", "defaults.json", robot::ArmConfig{}.toJson());
-  copySource("map_config", "map_default.yaml", "host/config/map_default.yaml");
-  copySource("map_config", "map_unknown_key.yaml", "tests/apps/data/map_unknown_key.yaml");
-  put("map_config", "vectors.yaml",
-      "observation_min_m: [-0.5, -0.5, 0.0]\nobservation_max_m: [0.5, 0.5, 1.5]\n"
-      "fine_map_extent: observation_box\nprob_hit: 0.7\n");
-  copySource("planner_config", "planner_default.yaml", "host/config/planner_default.yaml");
-  put("planner_config", "defaults.json", host::planner::PlannerConfig{}.toJson());
-  copySource("rvp_config", "rvp_default.yaml", "host/config/rvp_default.yaml");
-  put("rvp_config", "defaults.json", host::planner::RvpConfig{}.toJson());
-  for (const std::string name :
-       {"world_config", "arm_config", "map_config", "planner_config", "rvp_config"})
-    put(name, "empty.yaml", "");
+  putConfigSeeds();
 
   put("ground_truth", "isolated_seed7.json", truth_isolated);
   put("ground_truth", "default_seed1_no_leaves.json", truth1.dump(1));
   put("ground_truth", "minimal.json",
       R"({"fruitlets": [{"center_m": [0, 0.1, 1], "gt_size_mm": 6.5}]})");
 
-  // Coarse maps: empty, a few voxels, a ray's free voxels ending in an occupied one.
-  auto bt = [&](const std::string& file, const std::function<void(octomap::OcTree&)>& fill) {
-    octomap::OcTree tree(0.1);
-    fill(tree);
-    const fs::path path = scratch() / "seed.bt";
-    host::map::writeCoarseBt(tree, path);
-    put("coarse_bt", file, slurp(path));
-  };
-  bt("empty.bt", [](octomap::OcTree&) {});
-  bt("voxels.bt", [](octomap::OcTree& t) {
-    t.updateNode(octomap::point3d(0.05f, 0.05f, 0.05f), true);
-    t.updateNode(octomap::point3d(-0.35f, 0.2f, 1.0f), false);
-    t.updateNode(octomap::point3d(0.4f, -0.1f, 0.6f), true);
-  });
-  bt("ray.bt", [](octomap::OcTree& t) {
-    t.insertRay(octomap::point3d(0, 0, 0), octomap::point3d(0.6f, 0.3f, 0.4f));
-  });
+  putMapSeeds();
 
-  // A workspace-tree cache of a coarse grid (0.5 m cells, one direction bin per face).
-  {
-    robot::ArmConfig arm;
-    arm.workspace_samples = 2000;
-    arm.workspace_resolution_m = 0.5;
-    arm.workspace_direction_bins = 1;
-    arm.slider_travel_m = 1.0;
-    arm.workspace_cache_dir = "";
-    const robot::ArmModel model(arm);
-    const fs::path path = scratch() / "workspace.bin";
-    robot::WorkspaceTree::build(model).save(path);
-    put("workspace_tree", "coarse_0.5m.bin", slurp(path));
-  }
-
-  // trials.jsonl: finished trials as the runner appends them, and one cut short.
-  {
-    const nlohmann::json f0 = {{"gt_center_m", {0, 0, 1}},
-                               {"gt_size_mm", 6.0},
-                               {"matched", true},
-                               {"est_center_m", {0, 0, 1}},
-                               {"est_size_mm", 6.5}};
-    const nlohmann::json f1 = {
-        {"gt_center_m", {0.02, 0, 1}}, {"gt_size_mm", 8.0}, {"matched", false}};
-    const nlohmann::json fvp_trial = {
-        {"planner", "fvp"},      {"seed", 10},
-        {"engine", "grid"},      {"views", 30},
-        {"wall_time_s", 100.0},  {"detections", 2},
-        {"fruitlets", {f0, f1}}, {"fruitlets_paper_sizing", {f0, f1}}};
-    nlohmann::json rvp_trial = fvp_trial;
-    rvp_trial["planner"] = "rvp";
-    rvp_trial["engine"] = "octomap";
-    put("trials", "two_trials.jsonl", fvp_trial.dump() + "\n" + rvp_trial.dump() + "\n");
-    put("trials", "cut_short.jsonl", fvp_trial.dump() + "\n\n" + rvp_trial.dump().substr(0, 40));
-  }
+  putTrialsSeeds();
   return 0;
 }

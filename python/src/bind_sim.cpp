@@ -14,7 +14,8 @@ namespace {
 
 trials::TrialOptions trialOptions(const std::string& planner, std::uint64_t seed, double budget_s,
                                   const std::optional<int>& max_views, const std::string& clock,
-                                  const std::string& stop, bool size_history, bool register_views,
+                                  const std::string& stop, bool confirm_detections,
+                                  bool release_left_out, bool size_history, bool register_views,
                                   const std::string& backend, const std::string& engine,
                                   const std::string& world_config,
                                   const std::string& planner_config, const std::string& arm_config,
@@ -26,6 +27,8 @@ trials::TrialOptions trialOptions(const std::string& planner, std::uint64_t seed
   o.max_views = max_views;
   o.clock = clock;
   o.stop = stop;
+  o.confirm_detections = confirm_detections;
+  o.release_left_out = release_left_out;
   o.record_size_history = size_history;
   o.register_views = register_views;
   o.backend = backend;
@@ -43,6 +46,7 @@ trials::TrialOptions trialOptions(const std::string& planner, std::uint64_t seed
   py::kw_only(),                                                                                \
       py::arg("planner") = "fvp", py::arg("seed") = 1, py::arg("budget_s") = 180.0,             \
       py::arg("max_views") = py::none(), py::arg("clock") = "wall", py::arg("stop") = "budget", \
+      py::arg("confirm_detections") = true, py::arg("release_left_out") = true,                 \
       py::arg("size_history") = false, py::arg("register_views") = false,                       \
       py::arg("backend") = "auto", py::arg("engine") = "", py::arg("world_config") = "",        \
       py::arg("planner_config") = "", py::arg("arm_config") = "", py::arg("out_dir") = ""
@@ -57,13 +61,15 @@ void bindSim(py::module_& m) {
                             "as keywords). Its camera and arm are the simulator's.")
       .def(py::init([](const std::string& planner, std::uint64_t seed, double budget_s,
                        std::optional<int> max_views, const std::string& clock,
-                       const std::string& stop, bool size_history, bool register_views,
-                       const std::string& backend, const std::string& engine,
-                       const std::string& world_config, const std::string& planner_config,
-                       const std::string& arm_config, const std::string& out_dir) {
-             return std::make_unique<trials::Trial>(trialOptions(
-                 planner, seed, budget_s, max_views, clock, stop, size_history, register_views,
-                 backend, engine, world_config, planner_config, arm_config, out_dir));
+                       const std::string& stop, bool confirm_detections, bool release_left_out,
+                       bool size_history, bool register_views, const std::string& backend,
+                       const std::string& engine, const std::string& world_config,
+                       const std::string& planner_config, const std::string& arm_config,
+                       const std::string& out_dir) {
+             return std::make_unique<trials::Trial>(
+                 trialOptions(planner, seed, budget_s, max_views, clock, stop, confirm_detections,
+                              release_left_out, size_history, register_views, backend, engine,
+                              world_config, planner_config, arm_config, out_dir));
            }),
            FVP_TRIAL_ARGS)
       .def_property_readonly(
@@ -92,13 +98,14 @@ void bindSim(py::module_& m) {
       "run_trial",
       [](const std::string& planner, std::uint64_t seed, double budget_s,
          std::optional<int> max_views, const std::string& clock, const std::string& stop,
-         bool size_history, bool register_views, const std::string& backend,
-         const std::string& engine, const std::string& world_config,
+         bool confirm_detections, bool release_left_out, bool size_history, bool register_views,
+         const std::string& backend, const std::string& engine, const std::string& world_config,
          const std::string& planner_config, const std::string& arm_config,
          const std::string& out_dir) {
-        const trials::TrialOptions o = trialOptions(
-            planner, seed, budget_s, max_views, clock, stop, size_history, register_views, backend,
-            engine, world_config, planner_config, arm_config, out_dir);
+        const trials::TrialOptions o =
+            trialOptions(planner, seed, budget_s, max_views, clock, stop, confirm_detections,
+                         release_left_out, size_history, register_views, backend, engine,
+                         world_config, planner_config, arm_config, out_dir);
         nlohmann::json result;
         {
           py::gil_scoped_release release;

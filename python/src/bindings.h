@@ -42,7 +42,16 @@ struct Planner {
   std::mutex mutex;  ///< as Session::mutex
 };
 
-void bindNbv(py::module_& m);  ///< Camera, Arm, StopCondition, run_nbv
-void bindSim(py::module_& m);  ///< fvp.sim: Trial, run_trial
+/// The session's maps, or std::runtime_error naming `what` when no view placed a region yet.
+host::map::MapEngine& requireMap(Session& s, const char* what);
+
+// The module's areas, one file each (bind_*.cpp), called in this order by PYBIND11_MODULE.
+void bindCore(py::module_& m);  ///< planners(), backends(), StereoIntrinsics, StereoFrame
+void bindPerceptionSizing(py::module_& m);  ///< PerceptionConfig, size_captures
+void bindSession(py::module_& m);           ///< MapEngine, MappingSession
+void bindPlanners(py::module_& m);          ///< Planner, info_gain
+void bindRobot(py::module_& m);             ///< Camera, Arm, CaptureResult, MoveResult
+void bindLoop(py::module_& m);              ///< LoopState, StopCondition, run_nbv
+void bindSim(py::module_& m);               ///< fvp.sim: Trial, run_trial
 
 }  // namespace fvp::python

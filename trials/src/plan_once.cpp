@@ -40,6 +40,121 @@ std::array<std::uint8_t, 3> colour(double t) {
           std::uint8_t(255 * (1 - t))};
 }
 
+double secondsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+/// One planning iteration and what it took: mapping, then planning with its moves.
+struct PlanRun {
+  host::planner::PlanStep step;
+  double map_s = 0.0, plan_s = 0.0;
+  nlohmann::json motions = nlohmann::json::array();
+  nlohmann::json warnings = nlohmann::json::array();
+};
+
+// A robot's captures: the map from every view (their own masks and disparities as given),
+// the camera where the last view was taken. The robot's own planner makes the move, so every
+// candidate counts as reachable and the best one is chosen.
+PlanRun planFromCaptures(const PlanOnceOptions& o, const std::vector<std::filesystem::path>& dirs,
+                         const host::PerceptionConfig& perception, const std::string& engine,
+                         const host::map::MapConfig& map_config, accel::Backend* backend,
+                         host::planner::ViewPlanner& planner) {
+  PlanRun run;
+  const auto t_map = std::chrono::steady_clock::now();
+  host::MappingSession session(perception, engine, map_config, backend);
+  Eigen::Isometry3d T_now = Eigen::Isometry3d::Identity();
+  for (const auto& dir : dirs) {
+    const host::Capture capture = host::readCapture(dir);
+    session.addView(host::toStereoFrame(capture));
+    T_now = capture.T_world_camera;
+  }
+  run.map_s = secondsSince(t_map);
+  if (!session.map())
+    throw std::runtime_error("plan: no capture in " + o.captures_dir.string() +
+                             " showed the AprilTag (" + perception.tag.family + " id " +
+                             std::to_string(perception.tag.tag_id) +
+                             ") and no region_center_m is configured: no Cluster Region, "
+                             "no map");
+  const auto t_plan = std::chrono::steady_clock::now();
+  run.step = planner.planAndMove(
+      *session.map(), T_now, [](const Eigen::Isometry3d&) { return true; },
+      [&](const Eigen::Isometry3d&) {
+        run.motions.push_back({{"status", "not_planned"}});
+        return true;
+      });
+  run.plan_s = secondsSince(t_plan);
+  return run;
+}
+
+// A simulated world mapped from o.views views on an arc, then planned from its start view
+// with the simulated arm making the moves.
+PlanRun planInSimulation(const PlanOnceOptions& o, const std::string& engine,
+                         const host::map::MapConfig& map_config, accel::Backend* backend,
+                         host::planner::ViewPlanner& planner) {
+  PlanRun run;
+  const auto t_map = std::chrono::steady_clock::now();
+  const WorldConfig world_config =
+      o.world_config.empty() ? WorldConfig{} : WorldConfig::fromYamlFile(o.world_config);
+  const World world = World::generate(world_config, o.seed);
+  SimulatedMappingOptions mapping;
+  mapping.engine = engine;
+  mapping.map = map_config;
+  mapping.render.noise_seed = o.seed;
+  SimulatedMapping mapped =
+      mapSimulatedViews(world, orbitViews(world, o.views, 90.0), mapping, backend);
+  run.map_s = secondsSince(t_map);
+  if (!mapped.map)
+    throw std::runtime_error("plan: no view detected the AprilTag: no Cluster Region, no map");
+
+  ArmConfig arm_config;
+  arm_config.workspace_cache_dir = defaultCacheDir();
+  const ArmModel arm(arm_config);
+  const WorkspaceTree workspace =
+      loadWorkspaceTree(arm, [&](const std::string& text) { run.warnings.push_back(text); });
+  SimClock clock(SimClock::Mode::kWall);
+  const auto start = ArmController::startConfiguration(arm, world.startCameraPose());
+  if (!start) throw std::runtime_error("plan: the start view is out of the arm's reach");
+  ArmController controller(arm, clock, *start);
+  controller.setMap(mapped.map->coarseOcTree());
+  const auto t_plan = std::chrono::steady_clock::now();
+  run.step = planner.planAndMove(
+      *mapped.map, controller.cameraPose(),
+      [&](const Eigen::Isometry3d& T) { return workspace.reachable(T); },
+      [&](const Eigen::Isometry3d& T) {
+        const MotionPlan plan = controller.moveToPose(T);
+        run.motions.push_back({{"status", toString(plan.status)},
+                               {"planning_s", plan.planning_wall_s},
+                               {"duration_s", plan.ok() ? plan.trajectory.duration_s() : 0.0}});
+        return plan.ok();
+      });
+  run.plan_s = secondsSince(t_plan);
+  return run;
+}
+
+/// plan.json's candidates, and their positions and colours for candidates.ply.
+nlohmann::json candidatesJson(const host::planner::PlanStep& step,
+                              std::vector<Eigen::Vector3f>& positions,
+                              std::vector<std::array<std::uint8_t, 3>>& colours) {
+  nlohmann::json candidates = nlohmann::json::array();
+  double lo = INFINITY, hi = -INFINITY;
+  for (const auto& c : step.candidates)
+    if (std::isfinite(c.utility)) lo = std::min(lo, c.utility), hi = std::max(hi, c.utility);
+  for (const auto& c : step.candidates) {
+    candidates.push_back(
+        {{"kind", host::planner::toString(c.kind)},
+         {"position_m", vec3(c.position_m())},
+         {"target_m", vec3(c.target_m)},
+         {"ig", c.ig},
+         {"utility", std::isfinite(c.utility) ? nlohmann::json(c.utility) : nlohmann::json()},
+         {"reachable", c.reachable}});
+    positions.push_back(c.position_m().cast<float>());
+    colours.push_back(std::isfinite(c.utility)
+                          ? colour(hi > lo ? (c.utility - lo) / (hi - lo) : 1.0)
+                          : std::array<std::uint8_t, 3>{128, 128, 128});
+  }
+  return candidates;
+}
+
 }  // namespace
 
 nlohmann::json planOnce(const PlanOnceOptions& o) {
@@ -68,99 +183,16 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
   const std::unique_ptr<host::planner::ViewPlanner> planner =
       host::planner::createPlanner(o.planner, o.planner_config, o.seed, backend.get());
   const host::map::MapConfig map_config = host::planner::plannerMapConfig(o.planner, engine);
-  nlohmann::json warnings = nlohmann::json::array();
-  nlohmann::json motions = nlohmann::json::array();
-  const auto t_map = std::chrono::steady_clock::now();
-  host::planner::PlanStep step;
-  double map_s = 0.0;
-  const auto since = [](std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-  };
-  std::chrono::steady_clock::time_point t_plan;
+  const PlanRun run = from_captures
+                          ? planFromCaptures(o, capture_dirs, perception, engine, map_config,
+                                             backend.get(), *planner)
+                          : planInSimulation(o, engine, map_config, backend.get(), *planner);
+  const host::planner::PlanStep& step = run.step;
 
-  if (from_captures) {
-    // A robot's captures: the map from every view (their own masks and disparities as
-    // given), the camera where the last view was taken. The robot's own planner makes the
-    // move, so every candidate counts as reachable and the best one is chosen.
-    host::MappingSession session(perception, engine, map_config, backend.get());
-    Eigen::Isometry3d T_now = Eigen::Isometry3d::Identity();
-    for (const auto& dir : capture_dirs) {
-      const host::Capture capture = host::readCapture(dir);
-      session.addView(host::toStereoFrame(capture));
-      T_now = capture.T_world_camera;
-    }
-    map_s = since(t_map);
-    if (!session.map())
-      throw std::runtime_error("plan: no capture in " + o.captures_dir.string() +
-                               " showed the AprilTag (" + perception.tag.family + " id " +
-                               std::to_string(perception.tag.tag_id) +
-                               ") and no region_center_m is configured: no Cluster Region, "
-                               "no map");
-    t_plan = std::chrono::steady_clock::now();
-    step = planner->planAndMove(
-        *session.map(), T_now, [](const Eigen::Isometry3d&) { return true; },
-        [&](const Eigen::Isometry3d&) {
-          motions.push_back({{"status", "not_planned"}});
-          return true;
-        });
-  } else {
-    const WorldConfig world_config =
-        o.world_config.empty() ? WorldConfig{} : WorldConfig::fromYamlFile(o.world_config);
-    const World world = World::generate(world_config, o.seed);
-    SimulatedMappingOptions mapping;
-    mapping.engine = engine;
-    mapping.map = map_config;
-    mapping.render.noise_seed = o.seed;
-    SimulatedMapping mapped =
-        mapSimulatedViews(world, orbitViews(world, o.views, 90.0), mapping, backend.get());
-    map_s = since(t_map);
-    if (!mapped.map)
-      throw std::runtime_error("plan: no view detected the AprilTag: no Cluster Region, no map");
-
-    ArmConfig arm_config;
-    arm_config.workspace_cache_dir = defaultCacheDir();
-    const ArmModel arm(arm_config);
-    const WorkspaceTree workspace =
-        loadWorkspaceTree(arm, [&](const std::string& text) { warnings.push_back(text); });
-    SimClock clock(SimClock::Mode::kWall);
-    const auto start = ArmController::startConfiguration(arm, world.startCameraPose());
-    if (!start) throw std::runtime_error("plan: the start view is out of the arm's reach");
-    ArmController controller(arm, clock, *start);
-    controller.setMap(mapped.map->coarseOcTree());
-    t_plan = std::chrono::steady_clock::now();
-    step = planner->planAndMove(
-        *mapped.map, controller.cameraPose(),
-        [&](const Eigen::Isometry3d& T) { return workspace.reachable(T); },
-        [&](const Eigen::Isometry3d& T) {
-          const MotionPlan plan = controller.moveToPose(T);
-          motions.push_back({{"status", toString(plan.status)},
-                             {"planning_s", plan.planning_wall_s},
-                             {"duration_s", plan.ok() ? plan.trajectory.duration_s() : 0.0}});
-          return plan.ok();
-        });
-  }
-  const double plan_s = since(t_plan);
-
-  nlohmann::json candidates = nlohmann::json::array();
   std::vector<Eigen::Vector3f> positions;
   std::vector<std::array<std::uint8_t, 3>> colours;
-  double lo = INFINITY, hi = -INFINITY;
-  for (const auto& c : step.candidates)
-    if (std::isfinite(c.utility)) lo = std::min(lo, c.utility), hi = std::max(hi, c.utility);
-  for (const auto& c : step.candidates) {
-    candidates.push_back(
-        {{"kind", host::planner::toString(c.kind)},
-         {"position_m", vec3(c.position_m())},
-         {"target_m", vec3(c.target_m)},
-         {"ig", c.ig},
-         {"utility", std::isfinite(c.utility) ? nlohmann::json(c.utility) : nlohmann::json()},
-         {"reachable", c.reachable}});
-    positions.push_back(c.position_m().cast<float>());
-    colours.push_back(std::isfinite(c.utility)
-                          ? colour(hi > lo ? (c.utility - lo) / (hi - lo) : 1.0)
-                          : std::array<std::uint8_t, 3>{128, 128, 128});
-  }
-  nlohmann::json timings = {{"mapping_views", map_s}, {"plan_and_move", plan_s}};
+  const nlohmann::json candidates = candidatesJson(step, positions, colours);
+  nlohmann::json timings = {{"mapping_views", run.map_s}, {"plan_and_move", run.plan_s}};
   for (const auto& [stage, s] : step.timings_s) timings[stage] = s;
   nlohmann::json result = {
       {"chosen", step.chosen ? nlohmann::json(*step.chosen) : nlohmann::json()},
@@ -179,8 +211,8 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
       {"rejected_clearance", step.rejected_clearance},
       {"gain_rays", step.gain_rays},
       {"culled_rays", step.culled_rays},
-      {"motions", motions},
-      {"warnings", warnings}};
+      {"motions", run.motions},
+      {"warnings", run.warnings}};
   if (!o.out_dir.empty()) {
     // The result first, then the extra.
     host::writeFileAtomically(o.out_dir / "plan.json", "plan", result.dump(2) + "\n");

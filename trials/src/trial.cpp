@@ -344,6 +344,74 @@ std::vector<ApproachPose> approachPoses(const FruitletCluster& cluster) {
   return poses;
 }
 
+/// The cluster not yet visited whose start view is nearest `here` (the first on a tie).
+std::size_t nearestUnvisited(const std::vector<FruitletCluster>& clusters,
+                             const std::vector<bool>& visited, const Eigen::Vector3d& here) {
+  std::size_t k = clusters.size();
+  for (std::size_t i = 0; i < clusters.size(); ++i)
+    if (!visited[i] && (k == clusters.size() ||
+                        (clusters[i].T_world_start_camera.translation() - here).norm() <
+                            (clusters[k].T_world_start_camera.translation() - here).norm()))
+      k = i;
+  return k;
+}
+
+/// What a tree's tour has gathered so far, cluster by cluster: result.json's parts.
+struct TourRecord {
+  nlohmann::json cluster_entries = nlohmann::json::array();
+  nlohmann::json order = nlohmann::json::array();
+  nlohmann::json scored = nlohmann::json::object();  // "fruitlets..." arrays over the clusters
+  nlohmann::json events = nlohmann::json::object(), wall = nlohmann::json::object();
+  nlohmann::json transit_motion = nlohmann::json::object();
+  std::map<std::string, int> cluster_status;
+  std::vector<Eigen::Vector3d> camera_path;
+  nlohmann::json cluster_write_failures = nlohmann::json::object();  // as extraWriter records
+  std::uint64_t detections = 0;
+  int views = 0;
+  double transit_s = 0.0;
+  nlohmann::json planner_config, trial_config;
+  std::string scene_error;  // why the scene could not be built (no viewer then)
+  nlohmann::json overlays = nlohmann::json::array();
+};
+
+/// A cluster's approach views (approachPoses), tried in order: each moveToNext moves the arm
+/// to the next one it can reach, charging the transit to the tour, until a move succeeds.
+class ApproachSequence {
+ public:
+  explicit ApproachSequence(const FruitletCluster& cluster)
+      : cluster_(cluster), poses_(approachPoses(cluster)) {}
+
+  /// False when no approach view is left; a success records the view in `entry`.
+  bool moveToNext(host::nbv::Arm& arm, host::nbv::LoopClock& clock, nlohmann::json& entry,
+                  TourRecord& tour) {
+    for (; next_ < poses_.size(); ++next_) {
+      const auto& [T, yaw_deg] = poses_[next_];
+      if (arm.cameraPose().isApprox(T, 1e-9) || !arm.reachable(T)) continue;
+      const double before_s = clock.now_s();
+      const host::nbv::MoveResult move = arm.moveTo(T);
+      tour.transit_s += clock.now_s() - before_s;
+      move_status_ = host::nbv::toString(move.status);
+      tour.transit_motion[move_status_] = tour.transit_motion.value(move_status_, 0) + 1;
+      if (move.ok()) {
+        entry["approach_distance_m"] = (T.translation() - cluster_.center_m).norm();
+        entry["approach_yaw_deg"] = yaw_deg;
+        ++next_;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  /// The last move's status, "unreachable" when none was tried.
+  const std::string& lastMoveStatus() const { return move_status_; }
+
+ private:
+  const FruitletCluster& cluster_;
+  std::vector<ApproachPose> poses_;
+  std::size_t next_ = 0;
+  std::string move_status_ = "unreachable";
+};
+
 /// The perception of cluster k: in a world of several clusters only its own tag places a
 /// Cluster Region (one cluster: any tag, as a grower's single tag).
 host::PerceptionConfig perceptionFor(const World& world, std::size_t k) {
@@ -479,6 +547,20 @@ struct Trial::Impl {
 
   nlohmann::json run(host::nbv::Camera& loop_camera, host::nbv::Arm& loop_arm);
   nlohmann::json runTree(host::nbv::Camera& loop_camera, host::nbv::Arm& loop_arm);
+  /// The tree's steps: a cluster's loop, retried from its next approach view while no view
+  /// shows its tag; its entry and totals; its files and scene part; the result.
+  ClusterOutcome runClusterFromApproaches(TrialParts& cluster_parts, const FruitletCluster& cluster,
+                                          ApproachSequence& approach,
+                                          host::nbv::Camera& loop_camera, host::nbv::Arm& loop_arm,
+                                          host::nbv::LoopClock& loop_clock, TrialLog& log,
+                                          nlohmann::json& entry, TourRecord& tour);
+  void recordCluster(std::size_t k, TrialParts& cluster_parts, const ClusterOutcome& outcome,
+                     const TrialLog& log, double sim_time_s, nlohmann::json& entry,
+                     TourRecord& tour);
+  void writeClusterOutputs(std::size_t k, TrialParts& cluster_parts, const ClusterOutcome& outcome,
+                           const TrialLog& log, host::report::ViewerScene& scene, TourRecord& tour);
+  void scoreSkippedClusters(TourRecord& tour, host::report::ViewerScene& scene) const;
+  nlohmann::json treeResult(TourRecord& tour, host::report::ViewerScene& scene);
   /// The fields every result has: options, config, clock, logs, warnings.
   void describeRun(nlohmann::json& result, const TrialLog& log,
                    const std::vector<Eigen::Vector3d>& camera_path) const;
@@ -714,176 +796,163 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
   std::vector<bool> visited(clusters.size(), false);
   std::unique_ptr<host::map::MapEngine> carried_map;
   std::unique_ptr<TrialParts> cluster_parts = std::move(parts);
-  nlohmann::json cluster_entries = nlohmann::json::array(), tour = nlohmann::json::array();
-  nlohmann::json scored = nlohmann::json::object();  // "fruitlets..." arrays over the clusters
-  nlohmann::json events = nlohmann::json::object(), wall = nlohmann::json::object();
-  nlohmann::json transit_motion = nlohmann::json::object();
-  std::map<std::string, int> cluster_status;
-  std::vector<Eigen::Vector3d> camera_path;
-  nlohmann::json cluster_write_failures = nlohmann::json::object();  // as extraWriter records
-  std::uint64_t detections = 0;
-  int views = 0;
-  double transit_s = 0.0;
-  nlohmann::json planner_config, trial_config;
+  TourRecord tour;
   host::report::ViewerScene scene(viewerTitle(), "");
-  std::string scene_error;  // why the scene could not be built (no viewer then)
-  nlohmann::json overlays = nlohmann::json::array();
   for (std::size_t step = 0; step < clusters.size(); ++step) {
-    // The nearest unvisited start view from where the camera is now.
-    const Eigen::Vector3d here = loop_arm.cameraPose().translation();
-    std::size_t k = clusters.size();
-    for (std::size_t i = 0; i < clusters.size(); ++i)
-      if (!visited[i] && (k == clusters.size() ||
-                          (clusters[i].T_world_start_camera.translation() - here).norm() <
-                              (clusters[k].T_world_start_camera.translation() - here).norm()))
-        k = i;
+    const std::size_t k = nearestUnvisited(clusters, visited, loop_arm.cameraPose().translation());
     visited[k] = true;
-    tour.push_back(k);
+    tour.order.push_back(k);
     const FruitletCluster& cluster = clusters[k];
     nlohmann::json entry = {{"index", k},
                             {"tag_id", cluster.tag.tag_id},
                             {"gt_fruitlets", cluster.fruitlet_indices.size()},
                             {"start_sim_s", loop_clock.now_s()}};
-    const auto skip = [&](const std::string& status) {
-      entry["status"] = status;
-      ++cluster_status[status];
-      cluster_entries.push_back(entry);
-    };
     // To its start view (the first cluster's is where the arm starts), or, where the arm
     // cannot stand there, the same view from farther out along its axis, then turned.
-    const std::vector<ApproachPose> approaches = approachPoses(cluster);
-    std::size_t next_approach = 0;
-    std::string move_status = "unreachable";
-    const auto approach = [&] {
-      for (; next_approach < approaches.size(); ++next_approach) {
-        const auto& [T, yaw_deg] = approaches[next_approach];
-        if (loop_arm.cameraPose().isApprox(T, 1e-9) || !loop_arm.reachable(T)) continue;
-        const double before_s = loop_clock.now_s();
-        const host::nbv::MoveResult move = loop_arm.moveTo(T);
-        transit_s += loop_clock.now_s() - before_s;
-        move_status = host::nbv::toString(move.status);
-        transit_motion[move_status] = transit_motion.value(move_status, 0) + 1;
-        if (move.ok()) {
-          entry["approach_distance_m"] = (T.translation() - cluster.center_m).norm();
-          entry["approach_yaw_deg"] = yaw_deg;
-          ++next_approach;
-          return true;
-        }
-      }
-      return false;
-    };
-    if (!loop_arm.cameraPose().isApprox(cluster.T_world_start_camera, 1e-9) && !approach()) {
-      entry["move_status"] = move_status;
-      skip(move_status == "unreachable" ? "unreachable" : "move_failed");
+    ApproachSequence approach(cluster);
+    if (!loop_arm.cameraPose().isApprox(cluster.T_world_start_camera, 1e-9) &&
+        !approach.moveToNext(loop_arm, loop_clock, entry, tour)) {
+      entry["move_status"] = approach.lastMoveStatus();
+      const std::string status =
+          approach.lastMoveStatus() == "unreachable" ? "unreachable" : "move_failed";
+      entry["status"] = status;
+      ++tour.cluster_status[status];
+      tour.cluster_entries.push_back(entry);
       continue;
     }
     if (!cluster_parts) cluster_parts = makeParts(k);
     if (carried_map) cluster_parts->session().carryOnWith(std::move(carried_map));
     const double t0_s = loop_clock.now_s();
     log.startCluster(static_cast<int>(k), cluster.center_m);
-    ClusterOutcome outcome =
-        runCluster(*cluster_parts, cluster, loop_camera, loop_arm, loop_clock, log);
-    // A view that shows no tag (a leaf before it from there, foliage an earlier cluster's
-    // views put on the way) places no Cluster Region: the next approach view may show it.
-    // The views taken on the way are the cluster's too.
-    std::vector<Eigen::Isometry3d> untagged_poses;  // one per untagged view
-    int retried_approaches = 0;
-    while (!cluster_parts->map() && outcome.run.stop_reason == "no_region" && approach()) {
-      untagged_poses.insert(untagged_poses.end(), outcome.run.camera_poses.begin(),
-                            outcome.run.camera_poses.end());
-      ++retried_approaches;
-      outcome = runCluster(*cluster_parts, cluster, loop_camera, loop_arm, loop_clock, log);
-    }
-    outcome.run.views += untagged_poses.size();
-    outcome.run.camera_poses.insert(outcome.run.camera_poses.begin(), untagged_poses.begin(),
-                                    untagged_poses.end());
-    entry["approaches_without_tag"] = retried_approaches;
-    const bool mapped = cluster_parts->map() != nullptr;
-    if (options.register_views)
-      entry["anchor_offset"] = anchorOffsetJson(cluster_parts->session(), log.trueAnchorShift());
-    entry["status"] = mapped ? "sized" : "no_tag";
-    ++cluster_status[entry["status"].get<std::string>()];
-    entry["views"] = outcome.run.views;
-    entry["first_view"] = log.firstView();  // the run's number of its first view
-    entry["stop_reason"] = outcome.run.stop_reason;
-    entry["sim_time_s"] = loop_clock.now_s() - t0_s;
-    for (auto& [key, value] : outcome.sizing.items()) {
-      if (key.rfind("fruitlets", 0) == 0) {
-        // Every scored fruitlet says which cluster it is in.
-        nlohmann::json tagged = value;
-        for (auto& f : tagged) f["cluster"] = k;
-        for (const auto& f : tagged) scored[key].push_back(f);
-        entry[key] = std::move(tagged);
-      } else if (key == "detections" || key.rfind("metrics", 0) == 0 || key == "sizing_estimator" ||
-                 key == "unsupported_detections" || key == "sized_fruitlets" ||
-                 key == "sizing_stats") {
-        entry[key] = value;
-      }
-    }
-    detections += outcome.sizing.value("detections", std::uint64_t{0});
-    views += outcome.run.views;
-    entry["events"] = eventsJson(outcome.run.events);
-    entry["events"].update(outcome.guidance_events);
-    addNumbers(events, entry["events"]);
-    addNumbers(wall, {{"perception", outcome.run.wall_s.perception},
-                      {"mapping", outcome.run.wall_s.mapping},
-                      {"tsdf", outcome.run.wall_s.tsdf},
-                      {"planning", outcome.run.wall_s.planning},
-                      {"motion_planning", outcome.run.wall_s.motion_planning},
-                      {"sizing", outcome.sizing_wall_s},
-                      {"sizing_during_loop", outcome.sizing_during_loop_s}});
-    if (!outcome.size_history.is_null()) entry["size_history"] = outcome.size_history;
-    for (const auto& T : outcome.run.camera_poses) camera_path.push_back(T.translation());
-    planner_config = nlohmann::json::parse(cluster_parts->planner().configJson());
-    trial_config = cluster_parts->configJson();
-    if (!options.out_dir.empty()) {
-      // Written as the tour goes (the map moves on); a failure is recorded with the tree's
-      // result, not the end of the tour.
-      const ExtraWriter record = extraWriter(cluster_write_failures);
-      cluster_parts->writeClusterFiles(
-          options.out_dir / clusterDirName(k),
-          [&](const std::string& file, const std::function<void()>& write) {
-            record(clusterDirName(k) + "/" + file, write);
-          });
-      const int cluster = static_cast<int>(k);
-      // The scene's part of this cluster now: its map moves on to the next cluster.
-      try {
-        host::addSessionToScene(scene, cluster_parts->session(), outcome.sizing, log.firstView(),
-                                cluster);
-      } catch (const std::exception& e) {
-        scene_error = e.what();
-      }
-      for (auto& o : overlaysOrWarning([&] {
-             return host::writeSessionOverlays(cluster_parts->session(), outcome.sizing,
-                                               log.firstView(), cluster, imageSource(log),
-                                               options.out_dir, "start view");
-           }))
-        overlays.push_back(std::move(o));
-    }
-    cluster_entries.push_back(entry);
+    const ClusterOutcome outcome = runClusterFromApproaches(
+        *cluster_parts, cluster, approach, loop_camera, loop_arm, loop_clock, log, entry, tour);
+    recordCluster(k, *cluster_parts, outcome, log, loop_clock.now_s() - t0_s, entry, tour);
+    if (!options.out_dir.empty()) writeClusterOutputs(k, *cluster_parts, outcome, log, scene, tour);
+    tour.cluster_entries.push_back(entry);
     carried_map = std::move(cluster_parts->session()).releaseMap();
     cluster_parts.reset();
   }
 
-  nlohmann::json result;
-  result["planner"] = options.planner;
-  result["seed"] = options.seed;
-  result["engine"] = engine;
-  result["backend"] = backend ? std::string(accel::toString(backend->kind())) : "none";
-  result["views"] = views;
-  result["stop_reason"] = "tour_done";
-  result["sim_time_s"] = clock->now_s();
-  result["budget_s"] = options.budget_s;
-  result["wall_time_s"] = secondsSince(wall_start);
-  result["status"] = cluster_status["sized"] > 0 ? "ok" : "no_tag";
-  result["config"] = {{"planner", planner_config},
-                      {"arm", nlohmann::json::parse(arm_config.toJson())},
-                      {"trial", trial_config}};
-  // Every cluster's fruitlets, scored against its own ground truth, and the pooled metrics
-  // (a skipped cluster's fruitlets are in them, not matched).
-  for (const auto& c : cluster_entries) {
+  nlohmann::json result = treeResult(tour, scene);
+  describeRun(result, log, tour.camera_path);
+  for (const char* key : {"warnings", "unwritten_outputs"})
+    for (const auto& item : tour.cluster_write_failures.value(key, nlohmann::json::array()))
+      result[key].push_back(item);
+  for (const auto& c : result["clusters"])
+    if (c.contains("first_view"))
+      markSizedViews(result["view_log"], c, c["first_view"].get<int>(), c["index"].get<int>());
+  if (!options.out_dir.empty()) {
+    writeTreeOutputs(result, *world, carried_map.get(), tour.camera_path, options.out_dir,
+                     options.on_warning, extraWriter(result));
+    finishExtras(result, log, [&] {
+      if (!tour.scene_error.empty()) throw std::runtime_error(tour.scene_error);
+      writeTrialViewer(scene, result, log.intrinsics(), options.out_dir);
+    });
+  }
+  return result;
+}
+
+// A view that shows no tag (a leaf before it from there, foliage an earlier cluster's views
+// put on the way) places no Cluster Region: the next approach view may show it. The views
+// taken on the way are the cluster's too.
+ClusterOutcome Trial::Impl::runClusterFromApproaches(
+    TrialParts& cluster_parts, const FruitletCluster& cluster, ApproachSequence& approach,
+    host::nbv::Camera& loop_camera, host::nbv::Arm& loop_arm, host::nbv::LoopClock& loop_clock,
+    TrialLog& log, nlohmann::json& entry, TourRecord& tour) {
+  ClusterOutcome outcome =
+      runCluster(cluster_parts, cluster, loop_camera, loop_arm, loop_clock, log);
+  std::vector<Eigen::Isometry3d> untagged_poses;  // one per untagged view
+  int retried_approaches = 0;
+  while (!cluster_parts.map() && outcome.run.stop_reason == "no_region" &&
+         approach.moveToNext(loop_arm, loop_clock, entry, tour)) {
+    untagged_poses.insert(untagged_poses.end(), outcome.run.camera_poses.begin(),
+                          outcome.run.camera_poses.end());
+    ++retried_approaches;
+    outcome = runCluster(cluster_parts, cluster, loop_camera, loop_arm, loop_clock, log);
+  }
+  outcome.run.views += untagged_poses.size();
+  outcome.run.camera_poses.insert(outcome.run.camera_poses.begin(), untagged_poses.begin(),
+                                  untagged_poses.end());
+  entry["approaches_without_tag"] = retried_approaches;
+  return outcome;
+}
+
+// One visited cluster into its entry and the tour's totals.
+void Trial::Impl::recordCluster(std::size_t k, TrialParts& cluster_parts,
+                                const ClusterOutcome& outcome, const TrialLog& log,
+                                double sim_time_s, nlohmann::json& entry, TourRecord& tour) {
+  const bool mapped = cluster_parts.map() != nullptr;
+  if (options.register_views)
+    entry["anchor_offset"] = anchorOffsetJson(cluster_parts.session(), log.trueAnchorShift());
+  entry["status"] = mapped ? "sized" : "no_tag";
+  ++tour.cluster_status[entry["status"].get<std::string>()];
+  entry["views"] = outcome.run.views;
+  entry["first_view"] = log.firstView();  // the run's number of its first view
+  entry["stop_reason"] = outcome.run.stop_reason;
+  entry["sim_time_s"] = sim_time_s;
+  for (auto& [key, value] : outcome.sizing.items()) {
+    if (key.rfind("fruitlets", 0) == 0) {
+      // Every scored fruitlet says which cluster it is in.
+      nlohmann::json tagged = value;
+      for (auto& f : tagged) f["cluster"] = k;
+      for (const auto& f : tagged) tour.scored[key].push_back(f);
+      entry[key] = std::move(tagged);
+    } else if (key == "detections" || key.rfind("metrics", 0) == 0 || key == "sizing_estimator" ||
+               key == "unsupported_detections" || key == "sized_fruitlets" ||
+               key == "sizing_stats") {
+      entry[key] = value;
+    }
+  }
+  tour.detections += outcome.sizing.value("detections", std::uint64_t{0});
+  tour.views += outcome.run.views;
+  entry["events"] = eventsJson(outcome.run.events);
+  entry["events"].update(outcome.guidance_events);
+  addNumbers(tour.events, entry["events"]);
+  addNumbers(tour.wall, {{"perception", outcome.run.wall_s.perception},
+                         {"mapping", outcome.run.wall_s.mapping},
+                         {"tsdf", outcome.run.wall_s.tsdf},
+                         {"planning", outcome.run.wall_s.planning},
+                         {"motion_planning", outcome.run.wall_s.motion_planning},
+                         {"sizing", outcome.sizing_wall_s},
+                         {"sizing_during_loop", outcome.sizing_during_loop_s}});
+  if (!outcome.size_history.is_null()) entry["size_history"] = outcome.size_history;
+  for (const auto& T : outcome.run.camera_poses) tour.camera_path.push_back(T.translation());
+  tour.planner_config = nlohmann::json::parse(cluster_parts.planner().configJson());
+  tour.trial_config = cluster_parts.configJson();
+}
+
+// Written as the tour goes (the map moves on); a failure is recorded with the tree's result,
+// not the end of the tour.
+void Trial::Impl::writeClusterOutputs(std::size_t k, TrialParts& cluster_parts,
+                                      const ClusterOutcome& outcome, const TrialLog& log,
+                                      host::report::ViewerScene& scene, TourRecord& tour) {
+  const ExtraWriter record = extraWriter(tour.cluster_write_failures);
+  cluster_parts.writeClusterFiles(options.out_dir / clusterDirName(k),
+                                  [&](const std::string& file, const std::function<void()>& write) {
+                                    record(clusterDirName(k) + "/" + file, write);
+                                  });
+  const int cluster = static_cast<int>(k);
+  // The scene's part of this cluster now: its map moves on to the next cluster.
+  try {
+    host::addSessionToScene(scene, cluster_parts.session(), outcome.sizing, log.firstView(),
+                            cluster);
+  } catch (const std::exception& e) {
+    tour.scene_error = e.what();
+  }
+  for (auto& o : overlaysOrWarning([&] {
+         return host::writeSessionOverlays(cluster_parts.session(), outcome.sizing, log.firstView(),
+                                           cluster, imageSource(log), options.out_dir,
+                                           "start view");
+       }))
+    tour.overlays.push_back(std::move(o));
+}
+
+// Every cluster's fruitlets, scored against its own ground truth, and the pooled metrics (a
+// skipped cluster's fruitlets are in them, not matched).
+void Trial::Impl::scoreSkippedClusters(TourRecord& tour, host::report::ViewerScene& scene) const {
+  for (const auto& c : tour.cluster_entries) {
     if (c.contains("fruitlets")) continue;
-    const auto& indices = clusters[c.at("index").get<std::size_t>()].fruitlet_indices;
+    const auto& indices = world->clusters()[c.at("index").get<std::size_t>()].fruitlet_indices;
     nlohmann::json cluster_missed = nlohmann::json::array();
     for (const auto& g : groundTruthOf(*world, indices)) {
       const nlohmann::json missed = {{"gt_center_m", vec3Json(g.center_m)},
@@ -892,48 +961,53 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
                                      {"est_center_m", nullptr},
                                      {"est_size_mm", nullptr},
                                      {"cluster", c.at("index")}};
-      scored["fruitlets"].push_back(missed);
+      tour.scored["fruitlets"].push_back(missed);
       for (const char* other : {"fruitlets_paper_sizing", "fruitlets_ours_sizing"})
-        if (scored.contains(other)) scored[other].push_back(missed);
+        if (tour.scored.contains(other)) tour.scored[other].push_back(missed);
       cluster_missed.push_back(missed);
     }
     // The viewer shows a skipped cluster's fruitlets too, none matched.
     scene.addSizing({{"fruitlets", cluster_missed}}, 0, c.at("index").get<int>());
   }
-  if (!scored.contains("fruitlets")) scored["fruitlets"] = nlohmann::json::array();
-  for (const auto& [key, fruitlets] : scored.items()) {
+}
+
+// The tree's result.json before describeRun: the tour's totals, every cluster's entry and
+// the pooled metrics.
+nlohmann::json Trial::Impl::treeResult(TourRecord& tour, host::report::ViewerScene& scene) {
+  nlohmann::json result;
+  result["planner"] = options.planner;
+  result["seed"] = options.seed;
+  result["engine"] = engine;
+  result["backend"] = backend ? std::string(accel::toString(backend->kind())) : "none";
+  result["views"] = tour.views;
+  result["stop_reason"] = "tour_done";
+  result["sim_time_s"] = clock->now_s();
+  result["budget_s"] = options.budget_s;
+  result["wall_time_s"] = secondsSince(wall_start);
+  result["status"] = tour.cluster_status["sized"] > 0 ? "ok" : "no_tag";
+  result["config"] = {{"planner", tour.planner_config},
+                      {"arm", nlohmann::json::parse(arm_config.toJson())},
+                      {"trial", tour.trial_config}};
+  scoreSkippedClusters(tour, scene);
+  if (!tour.scored.contains("fruitlets")) tour.scored["fruitlets"] = nlohmann::json::array();
+  for (const auto& [key, fruitlets] : tour.scored.items()) {
     result[key] = fruitlets;
     result["metrics" + key.substr(std::string("fruitlets").size())] =
-        host::eval::pooledMetricsJson(fruitlets, detections);
+        host::eval::pooledMetricsJson(fruitlets, tour.detections);
   }
-  result["detections"] = detections;
-  if (!cluster_entries.empty() && cluster_entries.back().contains("sizing_estimator"))
-    result["sizing_estimator"] = cluster_entries.back()["sizing_estimator"];
-  result["clusters"] = cluster_entries;
-  result["tour"] = {{"order", tour},
-                    {"cluster_status", cluster_status},
-                    {"transit_sim_s", transit_s},
-                    {"transit_motion_status", transit_motion}};
-  result["events"] = events.empty() ? eventsJson({}) : events;
-  wall["rendering"] = camera->totalRenderSeconds();
-  result["wall_breakdown_s"] = wall;
+  result["detections"] = tour.detections;
+  if (!tour.cluster_entries.empty() && tour.cluster_entries.back().contains("sizing_estimator"))
+    result["sizing_estimator"] = tour.cluster_entries.back()["sizing_estimator"];
+  result["clusters"] = tour.cluster_entries;
+  result["tour"] = {{"order", tour.order},
+                    {"cluster_status", tour.cluster_status},
+                    {"transit_sim_s", tour.transit_s},
+                    {"transit_motion_status", tour.transit_motion}};
+  result["events"] = tour.events.empty() ? eventsJson({}) : tour.events;
+  tour.wall["rendering"] = camera->totalRenderSeconds();
+  result["wall_breakdown_s"] = tour.wall;
   result["stop"] = stopJson();
-  if (!options.out_dir.empty()) result["overlays"] = overlays;
-  describeRun(result, log, camera_path);
-  for (const char* key : {"warnings", "unwritten_outputs"})
-    for (const auto& item : cluster_write_failures.value(key, nlohmann::json::array()))
-      result[key].push_back(item);
-  for (const auto& c : result["clusters"])
-    if (c.contains("first_view"))
-      markSizedViews(result["view_log"], c, c["first_view"].get<int>(), c["index"].get<int>());
-  if (!options.out_dir.empty()) {
-    writeTreeOutputs(result, *world, carried_map.get(), camera_path, options.out_dir,
-                     options.on_warning, extraWriter(result));
-    finishExtras(result, log, [&] {
-      if (!scene_error.empty()) throw std::runtime_error(scene_error);
-      writeTrialViewer(scene, result, log.intrinsics(), options.out_dir);
-    });
-  }
+  if (!options.out_dir.empty()) result["overlays"] = tour.overlays;
   return result;
 }
 

@@ -192,6 +192,172 @@ void checkKeyRange(const char* name, const GridGeometry& g, int key_offset) {
   checkKeyRange(name, lo, end, key_offset);
 }
 
+// computeRayKeys on the part of the ray o -> e inside `clip`, keeping the keys `keep` accepts.
+template <typename Tree, typename Keep>
+void addFreeKeys(const Tree& tree, const octomap::point3d& o, const octomap::point3d& e,
+                 const Interval& clip, octomap::KeyRay& key_ray, const Keep& keep,
+                 OcTreeKeySet& out) {
+  if (clip.empty()) return;
+  const Eigen::Vector3d od(o.x(), o.y(), o.z());
+  const Eigen::Vector3d dd = Eigen::Vector3d(e.x(), e.y(), e.z()) - od;
+  auto at = [&](double t) {
+    const Eigen::Vector3d p = od + t * dd;
+    return octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()),
+                            static_cast<float>(p.z()));
+  };
+  const octomap::point3d a = clip.t0 > 0.0 ? at(clip.t0) : o;
+  const octomap::point3d b = clip.t1 < 1.0 ? at(clip.t1) : e;
+  if (!tree.computeRayKeys(a, b, key_ray)) return;
+  for (const octomap::OcTreeKey& key : key_ray) {
+    if (keep(key)) out.insert(key);
+  }
+}
+
+/// Where a scan updates the two trees: the coarse grid, and the fine map (the Cluster
+/// Region, and with an observation_box extent every voxel of the box too).
+struct ScanTarget {
+  const octomap::OcTree& coarse;
+  const RoiOcTree& fine;
+  const GridGeometry& coarse_grid;
+  const GridGeometry& fine_grid;
+  fvp_region fine_region;
+  int key_offset = 0;
+  bool whole_box = false;
+  std::array<std::int64_t, 3> box_lo, box_hi;  // the observation box on the fine lattice
+  Eigen::Vector3d region_center;
+  double region_radius_m = 0.0;
+
+  bool inFineRegion(const octomap::OcTreeKey& key) const {
+    std::array<int, 3> i;
+    return inGrid(fine_grid, key_offset, key, i) &&
+           fvp_region_contains(&fine_region, i[0], i[1], i[2]);
+  }
+  bool inCoarseGrid(const octomap::OcTreeKey& key) const {
+    std::array<int, 3> i;
+    return inGrid(coarse_grid, key_offset, key, i);
+  }
+  // The region is always updated (it may reach beyond the box); with an observation_box
+  // extent, every voxel of the box too.
+  bool inFineMap(const octomap::OcTreeKey& key) const {
+    if (inFineRegion(key)) return true;
+    if (!whole_box) return false;
+    for (int a = 0; a < 3; ++a) {
+      const std::int64_t i = std::int64_t{key[a]} - key_offset;
+      if (i < box_lo[a] || i >= box_hi[a]) return false;
+    }
+    return true;
+  }
+
+  std::vector<ScanKeys> collectKeys(const octomap::point3d& origin,
+                                    const std::vector<accel::ScanPoint>& points) const;
+};
+
+// Each thread collects the keys of its rays into its own sets.
+std::vector<ScanKeys> ScanTarget::collectKeys(const octomap::point3d& origin,
+                                              const std::vector<accel::ScanPoint>& points) const {
+  const double cs = coarse_grid.voxel_size_m, fs = fine_grid.voxel_size_m;
+  Eigen::Vector3d coarse_lo, coarse_hi, fine_lo, fine_hi;
+  for (int a = 0; a < 3; ++a) {
+    coarse_lo[a] = (coarse_grid.first_voxel[a] - kClipMarginVoxels) * cs;
+    coarse_hi[a] = (coarse_grid.first_voxel[a] + coarse_grid.dims[a] + kClipMarginVoxels) * cs;
+    fine_lo[a] = (fine_grid.first_voxel[a] - kClipMarginVoxels) * fs;
+    fine_hi[a] = (fine_grid.first_voxel[a] + fine_grid.dims[a] + kClipMarginVoxels) * fs;
+  }
+  const double region_clip_radius = region_radius_m + kClipMarginVoxels * fs;
+  const auto keepCoarse = [this](const octomap::OcTreeKey& key) { return inCoarseGrid(key); };
+  const auto keepFine = [this](const octomap::OcTreeKey& key) { return inFineMap(key); };
+
+  // The ray as OctoMap sees it: float end points (clipping is done in double from them).
+  const Eigen::Vector3d of(origin.x(), origin.y(), origin.z());
+  const auto ray_count = static_cast<std::int64_t>(points.size());
+  std::vector<ScanKeys> per_thread(static_cast<std::size_t>(std::max(1, omp_get_max_threads())));
+#pragma omp parallel
+  {
+    ScanKeys& local = per_thread[static_cast<std::size_t>(omp_get_thread_num())];
+    octomap::KeyRay key_ray;
+    // Large chunks of neighbouring pixels: a voxel seen by many rays is then mostly
+    // collected by one thread, which keeps the merge small.
+#pragma omp for schedule(dynamic, 4096)
+    for (std::int64_t r = 0; r < ray_count; ++r) {
+      const accel::ScanPoint& point = points[static_cast<std::size_t>(r)];
+      const octomap::point3d end(point.x_m, point.y_m, point.z_m);
+      const Eigen::Vector3d dd = Eigen::Vector3d(end.x(), end.y(), end.z()) - of;
+      addFreeKeys(coarse, origin, end, clipToBox(of, dd, coarse_lo, coarse_hi, {}), key_ray,
+                  keepCoarse, local[ScanKeys::kCoarseFree]);
+      const Interval region_clip = clipToSphere(of, dd, region_center, region_clip_radius,
+                                                clipToBox(of, dd, fine_lo, fine_hi, {}));
+      const Interval fine_clip =
+          whole_box ? hull(region_clip, clipToBox(of, dd, coarse_lo, coarse_hi, {})) : region_clip;
+      addFreeKeys(fine, origin, end, fine_clip, key_ray, keepFine, local[ScanKeys::kFineFree]);
+      if (point.flags & FVP_POINT_HIT) {
+        octomap::OcTreeKey key;
+        if (coarse.coordToKeyChecked(end, key) && inCoarseGrid(key)) {
+          local[ScanKeys::kCoarseHit].insert(key);
+        }
+        if (fine.coordToKeyChecked(end, key) && inFineMap(key)) {
+          local[point.flags & FVP_POINT_ROI ? ScanKeys::kFineRoiHit : ScanKeys::kFineOtherHit]
+              .insert(key);
+        }
+      }
+    }
+  }
+  return per_thread;
+}
+
+// Merge: shard s of every kind takes the keys of that shard from every thread's sets (no
+// lock, each key inserted once more).
+std::vector<ScanKeys> mergeByShard(const std::vector<ScanKeys>& per_thread) {
+  const std::size_t shard_count = per_thread.size();
+  std::vector<ScanKeys> shards(shard_count);
+  const auto merge_jobs = static_cast<std::int64_t>(shard_count * ScanKeys::kKindCount);
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::int64_t job = 0; job < merge_jobs; ++job) {
+    const std::size_t shard = static_cast<std::size_t>(job) / ScanKeys::kKindCount;
+    const auto kind = static_cast<ScanKeys::Kind>(job % ScanKeys::kKindCount);
+    OcTreeKeySet& merged = shards[shard][kind];
+    for (const ScanKeys& local : per_thread) {
+      local[kind].forEachPacked([&](OcTreeKeySet::Packed packed) {
+        if (shardOf(packed, shard_count) == shard) merged.insertPacked(packed);
+      });
+    }
+  }
+  return shards;
+}
+
+// Occupied wins over free, and an ROI end point makes the voxel an ROI hit (a key's kinds all
+// live in one shard): each shard's updates of the coarse and the fine tree, in tree order.
+void updatesOfShards(const std::vector<ScanKeys>& shards,
+                     std::vector<std::vector<std::uint64_t>>& coarse_updates,
+                     std::vector<std::vector<std::uint64_t>>& fine_updates) {
+  const std::size_t shard_count = shards.size();
+  coarse_updates.assign(shard_count, {});
+  fine_updates.assign(shard_count, {});
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::int64_t s = 0; s < static_cast<std::int64_t>(shard_count); ++s) {
+    const ScanKeys& shard = shards[static_cast<std::size_t>(s)];
+    const OcTreeKeySet& coarse_hit = shard[ScanKeys::kCoarseHit];
+    const OcTreeKeySet& roi_hit = shard[ScanKeys::kFineRoiHit];
+    const OcTreeKeySet& other_hit = shard[ScanKeys::kFineOtherHit];
+    std::vector<std::uint64_t>& coarse_out = coarse_updates[static_cast<std::size_t>(s)];
+    std::vector<std::uint64_t>& fine_out = fine_updates[static_cast<std::size_t>(s)];
+    shard[ScanKeys::kCoarseFree].forEachPacked([&](OcTreeKeySet::Packed p) {
+      if (!coarse_hit.containsPacked(p)) coarse_out.push_back(treeOrder(p, kUpdateFree));
+    });
+    coarse_hit.forEachPacked(
+        [&](OcTreeKeySet::Packed p) { coarse_out.push_back(treeOrder(p, kUpdateHit)); });
+    shard[ScanKeys::kFineFree].forEachPacked([&](OcTreeKeySet::Packed p) {
+      if (!roi_hit.containsPacked(p) && !other_hit.containsPacked(p)) {
+        fine_out.push_back(treeOrder(p, kUpdateFree));
+      }
+    });
+    roi_hit.forEachPacked(
+        [&](OcTreeKeySet::Packed p) { fine_out.push_back(treeOrder(p, kUpdateRoiHit)); });
+    other_hit.forEachPacked([&](OcTreeKeySet::Packed p) {
+      if (!roi_hit.containsPacked(p)) fine_out.push_back(treeOrder(p, kUpdateHit));
+    });
+  }
+}
+
 }  // namespace
 
 OctomapMapEngine::OctomapMapEngine(const MapConfig& config, const ClusterRegion& region)
@@ -265,148 +431,27 @@ void OctomapMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
   // 2. Key sets (computeUpdate): each thread collects the keys of its rays into its own
   //    sets, then the sets are merged by shard in parallel (no lock, each key inserted
   //    once more), then applied serially (OctoMap's tree is not thread-safe).
-  const double cs = coarse_grid_.voxel_size_m, fs = fine_grid_.voxel_size_m;
-  Eigen::Vector3d coarse_lo, coarse_hi, fine_lo, fine_hi;
-  for (int a = 0; a < 3; ++a) {
-    coarse_lo[a] = (coarse_grid_.first_voxel[a] - kClipMarginVoxels) * cs;
-    coarse_hi[a] = (coarse_grid_.first_voxel[a] + coarse_grid_.dims[a] + kClipMarginVoxels) * cs;
-    fine_lo[a] = (fine_grid_.first_voxel[a] - kClipMarginVoxels) * fs;
-    fine_hi[a] = (fine_grid_.first_voxel[a] + fine_grid_.dims[a] + kClipMarginVoxels) * fs;
-  }
-  const Eigen::Vector3d& region_center = region().center_m();
-  const double region_clip_radius = region().radius_m() + kClipMarginVoxels * fs;
+  const ScanTarget target{*coarse_,
+                          *fine_,
+                          coarse_grid_,
+                          fine_grid_,
+                          fine_region_,
+                          key_offset_,
+                          config().fine_map_extent == FineMapExtent::kObservationBox,
+                          fine_box_lo_,
+                          fine_box_hi_,
+                          region().center_m(),
+                          region().radius_m()};
+  std::vector<ScanKeys> shards = mergeByShard(target.collectKeys(origin, points));
 
-  const octomap::OcTree& coarse = *coarse_;
-  const RoiOcTree& fine = *fine_;
-  const GridGeometry& coarse_grid = coarse_grid_;
-  const GridGeometry& fine_grid = fine_grid_;
-  const fvp_region fine_region = fine_region_;
-  const int key_offset = key_offset_;
-  auto inFineRegion = [&](const octomap::OcTreeKey& key) {
-    std::array<int, 3> i;
-    return inGrid(fine_grid, key_offset, key, i) &&
-           fvp_region_contains(&fine_region, i[0], i[1], i[2]);
-  };
-  auto inCoarseGrid = [&](const octomap::OcTreeKey& key) {
-    std::array<int, 3> i;
-    return inGrid(coarse_grid, key_offset, key, i);
-  };
-  const bool whole_box = config().fine_map_extent == FineMapExtent::kObservationBox;
-  const std::array<std::int64_t, 3> box_lo = fine_box_lo_, box_hi = fine_box_hi_;
-  // The region is always updated (it may reach beyond the box); with an observation_box
-  // extent, every voxel of the box too.
-  auto inFineMap = [&](const octomap::OcTreeKey& key) {
-    if (inFineRegion(key)) return true;
-    if (!whole_box) return false;
-    for (int a = 0; a < 3; ++a) {
-      const std::int64_t i = std::int64_t{key[a]} - key_offset;
-      if (i < box_lo[a] || i >= box_hi[a]) return false;
-    }
-    return true;
-  };
-  // computeRayKeys on the part of the ray inside `clip`, keeping the keys `keep` accepts.
-  auto addFreeKeys = [](const auto& tree, const octomap::point3d& o, const octomap::point3d& e,
-                        const Interval& clip, octomap::KeyRay& key_ray, const auto& keep,
-                        OcTreeKeySet& out) {
-    if (clip.empty()) return;
-    const Eigen::Vector3d od(o.x(), o.y(), o.z());
-    const Eigen::Vector3d dd = Eigen::Vector3d(e.x(), e.y(), e.z()) - od;
-    auto at = [&](double t) {
-      const Eigen::Vector3d p = od + t * dd;
-      return octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()),
-                              static_cast<float>(p.z()));
-    };
-    const octomap::point3d a = clip.t0 > 0.0 ? at(clip.t0) : o;
-    const octomap::point3d b = clip.t1 < 1.0 ? at(clip.t1) : e;
-    if (!tree.computeRayKeys(a, b, key_ray)) return;
-    for (const octomap::OcTreeKey& key : key_ray) {
-      if (keep(key)) out.insert(key);
-    }
-  };
-
-  // The ray as OctoMap sees it: float end points (clipping is done in double from them).
-  const Eigen::Vector3d of(origin.x(), origin.y(), origin.z());
-  const auto ray_count = static_cast<std::int64_t>(points.size());
-  std::vector<ScanKeys> per_thread(static_cast<std::size_t>(std::max(1, omp_get_max_threads())));
-#pragma omp parallel
-  {
-    ScanKeys& local = per_thread[static_cast<std::size_t>(omp_get_thread_num())];
-    octomap::KeyRay key_ray;
-    // Large chunks of neighbouring pixels: a voxel seen by many rays is then mostly
-    // collected by one thread, which keeps the merge small.
-#pragma omp for schedule(dynamic, 4096)
-    for (std::int64_t r = 0; r < ray_count; ++r) {
-      const accel::ScanPoint& point = points[static_cast<std::size_t>(r)];
-      const octomap::point3d end(point.x_m, point.y_m, point.z_m);
-      const Eigen::Vector3d dd = Eigen::Vector3d(end.x(), end.y(), end.z()) - of;
-      addFreeKeys(coarse, origin, end, clipToBox(of, dd, coarse_lo, coarse_hi, {}), key_ray,
-                  inCoarseGrid, local[ScanKeys::kCoarseFree]);
-      const Interval region_clip = clipToSphere(of, dd, region_center, region_clip_radius,
-                                                clipToBox(of, dd, fine_lo, fine_hi, {}));
-      const Interval fine_clip =
-          whole_box ? hull(region_clip, clipToBox(of, dd, coarse_lo, coarse_hi, {})) : region_clip;
-      addFreeKeys(fine, origin, end, fine_clip, key_ray, inFineMap, local[ScanKeys::kFineFree]);
-      if (point.flags & FVP_POINT_HIT) {
-        octomap::OcTreeKey key;
-        if (coarse.coordToKeyChecked(end, key) && inCoarseGrid(key)) {
-          local[ScanKeys::kCoarseHit].insert(key);
-        }
-        if (fine.coordToKeyChecked(end, key) && inFineMap(key)) {
-          local[point.flags & FVP_POINT_ROI ? ScanKeys::kFineRoiHit : ScanKeys::kFineOtherHit]
-              .insert(key);
-        }
-      }
-    }
-  }
-
-  // Merge: shard s of every kind takes the keys of that shard from every thread's sets.
-  const std::size_t shard_count = per_thread.size();
-  std::vector<ScanKeys> shards(shard_count);
-  const auto merge_jobs = static_cast<std::int64_t>(shard_count * ScanKeys::kKindCount);
-#pragma omp parallel for schedule(dynamic, 1)
-  for (std::int64_t job = 0; job < merge_jobs; ++job) {
-    const std::size_t shard = static_cast<std::size_t>(job) / ScanKeys::kKindCount;
-    const auto kind = static_cast<ScanKeys::Kind>(job % ScanKeys::kKindCount);
-    OcTreeKeySet& merged = shards[shard][kind];
-    for (const ScanKeys& local : per_thread) {
-      local[kind].forEachPacked([&](OcTreeKeySet::Packed packed) {
-        if (shardOf(packed, shard_count) == shard) merged.insertPacked(packed);
-      });
-    }
-  }
-  per_thread.clear();
-
-  // 3. Occupied wins over free, and an ROI end point makes the voxel an ROI hit (a key's
-  //    kinds all live in one shard). Then one update per key, as insertPointCloud, in the
-  //    order the tree is laid out (Morton order, so consecutive updates share most of their
-  //    path from the root) and lazily (inner nodes and pruning once for the whole scan,
-  //    insertPointCloud's lazy_eval). Together: 3.9 s -> 1.3 s for the serial update of
-  //    the bench frame over hash order and eager inner nodes (BM_ScanIntegrateFineBox).
-  std::vector<std::vector<std::uint64_t>> coarse_updates(shard_count), fine_updates(shard_count);
-#pragma omp parallel for schedule(dynamic, 1)
-  for (std::int64_t s = 0; s < static_cast<std::int64_t>(shard_count); ++s) {
-    const ScanKeys& shard = shards[static_cast<std::size_t>(s)];
-    const OcTreeKeySet& coarse_hit = shard[ScanKeys::kCoarseHit];
-    const OcTreeKeySet& roi_hit = shard[ScanKeys::kFineRoiHit];
-    const OcTreeKeySet& other_hit = shard[ScanKeys::kFineOtherHit];
-    std::vector<std::uint64_t>& coarse_out = coarse_updates[static_cast<std::size_t>(s)];
-    std::vector<std::uint64_t>& fine_out = fine_updates[static_cast<std::size_t>(s)];
-    shard[ScanKeys::kCoarseFree].forEachPacked([&](OcTreeKeySet::Packed p) {
-      if (!coarse_hit.containsPacked(p)) coarse_out.push_back(treeOrder(p, kUpdateFree));
-    });
-    coarse_hit.forEachPacked(
-        [&](OcTreeKeySet::Packed p) { coarse_out.push_back(treeOrder(p, kUpdateHit)); });
-    shard[ScanKeys::kFineFree].forEachPacked([&](OcTreeKeySet::Packed p) {
-      if (!roi_hit.containsPacked(p) && !other_hit.containsPacked(p)) {
-        fine_out.push_back(treeOrder(p, kUpdateFree));
-      }
-    });
-    roi_hit.forEachPacked(
-        [&](OcTreeKeySet::Packed p) { fine_out.push_back(treeOrder(p, kUpdateRoiHit)); });
-    other_hit.forEachPacked([&](OcTreeKeySet::Packed p) {
-      if (!roi_hit.containsPacked(p)) fine_out.push_back(treeOrder(p, kUpdateHit));
-    });
-  }
+  // 3. Occupied wins over free, and an ROI end point makes the voxel an ROI hit. Then one
+  //    update per key, as insertPointCloud, in the order the tree is laid out (Morton
+  //    order, so consecutive updates share most of their path from the root) and lazily
+  //    (inner nodes and pruning once for the whole scan, insertPointCloud's lazy_eval).
+  //    Together: 3.9 s -> 1.3 s for the serial update of the bench frame over hash order
+  //    and eager inner nodes (BM_ScanIntegrateFineBox).
+  std::vector<std::vector<std::uint64_t>> coarse_updates, fine_updates;
+  updatesOfShards(shards, coarse_updates, fine_updates);
   shards.clear();
   const std::vector<std::uint64_t> coarse_sorted = sortedUnion(std::move(coarse_updates));
   const std::vector<std::uint64_t> fine_sorted = sortedUnion(std::move(fine_updates));

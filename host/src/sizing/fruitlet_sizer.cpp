@@ -250,6 +250,303 @@ void aggregate(FruitletEstimate& f, const SizingConfig& config) {
                               (config.surface_voxel_size_m * config.surface_voxel_size_m);
 }
 
+// sizeFruitlets' first stage: the surface points in the ROI voxels, outliers removed, into
+// result.points and their DBSCAN labels (merged clusters and instances split); returns the
+// points of each cluster.
+std::map<int, std::vector<Eigen::Vector3f>> clusterSurfacePoints(
+    const std::vector<SizingView>& views, const std::vector<Eigen::Vector3f>& surface_points_m,
+    const std::function<bool(const Eigen::Vector3f&)>& in_roi_voxel, const SizingConfig& config,
+    SizingResult& result) {
+  result.surface_points = surface_points_m.size();
+  std::vector<Eigen::Vector3f> roi;
+  for (const auto& p : surface_points_m)
+    if (!in_roi_voxel || in_roi_voxel(p)) roi.push_back(p);
+  result.in_roi_points = roi.size();
+  for (std::size_t i :
+       statisticalOutlierInliers(roi, config.outlier_neighbours, config.outlier_std_ratio))
+    result.points.push_back(roi[i]);
+  result.inlier_points = result.points.size();
+  result.labels = dbscan(result.points, config.dbscan_eps_m, config.dbscan_min_samples);
+  if (config.split_merged_clusters) {
+    ClusterSplitConfig split;
+    split.min_cluster_points = config.min_cluster_points;
+    result.events.clusters_split_off = splitMergedClusters(result.points, result.labels, split);
+  }
+  if (config.use_instances)
+    result.events.instance_parts_split_off =
+        splitByInstances(result.points, result.labels, views, config.instance_split);
+
+  std::map<int, std::vector<Eigen::Vector3f>> clusters;
+  for (std::size_t i = 0; i < result.points.size(); ++i)
+    if (result.labels[i] != kDbscanNoise) clusters[result.labels[i]].push_back(result.points[i]);
+  return clusters;
+}
+
+// sizeFruitlets' later stages over the clusters of enough points: where each falls in every
+// image, its own measurements, then the support and overlap rules, which drop and merge
+// detections, each time sizing the kept ones again.
+class DetectionSizer {
+ public:
+  DetectionSizer(const std::vector<SizingView>& views, const SizingConfig& config,
+                 std::map<int, std::vector<Eigen::Vector3f>> clusters, SizingResult& result)
+      : views_(views), config_(config), clusters_(std::move(clusters)), result_(result) {
+    segments_.reserve(views.size());
+    for (const auto& v : views)
+      segments_.push_back(v.fruitlet_instances.empty() ? segment(v.fruitlet_mask)
+                                                       : segmentInstances(v.fruitlet_instances));
+    for (auto& [label, pts] : clusters_) {
+      if (int(pts.size()) < config.min_cluster_points) {
+        ++result.events.small_clusters;
+        continue;
+      }
+      sized_.emplace_back(label, &pts);
+    }
+    falls_.assign(sized_.size(), std::vector<Fall>(views.size()));
+    measured_.resize(sized_.size());
+    with_instances_ = config.use_instances &&
+                      std::any_of(views.begin(), views.end(),
+                                  [](const auto& v) { return !v.fruitlet_instances.empty(); });
+    instance_of_.resize(sized_.size());
+    dropped_.assign(sized_.size(), false);
+    marks_segments_.assign(sized_.size(), true);
+    merged_into_.assign(sized_.size(), 0);
+    estimates_.resize(sized_.size());
+  }
+
+  // Which segment of each image every cluster falls on, first for all clusters, so that a
+  // segment two clusters fall on (touching fruitlets merged in 2-D) is known.
+  void measureAll() {
+    for (std::size_t ci = 0; ci < sized_.size(); ++ci) {
+      computeFalls(ci);
+      measure(ci, result_.events);
+    }
+  }
+
+  void applyRules();
+
+  /// The kept detections that were sized, into result.fruitlets.
+  void keepSized() {
+    for (std::size_t ci = 0; ci < sized_.size(); ++ci) {
+      if (dropped_[ci]) continue;
+      FruitletEstimate& f = estimates_[ci];
+      if (f.per_image.empty()) {
+        ++result_.events.unsized_clusters;
+        continue;
+      }
+      if (f.per_image.size() == 1) ++result_.events.single_image_fruitlets;
+      if (!(f.sphere_radius_m > 0.0)) ++result_.events.failed_sphere_fits;
+      measureViewAgreement(*sized_[ci].second, views_, config_, f.support);
+      result_.fruitlets.push_back(std::move(f));
+    }
+  }
+
+ private:
+  struct Fall {
+    bool in_image = false;
+    int segment = 0;
+    double visible = 0.0;
+  };
+
+  void computeFalls(std::size_t ci);
+  void measure(std::size_t ci, SizingEvents& events);
+
+  // Sizes a kept cluster from its images, an image's segment shared when another cluster
+  // that still marks segments falls on it.
+  FruitletEstimate sizeKept(std::size_t ci) const {
+    FruitletEstimate f = measured_[ci];
+    for (auto& s : f.per_image) {
+      const auto vi = std::size_t(s.view);
+      const int segment_label = falls_[ci][vi].segment;
+      s.shared_segment = false;
+      for (std::size_t other = 0; other < sized_.size(); ++other)
+        s.shared_segment |= other != ci && marks_segments_[other] &&
+                            falls_[other][vi].segment == segment_label &&
+                            falls_[other][vi].visible >= config_.min_visible_fraction;
+    }
+    aggregate(f, config_);
+    f.support.merged_detections = merged_into_[ci];
+    return f;
+  }
+
+  static double supportRatio(const FruitletEstimate& f) {
+    return f.support.required_points > 0.0 ? double(f.points) / f.support.required_points
+                                           : INFINITY;
+  }
+  // Against the quarter every detection must show, whatever sized it.
+  double quarterRatio(const FruitletEstimate& f) const {
+    if (!(config_.min_support_area_fraction > 0.0)) return double(INFINITY);
+    return supportRatio(f) * f.support.required_area_fraction / config_.min_support_area_fraction;
+  }
+
+  void drop(std::size_t ci, bool unconfirmed) {
+    estimates_[ci].support.unconfirmed = unconfirmed;
+    dropped_[ci] = true;
+    marks_segments_[ci] = estimates_[ci].support.own_segment_images > 0;
+    measureViewAgreement(*sized_[ci].second, views_, config_, estimates_[ci].support);
+    result_.unsupported.push_back(std::move(estimates_[ci]));
+  }
+
+  // The worst-supported kept and sized detection under `ratio` < 1, every kept one sized
+  // again first.
+  template <typename Ratio>
+  std::optional<std::size_t> worstUnder(const Ratio& ratio) {
+    std::optional<std::size_t> worst;
+    double worst_ratio = 1.0;
+    for (std::size_t ci = 0; ci < sized_.size(); ++ci) {
+      if (dropped_[ci]) continue;
+      estimates_[ci] = sizeKept(ci);
+      const FruitletEstimate& f = estimates_[ci];
+      if (f.per_image.empty()) continue;  // unsized: dropped below, not by the rule
+      if (const double r = ratio(f); r < worst_ratio) worst = ci, worst_ratio = r;
+    }
+    return worst;
+  }
+
+  std::optional<std::pair<std::size_t, std::size_t>> deepestOverlap() const;
+  void merge(std::size_t keep, std::size_t gone);
+
+  const std::vector<SizingView>& views_;
+  const SizingConfig& config_;
+  std::map<int, std::vector<Eigen::Vector3f>> clusters_;
+  SizingResult& result_;
+  std::vector<Segments> segments_;
+  std::vector<std::pair<int, std::vector<Eigen::Vector3f>*>> sized_;  // label, its points
+  std::vector<std::vector<Fall>> falls_;                              // per cluster, per view
+  // Each cluster's own measurements, once: its centroid and sphere, and Eq. 4 in every image
+  // it is visible in. Only whether an image's segment is shared depends on which other
+  // detections are kept (sizeKept).
+  std::vector<FruitletEstimate> measured_;
+  bool with_instances_ = false;
+  std::vector<std::vector<int>> instance_of_;  // per view (dominantInstances)
+  std::vector<bool> dropped_, marks_segments_;
+  std::vector<int> merged_into_;
+  std::vector<FruitletEstimate> estimates_;
+};
+
+void DetectionSizer::computeFalls(std::size_t ci) {
+  for (std::size_t vi = 0; vi < views_.size(); ++vi) {
+    const Eigen::Isometry3d T_camera_world = views_[vi].T_world_camera.inverse();
+    const cv::Mat& labels = segments_[vi].labels;
+    std::map<int, int> votes;
+    int in_image = 0;
+    for (const auto& p : *sized_[ci].second) {
+      const auto px = views_[vi].intrinsics.project(T_camera_world * p.cast<double>());
+      if (!px) continue;
+      const int u = int(std::lround(px->x())), v = int(std::lround(px->y()));
+      if (u < 0 || v < 0 || u >= labels.cols || v >= labels.rows) continue;
+      ++in_image;
+      if (const int l = labels.at<int>(v, u); l > 0) ++votes[l];
+    }
+    int best = 0, best_votes = 0;
+    for (const auto& [l, n] : votes)
+      if (n > best_votes) best = l, best_votes = n;
+    falls_[ci][vi] = in_image > 0 ? Fall{true, best, double(best_votes) / in_image} : Fall{};
+  }
+}
+
+void DetectionSizer::measure(std::size_t ci, SizingEvents& events) {
+  const std::vector<Eigen::Vector3f>& pts = *sized_[ci].second;
+  if (with_instances_) instance_of_[ci] = dominantInstances(pts, views_, config_.instance_split);
+  FruitletEstimate& f = measured_[ci];
+  f = FruitletEstimate{};
+  f.points = pts.size();
+  for (const auto& p : pts) f.centroid_m += p.cast<double>();
+  f.centroid_m /= double(pts.size());
+  for (std::size_t vi = 0; vi < views_.size(); ++vi) {
+    if (!falls_[ci][vi].in_image) continue;
+    if (auto s = measureImage(views_[vi], segments_[vi], falls_[ci][vi].segment,
+                              falls_[ci][vi].visible, config_, events)) {
+      s->view = int(vi);
+      f.per_image.push_back(*s);
+    }
+  }
+  f.sphere_center_m = f.centroid_m;
+  Eigen::Vector3d sphere;
+  double radius = 0.0;
+  // Accept a sphere only of a fruitlet's size near the points (3-8 mm radius and margin).
+  if (fitSphere(pts, sphere, radius) && radius > kDefaultMinFruitletRadius_m &&
+      radius < kDefaultMaxFruitletRadius_m && (sphere - f.centroid_m).norm() < 0.010) {
+    f.sphere_center_m = sphere;
+    f.sphere_radius_m = radius;
+    double sum_sq = 0.0;
+    for (const auto& p : pts) {
+      const double d = (p.cast<double>() - sphere).norm() - radius;
+      sum_sq += d * d;
+    }
+    f.support.sphere_rms_mm = 1000.0 * std::sqrt(sum_sq / double(pts.size()));
+  }
+}
+
+// The overlap rule: two fruitlets are firm bodies that touch but do not interpenetrate, so
+// two kept spheres that overlap by more than half the smaller one's radius are one fruitlet
+// seen twice (views whose poses disagree fuse its surface at two places). With instance
+// masks, two whose spheres overlap at all are one fruitlet when the views see them on one
+// instance (sameInstance). The pair overlapping most, if any.
+std::optional<std::pair<std::size_t, std::size_t>> DetectionSizer::deepestOverlap() const {
+  std::optional<std::pair<std::size_t, std::size_t>> pair;
+  double deepest = 0.0;
+  for (std::size_t a = 0; a < sized_.size(); ++a)
+    for (std::size_t b = a + 1; b < sized_.size(); ++b) {
+      if (dropped_[a] || dropped_[b]) continue;
+      const FruitletEstimate &fa = estimates_[a], &fb = estimates_[b];
+      // Only fitted spheres: a centroid lies inside its fruitlet, nearer the camera.
+      if (fa.per_image.empty() || fb.per_image.empty() || !(fa.sphere_radius_m > 0.0) ||
+          !(fb.sphere_radius_m > 0.0))
+        continue;
+      const double ra = 0.0005 * fa.size_ours_mm, rb = 0.0005 * fb.size_ours_mm;
+      const double overlap = ra + rb - (fa.sphere_center_m - fb.sphere_center_m).norm();
+      const double depth = overlap / std::min(ra, rb);
+      const bool one_instance =
+          with_instances_ && overlap > 0.0 && sameInstance(instance_of_[a], instance_of_[b]);
+      if ((depth > config_.max_detection_overlap_fraction || one_instance) &&
+          (!pair || depth > deepest))
+        deepest = depth, pair = {a, b};
+    }
+  return pair;
+}
+
+// An overlapping pair merged into the better-supported one, its points added.
+void DetectionSizer::merge(std::size_t keep, std::size_t gone) {
+  if (supportRatio(estimates_[gone]) > supportRatio(estimates_[keep])) std::swap(keep, gone);
+  sized_[keep].second->insert(sized_[keep].second->end(), sized_[gone].second->begin(),
+                              sized_[gone].second->end());
+  for (int& label : result_.labels)
+    if (label == sized_[gone].first) label = sized_[keep].first;
+  merged_into_[keep] += 1 + merged_into_[gone];
+  dropped_[gone] = true;
+  marks_segments_[gone] = false;
+  ++result_.events.overlapping_detections_merged;
+  computeFalls(keep);
+  SizingEvents counted_already;  // both parts' images were counted when first measured
+  measure(keep, counted_already);
+}
+
+void DetectionSizer::applyRules() {
+  for (;;) {
+    // The support rule, one detection at a time: the worst-supported one that fails is
+    // dropped and the rest are sized again, since a dropped phantom (no segment of its own:
+    // it lay on a fruitlet's) no longer makes that fruitlet's images shared. A dropped
+    // detection that had a segment of its own keeps marking segments: it may be a real
+    // fruitlet merged in 2-D with a neighbour, whose merged outline must not size the
+    // neighbour. The quarter first; the hemisphere a sphere-fit size asks for only once
+    // no two detections overlap, since two shells of one fruitlet (views whose poses
+    // disagree) are each sized by their sphere fit until the overlap rule merges them.
+    while (const auto worst =
+               worstUnder([this](const FruitletEstimate& f) { return quarterRatio(f); }))
+      drop(*worst, false);
+    // The pair overlapping most is merged, and everything is sized again.
+    if (const auto pair = deepestOverlap()) {
+      merge(pair->first, pair->second);
+      continue;
+    }
+    // The hemisphere rule (sphere_fit_support_area_fraction): a detection sized by its
+    // sphere fit alone must show half its sphere. One at a time, as above.
+    const auto worst = worstUnder(supportRatio);
+    if (!worst) break;
+    drop(*worst, true);
+  }
+}
+
 }  // namespace
 
 const char* toString(SizingEstimator estimator) {
@@ -328,237 +625,12 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
                            const SizingConfig& config) {
   config.validate();
   SizingResult result;
-  result.surface_points = surface_points_m.size();
-  std::vector<Eigen::Vector3f> roi;
-  for (const auto& p : surface_points_m)
-    if (!in_roi_voxel || in_roi_voxel(p)) roi.push_back(p);
-  result.in_roi_points = roi.size();
-  for (std::size_t i :
-       statisticalOutlierInliers(roi, config.outlier_neighbours, config.outlier_std_ratio))
-    result.points.push_back(roi[i]);
-  result.inlier_points = result.points.size();
-  result.labels = dbscan(result.points, config.dbscan_eps_m, config.dbscan_min_samples);
-  if (config.split_merged_clusters) {
-    ClusterSplitConfig split;
-    split.min_cluster_points = config.min_cluster_points;
-    result.events.clusters_split_off = splitMergedClusters(result.points, result.labels, split);
-  }
-  if (config.use_instances)
-    result.events.instance_parts_split_off =
-        splitByInstances(result.points, result.labels, views, config.instance_split);
-
-  std::map<int, std::vector<Eigen::Vector3f>> clusters;
-  for (std::size_t i = 0; i < result.points.size(); ++i)
-    if (result.labels[i] != kDbscanNoise) clusters[result.labels[i]].push_back(result.points[i]);
-
-  std::vector<Segments> segments;
-  segments.reserve(views.size());
-  for (const auto& v : views)
-    segments.push_back(v.fruitlet_instances.empty() ? segment(v.fruitlet_mask)
-                                                    : segmentInstances(v.fruitlet_instances));
-
-  // Which segment of each image every cluster falls on, first for all clusters, so that a
-  // segment two clusters fall on (touching fruitlets merged in 2-D) is known.
-  std::vector<std::pair<int, std::vector<Eigen::Vector3f>*>> sized;
-  for (auto& [label, pts] : clusters) {
-    if (int(pts.size()) < config.min_cluster_points) {
-      ++result.events.small_clusters;
-      continue;
-    }
-    sized.emplace_back(label, &pts);
-  }
-  struct Fall {
-    bool in_image = false;
-    int segment = 0;
-    double visible = 0.0;
-  };
-  std::vector<std::vector<Fall>> falls(sized.size(), std::vector<Fall>(views.size()));
-  const auto computeFalls = [&](std::size_t ci) {
-    for (std::size_t vi = 0; vi < views.size(); ++vi) {
-      const Eigen::Isometry3d T_camera_world = views[vi].T_world_camera.inverse();
-      const cv::Mat& labels = segments[vi].labels;
-      std::map<int, int> votes;
-      int in_image = 0;
-      for (const auto& p : *sized[ci].second) {
-        const auto px = views[vi].intrinsics.project(T_camera_world * p.cast<double>());
-        if (!px) continue;
-        const int u = int(std::lround(px->x())), v = int(std::lround(px->y()));
-        if (u < 0 || v < 0 || u >= labels.cols || v >= labels.rows) continue;
-        ++in_image;
-        if (const int l = labels.at<int>(v, u); l > 0) ++votes[l];
-      }
-      int best = 0, best_votes = 0;
-      for (const auto& [l, n] : votes)
-        if (n > best_votes) best = l, best_votes = n;
-      falls[ci][vi] = in_image > 0 ? Fall{true, best, double(best_votes) / in_image} : Fall{};
-    }
-  };
-
-  // Each cluster's own measurements, once: its centroid and sphere, and Eq. 4 in every image
-  // it is visible in. Only whether an image's segment is shared depends on which other
-  // detections are kept (below).
-  std::vector<FruitletEstimate> measured(sized.size());
-  const bool with_instances =
-      config.use_instances && std::any_of(views.begin(), views.end(), [](const auto& v) {
-        return !v.fruitlet_instances.empty();
-      });
-  std::vector<std::vector<int>> instance_of(sized.size());  // per view (dominantInstances)
-  const auto measure = [&](std::size_t ci, SizingEvents& events) {
-    const std::vector<Eigen::Vector3f>& pts = *sized[ci].second;
-    if (with_instances) instance_of[ci] = dominantInstances(pts, views, config.instance_split);
-    FruitletEstimate& f = measured[ci];
-    f = FruitletEstimate{};
-    f.points = pts.size();
-    for (const auto& p : pts) f.centroid_m += p.cast<double>();
-    f.centroid_m /= double(pts.size());
-    for (std::size_t vi = 0; vi < views.size(); ++vi) {
-      if (!falls[ci][vi].in_image) continue;
-      if (auto s = measureImage(views[vi], segments[vi], falls[ci][vi].segment,
-                                falls[ci][vi].visible, config, events)) {
-        s->view = int(vi);
-        f.per_image.push_back(*s);
-      }
-    }
-    f.sphere_center_m = f.centroid_m;
-    Eigen::Vector3d sphere;
-    double radius = 0.0;
-    // Accept a sphere only of a fruitlet's size near the points (3-8 mm radius and margin).
-    if (fitSphere(pts, sphere, radius) && radius > kDefaultMinFruitletRadius_m &&
-        radius < kDefaultMaxFruitletRadius_m && (sphere - f.centroid_m).norm() < 0.010) {
-      f.sphere_center_m = sphere;
-      f.sphere_radius_m = radius;
-      double sum_sq = 0.0;
-      for (const auto& p : pts) {
-        const double d = (p.cast<double>() - sphere).norm() - radius;
-        sum_sq += d * d;
-      }
-      f.support.sphere_rms_mm = 1000.0 * std::sqrt(sum_sq / double(pts.size()));
-    }
-  };
-  for (std::size_t ci = 0; ci < sized.size(); ++ci) {
-    computeFalls(ci);
-    measure(ci, result.events);
-  }
-
-  // Sizes every kept cluster from its images, an image's segment shared when another
-  // cluster that still marks segments falls on it.
-  std::vector<bool> dropped(sized.size(), false), marks_segments(sized.size(), true);
-  std::vector<int> merged_into(sized.size(), 0);
-  const auto sizeKept = [&](std::size_t ci) {
-    FruitletEstimate f = measured[ci];
-    for (auto& s : f.per_image) {
-      const auto vi = std::size_t(s.view);
-      const int segment_label = falls[ci][vi].segment;
-      s.shared_segment = false;
-      for (std::size_t other = 0; other < sized.size(); ++other)
-        s.shared_segment |= other != ci && marks_segments[other] &&
-                            falls[other][vi].segment == segment_label &&
-                            falls[other][vi].visible >= config.min_visible_fraction;
-    }
-    aggregate(f, config);
-    f.support.merged_detections = merged_into[ci];
-    return f;
-  };
-  const auto supportRatio = [](const FruitletEstimate& f) {
-    return f.support.required_points > 0.0 ? double(f.points) / f.support.required_points
-                                           : INFINITY;
-  };
-  // Against the quarter every detection must show, whatever sized it.
-  const auto quarterRatio = [&](const FruitletEstimate& f) {
-    if (!(config.min_support_area_fraction > 0.0)) return double(INFINITY);
-    return supportRatio(f) * f.support.required_area_fraction / config.min_support_area_fraction;
-  };
-  std::vector<FruitletEstimate> estimates(sized.size());
-  const auto drop = [&](std::size_t ci, bool unconfirmed) {
-    estimates[ci].support.unconfirmed = unconfirmed;
-    dropped[ci] = true;
-    marks_segments[ci] = estimates[ci].support.own_segment_images > 0;
-    measureViewAgreement(*sized[ci].second, views, config, estimates[ci].support);
-    result.unsupported.push_back(std::move(estimates[ci]));
-  };
-  // The worst-supported kept and sized detection under `ratio` < 1, every kept one sized
-  // again first.
-  const auto worstUnder = [&](const auto& ratio) {
-    std::optional<std::size_t> worst;
-    double worst_ratio = 1.0;
-    for (std::size_t ci = 0; ci < sized.size(); ++ci) {
-      if (dropped[ci]) continue;
-      estimates[ci] = sizeKept(ci);
-      const FruitletEstimate& f = estimates[ci];
-      if (f.per_image.empty()) continue;  // unsized: dropped below, not by the rule
-      if (const double r = ratio(f); r < worst_ratio) worst = ci, worst_ratio = r;
-    }
-    return worst;
-  };
-  for (;;) {
-    // The support rule, one detection at a time: the worst-supported one that fails is
-    // dropped and the rest are sized again, since a dropped phantom (no segment of its own:
-    // it lay on a fruitlet's) no longer makes that fruitlet's images shared. A dropped
-    // detection that had a segment of its own keeps marking segments: it may be a real
-    // fruitlet merged in 2-D with a neighbour, whose merged outline must not size the
-    // neighbour. The quarter first; the hemisphere a sphere-fit size asks for only once
-    // no two detections overlap, since two shells of one fruitlet (views whose poses
-    // disagree) are each sized by their sphere fit until the overlap rule merges them.
-    while (const auto worst = worstUnder(quarterRatio)) drop(*worst, false);
-    // The overlap rule: two fruitlets are firm bodies that touch but do not interpenetrate,
-    // so two kept spheres that overlap by more than half the smaller one's radius are one
-    // fruitlet seen twice (views whose poses disagree fuse its surface at two places). With
-    // instance masks, two whose spheres overlap at all are one fruitlet when the views see
-    // them on one instance (sameInstance). The pair overlapping most is merged into the
-    // better-supported one, its points added, and everything is sized again.
-    std::optional<std::pair<std::size_t, std::size_t>> pair;
-    double deepest = 0.0;
-    for (std::size_t a = 0; a < sized.size(); ++a)
-      for (std::size_t b = a + 1; b < sized.size(); ++b) {
-        if (dropped[a] || dropped[b]) continue;
-        const FruitletEstimate &fa = estimates[a], &fb = estimates[b];
-        // Only fitted spheres: a centroid lies inside its fruitlet, nearer the camera.
-        if (fa.per_image.empty() || fb.per_image.empty() || !(fa.sphere_radius_m > 0.0) ||
-            !(fb.sphere_radius_m > 0.0))
-          continue;
-        const double ra = 0.0005 * fa.size_ours_mm, rb = 0.0005 * fb.size_ours_mm;
-        const double overlap = ra + rb - (fa.sphere_center_m - fb.sphere_center_m).norm();
-        const double depth = overlap / std::min(ra, rb);
-        const bool one_instance =
-            with_instances && overlap > 0.0 && sameInstance(instance_of[a], instance_of[b]);
-        if ((depth > config.max_detection_overlap_fraction || one_instance) &&
-            (!pair || depth > deepest))
-          deepest = depth, pair = {a, b};
-      }
-    if (!pair) {
-      // The hemisphere rule (sphere_fit_support_area_fraction): a detection sized by its
-      // sphere fit alone must show half its sphere. One at a time, as above.
-      const auto worst = worstUnder(supportRatio);
-      if (!worst) break;
-      drop(*worst, true);
-      continue;
-    }
-    auto [keep, gone] = *pair;
-    if (supportRatio(estimates[gone]) > supportRatio(estimates[keep])) std::swap(keep, gone);
-    sized[keep].second->insert(sized[keep].second->end(), sized[gone].second->begin(),
-                               sized[gone].second->end());
-    for (int& label : result.labels)
-      if (label == sized[gone].first) label = sized[keep].first;
-    merged_into[keep] += 1 + merged_into[gone];
-    dropped[gone] = true;
-    marks_segments[gone] = false;
-    ++result.events.overlapping_detections_merged;
-    computeFalls(keep);
-    SizingEvents counted_already;  // both parts' images were counted when first measured
-    measure(keep, counted_already);
-  }
-  for (std::size_t ci = 0; ci < sized.size(); ++ci) {
-    if (dropped[ci]) continue;
-    FruitletEstimate& f = estimates[ci];
-    if (f.per_image.empty()) {
-      ++result.events.unsized_clusters;
-      continue;
-    }
-    if (f.per_image.size() == 1) ++result.events.single_image_fruitlets;
-    if (!(f.sphere_radius_m > 0.0)) ++result.events.failed_sphere_fits;
-    measureViewAgreement(*sized[ci].second, views, config, f.support);
-    result.fruitlets.push_back(std::move(f));
-  }
+  DetectionSizer sizer(views, config,
+                       clusterSurfacePoints(views, surface_points_m, in_roi_voxel, config, result),
+                       result);
+  sizer.measureAll();
+  sizer.applyRules();
+  sizer.keepSized();
   result.events.unsupported_detections = result.unsupported.size();
   return result;
 }

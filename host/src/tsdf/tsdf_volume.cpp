@@ -40,6 +40,126 @@ map::GridGeometry boundedGrid(double voxel_size_m, const Eigen::AlignedBox3d& bo
   return g;
 }
 
+/// Where a depth image meets the grid: the camera, and the grid's origin and brick size.
+struct DepthView {
+  const cv::Mat& depth_m;
+  const cv::Mat& roi_mask;
+  const StereoIntrinsics& in;
+  const Eigen::Isometry3d& T_world_camera;
+  Eigen::Vector3d grid_origin_m;
+  double brick_m = 0.0;
+};
+
+// The bricks of the truncation band around every ROI point (along its ray), in brick order
+// as a scan of the grid gives it. The fruitlets cover a few % of the image: skip the mask's
+// empty runs eight pixels at a time (faster than cv::boundingRect's own pass over the mask).
+// `flags`: one per brick of the grid, all 0 (and left so).
+std::vector<int> truncationBandBricks(const DepthView& view, double trunc,
+                                      const map::BrickLayer& layer,
+                                      std::vector<std::uint8_t>& flags, TsdfIntegrateStats& stats) {
+  const accel::BrickedGridParams& bp = layer.params();
+  const cv::Mat& depth_m = view.depth_m;
+  const cv::Mat& roi_mask = view.roi_mask;
+  const StereoIntrinsics& in = view.in;
+  std::vector<int> band;
+  const Eigen::Vector3d eye = view.T_world_camera.translation();
+  const int steps = static_cast<int>(std::ceil(2.0 * trunc / (0.5 * view.brick_m))) + 1;
+  for (int v = 0; v < roi_mask.rows; ++v) {
+    const float* z = depth_m.ptr<float>(v);
+    const std::uint8_t* m = roi_mask.ptr<std::uint8_t>(v);
+    for (int u = 0; u < roi_mask.cols; ++u) {
+      if (u + 8 <= roi_mask.cols && noneOfEight(m + u)) {
+        u += 7;
+        continue;
+      }
+      if (!m[u] || !(z[u] > 0.0f) || !std::isfinite(z[u])) continue;
+      ++stats.roi_pixels;
+      const Eigen::Vector3d ray_camera((u - in.cx_px) / in.fx_px, (v - in.cy_px) / in.fy_px, 1.0);
+      const Eigen::Vector3d p = view.T_world_camera * (z[u] * ray_camera);
+      const Eigen::Vector3d dir = (p - eye).normalized();
+      for (int s = 0; s <= steps; ++s) {
+        const Eigen::Vector3d q =
+            (p + (-trunc + 2.0 * trunc * s / steps) * dir - view.grid_origin_m) / view.brick_m;
+        const double b[3] = {std::floor(q.x()), std::floor(q.y()), std::floor(q.z())};
+        if (b[0] < 0 || b[1] < 0 || b[2] < 0 || b[0] >= bp.bricks_x || b[1] >= bp.bricks_y ||
+            b[2] >= bp.bricks_z)
+          continue;
+        const int id = layer.brickIndex(int(b[0]), int(b[1]), int(b[2]));
+        if (!flags[id]) {
+          flags[id] = 1;
+          band.push_back(id);
+        }
+      }
+    }
+  }
+  for (int id : band) flags[id] = 0;
+  std::sort(band.begin(), band.end());
+  return band;
+}
+
+/// A box of pixels, inclusive.
+struct PixelBox {
+  int u_min = 0, u_max = 0, v_min = 0, v_max = 0;
+  int width() const { return u_max - u_min + 1; }
+  int height() const { return v_max - v_min + 1; }
+};
+
+// The pixels a voxel of the band's bricks can project to: the box of the bricks' projected
+// corners (a brick is convex and in front of the camera, so its voxel centres project
+// inside), rounded as the kernel rounds, clamped to the image; the whole image when a corner
+// is not in front of the camera.
+PixelBox bandPixelBox(const DepthView& view, const std::vector<int>& band,
+                      const accel::BrickedGridParams& bp) {
+  const cv::Mat& depth_m = view.depth_m;
+  const StereoIntrinsics& in = view.in;
+  PixelBox box{0, depth_m.cols - 1, 0, depth_m.rows - 1};
+  const Eigen::Isometry3d T_camera_world = view.T_world_camera.inverse();
+  double lo_u = std::numeric_limits<double>::infinity(), hi_u = -lo_u, lo_v = lo_u, hi_v = -lo_u;
+  bool in_front = true;
+  for (int id : band) {
+    const int bx = id % bp.bricks_x, by = (id / bp.bricks_x) % bp.bricks_y,
+              bz = id / (bp.bricks_x * bp.bricks_y);
+    for (int corner = 0; corner < 8; ++corner) {
+      const Eigen::Vector3d c =
+          T_camera_world *
+          (view.grid_origin_m + view.brick_m * Eigen::Vector3d(bx + (corner & 1),
+                                                               by + ((corner >> 1) & 1),
+                                                               bz + (corner >> 2)));
+      if (!(c.z() > 0.0)) in_front = false;
+      const double u = in.fx_px * c.x() / c.z() + in.cx_px, v = in.fy_px * c.y() / c.z() + in.cy_px;
+      lo_u = std::min(lo_u, u), hi_u = std::max(hi_u, u);
+      lo_v = std::min(lo_v, v), hi_v = std::max(hi_v, v);
+    }
+  }
+  if (in_front) {  // else: keep the whole image
+    const auto pixel = [](double x, int size) {
+      return int(std::clamp(std::floor(x + 0.5), 0.0, double(size - 1)));
+    };
+    box.u_min = pixel(lo_u - 1.0, depth_m.cols), box.u_max = pixel(hi_u + 1.0, depth_m.cols);
+    box.v_min = pixel(lo_v - 1.0, depth_m.rows), box.v_max = pixel(hi_v + 1.0, depth_m.rows);
+  }
+  return box;
+}
+
+// The ROI depth over the box, 0 where a pixel is not ROI or has no depth.
+std::vector<float> croppedRoiDepth(const cv::Mat& depth_m, const cv::Mat& roi_mask,
+                                   const PixelBox& box) {
+  const int width = box.width(), height = box.height();
+  std::vector<float> crop(std::size_t(width) * height, 0.0f);
+  for (int v = 0; v < height; ++v) {
+    const float* z = depth_m.ptr<float>(v + box.v_min) + box.u_min;
+    const std::uint8_t* m = roi_mask.ptr<std::uint8_t>(v + box.v_min) + box.u_min;
+    for (int u = 0; u < width; ++u) {
+      if (u + 8 <= width && noneOfEight(m + u)) {
+        u += 7;
+        continue;
+      }
+      if (m[u] && z[u] > 0.0f && std::isfinite(z[u])) crop[std::size_t(v) * width + u] = z[u];
+    }
+  }
+  return crop;
+}
+
 }  // namespace
 
 void TsdfConfig::validate() const {
@@ -96,49 +216,18 @@ TsdfIntegrateStats TsdfVolume::integrate(const cv::Mat& depth_m, const cv::Mat& 
   const auto start = std::chrono::steady_clock::now();
   TsdfIntegrateStats stats;
   const double vs = config_.voxel_size_m, trunc = config_.truncation_m;
-  const Eigen::Vector3d grid_origin_m =
+  const DepthView view{
+      depth_m,
+      roi_mask,
+      in,
+      T_world_camera,
       vs * Eigen::Vector3d(double(geometry_.first_voxel[0]), double(geometry_.first_voxel[1]),
-                           double(geometry_.first_voxel[2]));
-  const accel::BrickedGridParams& bp = layer_->params();
+                           double(geometry_.first_voxel[2])),
+      vs * kBlockSide};
 
-  // 1. The bricks of the truncation band around every ROI point (along its ray). The
-  // fruitlets cover a few % of the image: skip the mask's empty runs eight pixels at a time
-  // (faster than cv::boundingRect's own pass over the mask).
+  // 1. The bricks of the truncation band around every ROI point.
   band_flags_.resize(layer_->gridBricks(), 0);
-  std::vector<int> band;
-  const Eigen::Vector3d eye = T_world_camera.translation();
-  const double brick_m = vs * kBlockSide;
-  const int steps = static_cast<int>(std::ceil(2.0 * trunc / (0.5 * brick_m))) + 1;
-  for (int v = 0; v < roi_mask.rows; ++v) {
-    const float* z = depth_m.ptr<float>(v);
-    const std::uint8_t* m = roi_mask.ptr<std::uint8_t>(v);
-    for (int u = 0; u < roi_mask.cols; ++u) {
-      if (u + 8 <= roi_mask.cols && noneOfEight(m + u)) {
-        u += 7;
-        continue;
-      }
-      if (!m[u] || !(z[u] > 0.0f) || !std::isfinite(z[u])) continue;
-      ++stats.roi_pixels;
-      const Eigen::Vector3d ray_camera((u - in.cx_px) / in.fx_px, (v - in.cy_px) / in.fy_px, 1.0);
-      const Eigen::Vector3d p = T_world_camera * (z[u] * ray_camera);
-      const Eigen::Vector3d dir = (p - eye).normalized();
-      for (int s = 0; s <= steps; ++s) {
-        const Eigen::Vector3d q =
-            (p + (-trunc + 2.0 * trunc * s / steps) * dir - grid_origin_m) / brick_m;
-        const double b[3] = {std::floor(q.x()), std::floor(q.y()), std::floor(q.z())};
-        if (b[0] < 0 || b[1] < 0 || b[2] < 0 || b[0] >= bp.bricks_x || b[1] >= bp.bricks_y ||
-            b[2] >= bp.bricks_z)
-          continue;
-        const int id = layer_->brickIndex(int(b[0]), int(b[1]), int(b[2]));
-        if (!band_flags_[id]) {
-          band_flags_[id] = 1;
-          band.push_back(id);
-        }
-      }
-    }
-  }
-  for (int id : band) band_flags_[id] = 0;
-  std::sort(band.begin(), band.end());  // brick order as a scan of the grid gives it
+  const std::vector<int> band = truncationBandBricks(view, trunc, *layer_, band_flags_, stats);
   if (band.empty()) {
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return stats;
@@ -153,58 +242,17 @@ TsdfIntegrateStats TsdfVolume::integrate(const cv::Mat& depth_m, const cv::Mat& 
   stats.blocks_updated = update.size();
   stats.voxels_updated = update.size() * kBlockVoxels;
 
-  // 2. The ROI depth over the pixels a voxel of the band's bricks can project to, 0 where a
-  // pixel is not ROI or has no depth: the box of the bricks' projected corners (a brick is
-  // convex and in front of the camera, so its voxel centres project inside), rounded as the
-  // kernel rounds, clamped to the image. The result equals integrating the whole image; fruit
-  // outside the Cluster Region no longer widens the upload.
-  int u_min = 0, u_max = depth_m.cols - 1, v_min = 0, v_max = depth_m.rows - 1;
-  {
-    const Eigen::Isometry3d T_camera_world = T_world_camera.inverse();
-    double lo_u = std::numeric_limits<double>::infinity(), hi_u = -lo_u, lo_v = lo_u, hi_v = -lo_u;
-    bool in_front = true;
-    for (int id : band) {
-      const int bx = id % bp.bricks_x, by = (id / bp.bricks_x) % bp.bricks_y,
-                bz = id / (bp.bricks_x * bp.bricks_y);
-      for (int corner = 0; corner < 8; ++corner) {
-        const Eigen::Vector3d c =
-            T_camera_world *
-            (grid_origin_m + brick_m * Eigen::Vector3d(bx + (corner & 1), by + ((corner >> 1) & 1),
-                                                       bz + (corner >> 2)));
-        if (!(c.z() > 0.0)) in_front = false;
-        const double u = in.fx_px * c.x() / c.z() + in.cx_px,
-                     v = in.fy_px * c.y() / c.z() + in.cy_px;
-        lo_u = std::min(lo_u, u), hi_u = std::max(hi_u, u);
-        lo_v = std::min(lo_v, v), hi_v = std::max(hi_v, v);
-      }
-    }
-    if (in_front) {  // else: keep the whole image
-      const auto pixel = [](double x, int size) {
-        return int(std::clamp(std::floor(x + 0.5), 0.0, double(size - 1)));
-      };
-      u_min = pixel(lo_u - 1.0, depth_m.cols), u_max = pixel(hi_u + 1.0, depth_m.cols);
-      v_min = pixel(lo_v - 1.0, depth_m.rows), v_max = pixel(hi_v + 1.0, depth_m.rows);
-    }
-  }
-  const int width = u_max - u_min + 1, height = v_max - v_min + 1;
-  std::vector<float> crop(std::size_t(width) * height, 0.0f);
-  for (int v = 0; v < height; ++v) {
-    const float* z = depth_m.ptr<float>(v + v_min) + u_min;
-    const std::uint8_t* m = roi_mask.ptr<std::uint8_t>(v + v_min) + u_min;
-    for (int u = 0; u < width; ++u) {
-      if (u + 8 <= width && noneOfEight(m + u)) {
-        u += 7;
-        continue;
-      }
-      if (m[u] && z[u] > 0.0f && std::isfinite(z[u])) crop[std::size_t(v) * width + u] = z[u];
-    }
-  }
+  // 2. The ROI depth over the pixels a voxel of the band's bricks can project to. The result
+  // equals integrating the whole image; fruit outside the Cluster Region no longer widens the
+  // upload.
+  const PixelBox box = bandPixelBox(view, band, layer_->params());
+  const std::vector<float> crop = croppedRoiDepth(depth_m, roi_mask, box);
   stats.depth_pixels_uploaded = crop.size();
 
   // 3. The kernel over every voxel of the band's bricks.
   accel::TsdfParams params{};
   Eigen::Isometry3d T_world_grid = Eigen::Isometry3d::Identity();
-  T_world_grid.translation() = grid_origin_m;
+  T_world_grid.translation() = view.grid_origin_m;
   const Eigen::Matrix<double, 3, 4> T_camera_grid =
       (T_world_camera.inverse() * T_world_grid).matrix().topRows<3>();
   for (int r = 0; r < 3; ++r)
@@ -214,10 +262,10 @@ TsdfIntegrateStats TsdfVolume::integrate(const cv::Mat& depth_m, const cv::Mat& 
   params.max_weight = config_.max_weight;
   params.fx_px = float(in.fx_px);
   params.fy_px = float(in.fy_px);
-  params.cx_px = float(in.cx_px - u_min);
-  params.cy_px = float(in.cy_px - v_min);
-  params.width_px = width;
-  params.height_px = height;
+  params.cx_px = float(in.cx_px - box.u_min);
+  params.cy_px = float(in.cy_px - box.v_min);
+  params.width_px = box.width();
+  params.height_px = box.height();
   params.update_bricks = static_cast<std::uint32_t>(update.size());
   params.allocated_bricks = static_cast<std::uint32_t>(layer_->allocatedBricks());
   const auto update_buf = backend_->createBufferFrom(update);

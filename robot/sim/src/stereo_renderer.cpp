@@ -79,6 +79,80 @@ struct CornerSample {
   std::uint32_t region;
 };
 
+/// One render's stereo rig: each camera's eye and rays, the flash, and the pixel sampling.
+struct RenderRig {
+  Eigen::Matrix3d R;
+  host::StereoIntrinsics in;
+  // The right camera's rows are offset: its pixel row v sees what row v - offset would.
+  std::array<double, 2> row_offset_px;
+  std::array<Eigen::Vector3d, 2> eyes;
+  Eigen::Vector3d flash;  ///< one flash for both cameras' simultaneous exposure
+  int spp = 1, strata_x = 1, strata_y = 1;
+
+  Eigen::Vector3d rayDir(int camera, double u, double v) const {
+    return Eigen::Vector3d(R * Eigen::Vector3d((u - in.cx_px) / in.fx_px,
+                                               (v - row_offset_px[camera] - in.cy_px) / in.fy_px,
+                                               1.0));
+  }
+};
+
+// Noise differs per view: mix the seed with the pose's bits.
+std::uint64_t viewSeed(std::uint64_t noise_seed, const Eigen::Isometry3d& T_world_camera) {
+  std::uint64_t view_seed = detail::mix64(noise_seed);
+  for (int i = 0; i < 16; ++i) {
+    std::uint64_t bits = 0;
+    const double value = T_world_camera.matrix().data()[i];
+    std::memcpy(&bits, &value, sizeof(bits));
+    view_seed = detail::hashCombine(view_seed, bits);
+  }
+  return view_seed;
+}
+
+// The mean of a pixel's four corners (c: its top-left one) when they all landed on one
+// region; false otherwise.
+bool uniformCorners(const CornerSample* c, int corner_cols, Eigen::Vector3d& linear) {
+  const CornerSample& c00 = c[0];
+  const CornerSample& c01 = c[1];
+  const CornerSample& c10 = c[corner_cols];
+  const CornerSample& c11 = c[corner_cols + 1];
+  const bool uniform =
+      c00.region == c01.region && c00.region == c10.region && c00.region == c11.region;
+  if (uniform) linear = (0.25f * (c00.rgb + c01.rgb + c10.rgb + c11.rgb)).cast<double>();
+  return uniform;
+}
+
+// A pixel's linear radiance as 8-bit sRGB, BGR, with the sensor's Gaussian noise.
+void writePixel(cv::Vec3b& out, const Eigen::Vector3d& linear, std::uint64_t pixel_seed, int camera,
+                double noise_sigma) {
+  for (int channel = 0; channel < 3; ++channel) {
+    double noise = 0.0;
+    if (noise_sigma > 0.0) {
+      // Box-Muller from two hashed uniforms.
+      const std::uint64_t h = detail::hashCombine(pixel_seed, 0x100 + 4 * camera + channel);
+      const double u1 = 1.0 - detail::unitFromHash(h);
+      const double u2 = detail::unitFromHash(detail::mix64(h));
+      noise = noise_sigma * std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
+    }
+    const double value = 255.0 * linearToSrgb(linear[channel]) + noise;
+    out[2 - channel] = static_cast<std::uint8_t>(std::clamp(std::lround(value), 0L, 255L));
+  }
+}
+
+// Exceptions must not leave an OpenMP region: keep the first, rethrow after the loop.
+class FirstError {
+ public:
+  void keep() {
+#pragma omp critical(fvp_render_error)
+    if (!error_) error_ = std::current_exception();
+  }
+  void rethrow() const {
+    if (error_) std::rethrow_exception(error_);
+  }
+
+ private:
+  std::exception_ptr error_;
+};
+
 }  // namespace
 
 struct StereoRenderer::Impl {
@@ -114,6 +188,13 @@ struct StereoRenderer::Impl {
   ShadedSample radiance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
                         const Eigen::Vector3d& flash, bool with_leaves) const;
   int threadCount() const { return config.threads > 0 ? config.threads : omp_get_max_threads(); }
+  RenderRig rig(const Eigen::Isometry3d& T_world_camera) const;
+  /// Adaptive anti-aliasing's first pass: every pixel corner of both cameras shaded once.
+  void shadeCorners(const RenderRig& r, bool with_leaves, int width, int height,
+                    std::array<std::vector<CornerSample>, 2>& corners) const;
+  /// A pixel's radiance from r.spp stratified, jittered samples.
+  Eigen::Vector3d sampledRadiance(const RenderRig& r, int camera, int row, int col,
+                                  std::uint64_t pixel_seed, bool with_leaves) const;
   /// The pair (unless options.images is false) and, when truth is set, the exact layers.
   host::StereoFrame render(const Eigen::Isometry3d& T_world_camera, const RenderOptions& options,
                            GroundTruthImages* truth) const;
@@ -446,6 +527,66 @@ RenderedView StereoRenderer::renderWithGroundTruth(const Eigen::Isometry3d& T_wo
   return view;
 }
 
+RenderRig StereoRenderer::Impl::rig(const Eigen::Isometry3d& T_world_camera) const {
+  RenderRig r;
+  r.in = config.intrinsics;
+  r.R = T_world_camera.linear();
+  const double baseline_m = r.in.baseline_m * config.right_baseline_scale;  // the true one
+  r.eyes = {T_world_camera.translation(), T_world_camera.translation() + baseline_m * r.R.col(0)};
+  // One flash for the simultaneous exposure of both cameras, at the rig's centre.
+  r.flash = T_world_camera.translation() + 0.5 * baseline_m * r.R.col(0);
+  r.row_offset_px = {0.0, config.right_vertical_offset_px};
+  r.spp = config.samples_per_pixel;
+  r.strata_x = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(r.spp))));
+  r.strata_y = (r.spp + r.strata_x - 1) / r.strata_x;
+  return r;
+}
+
+void StereoRenderer::Impl::shadeCorners(const RenderRig& r, bool with_leaves, int width, int height,
+                                        std::array<std::vector<CornerSample>, 2>& corners) const {
+  const int corner_cols = width + 1;
+  FirstError error;
+  for (auto& grid : corners) grid.resize(static_cast<std::size_t>(corner_cols) * (height + 1));
+#pragma omp parallel for schedule(dynamic, 2) num_threads(threadCount())
+  for (int row = 0; row <= height; ++row) {
+    try {
+      for (int col = 0; col < corner_cols; ++col) {
+        for (int camera = 0; camera < 2; ++camera) {
+          const ShadedSample sample = radiance(
+              r.eyes[camera], r.rayDir(camera, col - 0.5, row - 0.5), r.flash, with_leaves);
+          corners[camera][static_cast<std::size_t>(row) * corner_cols + col] = {
+              sample.rgb.cast<float>(), sample.region};
+        }
+      }
+      // Embree's error state is per thread, so each row checks its own.
+      accel::detail::checkEmbree(device, "rtcIntersect1", __FILE__, __LINE__);
+    } catch (...) {
+      error.keep();
+    }
+  }
+  error.rethrow();
+}
+
+Eigen::Vector3d StereoRenderer::Impl::sampledRadiance(const RenderRig& r, int camera, int row,
+                                                      int col, std::uint64_t pixel_seed,
+                                                      bool with_leaves) const {
+  Eigen::Vector3d linear = Eigen::Vector3d::Zero();
+  for (int s = 0; s < r.spp; ++s) {
+    double du = 0.0, dv = 0.0;  // one sample: the pixel centre
+    if (r.spp > 1) {
+      const std::uint64_t h = detail::hashCombine(pixel_seed, 2 * s + camera);
+      const double jx = detail::unitFromHash(h);
+      const double jy = detail::unitFromHash(detail::mix64(h));
+      du = ((s % r.strata_x) + jx) / r.strata_x - 0.5;
+      dv = ((s / r.strata_x) + jy) / r.strata_y - 0.5;
+    }
+    linear +=
+        radiance(r.eyes[camera], r.rayDir(camera, col + du, row + dv), r.flash, with_leaves).rgb;
+  }
+  linear /= r.spp;
+  return linear;
+}
+
 host::StereoFrame StereoRenderer::Impl::render(const Eigen::Isometry3d& T_world_camera,
                                                const RenderOptions& options,
                                                GroundTruthImages* truth) const {
@@ -464,67 +605,19 @@ host::StereoFrame StereoRenderer::Impl::render(const Eigen::Isometry3d& T_world_
     truth->depth_m = cv::Mat::zeros(height, width, CV_32F);
     truth->object_id = cv::Mat::zeros(height, width, CV_32S);
   }
-  const Eigen::Matrix3d R = T_world_camera.linear();
-  const double baseline_m = in.baseline_m * im.config.right_baseline_scale;  // the true one
-  const std::array<Eigen::Vector3d, 2> eyes = {
-      T_world_camera.translation(), T_world_camera.translation() + baseline_m * R.col(0)};
-  // One flash for the simultaneous exposure of both cameras, at the rig's centre.
-  const Eigen::Vector3d flash = T_world_camera.translation() + 0.5 * baseline_m * R.col(0);
-  // Noise differs per view: mix the seed with the pose's bits.
-  std::uint64_t view_seed = detail::mix64(im.config.noise_seed);
-  for (int i = 0; i < 16; ++i) {
-    std::uint64_t bits = 0;
-    const double value = T_world_camera.matrix().data()[i];
-    std::memcpy(&bits, &value, sizeof(bits));
-    view_seed = detail::hashCombine(view_seed, bits);
-  }
-  const int spp = im.config.samples_per_pixel;
-  const int strata_x = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(spp))));
-  const int strata_y = (spp + strata_x - 1) / strata_x;
-  // The right camera's rows are offset: its pixel row v sees what row v - offset would.
-  const std::array<double, 2> row_offset_px = {0.0, im.config.right_vertical_offset_px};
-  const auto rayDir = [&](int camera, double u, double v) {
-    return Eigen::Vector3d(R * Eigen::Vector3d((u - in.cx_px) / in.fx_px,
-                                               (v - row_offset_px[camera] - in.cy_px) / in.fy_px,
-                                               1.0));
-  };
+  const RenderRig r = rig(T_world_camera);
+  const std::uint64_t view_seed = viewSeed(im.config.noise_seed, T_world_camera);
 
   // Adaptive anti-aliasing: shade every pixel corner once (shared by four pixels); a pixel
   // whose corners all land on one region (no silhouette, shadow or print edge inside) is the
   // mean of its corners, the others get `spp` stratified samples. Same filtering of texture
   // as 4 samples, at about a third of the rays of supersampling every pixel.
-  const bool adaptive = options.images && spp > 1 && im.config.adaptive_antialiasing;
+  const bool adaptive = options.images && r.spp > 1 && im.config.adaptive_antialiasing;
   const int corner_cols = width + 1;
   std::array<std::vector<CornerSample>, 2> corners;
+  if (adaptive) shadeCorners(r, options.with_leaves, width, height, corners);
 
-  // Exceptions must not leave an OpenMP region: keep the first, rethrow after the loop.
-  // Embree's error state is per thread, so each row checks its own.
-  std::exception_ptr error;
-  const auto keepFirstError = [&error]() {
-#pragma omp critical(fvp_render_error)
-    if (!error) error = std::current_exception();
-  };
-  if (adaptive) {
-    for (auto& grid : corners) grid.resize(static_cast<std::size_t>(corner_cols) * (height + 1));
-#pragma omp parallel for schedule(dynamic, 2) num_threads(im.threadCount())
-    for (int row = 0; row <= height; ++row) {
-      try {
-        for (int col = 0; col < corner_cols; ++col) {
-          for (int camera = 0; camera < 2; ++camera) {
-            const ShadedSample sample = im.radiance(
-                eyes[camera], rayDir(camera, col - 0.5, row - 0.5), flash, options.with_leaves);
-            corners[camera][static_cast<std::size_t>(row) * corner_cols + col] = {
-                sample.rgb.cast<float>(), sample.region};
-          }
-        }
-        accel::detail::checkEmbree(im.device, "rtcIntersect1", __FILE__, __LINE__);
-      } catch (...) {
-        keepFirstError();
-      }
-    }
-    if (error) std::rethrow_exception(error);
-  }
-
+  FirstError error;
 #pragma omp parallel for schedule(dynamic, 2) num_threads(im.threadCount())
   for (int row = 0; row < height; ++row) {
     try {
@@ -532,7 +625,7 @@ host::StereoFrame StereoRenderer::Impl::render(const Eigen::Isometry3d& T_world_
         const std::uint64_t pixel_seed =
             detail::hashCombine(view_seed, static_cast<std::uint64_t>(row) * width + col);
         if (truth) {
-          const Hit hit = im.trace(eyes[0], rayDir(0, col, row), options.with_leaves);
+          const Hit hit = im.trace(r.eyes[0], r.rayDir(0, col, row), options.with_leaves);
           if (hit.primitive >= 0) {
             // The direction has unit z in the camera frame, so t is the z-depth.
             truth->depth_m.at<float>(row, col) = static_cast<float>(hit.t);
@@ -542,56 +635,22 @@ host::StereoFrame StereoRenderer::Impl::render(const Eigen::Isometry3d& T_world_
         if (!options.images) continue;
         for (int camera = 0; camera < 2; ++camera) {
           Eigen::Vector3d linear = Eigen::Vector3d::Zero();
-          bool uniform = false;
-          if (adaptive) {
-            const CornerSample* c =
-                corners[camera].data() + static_cast<std::size_t>(row) * corner_cols + col;
-            const CornerSample& c00 = c[0];
-            const CornerSample& c01 = c[1];
-            const CornerSample& c10 = c[corner_cols];
-            const CornerSample& c11 = c[corner_cols + 1];
-            uniform =
-                c00.region == c01.region && c00.region == c10.region && c00.region == c11.region;
-            if (uniform) linear = (0.25f * (c00.rgb + c01.rgb + c10.rgb + c11.rgb)).cast<double>();
-          }
-          if (!uniform) {
-            for (int s = 0; s < spp; ++s) {
-              double du = 0.0, dv = 0.0;  // one sample: the pixel centre
-              if (spp > 1) {
-                const std::uint64_t h = detail::hashCombine(pixel_seed, 2 * s + camera);
-                const double jx = detail::unitFromHash(h);
-                const double jy = detail::unitFromHash(detail::mix64(h));
-                du = ((s % strata_x) + jx) / strata_x - 0.5;
-                dv = ((s / strata_x) + jy) / strata_y - 0.5;
-              }
-              linear += im.radiance(eyes[camera], rayDir(camera, col + du, row + dv), flash,
-                                    options.with_leaves)
-                            .rgb;
-            }
-            linear /= spp;
-          }
-          cv::Vec3b& out = (camera == 0 ? frame.left_bgr : frame.right_bgr).at<cv::Vec3b>(row, col);
-          for (int channel = 0; channel < 3; ++channel) {
-            double noise = 0.0;
-            if (im.config.noise_sigma > 0.0) {
-              // Box-Muller from two hashed uniforms.
-              const std::uint64_t h = detail::hashCombine(pixel_seed, 0x100 + 4 * camera + channel);
-              const double u1 = 1.0 - detail::unitFromHash(h);
-              const double u2 = detail::unitFromHash(detail::mix64(h));
-              noise = im.config.noise_sigma * std::sqrt(-2.0 * std::log(u1)) *
-                      std::cos(2.0 * std::numbers::pi * u2);
-            }
-            const double value = 255.0 * linearToSrgb(linear[channel]) + noise;
-            out[2 - channel] = static_cast<std::uint8_t>(std::clamp(std::lround(value), 0L, 255L));
-          }
+          const bool uniform =
+              adaptive && uniformCorners(corners[camera].data() +
+                                             static_cast<std::size_t>(row) * corner_cols + col,
+                                         corner_cols, linear);
+          if (!uniform)
+            linear = sampledRadiance(r, camera, row, col, pixel_seed, options.with_leaves);
+          writePixel((camera == 0 ? frame.left_bgr : frame.right_bgr).at<cv::Vec3b>(row, col),
+                     linear, pixel_seed, camera, im.config.noise_sigma);
         }
       }
       accel::detail::checkEmbree(im.device, "rtcIntersect1", __FILE__, __LINE__);
     } catch (...) {
-      keepFirstError();
+      error.keep();
     }
   }
-  if (error) std::rethrow_exception(error);
+  error.rethrow();
   last_seconds.store(
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   return frame;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <stdexcept>
 
@@ -150,6 +151,326 @@ nlohmann::ordered_json toJson(const Eigen::Matrix3d& m) {
   return rows;
 }
 
+// World::generate's pieces. The order of the draws is the world: a seed gives the same world
+// only while every piece draws from the sampler in the same order.
+
+/// What the generator has placed so far.
+struct TreeParts {
+  std::vector<FruitletCluster> clusters;
+  std::vector<Fruitlet> fruitlets;
+  std::vector<Leaf> leaves;
+  std::vector<BranchSegment> branches;     // the trunk, fruiting and extra branches, in order
+  std::vector<BranchSegment> fruiting;     // each cluster's fruiting branch
+  std::vector<Eigen::Vector3d> cameras_m;  // each cluster's start camera centre
+};
+
+/// The largest semi-axis a fruitlet may have.
+double maxFruitletBound_m(const WorldConfig& config) {
+  return config.max_radius_m * std::max(1.0, config.max_elongation);
+}
+
+double plateHalf_m(const WorldConfig& config) {
+  return 0.5 * kTagPlateScale * config.tag_size_m;
+}
+
+/// A cluster's fruiting branch and where the cluster hangs under it.
+struct BranchLayout {
+  Eigen::Vector3d heading, branch_dir, branch_start, branch_end, branch_point;
+  Eigen::Vector3d toward_view;  ///< horizontal normal of the branch towards -y
+  Eigen::Vector3d anchor;       ///< the cluster's centroid
+};
+
+// The fruiting branch, heading along +x or -x with some yaw, sloping up.
+BranchLayout drawBranchLayout(const WorldConfig& config, bool several, Sampler& rng) {
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  BranchLayout b;
+  const double side = rng.coin() ? 1.0 : -1.0;
+  const double yaw = rng.uniform(-kMaxBranchYawDeg, kMaxBranchYawDeg) * kDegToRad;
+  const double elevation = rng.uniform(kMinBranchElevationDeg, kMaxBranchElevationDeg) * kDegToRad;
+  const double height =
+      several ? config.cluster_height_m + config.cluster_height_spread_m * rng.uniform(-0.5, 0.5)
+              : config.cluster_height_m;
+  b.heading = Eigen::Vector3d(side * std::cos(yaw), std::sin(yaw), 0.0);
+  b.branch_dir = std::cos(elevation) * b.heading + std::sin(elevation) * up;
+  b.branch_start = height * up;
+  b.branch_end = b.branch_start + kFruitingBranchLengthM * b.branch_dir;
+  const double along_m = rng.uniform(kMinClusterAlongBranchM, kMaxClusterAlongBranchM);
+  b.branch_point = b.branch_start + along_m * b.branch_dir;
+  // Where the start view and the tag face.
+  b.toward_view = (-Eigen::Vector3d::UnitY() + b.heading.y() * b.heading).normalized();
+  // The cluster hangs under the branch; its centroid is exactly the anchor below.
+  b.anchor =
+      b.branch_point -
+      (config.branch_radius_m + 0.5 * config.cluster_spread_m + maxFruitletBound_m(config)) * up;
+  return b;
+}
+
+bool clearOfBranch(const Fruitlet& f, const BranchLayout& b, const WorldConfig& config) {
+  return pointSegmentDistance(f.center_m, b.branch_start, b.branch_end) >=
+         config.branch_radius_m + f.boundingRadius_m() + config.min_gap_m;
+}
+
+// Apart from every earlier cluster; the new branch clear of their fruitlets and tags, their
+// branches clear of the new cluster.
+bool apartFromEarlierClusters(const BranchLayout& b, const TreeParts& tree,
+                              const WorldConfig& config) {
+  bool apart = true;
+  for (const FruitletCluster& c : tree.clusters) {
+    apart = apart && (b.anchor - c.center_m).norm() >= config.min_cluster_spacing_m &&
+            pointSegmentDistance(c.tag.T_world_tag.translation(), b.branch_start, b.branch_end) >=
+                config.branch_radius_m + std::sqrt(2.0) * plateHalf_m(config) + config.min_gap_m;
+  }
+  for (const Fruitlet& f : tree.fruitlets) apart = apart && clearOfBranch(f, b, config);
+  for (const BranchSegment& s : tree.fruiting) {
+    apart = apart && pointSegmentDistance(b.anchor, s.start_m, s.end_m) >=
+                         s.radius_m + config.cluster_spread_m + maxFruitletBound_m(config) +
+                             config.min_gap_m;
+  }
+  return apart;
+}
+
+// A cluster's fruitlets around its anchor, their indices from first_index on: none closer to
+// another than min_gap_m (bounding spheres), all within cluster_spread_m and clear of the
+// branch once their centroid is moved onto the anchor.
+std::vector<Fruitlet> drawClusterFruitlets(const WorldConfig& config, const BranchLayout& b,
+                                           int first_index, std::uint64_t seed, Sampler& rng) {
+  const int count = rng.uniformInt(config.min_fruitlets, config.max_fruitlets);
+  std::array<int, kPaletteSrgb.size()> palette_order = {0, 1, 2, 3, 4, 5};
+  for (std::size_t i = palette_order.size() - 1; i > 0; --i) {
+    std::swap(palette_order[i], palette_order[rng.uniformInt(0, static_cast<int>(i))]);
+  }
+  for (int attempt = 0; attempt < kClusterAttempts; ++attempt) {
+    std::vector<Fruitlet> fruitlets;
+    for (int i = 0; i < count; ++i) {
+      Fruitlet f;
+      f.index = first_index + i;
+      f.radius_m = rng.uniform(config.min_radius_m, config.max_radius_m);
+      f.elongation = rng.uniform(config.min_elongation, config.max_elongation);
+      f.R_world_fruitlet = rng.rotation();
+      const auto& srgb = kPaletteSrgb[palette_order[i % palette_order.size()]];
+      f.rgb = {srgbToLinear(srgb[0]), srgbToLinear(srgb[1]), srgbToLinear(srgb[2])};
+      bool clear = false;
+      for (int tries = 0; tries < kPlacementAttempts && !clear; ++tries) {
+        f.center_m = b.anchor + rng.inBall(config.cluster_spread_m);
+        // Conservative: bounding spheres (largest semi-axis) at least min_gap_m apart.
+        clear = true;
+        for (const Fruitlet& other : fruitlets) {
+          clear = clear && (f.center_m - other.center_m).norm() >=
+                               f.boundingRadius_m() + other.boundingRadius_m() + config.min_gap_m;
+        }
+      }
+      if (!clear) break;
+      fruitlets.push_back(f);
+    }
+    if (static_cast<int>(fruitlets.size()) != count) continue;
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (const Fruitlet& f : fruitlets) centroid += f.center_m;
+    centroid /= count;
+    bool placed = true;
+    for (Fruitlet& f : fruitlets) {
+      f.center_m += b.anchor - centroid;  // pairwise gaps are unchanged by the shift
+      placed = placed && (f.center_m - b.anchor).norm() <= config.cluster_spread_m &&
+               clearOfBranch(f, b, config);
+    }
+    if (placed) return fruitlets;
+  }
+  throw std::runtime_error(
+      "world generation (seed " + std::to_string(seed) + "): cannot fit " + std::to_string(count) +
+      " fruitlets within cluster_spread_m = " + std::to_string(config.cluster_spread_m) +
+      " m; increase cluster_spread_m or reduce max_radius_m");
+}
+
+// The tag plate of cluster k, beside the cluster on the branch, facing the start view up to a
+// tilt, clear of every fruitlet and earlier tag; none when no try fits.
+std::optional<AprilTagPlacement> drawTag(const WorldConfig& config, int k, const BranchLayout& b,
+                                         const Eigen::Isometry3d& T_world_start_camera,
+                                         const std::vector<Fruitlet>& cluster_fruitlets,
+                                         const TreeParts& tree, Sampler& rng) {
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  AprilTagPlacement tag;
+  tag.tag_id = config.tag_id + k;
+  tag.tag_size_m = config.tag_size_m;
+  tag.plate_size_m = kTagPlateScale * config.tag_size_m;
+  for (int tries = 0; tries < kPlacementAttempts; ++tries) {
+    // tag_side is right (+1) or left (-1) of the cluster as the start view sees it.
+    const double rightward =
+        b.branch_dir.dot(T_world_start_camera.linear().col(0)) >= 0.0 ? 1.0 : -1.0;
+    const double sign =
+        config.tag_side != 0 ? config.tag_side * rightward : (rng.coin() ? 1.0 : -1.0);
+    const double t = rng.uniform(0.0, config.max_tag_distance_m + config.cluster_spread_m);
+    const double tilt = config.max_tag_tilt_deg * kDegToRad;
+    const double yaw_t = rng.uniform(-tilt, tilt), pitch_t = rng.uniform(-tilt, tilt);
+    const double roll_t = rng.uniform(-tilt, tilt);
+    // Yaw and pitch swing the plate's edges back towards the branch: stand off that much more.
+    const double swing_m =
+        0.5 * tag.plate_size_m * (std::abs(std::sin(yaw_t)) + std::abs(std::sin(pitch_t)));
+    const Eigen::Vector3d centre =
+        b.branch_point + sign * t * b.branch_dir +
+        (config.branch_radius_m + kTagStandoffM + swing_m) * b.toward_view;
+    const double distance = (centre - b.anchor).norm();
+    if (distance < config.min_tag_distance_m || distance > config.max_tag_distance_m) continue;
+    const Eigen::Isometry3d upright = lookAt(centre + b.toward_view, centre);
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = Eigen::AngleAxisd(yaw_t, up).toRotationMatrix() *
+                 Eigen::AngleAxisd(pitch_t, upright.linear().col(0)).toRotationMatrix() *
+                 upright.linear() * Eigen::AngleAxisd(roll_t, Eigen::Vector3d::UnitZ());
+    T.translation() = centre;
+    tag.T_world_tag = T;
+    bool tag_placed = true;
+    for (const auto* fruitlets : {&cluster_fruitlets, &tree.fruitlets}) {
+      for (const Fruitlet& f : *fruitlets) {
+        tag_placed = tag_placed &&
+                     pointPlateDistance(f.center_m, tag) >= f.boundingRadius_m() + config.min_gap_m;
+      }
+    }
+    for (const FruitletCluster& c : tree.clusters) {
+      tag_placed = tag_placed && (c.tag.T_world_tag.translation() - centre).norm() >=
+                                     2.0 * std::sqrt(2.0) * plateHalf_m(config) + config.min_gap_m;
+    }
+    if (tag_placed) return tag;
+  }
+  return std::nullopt;
+}
+
+// One layout of cluster k: its branch, fruitlets, start view and tag, added to the tree. One
+// cluster: its layout is drawn once (the paper's world). Several: false for a layout that
+// crowds an earlier cluster, its branch or its tag (the caller draws another).
+bool placeCluster(const WorldConfig& config, std::uint64_t seed, int k, TreeParts& tree,
+                  Sampler& rng) {
+  const bool several = config.cluster_count > 1;
+  const BranchLayout b = drawBranchLayout(config, several, rng);
+  if (several && !apartFromEarlierClusters(b, tree, config)) return false;
+  const std::vector<Fruitlet> cluster_fruitlets =
+      drawClusterFruitlets(config, b, static_cast<int>(tree.fruitlets.size()), seed, rng);
+  // Start view: straight out from the branch, at the requested distance.
+  const Eigen::Vector3d camera_m = b.anchor + config.start_view_distance_m * b.toward_view;
+  const Eigen::Isometry3d T_world_start_camera = lookAt(camera_m, b.anchor);
+  const std::optional<AprilTagPlacement> tag =
+      drawTag(config, k, b, T_world_start_camera, cluster_fruitlets, tree, rng);
+  if (!tag) {
+    if (several) return false;  // another layout
+    throw std::runtime_error("world generation (seed " + std::to_string(seed) +
+                             "): cannot place the tag between min_tag_distance_m and "
+                             "max_tag_distance_m without touching a fruitlet");
+  }
+  FruitletCluster placed_cluster;
+  placed_cluster.index = k;
+  for (const Fruitlet& f : cluster_fruitlets) placed_cluster.fruitlet_indices.push_back(f.index);
+  placed_cluster.center_m = b.anchor;
+  placed_cluster.tag = *tag;
+  placed_cluster.T_world_start_camera = T_world_start_camera;
+  tree.clusters.push_back(placed_cluster);
+  tree.fruitlets.insert(tree.fruitlets.end(), cluster_fruitlets.begin(), cluster_fruitlets.end());
+  tree.fruiting.push_back({b.branch_start, b.branch_end, config.branch_radius_m});
+  tree.branches.push_back(tree.fruiting.back());
+  tree.cameras_m.push_back(camera_m);
+  return true;
+}
+
+// Extra branches: clutter that keeps off every cluster and its start view's lines of sight.
+void addExtraBranches(const WorldConfig& config, TreeParts& tree, Sampler& rng) {
+  for (int b = 0; b < config.extra_branch_count; ++b) {
+    for (int tries = 0; tries < kPlacementAttempts; ++tries) {
+      const double height = config.cluster_height_m + rng.uniform(-0.4, 0.4);
+      const double azimuth = rng.uniform(0.0, 2.0 * kPi);
+      const double slope = rng.uniform(10.0, 50.0) * kDegToRad;
+      const double length = rng.uniform(0.3, 0.6);
+      const double radius = config.branch_radius_m * rng.uniform(0.6, 1.5);
+      const Eigen::Vector3d start(0.0, 0.0, std::clamp(height, 0.0, config.trunk_height_m));
+      const Eigen::Vector3d end =
+          start + length * Eigen::Vector3d(std::cos(slope) * std::cos(azimuth),
+                                           std::cos(slope) * std::sin(azimuth), std::sin(slope));
+      const double clearance = radius + std::max(0.01, config.min_gap_m);
+      bool clear = true;
+      for (std::size_t k = 0; k < tree.clusters.size(); ++k) {
+        const FruitletCluster& c = tree.clusters[k];
+        clear = clear &&
+                segmentSegmentDistance(start, end, tree.cameras_m[k], c.center_m) >=
+                    clearance + config.cluster_spread_m + maxFruitletBound_m(config) &&
+                segmentSegmentDistance(start, end, tree.cameras_m[k],
+                                       c.tag.T_world_tag.translation()) >=
+                    clearance + plateHalf_m(config) * std::sqrt(2.0);
+      }
+      if (!clear) continue;
+      tree.branches.push_back({start, end, radius});
+      break;
+    }
+  }
+}
+
+// Leaves, leaf_count around each cluster: a share in front of it (towards its start view),
+// the rest anywhere in its leaf region; never touching a fruitlet, never hiding a tag from
+// its start view.
+void addLeaves(const WorldConfig& config, std::uint64_t seed, TreeParts& tree, Sampler& rng) {
+  const int front_leaves =
+      static_cast<int>(std::lround(config.front_leaf_fraction * config.leaf_count));
+  const double front_reach_m =
+      std::max(0.02, std::min(config.leaf_region_m, 0.5 * config.start_view_distance_m));
+  for (std::size_t k = 0; k < tree.clusters.size(); ++k) {
+    const Eigen::Vector3d& cluster = tree.clusters[k].center_m;
+    const Eigen::Matrix3d R_view = tree.clusters[k].T_world_start_camera.linear();
+    for (int j = 0; j < config.leaf_count; ++j) {
+      const int leaf_index = static_cast<int>(tree.leaves.size());
+      bool leaf_placed = false;
+      for (int tries = 0; tries < kPlacementAttempts && !leaf_placed; ++tries) {
+        Leaf leaf;
+        leaf.index = leaf_index;
+        leaf.half_length_m = 0.5 * rng.uniform(config.min_leaf_length_m, config.max_leaf_length_m);
+        leaf.half_width_m = 0.5 * rng.uniform(config.min_leaf_width_m, config.max_leaf_width_m);
+        leaf.curl_per_m = rng.coin() ? 0.0 : rng.uniform(-1.0, 1.0) * config.max_leaf_curl_per_m;
+        leaf.T_world_leaf.linear() = rng.rotation();
+        Eigen::Vector3d centre;
+        if (j < front_leaves) {
+          const double ahead = rng.uniform(0.02, front_reach_m);
+          const double lateral = (config.cluster_spread_m + 0.02) * std::sqrt(rng.uniform());
+          const double phi = rng.uniform(0.0, 2.0 * kPi);
+          centre = cluster + R_view * Eigen::Vector3d(lateral * std::cos(phi),
+                                                      lateral * std::sin(phi), -ahead);
+        } else {
+          centre = cluster + rng.inBall(config.leaf_region_m);
+        }
+        if ((centre - cluster).norm() > config.leaf_region_m) continue;
+        leaf.T_world_leaf.translation() = centre;
+        bool clear = true;
+        for (std::size_t c = 0; c < tree.clusters.size(); ++c) {
+          clear =
+              clear &&
+              (centre - tree.cameras_m[c]).norm() >= kLeafCameraClearanceM + leaf.half_length_m &&
+              !leafHidesTag(leaf, tree.clusters[c].tag, tree.cameras_m[c]);
+        }
+        if (!clear) continue;
+        leaf_placed = true;
+        for (const Fruitlet& f : tree.fruitlets) {
+          leaf_placed = leaf_placed && leaf.distanceLowerBound_m(f.center_m) >=
+                                           f.boundingRadius_m() + config.min_gap_m;
+        }
+        if (leaf_placed) tree.leaves.push_back(leaf);
+      }
+      if (!leaf_placed) {
+        throw std::runtime_error("world generation (seed " + std::to_string(seed) +
+                                 "): cannot place leaf " + std::to_string(leaf_index) +
+                                 "; reduce leaf_count or enlarge leaf_region_m");
+      }
+    }
+  }
+}
+
+// Green fruitlets, on a stream of their own so the rest of the world stays as it was.
+void paintGreenFruitlets(const WorldConfig& config, std::uint64_t seed,
+                         std::vector<Fruitlet>& fruitlets) {
+  if (config.fruitlet_green_fraction <= 0.0) return;
+  std::seed_seq seq{seed, kGreenStream};
+  std::mt19937_64 green_rng(seq);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (Fruitlet& f : fruitlets) {
+    const double shade = 0.9 + 0.2 * unit(green_rng);  // a little lighter or darker
+    if (unit(green_rng) >= config.fruitlet_green_fraction) continue;
+    f.rgb = {srgbToLinear(std::min(1.0, shade * kGreenFruitletSrgb[0])),
+             srgbToLinear(std::min(1.0, shade * kGreenFruitletSrgb[1])),
+             srgbToLinear(std::min(1.0, shade * kGreenFruitletSrgb[2]))};
+  }
+}
+
 }  // namespace
 
 double Leaf::distanceLowerBound_m(const Eigen::Vector3d& p_world_m) const {
@@ -226,190 +547,15 @@ World World::fromParts(std::vector<Fruitlet> fruitlets, std::vector<Leaf> leaves
 World World::generate(const WorldConfig& config, std::uint64_t seed) {
   config.validate("world config");
   Sampler rng(seed);
-  World world;
-  world.config_ = config;
-  world.seed_ = seed;
-  world.clusters_.clear();
-  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
-  const int cluster_count = config.cluster_count;
-  const bool several = cluster_count > 1;
-
-  world.branches_.push_back(
-      {Eigen::Vector3d::Zero(), config.trunk_height_m * up, config.trunk_radius_m});
-  const double max_bound_m = config.max_radius_m * std::max(1.0, config.max_elongation);
-  const double plate_half_m = 0.5 * kTagPlateScale * config.tag_size_m;
-  std::vector<BranchSegment> fruiting;  // each cluster's fruiting branch
-  std::vector<Eigen::Vector3d> cameras_m;
-
-  for (int k = 0; k < cluster_count; ++k) {
+  const bool several = config.cluster_count > 1;
+  TreeParts tree;
+  tree.branches.push_back({Eigen::Vector3d::Zero(),
+                           config.trunk_height_m * Eigen::Vector3d::UnitZ(),
+                           config.trunk_radius_m});
+  for (int k = 0; k < config.cluster_count; ++k) {
     bool cluster_placed = false;
-    // One cluster: its layout is drawn once (the paper's world). Several: a layout that
-    // crowds an earlier cluster, its branch or its tag is drawn again.
-    for (int layout = 0; layout < (several ? kLayoutAttempts : 1) && !cluster_placed; ++layout) {
-      // The fruiting branch, heading along +x or -x with some yaw, sloping up.
-      const double side = rng.coin() ? 1.0 : -1.0;
-      const double yaw = rng.uniform(-kMaxBranchYawDeg, kMaxBranchYawDeg) * kDegToRad;
-      const double elevation =
-          rng.uniform(kMinBranchElevationDeg, kMaxBranchElevationDeg) * kDegToRad;
-      const double height = several ? config.cluster_height_m +
-                                          config.cluster_height_spread_m * rng.uniform(-0.5, 0.5)
-                                    : config.cluster_height_m;
-      const Eigen::Vector3d heading(side * std::cos(yaw), std::sin(yaw), 0.0);
-      const Eigen::Vector3d branch_dir = std::cos(elevation) * heading + std::sin(elevation) * up;
-      const Eigen::Vector3d branch_start = height * up;
-      const Eigen::Vector3d branch_end = branch_start + kFruitingBranchLengthM * branch_dir;
-      const double along_m = rng.uniform(kMinClusterAlongBranchM, kMaxClusterAlongBranchM);
-      const Eigen::Vector3d branch_point = branch_start + along_m * branch_dir;
-      // Horizontal normal of the branch towards -y: where the start view and the tag face.
-      const Eigen::Vector3d toward_view =
-          (-Eigen::Vector3d::UnitY() + heading.y() * heading).normalized();
-      // The cluster hangs under the branch; its centroid is exactly the anchor below.
-      const Eigen::Vector3d anchor =
-          branch_point -
-          (config.branch_radius_m + 0.5 * config.cluster_spread_m + max_bound_m) * up;
-      const auto clearOfBranch = [&](const Fruitlet& f) {
-        return pointSegmentDistance(f.center_m, branch_start, branch_end) >=
-               config.branch_radius_m + f.boundingRadius_m() + config.min_gap_m;
-      };
-      if (several) {
-        // Apart from every earlier cluster; the new branch clear of their fruitlets and tags,
-        // their branches clear of the new cluster.
-        bool apart = true;
-        for (const FruitletCluster& c : world.clusters_) {
-          apart = apart && (anchor - c.center_m).norm() >= config.min_cluster_spacing_m &&
-                  pointSegmentDistance(c.tag.T_world_tag.translation(), branch_start, branch_end) >=
-                      config.branch_radius_m + std::sqrt(2.0) * plate_half_m + config.min_gap_m;
-        }
-        for (const Fruitlet& f : world.fruitlets_) apart = apart && clearOfBranch(f);
-        for (const BranchSegment& b : fruiting) {
-          apart =
-              apart && pointSegmentDistance(anchor, b.start_m, b.end_m) >=
-                           b.radius_m + config.cluster_spread_m + max_bound_m + config.min_gap_m;
-        }
-        if (!apart) continue;
-      }
-      const int first_index = static_cast<int>(world.fruitlets_.size());
-      const int count = rng.uniformInt(config.min_fruitlets, config.max_fruitlets);
-      std::array<int, kPaletteSrgb.size()> palette_order = {0, 1, 2, 3, 4, 5};
-      for (std::size_t i = palette_order.size() - 1; i > 0; --i) {
-        std::swap(palette_order[i], palette_order[rng.uniformInt(0, static_cast<int>(i))]);
-      }
-      std::vector<Fruitlet> cluster_fruitlets;
-      bool placed = false;
-      for (int attempt = 0; attempt < kClusterAttempts && !placed; ++attempt) {
-        std::vector<Fruitlet> fruitlets;
-        for (int i = 0; i < count; ++i) {
-          Fruitlet f;
-          f.index = first_index + i;
-          f.radius_m = rng.uniform(config.min_radius_m, config.max_radius_m);
-          f.elongation = rng.uniform(config.min_elongation, config.max_elongation);
-          f.R_world_fruitlet = rng.rotation();
-          const auto& srgb = kPaletteSrgb[palette_order[i % palette_order.size()]];
-          f.rgb = {srgbToLinear(srgb[0]), srgbToLinear(srgb[1]), srgbToLinear(srgb[2])};
-          bool clear = false;
-          for (int tries = 0; tries < kPlacementAttempts && !clear; ++tries) {
-            f.center_m = anchor + rng.inBall(config.cluster_spread_m);
-            // Conservative: bounding spheres (largest semi-axis) at least min_gap_m apart.
-            clear = true;
-            for (const Fruitlet& other : fruitlets) {
-              clear =
-                  clear && (f.center_m - other.center_m).norm() >=
-                               f.boundingRadius_m() + other.boundingRadius_m() + config.min_gap_m;
-            }
-          }
-          if (!clear) break;
-          fruitlets.push_back(f);
-        }
-        if (static_cast<int>(fruitlets.size()) != count) continue;
-        Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-        for (const Fruitlet& f : fruitlets) centroid += f.center_m;
-        centroid /= count;
-        placed = true;
-        for (Fruitlet& f : fruitlets) {
-          f.center_m += anchor - centroid;  // pairwise gaps are unchanged by the shift
-          placed =
-              placed && (f.center_m - anchor).norm() <= config.cluster_spread_m && clearOfBranch(f);
-        }
-        if (placed) cluster_fruitlets = std::move(fruitlets);
-      }
-      if (!placed) {
-        throw std::runtime_error(
-            "world generation (seed " + std::to_string(seed) + "): cannot fit " +
-            std::to_string(count) +
-            " fruitlets within cluster_spread_m = " + std::to_string(config.cluster_spread_m) +
-            " m; increase cluster_spread_m or reduce max_radius_m");
-      }
-      const Eigen::Vector3d cluster = anchor;
-
-      // Start view: straight out from the branch, at the requested distance.
-      const Eigen::Vector3d camera_m = cluster + config.start_view_distance_m * toward_view;
-      const Eigen::Isometry3d T_world_start_camera = lookAt(camera_m, cluster);
-
-      // The tag plate, beside the cluster on the branch, facing the start view up to a tilt.
-      AprilTagPlacement tag;
-      tag.tag_id = config.tag_id + k;
-      tag.tag_size_m = config.tag_size_m;
-      tag.plate_size_m = kTagPlateScale * config.tag_size_m;
-      bool tag_placed = false;
-      for (int tries = 0; tries < kPlacementAttempts && !tag_placed; ++tries) {
-        // tag_side is right (+1) or left (-1) of the cluster as the start view sees it.
-        const double rightward =
-            branch_dir.dot(T_world_start_camera.linear().col(0)) >= 0.0 ? 1.0 : -1.0;
-        const double sign =
-            config.tag_side != 0 ? config.tag_side * rightward : (rng.coin() ? 1.0 : -1.0);
-        const double t = rng.uniform(0.0, config.max_tag_distance_m + config.cluster_spread_m);
-        const double tilt = config.max_tag_tilt_deg * kDegToRad;
-        const double yaw_t = rng.uniform(-tilt, tilt), pitch_t = rng.uniform(-tilt, tilt);
-        const double roll_t = rng.uniform(-tilt, tilt);
-        // Yaw and pitch swing the plate's edges back towards the branch: stand off that much
-        // more.
-        const double swing_m =
-            0.5 * tag.plate_size_m * (std::abs(std::sin(yaw_t)) + std::abs(std::sin(pitch_t)));
-        const Eigen::Vector3d centre =
-            branch_point + sign * t * branch_dir +
-            (config.branch_radius_m + kTagStandoffM + swing_m) * toward_view;
-        const double distance = (centre - cluster).norm();
-        if (distance < config.min_tag_distance_m || distance > config.max_tag_distance_m) continue;
-        const Eigen::Isometry3d upright = lookAt(centre + toward_view, centre);
-        Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-        T.linear() = Eigen::AngleAxisd(yaw_t, up).toRotationMatrix() *
-                     Eigen::AngleAxisd(pitch_t, upright.linear().col(0)).toRotationMatrix() *
-                     upright.linear() * Eigen::AngleAxisd(roll_t, Eigen::Vector3d::UnitZ());
-        T.translation() = centre;
-        tag.T_world_tag = T;
-        tag_placed = true;
-        for (const auto* fruitlets : {&cluster_fruitlets, &world.fruitlets_}) {
-          for (const Fruitlet& f : *fruitlets) {
-            tag_placed = tag_placed && pointPlateDistance(f.center_m, tag) >=
-                                           f.boundingRadius_m() + config.min_gap_m;
-          }
-        }
-        for (const FruitletCluster& c : world.clusters_) {
-          tag_placed = tag_placed && (c.tag.T_world_tag.translation() - centre).norm() >=
-                                         2.0 * std::sqrt(2.0) * plate_half_m + config.min_gap_m;
-        }
-      }
-      if (!tag_placed) {
-        if (several) continue;  // another layout
-        throw std::runtime_error("world generation (seed " + std::to_string(seed) +
-                                 "): cannot place the tag between min_tag_distance_m and "
-                                 "max_tag_distance_m without touching a fruitlet");
-      }
-      FruitletCluster placed_cluster;
-      placed_cluster.index = k;
-      for (const Fruitlet& f : cluster_fruitlets)
-        placed_cluster.fruitlet_indices.push_back(f.index);
-      placed_cluster.center_m = cluster;
-      placed_cluster.tag = tag;
-      placed_cluster.T_world_start_camera = T_world_start_camera;
-      world.clusters_.push_back(placed_cluster);
-      world.fruitlets_.insert(world.fruitlets_.end(), cluster_fruitlets.begin(),
-                              cluster_fruitlets.end());
-      fruiting.push_back({branch_start, branch_end, config.branch_radius_m});
-      world.branches_.push_back(fruiting.back());
-      cameras_m.push_back(camera_m);
-      cluster_placed = true;
-    }
+    for (int layout = 0; layout < (several ? kLayoutAttempts : 1) && !cluster_placed; ++layout)
+      cluster_placed = placeCluster(config, seed, k, tree, rng);
     if (!cluster_placed) {
       throw std::runtime_error(
           "world generation (seed " + std::to_string(seed) + "): cannot place cluster " +
@@ -419,102 +565,17 @@ World World::generate(const WorldConfig& config, std::uint64_t seed) {
           "min_cluster_spacing_m, or raise cluster_height_spread_m");
     }
   }
+  addExtraBranches(config, tree, rng);
+  addLeaves(config, seed, tree, rng);
+  paintGreenFruitlets(config, seed, tree.fruitlets);
+  World world;
+  world.config_ = config;
+  world.seed_ = seed;
+  world.clusters_ = std::move(tree.clusters);
+  world.fruitlets_ = std::move(tree.fruitlets);
+  world.leaves_ = std::move(tree.leaves);
+  world.branches_ = std::move(tree.branches);
   world.has_tag_ = true;
-
-  // Extra branches: clutter that keeps off every cluster and its start view's lines of sight.
-  for (int b = 0; b < config.extra_branch_count; ++b) {
-    for (int tries = 0; tries < kPlacementAttempts; ++tries) {
-      const double height = config.cluster_height_m + rng.uniform(-0.4, 0.4);
-      const double azimuth = rng.uniform(0.0, 2.0 * kPi);
-      const double slope = rng.uniform(10.0, 50.0) * kDegToRad;
-      const double length = rng.uniform(0.3, 0.6);
-      const double radius = config.branch_radius_m * rng.uniform(0.6, 1.5);
-      const Eigen::Vector3d start(0.0, 0.0, std::clamp(height, 0.0, config.trunk_height_m));
-      const Eigen::Vector3d end =
-          start + length * Eigen::Vector3d(std::cos(slope) * std::cos(azimuth),
-                                           std::cos(slope) * std::sin(azimuth), std::sin(slope));
-      const double clearance = radius + std::max(0.01, config.min_gap_m);
-      bool clear = true;
-      for (std::size_t k = 0; k < world.clusters_.size(); ++k) {
-        const FruitletCluster& c = world.clusters_[k];
-        clear = clear &&
-                segmentSegmentDistance(start, end, cameras_m[k], c.center_m) >=
-                    clearance + config.cluster_spread_m + max_bound_m &&
-                segmentSegmentDistance(start, end, cameras_m[k], c.tag.T_world_tag.translation()) >=
-                    clearance + plate_half_m * std::sqrt(2.0);
-      }
-      if (!clear) continue;
-      world.branches_.push_back({start, end, radius});
-      break;
-    }
-  }
-
-  // Leaves, leaf_count around each cluster: a share in front of it (towards its start view),
-  // the rest anywhere in its leaf region; never touching a fruitlet, never hiding a tag from
-  // its start view.
-  const int front_leaves =
-      static_cast<int>(std::lround(config.front_leaf_fraction * config.leaf_count));
-  const double front_reach_m =
-      std::max(0.02, std::min(config.leaf_region_m, 0.5 * config.start_view_distance_m));
-  for (std::size_t k = 0; k < world.clusters_.size(); ++k) {
-    const Eigen::Vector3d& cluster = world.clusters_[k].center_m;
-    const Eigen::Matrix3d R_view = world.clusters_[k].T_world_start_camera.linear();
-    for (int j = 0; j < config.leaf_count; ++j) {
-      const int leaf_index = static_cast<int>(world.leaves_.size());
-      bool leaf_placed = false;
-      for (int tries = 0; tries < kPlacementAttempts && !leaf_placed; ++tries) {
-        Leaf leaf;
-        leaf.index = leaf_index;
-        leaf.half_length_m = 0.5 * rng.uniform(config.min_leaf_length_m, config.max_leaf_length_m);
-        leaf.half_width_m = 0.5 * rng.uniform(config.min_leaf_width_m, config.max_leaf_width_m);
-        leaf.curl_per_m = rng.coin() ? 0.0 : rng.uniform(-1.0, 1.0) * config.max_leaf_curl_per_m;
-        leaf.T_world_leaf.linear() = rng.rotation();
-        Eigen::Vector3d centre;
-        if (j < front_leaves) {
-          const double ahead = rng.uniform(0.02, front_reach_m);
-          const double lateral = (config.cluster_spread_m + 0.02) * std::sqrt(rng.uniform());
-          const double phi = rng.uniform(0.0, 2.0 * kPi);
-          centre = cluster + R_view * Eigen::Vector3d(lateral * std::cos(phi),
-                                                      lateral * std::sin(phi), -ahead);
-        } else {
-          centre = cluster + rng.inBall(config.leaf_region_m);
-        }
-        if ((centre - cluster).norm() > config.leaf_region_m) continue;
-        leaf.T_world_leaf.translation() = centre;
-        bool clear = true;
-        for (std::size_t c = 0; c < world.clusters_.size(); ++c) {
-          clear = clear &&
-                  (centre - cameras_m[c]).norm() >= kLeafCameraClearanceM + leaf.half_length_m &&
-                  !leafHidesTag(leaf, world.clusters_[c].tag, cameras_m[c]);
-        }
-        if (!clear) continue;
-        leaf_placed = true;
-        for (const Fruitlet& f : world.fruitlets_) {
-          leaf_placed = leaf_placed && leaf.distanceLowerBound_m(f.center_m) >=
-                                           f.boundingRadius_m() + config.min_gap_m;
-        }
-        if (leaf_placed) world.leaves_.push_back(leaf);
-      }
-      if (!leaf_placed) {
-        throw std::runtime_error("world generation (seed " + std::to_string(seed) +
-                                 "): cannot place leaf " + std::to_string(leaf_index) +
-                                 "; reduce leaf_count or enlarge leaf_region_m");
-      }
-    }
-  }
-  // Green fruitlets, on a stream of their own so the rest of the world stays as it was.
-  if (config.fruitlet_green_fraction > 0.0) {
-    std::seed_seq seq{seed, kGreenStream};
-    std::mt19937_64 green_rng(seq);
-    std::uniform_real_distribution<double> unit(0.0, 1.0);
-    for (Fruitlet& f : world.fruitlets_) {
-      const double shade = 0.9 + 0.2 * unit(green_rng);  // a little lighter or darker
-      if (unit(green_rng) >= config.fruitlet_green_fraction) continue;
-      f.rgb = {srgbToLinear(std::min(1.0, shade * kGreenFruitletSrgb[0])),
-               srgbToLinear(std::min(1.0, shade * kGreenFruitletSrgb[1])),
-               srgbToLinear(std::min(1.0, shade * kGreenFruitletSrgb[2]))};
-    }
-  }
   return world;
 }
 

@@ -1,0 +1,87 @@
+"""fvp.sim's trial keywords are `fvp run`'s options: none missing, the automatic stop's
+switches with the CLI's defaults, and each reaching the trial."""
+import re
+import subprocess
+
+import pytest
+
+import fvp
+
+# `fvp run` options whose keyword is not the option's name with '-' as '_', each with why.
+RENAMED = {
+    "--world": "world_config",     # a keyword says what the file holds, as Trial's options do
+    "--config": "planner_config",  # ditto: the planner's config, beside world_ and arm_config
+    "--arm": "arm_config",         # ditto
+    "--out": "out_dir",            # optional in Python (no files unless asked for)
+}
+# `fvp run` options with no keyword at all, each with why.
+NOT_KEYWORDS = {
+    "--help": "the CLI's own",
+}
+
+
+def run_options(fvp_exe):
+    """The long options of `fvp run --help`, a negated flag's --no- form left out."""
+    text = subprocess.run([fvp_exe, "run", "--help"], check=True, capture_output=True,
+                          text=True).stdout
+    names = set()
+    for line in text.splitlines():
+        # An option's line: its names first ("-h,--help", "--stop TEXT:{budget,auto}=budget").
+        if not line.lstrip().startswith("-"):
+            continue
+        for name in re.findall(r"--[a-z][a-z0-9-]*", line.split()[0]):
+            if not name.startswith("--no-"):
+                names.add(name)
+    return names
+
+
+def keywords(function):
+    """The keyword arguments of a pybind11 function, from its signature line."""
+    signature = function.__doc__.splitlines()[0]
+    return set(re.findall(r"(\w+): [\w.\[\]]+(?: = [^,)]+)?", signature)) - {"self"}
+
+
+def keyword_for(option):
+    return RENAMED.get(option, option[2:].replace("-", "_"))
+
+
+def test_every_run_option_has_a_keyword(fvp_exe):
+    options = run_options(fvp_exe)
+    # The parse found the options (a changed help layout would make this test vacuous).
+    assert {"--planner", "--seed", "--stop", "--confirm-detections", "--out"} <= options
+    for function in (fvp.sim.Trial.__init__, fvp.sim.run_trial):
+        missing = sorted(o for o in options - NOT_KEYWORDS.keys()
+                         if keyword_for(o) not in keywords(function))
+        assert not missing, f"{function.__qualname__}: no keyword for {missing}"
+
+
+def test_exceptions_are_still_options(fvp_exe):
+    # A stale exception would hide nothing, but says something false about the CLI.
+    options = run_options(fvp_exe)
+    assert set(RENAMED) <= options and set(NOT_KEYWORDS) <= options
+
+
+def test_automatic_stop_switches_default_as_the_cli(fvp_exe):
+    signature = fvp.sim.Trial.__init__.__doc__.splitlines()[0]
+    assert "confirm_detections: bool = True" in signature
+    assert "release_left_out: bool = True" in signature
+    help_text = subprocess.run([fvp_exe, "run", "--help"], check=True, capture_output=True,
+                               text=True).stdout
+    # The CLI's flags are on unless negated (TrialOptions' defaults).
+    assert "--confirm-detections,--no-confirm-detections" in help_text
+    assert "--release-left-out,--no-release-left-out" in help_text
+
+
+@pytest.mark.parametrize("confirm,release", [(False, True), (True, False)])
+def test_automatic_stop_switches_reach_the_trial(confirm, release):
+    result = fvp.sim.run_trial(seed=2, clock="fixed", stop="auto", max_views=1,
+                               confirm_detections=confirm, release_left_out=release)
+    assert result["stop"]["rule"] == "auto"
+    assert result["stop"]["confirm_detections"] is confirm
+    assert result["stop"]["release_left_out"] is release
+
+
+def test_automatic_stop_switches_default_on():
+    result = fvp.sim.Trial(seed=2, clock="fixed", stop="auto", max_views=1).run()
+    assert result["stop"]["confirm_detections"] is True
+    assert result["stop"]["release_left_out"] is True
