@@ -72,6 +72,24 @@ std::string vec(const Eigen::Vector3d& p) {
   return os.str();
 }
 
+/// What `fvp capture` stores of one rendered, perceived view (docs/capture-format.md).
+[[maybe_unused]] host::Capture captureOf(const host::StereoFrame& frame,
+                                         const host::PerceptionResult& result,
+                                         const robot::sim::World& world) {
+  host::Capture capture;
+  capture.left_bgr = frame.left_bgr;
+  capture.right_bgr = frame.right_bgr;
+  capture.intrinsics = frame.intrinsics;
+  capture.T_world_camera = frame.T_world_camera;
+  capture.disparity_px = result.disparity.disparity_px;
+  capture.fruitlet_mask = result.fruitlet_mask;
+  capture.roi_points_m = result.clouds.roi_points_m;
+  capture.other_points_m = result.clouds.other_points_m;
+  capture.has_clouds = true;
+  capture.ground_truth_json = world.groundTruthJson();
+  return capture;
+}
+
 }  // namespace
 
 // A single view written into a capture set would leave a camera.yaml beside its views, and
@@ -114,17 +132,7 @@ static void writeCaptureSet(std::uint64_t seed, const std::string& world_file, i
     const host::StereoFrame frame = renderer.render(poses[i]);
     const host::PerceptionResult result = pipeline.process(frame, region);
     if (!region && result.region) region = result.region;
-    host::Capture capture;
-    capture.left_bgr = frame.left_bgr;
-    capture.right_bgr = frame.right_bgr;
-    capture.intrinsics = frame.intrinsics;
-    capture.T_world_camera = frame.T_world_camera;
-    capture.disparity_px = result.disparity.disparity_px;
-    capture.fruitlet_mask = result.fruitlet_mask;
-    capture.roi_points_m = result.clouds.roi_points_m;
-    capture.other_points_m = result.clouds.other_points_m;
-    capture.has_clouds = true;
-    capture.ground_truth_json = world.groundTruthJson();
+    const host::Capture capture = captureOf(frame, result, world);
     char name[24];  // any size_t in %03zu fits
     std::snprintf(name, sizeof(name), "%03zu", i);
     host::writeCapture(out / name, capture);
@@ -222,18 +230,7 @@ void printPerceptionStats(const host::PerceptionResult& result) {
   const host::PerceptionPipeline pipeline(config);
   const host::PerceptionResult result = pipeline.process(frame);
 
-  host::Capture capture;
-  capture.left_bgr = frame.left_bgr;
-  capture.right_bgr = frame.right_bgr;
-  capture.intrinsics = frame.intrinsics;
-  capture.T_world_camera = frame.T_world_camera;
-  capture.disparity_px = result.disparity.disparity_px;
-  capture.fruitlet_mask = result.fruitlet_mask;
-  capture.roi_points_m = result.clouds.roi_points_m;
-  capture.other_points_m = result.clouds.other_points_m;
-  capture.has_clouds = true;
-  capture.ground_truth_json = world.groundTruthJson();
-  host::writeCapture(opt->out, capture);
+  host::writeCapture(opt->out, captureOf(frame, result, world));
 
   const auto occlusion = robot::sim::OcclusionStatistic::compute(view.ground_truth.object_id,
                                                                  bare.ground_truth.object_id);
