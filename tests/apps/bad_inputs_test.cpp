@@ -610,7 +610,7 @@ const std::vector<BadInput>& cases() {
                                          "1",       "--out",   p(d / "out")};
        },
        1,
-       {"world.yaml': expected one YAML document, got 2"},
+       {"world.yaml': expected one YAML document, got 2 or more"},
        {"out/camera.yaml"}},
       {"WorldConfigNestedTooDeeply",
        [](const fs::path& d) {

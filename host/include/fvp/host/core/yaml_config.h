@@ -6,6 +6,7 @@
 #pragma once
 
 #include <yaml-cpp/depthguard.h>  // YAML::DeepRecursion
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <Eigen/Core>
@@ -50,6 +51,28 @@ inline void checkNoDuplicateKeys(const YAML::Node& node, const std::string& sour
   }
 }
 
+namespace detail {
+
+/// Parses a YAML stream document by document without building nodes (the count is all
+/// loadOneYamlDocument needs of the documents after the first).
+class YamlDocumentCounter : public YAML::EventHandler {
+ public:
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                const std::string&) override {}
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {}
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {}
+  void OnMapEnd() override {}
+};
+
+}  // namespace detail
+
 /// The one YAML document of a file (null when the file is empty), with no key twice in any
 /// mapping. Throws std::invalid_argument naming source when the file is not a regular file
 /// of at most max_bytes (a bound keeps a 100 MB list from exhausting memory in the parser,
@@ -69,23 +92,27 @@ inline YAML::Node loadOneYamlDocument(const std::filesystem::path& path, const s
     if (why.rfind(path_prefix, 0) == 0) why.erase(0, path_prefix.size());
     throw std::invalid_argument(source + ": " + why);
   }
-  std::vector<YAML::Node> docs;
+  YAML::Node root;
+  int documents = 0;
   try {
-    docs = YAML::LoadAll(text);
+    // YAML::LoadAll loops forever on some inputs (yaml-cpp 0.7, e.g. ","): count at most two
+    // documents with the parser itself, then load the first.
+    std::istringstream stream(text);
+    YAML::Parser parser(stream);
+    detail::YamlDocumentCounter counter;
+    while (documents < 2 && parser.HandleNextDocument(counter)) ++documents;
+    if (documents == 1) root = YAML::Load(text);
   } catch (const YAML::DeepRecursion&) {
     throw std::invalid_argument(source +
                                 ": cannot read YAML: lists or mappings nested too deeply "
                                 "(expected a flat file of key: value)");
-  } catch (const YAML::BadFile&) {
-    throw std::invalid_argument(source + ": cannot open the file");
   } catch (const YAML::Exception& e) {
     throw std::invalid_argument(source + ": cannot read YAML: " + e.what());
   }
-  if (docs.size() > 1)
-    throw std::invalid_argument(source + ": expected one YAML document, got " +
-                                std::to_string(docs.size()) +
-                                " (a '---' line starts another; remove it or the later ones)");
-  const YAML::Node root = docs.empty() ? YAML::Node() : docs[0];
+  if (documents > 1)
+    throw std::invalid_argument(source +
+                                ": expected one YAML document, got 2 or more (a '---' line "
+                                "starts another; remove it or the later ones)");
   checkNoDuplicateKeys(root, source);
   return root;
 }
