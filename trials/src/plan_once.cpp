@@ -170,7 +170,9 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
     host::checkOutputPaths(o.out_dir, "plan output directory", {"plan.json", "candidates.ply"}, {});
     host::removeStaleOutputs(o.out_dir, {"plan.json", "candidates.ply"});
   }
-  const std::string engine = o.engine.empty() ? defaultEngine(o.planner) : o.engine;
+  const std::string engine =
+      o.engine.empty() ? host::planner::PlannerRegistry::instance().at(o.planner).default_engine
+                       : o.engine;
   const bool from_captures = !o.captures_dir.empty();
   // Checked first: a bad config fails before anything is mapped.
   const host::PerceptionConfig perception =

@@ -255,17 +255,6 @@ std::function<cv::Mat(int)> imageSource(const TrialLog& log) {
   return [&log](int view) { return log.images().image(view); };
 }
 
-/// The loop clock as an observer sees it: the time, with nothing charged (sizing for a
-/// figure is not part of the loop).
-class UnchargedClock : public host::nbv::LoopClock {
- public:
-  explicit UnchargedClock(const host::nbv::LoopClock& clock) : clock_(clock) {}
-  double now_s() const override { return clock_.now_s(); }
-
- private:
-  const host::nbv::LoopClock& clock_;
-};
-
 /// The cluster as the automatic stop sized it after each view, each sizing scored against
 /// the world's ground truth: what a shorter budget would have reported.
 /// Times are from the start of the cluster (t0_s on the run's clock).
@@ -309,53 +298,6 @@ nlohmann::json sizeHistoryJson(const std::vector<host::nbv::SizingSnapshot>& his
   return out;
 }
 
-// A cluster's start view and the same view from farther out: its camera body (3 cm) with
-// the collision padding (1 cm) and a coarse voxel (1 cm) needs about 5 cm around it, and
-// leaves may hang that close to the start view (the generator keeps them 5 cm off the
-// camera centre), so each step backs off by that much; 0.45 m is the farthest, where the
-// 3 cm tag still spans about 70 px. Where none of those can be reached (the foliage an
-// earlier cluster's views mapped may stand where the arm must), the same views turned about
-// the vertical through the cluster's centre by 20 and then 40 degrees either way: the tag,
-// tilted at most 5 degrees, is then seen 45 degrees off its axis at most, well inside what
-// AprilTag detects.
-constexpr double kApproachStepM = 0.05;
-constexpr int kApproachSteps = 3;
-constexpr std::array<double, 5> kApproachYawDeg = {0.0, 20.0, -20.0, 40.0, -40.0};
-
-struct ApproachPose {
-  Eigen::Isometry3d T_world_camera;
-  double yaw_deg = 0.0;  ///< turned about the vertical through the cluster's centre
-};
-
-std::vector<ApproachPose> approachPoses(const FruitletCluster& cluster) {
-  std::vector<ApproachPose> poses;
-  const Eigen::Vector3d back = -cluster.T_world_start_camera.linear().col(2);
-  for (const double yaw_deg : kApproachYawDeg) {
-    const Eigen::Isometry3d turn =
-        Eigen::Translation3d(cluster.center_m) *
-        Eigen::AngleAxisd(yaw_deg * std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ()) *
-        Eigen::Translation3d(-cluster.center_m);
-    for (int step = 0; step <= kApproachSteps; ++step) {
-      Eigen::Isometry3d T = cluster.T_world_start_camera;
-      T.translation() += step * kApproachStepM * back;
-      poses.push_back({turn * T, yaw_deg});
-    }
-  }
-  return poses;
-}
-
-/// The cluster not yet visited whose start view is nearest `here` (the first on a tie).
-std::size_t nearestUnvisited(const std::vector<FruitletCluster>& clusters,
-                             const std::vector<bool>& visited, const Eigen::Vector3d& here) {
-  std::size_t k = clusters.size();
-  for (std::size_t i = 0; i < clusters.size(); ++i)
-    if (!visited[i] && (k == clusters.size() ||
-                        (clusters[i].T_world_start_camera.translation() - here).norm() <
-                            (clusters[k].T_world_start_camera.translation() - here).norm()))
-      k = i;
-  return k;
-}
-
 /// What a tree's tour has gathered so far, cluster by cluster: result.json's parts.
 struct TourRecord {
   nlohmann::json cluster_entries = nlohmann::json::array();
@@ -373,52 +315,6 @@ struct TourRecord {
   std::string scene_error;  // why the scene could not be built (no viewer then)
   nlohmann::json overlays = nlohmann::json::array();
 };
-
-/// A cluster's approach views (approachPoses), tried in order: each moveToNext moves the arm
-/// to the next one it can reach, charging the transit to the tour, until a move succeeds.
-class ApproachSequence {
- public:
-  explicit ApproachSequence(const FruitletCluster& cluster)
-      : cluster_(cluster), poses_(approachPoses(cluster)) {}
-
-  /// False when no approach view is left; a success records the view in `entry`.
-  bool moveToNext(host::nbv::Arm& arm, host::nbv::LoopClock& clock, nlohmann::json& entry,
-                  TourRecord& tour) {
-    for (; next_ < poses_.size(); ++next_) {
-      const auto& [T, yaw_deg] = poses_[next_];
-      if (arm.cameraPose().isApprox(T, 1e-9) || !arm.reachable(T)) continue;
-      const double before_s = clock.now_s();
-      const host::nbv::MoveResult move = arm.moveTo(T);
-      tour.transit_s += clock.now_s() - before_s;
-      move_status_ = host::nbv::toString(move.status);
-      tour.transit_motion[move_status_] = tour.transit_motion.value(move_status_, 0) + 1;
-      if (move.ok()) {
-        entry["approach_distance_m"] = (T.translation() - cluster_.center_m).norm();
-        entry["approach_yaw_deg"] = yaw_deg;
-        ++next_;
-        return true;
-      }
-    }
-    return false;
-  }
-
-  /// The last move's status, "unreachable" when none was tried.
-  const std::string& lastMoveStatus() const { return move_status_; }
-
- private:
-  const FruitletCluster& cluster_;
-  std::vector<ApproachPose> poses_;
-  std::size_t next_ = 0;
-  std::string move_status_ = "unreachable";
-};
-
-/// The perception of cluster k: in a world of several clusters only its own tag places a
-/// Cluster Region (one cluster: any tag, as a grower's single tag).
-host::PerceptionConfig perceptionFor(const World& world, std::size_t k) {
-  host::PerceptionConfig perception;
-  if (world.clusters().size() > 1) perception.tag.tag_id = world.clusters()[k].tag.tag_id;
-  return perception;
-}
 
 nlohmann::json eventsJson(const host::nbv::NbvEvents& events) {
   return {{"planning_iterations", events.planning_iterations},
@@ -451,21 +347,58 @@ void addNumbers(nlohmann::json& total, const nlohmann::json& part) {
 
 }  // namespace
 
-/// What running the loop on one cluster gave.
+/// What running the loop on one cluster gave, scored.
 struct ClusterOutcome {
   host::nbv::NbvResult run;
-  nlohmann::json sizing;        ///< sizeAndScore's object
+  nlohmann::json sizing;        ///< TrialParts::score's object
   nlohmann::json size_history;  ///< null unless sizes were kept after every view
   double sizing_wall_s = 0.0, sizing_during_loop_s = 0.0;
   /// With the automatic stop: what the sizing guidance did (added to the events).
   nlohmann::json guidance_events = nlohmann::json::object();
 };
 
+namespace {
+
+/// The simulator's clusters as the library's targets: in a world of several clusters only
+/// a cluster's own tag places its Cluster Region (one cluster: the perception config's tag,
+/// as a grower's single tag).
+std::vector<host::nbv::ClusterTarget> clusterTargets(const World& world) {
+  std::vector<host::nbv::ClusterTarget> targets;
+  for (const FruitletCluster& c : world.clusters()) {
+    host::nbv::ClusterTarget t;
+    if (world.clusters().size() > 1) t.tag_id = c.tag.tag_id;
+    t.T_world_start_camera = c.T_world_start_camera;
+    t.center_m = c.center_m;
+    targets.push_back(t);
+  }
+  return targets;
+}
+
+/// The library's setup of a trial's options.
+host::nbv::NbvSetupOptions setupOptions(const TrialOptions& o) {
+  host::nbv::NbvSetupOptions s;
+  s.planner = o.planner;
+  s.planner_config = o.planner_config;
+  s.engine = o.engine;
+  s.backend = o.backend;
+  s.planner_seed = o.seed;  // cluster k: seed + k (one cluster: the trial's seed)
+  s.register_views = o.register_views;
+  s.stop.rule = *host::nbv::stopRuleFromString(o.stop);
+  s.stop.budget_s = o.budget_s;
+  s.stop.max_views = o.max_views;
+  s.stop.record_size_history = o.record_size_history;
+  s.stop.completion.confirm_detections = o.confirm_detections;
+  s.stop.completion.release_left_out = o.release_left_out;
+  return s;
+}
+
+}  // namespace
+
 struct Trial::Impl {
+  class TourRecorder;
+
   explicit Impl(TrialOptions opts) : options(std::move(opts)) {
     validate(options);
-    completion_config.confirm_detections = options.confirm_detections;
-    completion_config.release_left_out = options.release_left_out;
     if (!options.out_dir.empty()) {
       host::prepareOutputDirectory(options.out_dir, "trial output directory");
       lock.emplace(options.out_dir, "trial output directory");
@@ -482,23 +415,21 @@ struct Trial::Impl {
       host::checkOutputPaths(options.out_dir, "trial output directory", stale, subdirs);
       host::removeStaleOutputs(options.out_dir, stale, {"views", "overlays"});
     }
-    engine = options.engine.empty() ? defaultEngine(options.planner) : options.engine;
-
     // First: a missing backend or a bad planner config fails before the arm is built.
-    backend = host::map::createBackendFor(engine, options.backend);
+    setup = std::make_unique<host::nbv::NbvSetup>(setupOptions(options));
     const WorldConfig world_config = options.world_config.empty()
                                          ? WorldConfig{}
                                          : WorldConfig::fromYamlFile(options.world_config);
     world = std::make_unique<World>(World::generate(world_config, options.seed));
-    // The first cluster's session and planner (maps + TSDF fed view by view, then sizing).
-    parts = makeParts(0);
+    targets = clusterTargets(*world);
+    buildSimulator();
+  }
 
-    // The simulated camera.
+  /// The simulated camera, the arm with its workspace tree, and the simulated clock.
+  void buildSimulator() {
     RenderConfig render_config = renderConfigFor(world->config(), {}, options.seed);
     render_config.noise_seed = options.seed;
     renderer = std::make_unique<StereoRenderer>(*world, render_config);
-
-    // The arm, its workspace tree and the simulated clock.
     if (!options.arm_config.empty()) arm_config = ArmConfig::fromYamlFile(options.arm_config);
     if (arm_config.workspace_cache_dir.empty()) arm_config.workspace_cache_dir = defaultCacheDir();
     arm = std::make_unique<ArmModel>(arm_config);
@@ -528,37 +459,27 @@ struct Trial::Impl {
   static constexpr int kMaxClusterDirs = 8;
   static std::string clusterDirName(std::size_t k) { return "cluster_" + std::to_string(k); }
 
-  std::unique_ptr<TrialParts> makeParts(std::size_t k) const {
-    // One cluster: the planner's seed is the trial's, as it always was.
-    return std::make_unique<TrialParts>(options, engine, backend.get(), perceptionFor(*world, k),
-                                        options.seed + k);
-  }
-
   void warn(const std::string& text) {
     warnings.push_back(text);
     if (options.on_warning) options.on_warning(text);
   }
 
-  /// The loop on one cluster from where the camera is, until the cluster's stop (its cap
-  /// counted from t0_s), then its sizing scored against its fruitlets.
-  ClusterOutcome runCluster(TrialParts& cluster_parts, const FruitletCluster& cluster,
-                            host::nbv::Camera& loop_camera, host::nbv::Arm& loop_arm,
-                            host::nbv::LoopClock& loop_clock, TrialLog& log);
+  /// A cluster's run through the library, scored against its fruitlets (size_history's
+  /// times from the start of its last loop).
+  ClusterOutcome scored(host::nbv::ClusterRun run, TrialParts& cluster_parts,
+                        const FruitletCluster& cluster) const;
 
   nlohmann::json run(host::nbv::Camera& loop_camera, host::nbv::Arm& loop_arm);
   nlohmann::json runTree(host::nbv::Camera& loop_camera, host::nbv::Arm& loop_arm);
-  /// The tree's steps: a cluster's loop, retried from its next approach view while no view
-  /// shows its tag; its entry and totals; its files and scene part; the result.
-  ClusterOutcome runClusterFromApproaches(TrialParts& cluster_parts, const FruitletCluster& cluster,
-                                          ApproachSequence& approach,
-                                          host::nbv::Camera& loop_camera, host::nbv::Arm& loop_arm,
-                                          host::nbv::LoopClock& loop_clock, TrialLog& log,
-                                          nlohmann::json& entry, TourRecord& tour);
-  void recordCluster(std::size_t k, TrialParts& cluster_parts, const ClusterOutcome& outcome,
-                     const TrialLog& log, double sim_time_s, nlohmann::json& entry,
+  /// The tree's steps: a visited cluster's entry and totals; its files and scene part; a
+  /// skipped cluster's entry; the result.
+  void recordCluster(const host::nbv::ClusterVisit& visit, TrialParts& cluster_parts,
+                     const ClusterOutcome& outcome, const TrialLog& log, nlohmann::json& entry,
                      TourRecord& tour);
-  void writeClusterOutputs(std::size_t k, TrialParts& cluster_parts, const ClusterOutcome& outcome,
-                           const TrialLog& log, host::report::ViewerScene& scene, TourRecord& tour);
+  void writeClusterOutputs(std::size_t k, const TrialParts& cluster_parts,
+                           const ClusterOutcome& outcome, const TrialLog& log,
+                           host::report::ViewerScene& scene, TourRecord& tour);
+  nlohmann::json clusterEntry(const host::nbv::ClusterVisit& visit) const;
   void scoreSkippedClusters(TourRecord& tour, host::report::ViewerScene& scene) const;
   nlohmann::json treeResult(TourRecord& tour, host::report::ViewerScene& scene);
   /// The fields every result has: options, config, clock, logs, warnings.
@@ -619,18 +540,19 @@ struct Trial::Impl {
     return (world->clusters().size() > 1 ? "Tree trial: " : "Trial: ") + options.planner +
            ", world seed " + std::to_string(options.seed);
   }
+  std::string backendName() const {
+    return setup->backend() ? std::string(accel::toString(setup->backend()->kind())) : "none";
+  }
 
   TrialOptions options;
   /// One writer per output directory, for the trial's life.
   std::optional<host::OutputDirectoryLock> lock;
-  /// The automatic stop's parameters, for every cluster (and the record of them).
-  host::nbv::ClusterCompletionConfig completion_config;
   Clock::time_point wall_start = Clock::now();
   std::vector<std::string> warnings;
-  std::string engine;
-  std::unique_ptr<accel::Backend> backend;
+  /// The library's run: sessions, planners, the stop and the tour.
+  std::unique_ptr<host::nbv::NbvSetup> setup;
   std::unique_ptr<World> world;
-  std::unique_ptr<TrialParts> parts;
+  std::vector<host::nbv::ClusterTarget> targets;
   std::unique_ptr<StereoRenderer> renderer;
   ArmConfig arm_config;
   std::unique_ptr<ArmModel> arm;
@@ -645,60 +567,26 @@ struct Trial::Impl {
   bool ran = false;
 };
 
-ClusterOutcome Trial::Impl::runCluster(TrialParts& cluster_parts, const FruitletCluster& cluster,
-                                       host::nbv::Camera& loop_camera, host::nbv::Arm& loop_arm,
-                                       host::nbv::LoopClock& loop_clock, TrialLog& log) {
-  const double t0_s = loop_clock.now_s();
-  // The budget is a time on the run's clock: this cluster's cap from its arrival.
-  host::nbv::StopCondition stop = host::nbv::StopCondition::budget(t0_s + options.budget_s);
-  if (options.max_views) stop = stop || host::nbv::StopCondition::views(*options.max_views);
-  host::nbv::LoopObservers observers;
-  observers.add(&log);
-  UnchargedClock observing_clock(loop_clock);  // before completion: it outlives it
-  std::optional<host::nbv::ClusterCompletion> completion;
-  std::optional<host::nbv::SizingGuidance> guidance;
-  if (options.stop == "auto") {
-    completion.emplace(cluster_parts.session(), loop_clock, cluster_parts.sizingConfig(),
-                       completion_config);
-    observers.add(&*completion);
-    guidance.emplace(*completion, cluster_parts.planner(),
-                     cluster_parts.sizingConfig().well_seen_fraction);
-    observers.add(&*guidance);  // after completion: it reads completion's sizing
-    completion->holdWhile([&g = *guidance] { return g.waitingOnUnconfirmed(); });
-    if (completion_config.release_left_out)
-      completion->releaseWhen(
-          [&g = *guidance](const host::nbv::FruitletSnapshot& f) { return g.leftOut(f.center_m); });
-    stop = stop || completion->stopCondition();
-  } else if (options.record_size_history) {
-    completion.emplace(cluster_parts.session(), observing_clock, cluster_parts.sizingConfig(),
-                       completion_config);
-    observers.add(&*completion);
-  }
-  host::nbv::NbvLoop loop(cluster_parts.session(), cluster_parts.planner(), loop_camera, loop_arm,
-                          loop_clock);
+ClusterOutcome Trial::Impl::scored(host::nbv::ClusterRun run, TrialParts& cluster_parts,
+                                   const FruitletCluster& cluster) const {
   ClusterOutcome out;
-  out.run = loop.run(stop, &observers);
-  if (guidance) {
-    out.guidance_events = {{"sizing_views", guidance->aimedViews()},
-                           {"sizing_targets_dropped", guidance->droppedTargets()}};
-    cluster_parts.planner().setSizingTargets({});  // this cluster's fruitlets
-  }
-
-  const auto t_size = Clock::now();
-  out.sizing = cluster_parts.sizeAndScore(*world, cluster.fruitlet_indices);
-  out.sizing_wall_s = secondsSince(t_size);
-  if (completion) {
-    for (const auto& snapshot : completion->history())
-      out.sizing_during_loop_s += snapshot.sizing_s;
+  out.run = std::move(run.run);
+  out.sizing_wall_s = run.sizing_wall_s;
+  out.sizing_during_loop_s = run.sizing_during_loop_s;
+  out.sizing = cluster_parts.score(std::move(run.sizing), setup->options().sizing.estimator, *world,
+                                   cluster.fruitlet_indices);
+  if (options.stop == "auto" || options.record_size_history)
     out.size_history =
-        sizeHistoryJson(completion->history(), *world, cluster.fruitlet_indices, t0_s);
-  }
+        sizeHistoryJson(run.size_history, *world, cluster.fruitlet_indices, run.start_s);
+  if (options.stop == "auto")
+    out.guidance_events = {{"sizing_views", run.sizing_views},
+                           {"sizing_targets_dropped", run.sizing_targets_dropped}};
   return out;
 }
 
 nlohmann::json Trial::Impl::stopJson() const {
   if (options.stop != "auto") return {{"rule", "budget"}};
-  const host::nbv::ClusterCompletionConfig& c = completion_config;
+  const host::nbv::ClusterCompletionConfig& c = setup->options().stop.completion;
   return {{"rule", "auto"},
           {"stable_views", c.stable_views},
           {"size_tolerance_mm", c.size_tolerance_mm},
@@ -731,8 +619,11 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
   SimulatedLoopClock loop_clock(*clock);
   TrialLog log(*camera, options, wall_start);
   log.setClusterCenter(world->clusterCenter_m());
+  const std::unique_ptr<host::nbv::ClusterWork> work = setup->makeWork(targets.front());
+  TrialParts parts(options, setup->engine(), *work);
   const ClusterOutcome outcome =
-      runCluster(*parts, world->clusters().front(), loop_camera, loop_arm, loop_clock, log);
+      scored(setup->runCluster({loop_camera, loop_arm, loop_clock}, *work, &log), parts,
+             world->clusters().front());
   const host::nbv::NbvResult& run = outcome.run;
   std::vector<Eigen::Vector3d> camera_path;
   for (const auto& T : run.camera_poses) camera_path.push_back(T.translation());
@@ -740,22 +631,22 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
   nlohmann::json result;
   result["planner"] = options.planner;
   result["seed"] = options.seed;
-  result["engine"] = engine;
-  result["backend"] = backend ? std::string(accel::toString(backend->kind())) : "none";
+  result["engine"] = setup->engine();
+  result["backend"] = backendName();
   result["views"] = run.views;
   result["stop_reason"] = run.stop_reason;
   result["sim_time_s"] = clock->now_s();
   result["budget_s"] = options.budget_s;
   result["wall_time_s"] = secondsSince(wall_start);
-  result["status"] = parts->map() ? "ok" : "no_tag";
-  result["config"] = {{"planner", nlohmann::json::parse(parts->planner().configJson())},
+  result["status"] = parts.session().map() ? "ok" : "no_tag";
+  result["config"] = {{"planner", nlohmann::json::parse(parts.planner().configJson())},
                       {"arm", nlohmann::json::parse(arm_config.toJson())},
-                      {"trial", parts->configJson()}};
+                      {"trial", parts.configJson(setup->options().sizing)}};
   for (auto& [key, value] : outcome.sizing.items()) result[key] = value;
   result["events"] = eventsJson(run.events);
   result["events"].update(outcome.guidance_events);
   if (options.register_views)
-    result["anchor_offset"] = anchorOffsetJson(parts->session(), log.trueAnchorShift());
+    result["anchor_offset"] = anchorOffsetJson(parts.session(), log.trueAnchorShift());
   result["wall_breakdown_s"] = {{"rendering", camera->totalRenderSeconds()},
                                 {"perception", run.wall_s.perception},
                                 {"mapping", run.wall_s.mapping},
@@ -768,70 +659,76 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
   result["stop"] = stopJson();
   if (!options.out_dir.empty())
     result["overlays"] = overlaysOrWarning([&] {
-      return host::writeSessionOverlays(parts->session(), outcome.sizing, 0, std::nullopt,
+      return host::writeSessionOverlays(parts.session(), outcome.sizing, 0, std::nullopt,
                                         imageSource(log), options.out_dir, "start view");
     });
   describeRun(result, log, camera_path);
   markSizedViews(result["view_log"], outcome.sizing, 0, std::nullopt);
   if (!options.out_dir.empty()) {
-    parts->writeOutputs(result, *world, camera_path, options.out_dir, options.on_warning,
-                        extraWriter(result));
+    parts.writeOutputs(result, *world, camera_path, options.out_dir, options.on_warning,
+                       extraWriter(result));
     finishExtras(result, log, [&] {
       host::report::ViewerScene scene(viewerTitle(), "");
-      host::addSessionToScene(scene, parts->session(), outcome.sizing, 0, std::nullopt);
+      host::addSessionToScene(scene, parts.session(), outcome.sizing, 0, std::nullopt);
       writeTrialViewer(scene, result, log.intrinsics(), options.out_dir);
     });
   }
   return result;
 }
 
-// A tree: the clusters one after another, nearest start view next, on one clock and one
-// coarse map (each cluster's session carries the map on to the next, which moves the fine
-// map to its own region). A cluster whose start view the arm cannot reach is skipped and
-// counted.
+/// A tree's tour as the trial hears of it: views and plans into the log, each cluster
+/// scored, recorded and written as it is finished (before its map moves on).
+class Trial::Impl::TourRecorder : public host::nbv::TourObserver {
+ public:
+  TourRecorder(Trial::Impl& trial, TrialLog& log, TourRecord& tour,
+               host::report::ViewerScene& scene)
+      : trial_(trial), log_(log), tour_(tour), scene_(scene) {}
+
+  void onView(const host::nbv::ViewEvent& e) override { log_.onView(e); }
+  void onPlan(const host::nbv::PlanEvent& e) override { log_.onPlan(e); }
+  void onDroppedFrame(const std::string& detail) override { log_.onDroppedFrame(detail); }
+  void onClusterStart(std::size_t index, const host::nbv::ClusterTarget& target) override {
+    log_.startCluster(static_cast<int>(index), target.center_m);
+  }
+  void onClusterDone(const host::nbv::ClusterVisit& visit,
+                     const host::nbv::ClusterWork& work) override {
+    const std::size_t k = visit.index;
+    TrialParts parts(trial_.options, trial_.setup->engine(), work);
+    const ClusterOutcome outcome = trial_.scored(*visit.run, parts, trial_.world->clusters()[k]);
+    nlohmann::json entry = trial_.clusterEntry(visit);
+    trial_.recordCluster(visit, parts, outcome, log_, entry, tour_);
+    if (!trial_.options.out_dir.empty())
+      trial_.writeClusterOutputs(k, parts, outcome, log_, scene_, tour_);
+    tour_.cluster_entries.push_back(entry);
+  }
+  void onClusterSkipped(const host::nbv::ClusterVisit& visit) override {
+    nlohmann::json entry = trial_.clusterEntry(visit);
+    entry["move_status"] = visit.move_status;
+    entry["status"] = host::nbv::toString(visit.status);
+    ++tour_.cluster_status[host::nbv::toString(visit.status)];
+    tour_.cluster_entries.push_back(entry);
+  }
+
+ private:
+  Trial::Impl& trial_;
+  TrialLog& log_;
+  TourRecord& tour_;
+  host::report::ViewerScene& scene_;
+};
+
+// A tree: the library's tour (the clusters one after another on one clock and one coarse
+// map), each cluster scored against its fruitlets as it is finished.
 nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::Arm& loop_arm) {
   SimulatedLoopClock loop_clock(*clock);
   TrialLog log(*camera, options, wall_start);
-  const std::vector<FruitletCluster>& clusters = world->clusters();
-  std::vector<bool> visited(clusters.size(), false);
-  std::unique_ptr<host::map::MapEngine> carried_map;
-  std::unique_ptr<TrialParts> cluster_parts = std::move(parts);
   TourRecord tour;
   host::report::ViewerScene scene(viewerTitle(), "");
-  for (std::size_t step = 0; step < clusters.size(); ++step) {
-    const std::size_t k = nearestUnvisited(clusters, visited, loop_arm.cameraPose().translation());
-    visited[k] = true;
-    tour.order.push_back(k);
-    const FruitletCluster& cluster = clusters[k];
-    nlohmann::json entry = {{"index", k},
-                            {"tag_id", cluster.tag.tag_id},
-                            {"gt_fruitlets", cluster.fruitlet_indices.size()},
-                            {"start_sim_s", loop_clock.now_s()}};
-    // To its start view (the first cluster's is where the arm starts), or, where the arm
-    // cannot stand there, the same view from farther out along its axis, then turned.
-    ApproachSequence approach(cluster);
-    if (!loop_arm.cameraPose().isApprox(cluster.T_world_start_camera, 1e-9) &&
-        !approach.moveToNext(loop_arm, loop_clock, entry, tour)) {
-      entry["move_status"] = approach.lastMoveStatus();
-      const std::string status =
-          approach.lastMoveStatus() == "unreachable" ? "unreachable" : "move_failed";
-      entry["status"] = status;
-      ++tour.cluster_status[status];
-      tour.cluster_entries.push_back(entry);
-      continue;
-    }
-    if (!cluster_parts) cluster_parts = makeParts(k);
-    if (carried_map) cluster_parts->session().carryOnWith(std::move(carried_map));
-    const double t0_s = loop_clock.now_s();
-    log.startCluster(static_cast<int>(k), cluster.center_m);
-    const ClusterOutcome outcome = runClusterFromApproaches(
-        *cluster_parts, cluster, approach, loop_camera, loop_arm, loop_clock, log, entry, tour);
-    recordCluster(k, *cluster_parts, outcome, log, loop_clock.now_s() - t0_s, entry, tour);
-    if (!options.out_dir.empty()) writeClusterOutputs(k, *cluster_parts, outcome, log, scene, tour);
-    tour.cluster_entries.push_back(entry);
-    carried_map = std::move(cluster_parts->session()).releaseMap();
-    cluster_parts.reset();
-  }
+  TourRecorder recorder(*this, log, tour, scene);
+  const host::nbv::TourResult done =
+      setup->runTour({loop_camera, loop_arm, loop_clock}, targets, &recorder);
+  for (const auto& visit : done.visits) tour.order.push_back(visit.index);
+  tour.transit_s = done.transit_s;
+  for (const auto& [status, count] : done.transit_motion) tour.transit_motion[status] = count;
 
   nlohmann::json result = treeResult(tour, scene);
   describeRun(result, log, tour.camera_path);
@@ -842,7 +739,7 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
     if (c.contains("first_view"))
       markSizedViews(result["view_log"], c, c["first_view"].get<int>(), c["index"].get<int>());
   if (!options.out_dir.empty()) {
-    writeTreeOutputs(result, *world, carried_map.get(), tour.camera_path, options.out_dir,
+    writeTreeOutputs(result, *world, done.map.get(), tour.camera_path, options.out_dir,
                      options.on_warning, extraWriter(result));
     finishExtras(result, log, [&] {
       if (!tour.scene_error.empty()) throw std::runtime_error(tour.scene_error);
@@ -852,44 +749,33 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
   return result;
 }
 
-// A view that shows no tag (a leaf before it from there, foliage an earlier cluster's views
-// put on the way) places no Cluster Region: the next approach view may show it. The views
-// taken on the way are the cluster's too.
-ClusterOutcome Trial::Impl::runClusterFromApproaches(
-    TrialParts& cluster_parts, const FruitletCluster& cluster, ApproachSequence& approach,
-    host::nbv::Camera& loop_camera, host::nbv::Arm& loop_arm, host::nbv::LoopClock& loop_clock,
-    TrialLog& log, nlohmann::json& entry, TourRecord& tour) {
-  ClusterOutcome outcome =
-      runCluster(cluster_parts, cluster, loop_camera, loop_arm, loop_clock, log);
-  std::vector<Eigen::Isometry3d> untagged_poses;  // one per untagged view
-  int retried_approaches = 0;
-  while (!cluster_parts.map() && outcome.run.stop_reason == "no_region" &&
-         approach.moveToNext(loop_arm, loop_clock, entry, tour)) {
-    untagged_poses.insert(untagged_poses.end(), outcome.run.camera_poses.begin(),
-                          outcome.run.camera_poses.end());
-    ++retried_approaches;
-    outcome = runCluster(cluster_parts, cluster, loop_camera, loop_arm, loop_clock, log);
-  }
-  outcome.run.views += untagged_poses.size();
-  outcome.run.camera_poses.insert(outcome.run.camera_poses.begin(), untagged_poses.begin(),
-                                  untagged_poses.end());
-  entry["approaches_without_tag"] = retried_approaches;
-  return outcome;
+// A cluster's entry as the tour reached it.
+nlohmann::json Trial::Impl::clusterEntry(const host::nbv::ClusterVisit& visit) const {
+  const FruitletCluster& cluster = world->clusters()[visit.index];
+  nlohmann::json entry = {{"index", visit.index},
+                          {"tag_id", cluster.tag.tag_id},
+                          {"gt_fruitlets", cluster.fruitlet_indices.size()},
+                          {"start_sim_s", visit.arrival_s}};
+  if (visit.approach_distance_m) entry["approach_distance_m"] = *visit.approach_distance_m;
+  if (visit.approach_yaw_deg) entry["approach_yaw_deg"] = *visit.approach_yaw_deg;
+  return entry;
 }
 
 // One visited cluster into its entry and the tour's totals.
-void Trial::Impl::recordCluster(std::size_t k, TrialParts& cluster_parts,
+void Trial::Impl::recordCluster(const host::nbv::ClusterVisit& visit, TrialParts& cluster_parts,
                                 const ClusterOutcome& outcome, const TrialLog& log,
-                                double sim_time_s, nlohmann::json& entry, TourRecord& tour) {
-  const bool mapped = cluster_parts.map() != nullptr;
+                                nlohmann::json& entry, TourRecord& tour) {
+  const std::size_t k = visit.index;
+  entry["approaches_without_tag"] = visit.run->approaches_without_tag;
   if (options.register_views)
     entry["anchor_offset"] = anchorOffsetJson(cluster_parts.session(), log.trueAnchorShift());
-  entry["status"] = mapped ? "sized" : "no_tag";
+  entry["status"] = host::nbv::toString(visit.status);
   ++tour.cluster_status[entry["status"].get<std::string>()];
   entry["views"] = outcome.run.views;
   entry["first_view"] = log.firstView();  // the run's number of its first view
   entry["stop_reason"] = outcome.run.stop_reason;
-  entry["sim_time_s"] = sim_time_s;
+  entry["sim_time_s"] = clock->now_s() - visit.loop_start_s;
+
   for (auto& [key, value] : outcome.sizing.items()) {
     if (key.rfind("fruitlets", 0) == 0) {
       // Every scored fruitlet says which cluster it is in.
@@ -918,12 +804,12 @@ void Trial::Impl::recordCluster(std::size_t k, TrialParts& cluster_parts,
   if (!outcome.size_history.is_null()) entry["size_history"] = outcome.size_history;
   for (const auto& T : outcome.run.camera_poses) tour.camera_path.push_back(T.translation());
   tour.planner_config = nlohmann::json::parse(cluster_parts.planner().configJson());
-  tour.trial_config = cluster_parts.configJson();
+  tour.trial_config = cluster_parts.configJson(setup->options().sizing);
 }
 
 // Written as the tour goes (the map moves on); a failure is recorded with the tree's result,
 // not the end of the tour.
-void Trial::Impl::writeClusterOutputs(std::size_t k, TrialParts& cluster_parts,
+void Trial::Impl::writeClusterOutputs(std::size_t k, const TrialParts& cluster_parts,
                                       const ClusterOutcome& outcome, const TrialLog& log,
                                       host::report::ViewerScene& scene, TourRecord& tour) {
   const ExtraWriter record = extraWriter(tour.cluster_write_failures);
@@ -977,8 +863,8 @@ nlohmann::json Trial::Impl::treeResult(TourRecord& tour, host::report::ViewerSce
   nlohmann::json result;
   result["planner"] = options.planner;
   result["seed"] = options.seed;
-  result["engine"] = engine;
-  result["backend"] = backend ? std::string(accel::toString(backend->kind())) : "none";
+  result["engine"] = setup->engine();
+  result["backend"] = backendName();
   result["views"] = tour.views;
   result["stop_reason"] = "tour_done";
   result["sim_time_s"] = clock->now_s();

@@ -39,10 +39,6 @@ constexpr int kReportImageWidthPx = 360;
 
 }  // namespace
 
-std::string defaultEngine(const std::string& planner) {
-  return host::planner::PlannerRegistry::instance().at(planner).default_engine;
-}
-
 std::string defaultCacheDir() {
   if (const char* dir = std::getenv("FVP_CACHE_DIR"); dir && *dir) return dir;
   if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
@@ -62,73 +58,21 @@ WorkspaceTree loadWorkspaceTree(const ArmModel& arm,
   return tree;
 }
 
-struct TrialParts::Impl {
-  Impl(const TrialOptions& options, const std::string& engine, accel::Backend* backend,
-       const host::PerceptionConfig& perception, std::uint64_t planner_seed)
-      : options(options),
-        engine(engine),
-        backend(backend),
-        map_config(host::planner::plannerMapConfig(options.planner, engine)),
-        session(perception, engine, map_config, backend) {
-    session.enableTsdf();
-    if (options.register_views) session.enableViewRegistration();
-    planner = host::planner::createPlanner(options.planner, options.planner_config, planner_seed,
-                                           backend);
-  }
-
-  TrialOptions options;
-  std::string engine;
-  accel::Backend* backend;
-  host::map::MapConfig map_config;  ///< the maps' config, as the session got it
-  host::MappingSession session;
-  std::unique_ptr<host::planner::ViewPlanner> planner;
-  host::sizing::SizingConfig sizing_config;
-  host::sizing::SizingResult sizing;  ///< of the last sizeAndScore
-};
-
 TrialParts::TrialParts(const TrialOptions& options, const std::string& engine,
-                       accel::Backend* backend, const host::PerceptionConfig& perception,
-                       std::uint64_t planner_seed)
-    : impl_(std::make_unique<Impl>(options, engine, backend, perception, planner_seed)) {}
+                       const host::nbv::ClusterWork& work)
+    : options_(options), engine_(engine), work_(work) {}
 
-TrialParts::~TrialParts() = default;
-
-ViewOutcome TrialParts::addView(const host::StereoFrame& frame) {
-  ViewOutcome outcome;
-  outcome.result = impl_->session.addView(frame);
-  outcome.mapping_s = outcome.result.scan.seconds;
-  outcome.tsdf_s = outcome.result.tsdf_s;
-  return outcome;
-}
-
-host::map::MapEngine* TrialParts::map() {
-  return impl_->session.map();
-}
-
-host::MappingSession& TrialParts::session() {
-  return impl_->session;
-}
-
-const host::sizing::SizingConfig& TrialParts::sizingConfig() const {
-  return impl_->sizing_config;
-}
-
-host::planner::ViewPlanner& TrialParts::planner() {
-  return *impl_->planner;
-}
-
-nlohmann::json TrialParts::configJson() const {
-  return {
-      {"engine", impl_->engine},
-      {"clock", impl_->options.clock},
-      {"fine_map_extent", host::map::toString(impl_->map_config.fine_map_extent)},
-      {"stop", impl_->options.stop},
-      {"sizing",
-       {{"estimator", host::sizing::toString(impl_->sizing_config.estimator)},
-        {"min_support_area_fraction", impl_->sizing_config.min_support_area_fraction},
-        {"sphere_fit_support_area_fraction", impl_->sizing_config.sphere_fit_support_area_fraction},
-        {"max_detection_overlap_fraction", impl_->sizing_config.max_detection_overlap_fraction},
-        {"view_agreement_disparity_px", impl_->sizing_config.view_agreement_disparity_px}}}};
+nlohmann::json TrialParts::configJson(const host::sizing::SizingConfig& sizing_config) const {
+  return {{"engine", engine_},
+          {"clock", options_.clock},
+          {"fine_map_extent", host::map::toString(work_.map_config.fine_map_extent)},
+          {"stop", options_.stop},
+          {"sizing",
+           {{"estimator", host::sizing::toString(sizing_config.estimator)},
+            {"min_support_area_fraction", sizing_config.min_support_area_fraction},
+            {"sphere_fit_support_area_fraction", sizing_config.sphere_fit_support_area_fraction},
+            {"max_detection_overlap_fraction", sizing_config.max_detection_overlap_fraction},
+            {"view_agreement_disparity_px", sizing_config.view_agreement_disparity_px}}}};
 }
 
 std::vector<host::eval::GroundTruthFruitlet> groundTruthOf(const World& world,
@@ -771,13 +715,12 @@ void TrialParts::writeClusterFiles(const std::filesystem::path& dir,
                                    const ExtraWriter& extra) const {
   std::error_code ignored;  // a directory that cannot be made fails each file's write below
   std::filesystem::create_directories(dir, ignored);
-  if (const host::map::MapEngine* map = impl_->session.map())
+  if (const host::map::MapEngine* map = session().map())
     extra("fine.ot", [&] { map->exportFine(dir / "fine.ot"); });
-  const auto& sz = impl_->sizing;
-  extra("surface.ply",
-        [&] { host::writePlyPoints(dir / "surface.ply", impl_->session.surfacePoints()); });
+  const auto& sz = sizing_;
+  extra("surface.ply", [&] { host::writePlyPoints(dir / "surface.ply", session().surfacePoints()); });
   extra("mesh.ply", [&] {
-    const host::tsdf::TriangleMesh mesh = impl_->session.surfaceMesh();
+    const host::tsdf::TriangleMesh mesh = session().surfaceMesh();
     host::writePlyMesh(dir / "mesh.ply", mesh.vertices_m, mesh.triangles,
                        "fvp TSDF mesh (marching cubes), world frame, metres");
   });
@@ -801,10 +744,10 @@ void TrialParts::writeOutputs(nlohmann::json& result, const World& world,
                               const std::function<void(const std::string&)>& warn,
                               const ExtraWriter& extra) const {
   std::vector<PathRegion> regions;
-  if (const auto& region = impl_->session.region())
+  if (const auto& region = session().region())
     regions.push_back({region->center_m(), region->radius_m()});
   const ReportFigures figures =
-      writeResultMapAndPath(result, world, impl_->session.map(), camera_path, regions,
+      writeResultMapAndPath(result, world, session().map(), camera_path, regions,
                             "Cluster Region", out_dir, warn, extra);
   writeClusterFiles(out_dir, extra);
   extra("report.md", [&] {
@@ -841,17 +784,17 @@ void writeTreeOutputs(nlohmann::json& result, const World& world, const host::ma
 
 namespace fvp::trials {
 
-nlohmann::json TrialParts::sizeAndScore(const World& world,
-                                        const std::vector<int>& fruitlet_indices) {
-  impl_->sizing = impl_->session.sizeFruitlets(impl_->sizing_config);
+nlohmann::json TrialParts::score(host::sizing::SizingResult sizing,
+                                 host::sizing::SizingEstimator estimator, const World& world,
+                                 const std::vector<int>& fruitlet_indices) {
+  sizing_ = std::move(sizing);
   const std::vector<host::eval::GroundTruthFruitlet> truth = groundTruthOf(world, fruitlet_indices);
-  nlohmann::json out =
-      host::eval::scoreBothEstimators(impl_->sizing, truth, impl_->sizing_config.estimator);
+  nlohmann::json out = host::eval::scoreBothEstimators(sizing_, truth, estimator);
   // The details object must outlive the loop (items() of a temporary would dangle).
-  const nlohmann::json details = host::eval::sizingDetails(impl_->sizing);
+  const nlohmann::json details = host::eval::sizingDetails(sizing_);
   for (const auto& [key, value] : details.items()) out[key] = value;
   // No TSDF when no view ever saw the tag (nothing was sized then).
-  const host::tsdf::TsdfVolume* tsdf = impl_->session.tsdf();
+  const host::tsdf::TsdfVolume* tsdf = session().tsdf();
   out["sizing_stats"]["tsdf_blocks"] = tsdf ? tsdf->blockCount() : 0;
   out["sizing_stats"]["tsdf_bytes"] = tsdf ? tsdf->memoryBytes() : 0;
   out["sizing_stats"]["tsdf_bytes_per_block"] =

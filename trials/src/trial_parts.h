@@ -14,6 +14,7 @@
 
 #include "fvp/host/eval/ground_truth.h"
 #include "fvp/host/map/map_config.h"
+#include "fvp/host/nbv/nbv_setup.h"
 #include "fvp/host/perception/stereo_frame.h"
 #include "fvp/host/planner/view_planner.h"
 #include "fvp/host/session/mapping_session.h"
@@ -27,9 +28,6 @@ class Backend;
 
 namespace fvp::trials {
 
-/// The map engine a planner runs on unless --engine says otherwise (its registry entry's:
-/// FVP grid, RVP octomap, as the original did).
-std::string defaultEngine(const std::string& planner);
 /// Where the workspace tree is cached between trials: $FVP_CACHE_DIR, else
 /// $XDG_CACHE_HOME/fvp, else ~/.cache/fvp, else a directory under the system temp dir.
 std::string defaultCacheDir();
@@ -62,35 +60,24 @@ std::string encodeViewImage(int index, const host::StereoFrame& frame);
 std::vector<host::eval::GroundTruthFruitlet> groundTruthOf(const robot::sim::World& world,
                                                            const std::vector<int>& indices);
 
-/// What one view did, with the wall times the clock charges.
-struct ViewOutcome {
-  host::ViewResult result;
-  double mapping_s = 0.0;  ///< map integration (charged as mapping)
-  double tsdf_s = 0.0;     ///< TSDF integration (charged as TSDF)
-};
-
+/// A trial's view of one cluster's work (the library's session and planner, NbvSetup):
+/// its configuration for result.json, its sizing scored against the world, and its files.
 class TrialParts {
  public:
-  /// perception: the tag (and so the cluster) this part's session maps; planner_seed seeds
-  /// its planner (the trial's seed for one cluster).
-  TrialParts(const TrialOptions& options, const std::string& engine, accel::Backend* backend,
-             const host::PerceptionConfig& perception, std::uint64_t planner_seed);
-  ~TrialParts();
+  /// work must outlive this.
+  TrialParts(const TrialOptions& options, const std::string& engine,
+             const host::nbv::ClusterWork& work);
 
-  ViewOutcome addView(const host::StereoFrame& frame);
-  /// Null until a view detected the tag.
-  host::map::MapEngine* map();
-  host::planner::ViewPlanner& planner();
-  host::MappingSession& session();
-  const host::sizing::SizingConfig& sizingConfig() const;
+  const host::MappingSession& session() const { return *work_.session; }
+  const host::planner::ViewPlanner& planner() const { return *work_.planner; }
   /// The trial-level configuration (engine, map, perception, sizing) as JSON.
-  nlohmann::json configJson() const;
-  /// Sizes the fruitlets from the views so far and scores them against the ground truth of
-  /// the fruitlets with these indices in the world (the cluster's): {"fruitlets",
-  /// "detections", "metrics", ...} of result.json.
-  nlohmann::json sizeAndScore(const robot::sim::World& world,
-                              const std::vector<int>& fruitlet_indices);
-  /// The cluster's files from the last sizeAndScore, each atomically, into dir: fine.ot (while
+  nlohmann::json configJson(const host::sizing::SizingConfig& sizing_config) const;
+  /// The cluster's sizing scored against the ground truth of the fruitlets with these
+  /// indices in the world (the cluster's): {"fruitlets", "detections", "metrics", ...} of
+  /// result.json. Kept for writeClusterFiles.
+  nlohmann::json score(host::sizing::SizingResult sizing, host::sizing::SizingEstimator estimator,
+                       const robot::sim::World& world, const std::vector<int>& fruitlet_indices);
+  /// The cluster's files from the last score, each atomically, into dir: fine.ot (while
   /// the session holds its map), surface.ply, mesh.ply and clusters.ply.
   void writeClusterFiles(const std::filesystem::path& dir, const ExtraWriter& extra) const;
   /// Those files' names.
@@ -107,8 +94,10 @@ class TrialParts {
   static const std::vector<std::string>& outputFiles();
 
  private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
+  const TrialOptions& options_;
+  std::string engine_;
+  const host::nbv::ClusterWork& work_;
+  host::sizing::SizingResult sizing_;  ///< of the last score
 };
 
 /// Which figures a trial's report shows (drawn into its directory beside report.md).

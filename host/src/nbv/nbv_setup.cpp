@@ -1,0 +1,234 @@
+#include "fvp/host/nbv/nbv_setup.h"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include "fvp/accel/backend.h"
+#include "fvp/host/map/map_engine.h"
+#include "fvp/host/map/map_engine_registry.h"
+#include "fvp/host/nbv/approach_sequence.h"
+#include "fvp/host/nbv/loop_observers.h"
+#include "fvp/host/nbv/sizing_guidance.h"
+#include "fvp/host/planner/planner_registry.h"
+
+namespace fvp::host::nbv {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// The loop clock as an observer sees it: the time, with nothing charged (sizing for a
+/// record under the budget rule is not part of the loop).
+class UnchargedClock : public LoopClock {
+ public:
+  explicit UnchargedClock(const LoopClock& clock) : clock_(clock) {}
+  double now_s() const override { return clock_.now_s(); }
+
+ private:
+  const LoopClock& clock_;
+};
+
+/// The target not yet visited whose start view is nearest `here` (the first on a tie).
+std::size_t nearestUnvisited(const std::vector<ClusterTarget>& targets,
+                             const std::vector<bool>& visited, const Eigen::Vector3d& here) {
+  std::size_t k = targets.size();
+  const auto distance = [&](std::size_t i) {
+    return (targets[i].T_world_start_camera.translation() - here).norm();
+  };
+  for (std::size_t i = 0; i < targets.size(); ++i)
+    if (!visited[i] && (k == targets.size() || distance(i) < distance(k))) k = i;
+  return k;
+}
+
+}  // namespace
+
+const char* toString(StopRule rule) {
+  switch (rule) {
+    case StopRule::kBudget:
+      return "budget";
+    case StopRule::kAuto:
+      return "auto";
+  }
+  return "unknown";
+}
+
+std::optional<StopRule> stopRuleFromString(std::string_view name) {
+  for (const StopRule rule : {StopRule::kBudget, StopRule::kAuto})
+    if (name == toString(rule)) return rule;
+  return std::nullopt;
+}
+
+std::string stopRuleNames() {
+  return std::string(toString(StopRule::kBudget)) + "," + toString(StopRule::kAuto);
+}
+
+const char* toString(VisitStatus status) {
+  switch (status) {
+    case VisitStatus::kSized:
+      return "sized";
+    case VisitStatus::kNoTag:
+      return "no_tag";
+    case VisitStatus::kUnreachable:
+      return "unreachable";
+    case VisitStatus::kMoveFailed:
+      return "move_failed";
+  }
+  return "unknown";
+}
+
+void StopSpec::validate() const {
+  if (!(budget_s > 0.0) || !std::isfinite(budget_s))
+    throw std::invalid_argument("stop 'budget_s': expected a positive number of seconds");
+  if (max_views && *max_views < 1)
+    throw std::invalid_argument("stop 'max_views': expected at least 1");
+  completion.validate();
+}
+
+NbvSetup::NbvSetup(NbvSetupOptions options) : options_(std::move(options)) {
+  const auto& planners = planner::PlannerRegistry::instance();
+  if (!planners.contains(options_.planner))
+    throw std::invalid_argument("planner: expected one of " + planners.knownNames() + ", got '" +
+                                options_.planner + "'");
+  const auto& engines = map::MapEngineRegistry::instance();
+  if (!options_.engine.empty() && !engines.contains(options_.engine))
+    throw std::invalid_argument("engine: expected one of " + engines.knownNames() + ", got '" +
+                                options_.engine + "'");
+  options_.stop.validate();
+  options_.perception.validate();
+  engine_ = options_.engine.empty() ? planners.at(options_.planner).default_engine
+                                    : options_.engine;
+  // A missing backend or a bad planner config fails here, before anything moves.
+  backend_ = map::createBackendFor(engine_, options_.backend);
+  first_planner_ = planner::createPlanner(options_.planner, options_.planner_config,
+                                          options_.planner_seed, backend_.get());
+}
+
+NbvSetup::~NbvSetup() = default;
+
+std::unique_ptr<ClusterWork> NbvSetup::makeWork(const ClusterTarget& target, std::size_t index) {
+  PerceptionConfig perception = options_.perception;
+  if (target.tag_id) perception.tag.tag_id = *target.tag_id;
+  if (target.region_center_m) perception.region.center_m = target.region_center_m;
+  auto work = std::make_unique<ClusterWork>();
+  work->map_config = planner::plannerMapConfig(options_.planner, engine_);
+  work->session =
+      std::make_unique<MappingSession>(perception, engine_, work->map_config, backend_.get());
+  work->session->enableTsdf();
+  if (options_.register_views) work->session->enableViewRegistration();
+  work->planner = index == 0 && first_planner_
+                      ? std::move(first_planner_)
+                      : planner::createPlanner(options_.planner, options_.planner_config,
+                                               options_.planner_seed + index, backend_.get());
+  return work;
+}
+
+ClusterRun NbvSetup::runCluster(const NbvRig& rig, ClusterWork& work, LoopObserver* observer) {
+  const StopSpec& spec = options_.stop;
+  ClusterRun out;
+  out.start_s = rig.clock.now_s();
+  // The budget is a time on the run's clock: this cluster's cap from its arrival.
+  StopCondition stop = StopCondition::budget(out.start_s + spec.budget_s);
+  if (spec.max_views) stop = stop || StopCondition::views(*spec.max_views);
+  LoopObservers observers;
+  observers.add(observer);
+  UnchargedClock observing_clock(rig.clock);  // before completion: it outlives it
+  std::optional<ClusterCompletion> completion;
+  std::optional<SizingGuidance> guidance;
+  if (spec.rule == StopRule::kAuto) {
+    completion.emplace(*work.session, rig.clock, options_.sizing, spec.completion);
+    observers.add(&*completion);
+    guidance.emplace(*completion, *work.planner, options_.sizing.well_seen_fraction);
+    observers.add(&*guidance);  // after completion: it reads completion's sizing
+    completion->holdWhile([&g = *guidance] { return g.waitingOnUnconfirmed(); });
+    if (spec.completion.release_left_out)
+      completion->releaseWhen([&g = *guidance](const FruitletSnapshot& f) {
+        return g.leftOut(f.center_m);
+      });
+    stop = stop || completion->stopCondition();
+  } else if (spec.record_size_history) {
+    completion.emplace(*work.session, observing_clock, options_.sizing, spec.completion);
+    observers.add(&*completion);
+  }
+  NbvLoop loop(*work.session, *work.planner, rig.camera, rig.arm, rig.clock, options_.loop);
+  out.run = loop.run(stop, &observers);
+  if (guidance) {
+    out.sizing_views = guidance->aimedViews();
+    out.sizing_targets_dropped = guidance->droppedTargets();
+    work.planner->setSizingTargets({});  // they were this cluster's fruitlets
+  }
+  const auto t_size = Clock::now();
+  out.sizing = work.session->sizeFruitlets(options_.sizing);
+  out.sizing_wall_s = secondsSince(t_size);
+  if (completion) {
+    out.size_history = completion->history();
+    for (const auto& snapshot : out.size_history) out.sizing_during_loop_s += snapshot.sizing_s;
+  }
+  return out;
+}
+
+// A view that shows no tag (a leaf before it from there, foliage an earlier cluster's views
+// put on the way) places no Cluster Region: the next approach view may show it. The views
+// taken on the way are the cluster's too.
+ClusterRun NbvSetup::runFromApproaches(const NbvRig& rig, ClusterWork& work,
+                                       ApproachSequence& approach, LoopObserver* observer,
+                                       ClusterVisit& visit, TourResult& tour) {
+  ClusterRun out = runCluster(rig, work, observer);
+  std::vector<Eigen::Isometry3d> untagged_poses;  // one per untagged view
+  int retried = 0;
+  while (!work.session->map() && out.run.stop_reason == "no_region" &&
+         approach.moveToNext(rig.arm, rig.clock, visit, tour)) {
+    untagged_poses.insert(untagged_poses.end(), out.run.camera_poses.begin(),
+                          out.run.camera_poses.end());
+    ++retried;
+    out = runCluster(rig, work, observer);
+  }
+  out.run.views += static_cast<int>(untagged_poses.size());
+  out.run.camera_poses.insert(out.run.camera_poses.begin(), untagged_poses.begin(),
+                              untagged_poses.end());
+  out.approaches_without_tag = retried;
+  return out;
+}
+
+TourResult NbvSetup::runTour(const NbvRig& rig, const std::vector<ClusterTarget>& targets,
+                             TourObserver* observer) {
+  TourResult tour;
+  std::vector<bool> visited(targets.size(), false);
+  std::unique_ptr<map::MapEngine> carried_map;
+  for (std::size_t step = 0; step < targets.size(); ++step) {
+    const std::size_t k = nearestUnvisited(targets, visited, rig.arm.cameraPose().translation());
+    visited[k] = true;
+    const ClusterTarget& target = targets[k];
+    ClusterVisit visit;
+    visit.index = k;
+    visit.arrival_s = rig.clock.now_s();
+    // To its start view (unless the arm is there), or, where the arm cannot stand there,
+    // the same view from farther out along its axis, then turned.
+    ApproachSequence approach(target);
+    if (!rig.arm.cameraPose().isApprox(target.T_world_start_camera, 1e-9) &&
+        !approach.moveToNext(rig.arm, rig.clock, visit, tour)) {
+      visit.move_status = approach.lastMoveStatus();
+      visit.status = visit.move_status == "unreachable" ? VisitStatus::kUnreachable
+                                                        : VisitStatus::kMoveFailed;
+      if (observer) observer->onClusterSkipped(visit);
+      tour.visits.push_back(std::move(visit));
+      continue;
+    }
+    visit.move_status = approach.lastMoveStatus();
+    std::unique_ptr<ClusterWork> work = makeWork(target, k);
+    if (carried_map) work->session->carryOnWith(std::move(carried_map));
+    visit.loop_start_s = rig.clock.now_s();
+    if (observer) observer->onClusterStart(k, target);
+    visit.run = runFromApproaches(rig, *work, approach, observer, visit, tour);
+    visit.status = work->session->map() ? VisitStatus::kSized : VisitStatus::kNoTag;
+    if (observer) observer->onClusterDone(visit, *work);
+    carried_map = std::move(*work->session).releaseMap();
+    tour.visits.push_back(std::move(visit));
+  }
+  tour.map = std::move(carried_map);
+  return tour;
+}
+
+}  // namespace fvp::host::nbv
