@@ -11,14 +11,8 @@
 #include "fvp/host/nbv/nbv_loop.h"
 
 namespace fvp::python {
-namespace {
 
-/// Observer hooks a Python object may define: on_view(dict), on_plan(dict),
-/// on_dropped_frame(str).
-class PyObserver : public host::nbv::LoopObserver {
- public:
-  explicit PyObserver(py::object target) : target_(std::move(target)) {}
-  void onView(const host::nbv::ViewEvent& e) override {
+void PyObserver::onView(const host::nbv::ViewEvent& e) {
     py::gil_scoped_acquire gil;
     if (!py::hasattr(target_, "on_view")) return;
     py::dict d;
@@ -29,7 +23,7 @@ class PyObserver : public host::nbv::LoopObserver {
     d["now_s"] = e.now_s;
     target_.attr("on_view")(d);
   }
-  void onPlan(const host::nbv::PlanEvent& e) override {
+void PyObserver::onPlan(const host::nbv::PlanEvent& e) {
     py::gil_scoped_acquire gil;
     if (!py::hasattr(target_, "on_plan")) return;
     py::dict d;
@@ -41,14 +35,10 @@ class PyObserver : public host::nbv::LoopObserver {
     d["now_s"] = e.now_s;
     target_.attr("on_plan")(d);
   }
-  void onDroppedFrame(const std::string& detail) override {
+void PyObserver::onDroppedFrame(const std::string& detail) {
     py::gil_scoped_acquire gil;
     if (py::hasattr(target_, "on_dropped_frame")) target_.attr("on_dropped_frame")(detail);
   }
-
- private:
-  py::object target_;
-};
 
 py::dict nbvResultToDict(const host::nbv::NbvResult& r) {
   py::dict d;
@@ -79,8 +69,6 @@ py::dict nbvResultToDict(const host::nbv::NbvResult& r) {
   d["wall_s"] = wall;
   return d;
 }
-
-}  // namespace
 
 void bindLoop(py::module_& m) {
   py::class_<host::nbv::LoopState>(m, "LoopState", "What a stop condition sees.")

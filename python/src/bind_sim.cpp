@@ -7,6 +7,8 @@
 #include "conversions.h"
 #include "fvp/host/nbv/arm.h"
 #include "fvp/host/nbv/camera.h"
+#include "fvp/robot/sim/simulated_camera.h"
+#include "fvp/trials/simulated_robot.h"
 #include "fvp/trials/trial.h"
 
 namespace fvp::python {
@@ -55,6 +57,35 @@ trials::TrialOptions trialOptions(const std::string& planner, std::uint64_t seed
 
 void bindSim(py::module_& m) {
   py::module_ sim = m.def_submodule("sim", "The simulated orchard and its trials (fvp run).");
+
+  py::class_<trials::SimulatedRobot>(
+      sim, "Robot",
+      "The simulator as a robot: a world from a seed, its stereo camera, the UR5 on its slider "
+      "and the simulated clock, for the library's fvp.NbvSetup (as a real robot's would be).")
+      .def(py::init([](std::uint64_t seed, const std::string& world_config,
+                       const std::string& arm_config, const std::string& clock) {
+             trials::SimulatedRobotOptions o;
+             o.seed = seed;
+             o.world_config = world_config;
+             o.arm_config = arm_config;
+             o.clock = clock;
+             return std::make_unique<trials::SimulatedRobot>(o);
+           }),
+           py::kw_only(), py::arg("seed") = 1, py::arg("world_config") = "",
+           py::arg("arm_config") = "", py::arg("clock") = "wall")
+      .def_property_readonly(
+          "camera", [](trials::SimulatedRobot& r) -> host::nbv::Camera& { return r.camera(); },
+          py::return_value_policy::reference_internal, "The simulated camera (fvp.Camera).")
+      .def_property_readonly(
+          "arm", [](trials::SimulatedRobot& r) -> host::nbv::Arm& { return r.arm(); },
+          py::return_value_policy::reference_internal, "The simulated UR5 on its slider (fvp.Arm).")
+      .def_property_readonly(
+          "clock",
+          [](trials::SimulatedRobot& r) -> host::nbv::LoopClock& { return r.loopClock(); },
+          py::return_value_policy::reference_internal,
+          "The simulated clock as the loop's clock (fvp.LoopClock).")
+      .def_property_readonly("targets", &trials::SimulatedRobot::clusterTargets,
+                             "The world's clusters as fvp.ClusterTarget, in the world's order.");
 
   py::class_<trials::Trial>(sim, "Trial",
                             "One simulated trial, built and not yet run (fvp run's options "

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "fvp/accel/backend.h"
+#include "fvp/host/nbv/nbv_loop.h"
 #include "fvp/host/planner/view_planner.h"
 #include "fvp/host/session/mapping_session.h"
 
@@ -45,6 +46,22 @@ struct Planner {
 /// The session's maps, or std::runtime_error naming `what` when no view placed a region yet.
 host::map::MapEngine& requireMap(Session& s, const char* what);
 
+/// Observer hooks a Python object may define: on_view(dict), on_plan(dict),
+/// on_dropped_frame(str). Each call takes the GIL.
+class PyObserver : public host::nbv::LoopObserver {
+ public:
+  explicit PyObserver(py::object target) : target_(std::move(target)) {}
+  void onView(const host::nbv::ViewEvent& e) override;
+  void onPlan(const host::nbv::PlanEvent& e) override;
+  void onDroppedFrame(const std::string& detail) override;
+
+ protected:
+  py::object target_;
+};
+
+/// A loop's result as a dict: views, stop_reason, camera_poses, events, wall_s.
+py::dict nbvResultToDict(const host::nbv::NbvResult& r);
+
 // The module's areas, one file each (bind_*.cpp), called in this order by PYBIND11_MODULE.
 void bindCore(py::module_& m);  ///< planners(), backends(), StereoIntrinsics, StereoFrame
 void bindPerceptionSizing(py::module_& m);  ///< PerceptionConfig, size_captures
@@ -52,6 +69,7 @@ void bindSession(py::module_& m);           ///< MapEngine, MappingSession
 void bindPlanners(py::module_& m);          ///< Planner, info_gain
 void bindRobot(py::module_& m);             ///< Camera, Arm, CaptureResult, MoveResult
 void bindLoop(py::module_& m);              ///< LoopState, StopCondition, run_nbv
+void bindSetup(py::module_& m);  ///< LoopClock, ClusterTarget, NbvSetup (cluster, tour)
 void bindSim(py::module_& m);               ///< fvp.sim: Trial, run_trial
 
 }  // namespace fvp::python

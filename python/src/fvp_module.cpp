@@ -11,5 +11,6 @@ PYBIND11_MODULE(fvp, m) {
   fvp::python::bindPlanners(m);
   fvp::python::bindRobot(m);
   fvp::python::bindLoop(m);
+  fvp::python::bindSetup(m);
   fvp::python::bindSim(m);
 }

@@ -20,6 +20,7 @@
 #include "fvp/robot/sim/camera_views.h"
 #include "fvp/robot/sim/simulated_mapping.h"
 #include "fvp/robot/workspace_tree.h"
+#include "fvp/trials/simulated_robot.h"
 #include "trial_parts.h"
 
 namespace fvp::trials {

@@ -40,6 +40,7 @@
 #include "fvp/robot/sim/stereo_renderer.h"
 #include "fvp/robot/sim/world.h"
 #include "fvp/robot/workspace_tree.h"
+#include "fvp/trials/simulated_robot.h"
 #include "trial_parts.h"
 #include "trial_viewer.h"
 
@@ -359,21 +360,6 @@ struct ClusterOutcome {
 
 namespace {
 
-/// The simulator's clusters as the library's targets: in a world of several clusters only
-/// a cluster's own tag places its Cluster Region (one cluster: the perception config's tag,
-/// as a grower's single tag).
-std::vector<host::nbv::ClusterTarget> clusterTargets(const World& world) {
-  std::vector<host::nbv::ClusterTarget> targets;
-  for (const FruitletCluster& c : world.clusters()) {
-    host::nbv::ClusterTarget t;
-    if (world.clusters().size() > 1) t.tag_id = c.tag.tag_id;
-    t.T_world_start_camera = c.T_world_start_camera;
-    t.center_m = c.center_m;
-    targets.push_back(t);
-  }
-  return targets;
-}
-
 /// The library's setup of a trial's options.
 host::nbv::NbvSetupOptions setupOptions(const TrialOptions& o) {
   host::nbv::NbvSetupOptions s;
@@ -417,42 +403,15 @@ struct Trial::Impl {
     }
     // First: a missing backend or a bad planner config fails before the arm is built.
     setup = std::make_unique<host::nbv::NbvSetup>(setupOptions(options));
-    const WorldConfig world_config = options.world_config.empty()
-                                         ? WorldConfig{}
-                                         : WorldConfig::fromYamlFile(options.world_config);
-    world = std::make_unique<World>(World::generate(world_config, options.seed));
-    targets = clusterTargets(*world);
-    buildSimulator();
-  }
-
-  /// The simulated camera, the arm with its workspace tree, and the simulated clock.
-  void buildSimulator() {
-    RenderConfig render_config = renderConfigFor(world->config(), {}, options.seed);
-    render_config.noise_seed = options.seed;
-    renderer = std::make_unique<StereoRenderer>(*world, render_config);
-    if (!options.arm_config.empty()) arm_config = ArmConfig::fromYamlFile(options.arm_config);
-    if (arm_config.workspace_cache_dir.empty()) arm_config.workspace_cache_dir = defaultCacheDir();
-    arm = std::make_unique<ArmModel>(arm_config);
-    workspace = std::make_unique<WorkspaceTree>(
-        loadWorkspaceTree(*arm, [this](const std::string& text) { warn(text); }));
-    clock = std::make_unique<SimClock>(SimClock::modeFromString(options.clock));
-    const auto start = ArmController::startConfiguration(*arm, world->startCameraPose());
-    if (!start)
-      throw std::runtime_error("world seed " + std::to_string(options.seed) +
-                               ": the start view is out of the arm's reach");
-    controller = std::make_unique<ArmController>(*arm, *clock, *start);
-    // A fixed clock is for runs that repeat: then the moves must repeat too.
-    if (clock->mode() == SimClock::Mode::kFixed)
-      controller->setReproducibleMotionPlanning(options.seed);
-    pose_errors = std::make_unique<PoseErrorModel>(world->config(), options.seed);
-    wind = std::make_unique<WindModel>(*world, options.seed);
-    segmentation = std::make_unique<SegmentationModel>(world->config(), options.seed);
-    camera = std::make_unique<SimulatedCamera>(
-        *renderer, *clock,
-        SimulatedErrors{pose_errors->enabled() ? pose_errors.get() : nullptr,
-                        wind->enabled() ? wind.get() : nullptr,
-                        segmentation->enabled() ? segmentation.get() : nullptr});
-    sim_arm = std::make_unique<SimulatedArm>(*controller, *workspace);
+    SimulatedRobotOptions sim;
+    sim.seed = options.seed;
+    sim.world_config = options.world_config;
+    sim.arm_config = options.arm_config;
+    sim.clock = options.clock;
+    sim.on_warning = [this](const std::string& text) { warn(text); };
+    robot = std::make_unique<SimulatedRobot>(sim);
+    world = &robot->world();
+    camera = &robot->camera();
   }
 
   // Cluster k's files go to out_dir/cluster_K (a world has at most 8 clusters).
@@ -551,19 +510,10 @@ struct Trial::Impl {
   std::vector<std::string> warnings;
   /// The library's run: sessions, planners, the stop and the tour.
   std::unique_ptr<host::nbv::NbvSetup> setup;
-  std::unique_ptr<World> world;
-  std::vector<host::nbv::ClusterTarget> targets;
-  std::unique_ptr<StereoRenderer> renderer;
-  ArmConfig arm_config;
-  std::unique_ptr<ArmModel> arm;
-  std::unique_ptr<WorkspaceTree> workspace;
-  std::unique_ptr<SimClock> clock;
-  std::unique_ptr<ArmController> controller;
-  std::unique_ptr<PoseErrorModel> pose_errors;
-  std::unique_ptr<WindModel> wind;
-  std::unique_ptr<SegmentationModel> segmentation;
-  std::unique_ptr<SimulatedCamera> camera;
-  std::unique_ptr<SimulatedArm> sim_arm;
+  /// The simulator: world, camera, arm, clock.
+  std::unique_ptr<SimulatedRobot> robot;
+  const World* world = nullptr;
+  const SimulatedCamera* camera = nullptr;
   bool ran = false;
 };
 
@@ -601,7 +551,7 @@ nlohmann::json Trial::Impl::stopJson() const {
 
 void Trial::Impl::describeRun(nlohmann::json& result, const TrialLog& log,
                               const std::vector<Eigen::Vector3d>& camera_path) const {
-  result["clock"] = nlohmann::json::parse(clock->toJson());
+  result["clock"] = nlohmann::json::parse(robot->clock().toJson());
   result["register_views"] = options.register_views;
   result["view_log"] = log.views();
   result["plan_log"] = log.plans();
@@ -616,10 +566,10 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
   ran = true;
   if (world->clusters().size() > 1) return runTree(loop_camera, loop_arm);
   // The loop, driven through the camera, arm and clock like a robot's.
-  SimulatedLoopClock loop_clock(*clock);
+  host::nbv::LoopClock& loop_clock = robot->loopClock();
   TrialLog log(*camera, options, wall_start);
   log.setClusterCenter(world->clusterCenter_m());
-  const std::unique_ptr<host::nbv::ClusterWork> work = setup->makeWork(targets.front());
+  const std::unique_ptr<host::nbv::ClusterWork> work = setup->makeWork(robot->clusterTargets().front());
   TrialParts parts(options, setup->engine(), *work);
   const ClusterOutcome outcome =
       scored(setup->runCluster({loop_camera, loop_arm, loop_clock}, *work, &log), parts,
@@ -635,12 +585,12 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
   result["backend"] = backendName();
   result["views"] = run.views;
   result["stop_reason"] = run.stop_reason;
-  result["sim_time_s"] = clock->now_s();
+  result["sim_time_s"] = robot->clock().now_s();
   result["budget_s"] = options.budget_s;
   result["wall_time_s"] = secondsSince(wall_start);
   result["status"] = parts.session().map() ? "ok" : "no_tag";
   result["config"] = {{"planner", nlohmann::json::parse(parts.planner().configJson())},
-                      {"arm", nlohmann::json::parse(arm_config.toJson())},
+                      {"arm", nlohmann::json::parse(robot->armConfig().toJson())},
                       {"trial", parts.configJson(setup->options().sizing)}};
   for (auto& [key, value] : outcome.sizing.items()) result[key] = value;
   result["events"] = eventsJson(run.events);
@@ -719,13 +669,13 @@ class Trial::Impl::TourRecorder : public host::nbv::TourObserver {
 // A tree: the library's tour (the clusters one after another on one clock and one coarse
 // map), each cluster scored against its fruitlets as it is finished.
 nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::Arm& loop_arm) {
-  SimulatedLoopClock loop_clock(*clock);
+  host::nbv::LoopClock& loop_clock = robot->loopClock();
   TrialLog log(*camera, options, wall_start);
   TourRecord tour;
   host::report::ViewerScene scene(viewerTitle(), "");
   TourRecorder recorder(*this, log, tour, scene);
   const host::nbv::TourResult done =
-      setup->runTour({loop_camera, loop_arm, loop_clock}, targets, &recorder);
+      setup->runTour({loop_camera, loop_arm, loop_clock}, robot->clusterTargets(), &recorder);
   for (const auto& visit : done.visits) tour.order.push_back(visit.index);
   tour.transit_s = done.transit_s;
   for (const auto& [status, count] : done.transit_motion) tour.transit_motion[status] = count;
@@ -774,7 +724,7 @@ void Trial::Impl::recordCluster(const host::nbv::ClusterVisit& visit, TrialParts
   entry["views"] = outcome.run.views;
   entry["first_view"] = log.firstView();  // the run's number of its first view
   entry["stop_reason"] = outcome.run.stop_reason;
-  entry["sim_time_s"] = clock->now_s() - visit.loop_start_s;
+  entry["sim_time_s"] = robot->clock().now_s() - visit.loop_start_s;
 
   for (auto& [key, value] : outcome.sizing.items()) {
     if (key.rfind("fruitlets", 0) == 0) {
@@ -867,12 +817,12 @@ nlohmann::json Trial::Impl::treeResult(TourRecord& tour, host::report::ViewerSce
   result["backend"] = backendName();
   result["views"] = tour.views;
   result["stop_reason"] = "tour_done";
-  result["sim_time_s"] = clock->now_s();
+  result["sim_time_s"] = robot->clock().now_s();
   result["budget_s"] = options.budget_s;
   result["wall_time_s"] = secondsSince(wall_start);
   result["status"] = tour.cluster_status["sized"] > 0 ? "ok" : "no_tag";
   result["config"] = {{"planner", tour.planner_config},
-                      {"arm", nlohmann::json::parse(arm_config.toJson())},
+                      {"arm", nlohmann::json::parse(robot->armConfig().toJson())},
                       {"trial", tour.trial_config}};
   scoreSkippedClusters(tour, scene);
   if (!tour.scored.contains("fruitlets")) tour.scored["fruitlets"] = nlohmann::json::array();
@@ -901,15 +851,15 @@ Trial::Trial(TrialOptions options) : impl_(std::make_unique<Impl>(std::move(opti
 Trial::~Trial() = default;
 
 host::nbv::Camera& Trial::simulatedCamera() {
-  return *impl_->camera;
+  return impl_->robot->camera();
 }
 
 host::nbv::Arm& Trial::simulatedArm() {
-  return *impl_->sim_arm;
+  return impl_->robot->arm();
 }
 
 nlohmann::json Trial::run() {
-  return impl_->run(*impl_->camera, *impl_->sim_arm);
+  return impl_->run(simulatedCamera(), simulatedArm());
 }
 
 nlohmann::json Trial::run(host::nbv::Camera& camera, host::nbv::Arm& arm) {

@@ -39,15 +39,6 @@ constexpr int kReportImageWidthPx = 360;
 
 }  // namespace
 
-std::string defaultCacheDir() {
-  if (const char* dir = std::getenv("FVP_CACHE_DIR"); dir && *dir) return dir;
-  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
-    return (std::filesystem::path(xdg) / "fvp").string();
-  if (const char* home = std::getenv("HOME"); home && *home)
-    return (std::filesystem::path(home) / ".cache" / "fvp").string();
-  return (std::filesystem::temp_directory_path() / "fvp-cache").string();
-}
-
 WorkspaceTree loadWorkspaceTree(const ArmModel& arm,
                                 const std::function<void(const std::string&)>& warn) {
   std::ostringstream log;

@@ -28,9 +28,6 @@ class Backend;
 
 namespace fvp::trials {
 
-/// Where the workspace tree is cached between trials: $FVP_CACHE_DIR, else
-/// $XDG_CACHE_HOME/fvp, else ~/.cache/fvp, else a directory under the system temp dir.
-std::string defaultCacheDir();
 /// The arm's workspace tree from its cache (built and cached when missing or stale); each
 /// warning the cache gave (a stale or unreadable file, a cache it could not write) goes to
 /// warn, without its "warning: " prefix.
