@@ -20,3 +20,8 @@ def capture_set(fvp_exe, tmp_path_factory):
     subprocess.run([fvp_exe, "capture", "--seed", "2", "--views", "6", "--out", str(out)],
                    check=True, stdout=subprocess.DEVNULL)
     return out
+
+
+def pytest_configure(config):
+    config.addinivalue_line(
+        "markers", "heavy: minutes long; run by the python.pytest_heavy CTest (label heavy)")
