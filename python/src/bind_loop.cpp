@@ -13,32 +13,32 @@
 namespace fvp::python {
 
 void PyObserver::onView(const host::nbv::ViewEvent& e) {
-    py::gil_scoped_acquire gil;
-    if (!py::hasattr(target_, "on_view")) return;
-    py::dict d;
-    d["index"] = e.index;
-    d["T_world_camera"] = poseToArray(e.T_world_camera);
-    d["tag_detected"] = e.result->tag_detected;
-    d["roi_points"] = e.result->roi_points;
-    d["now_s"] = e.now_s;
-    target_.attr("on_view")(d);
-  }
+  py::gil_scoped_acquire gil;
+  if (!py::hasattr(target_, "on_view")) return;
+  py::dict d;
+  d["index"] = e.index;
+  d["T_world_camera"] = poseToArray(e.T_world_camera);
+  d["tag_detected"] = e.result->tag_detected;
+  d["roi_points"] = e.result->roi_points;
+  d["now_s"] = e.now_s;
+  target_.attr("on_view")(d);
+}
 void PyObserver::onPlan(const host::nbv::PlanEvent& e) {
-    py::gil_scoped_acquire gil;
-    if (!py::hasattr(target_, "on_plan")) return;
-    py::dict d;
-    d["iteration"] = e.iteration;
-    d["candidates"] = e.step->candidates.size();
-    d["moved"] = e.step->moved();
-    d["move_attempts"] = e.step->move_attempts;
-    d["planning_s"] = e.planning_s;
-    d["now_s"] = e.now_s;
-    target_.attr("on_plan")(d);
-  }
+  py::gil_scoped_acquire gil;
+  if (!py::hasattr(target_, "on_plan")) return;
+  py::dict d;
+  d["iteration"] = e.iteration;
+  d["candidates"] = e.step->candidates.size();
+  d["moved"] = e.step->moved();
+  d["move_attempts"] = e.step->move_attempts;
+  d["planning_s"] = e.planning_s;
+  d["now_s"] = e.now_s;
+  target_.attr("on_plan")(d);
+}
 void PyObserver::onDroppedFrame(const std::string& detail) {
-    py::gil_scoped_acquire gil;
-    if (py::hasattr(target_, "on_dropped_frame")) target_.attr("on_dropped_frame")(detail);
-  }
+  py::gil_scoped_acquire gil;
+  if (py::hasattr(target_, "on_dropped_frame")) target_.attr("on_dropped_frame")(detail);
+}
 
 py::dict nbvResultToDict(const host::nbv::NbvResult& r) {
   py::dict d;

@@ -77,8 +77,8 @@ void bindPlanners(py::module_& m) {
               const std::scoped_lock lock(p.mutex, s.mutex);
               host::map::MapEngine& map = requireMap(s, "next_best_view");
               // The robot makes the move: the best candidate is taken.
-              step = p.planner->planAndMove(
-                  map, T,
+              step = host::planner::planAndMove(
+                  *p.planner, map, T,
                   [&](const Eigen::Isometry3d& pose) {
                     if (reachable.is_none()) return true;
                     py::gil_scoped_acquire gil;

@@ -78,7 +78,8 @@ class PyTourObserver : public host::nbv::TourObserver {
   }
   void onClusterDone(const ClusterVisit& visit, const host::nbv::ClusterWork&) override {
     py::gil_scoped_acquire gil;
-    if (py::hasattr(target_, "on_cluster_done")) target_.attr("on_cluster_done")(visitToDict(visit));
+    if (py::hasattr(target_, "on_cluster_done"))
+      target_.attr("on_cluster_done")(visitToDict(visit));
   }
   void onClusterSkipped(const ClusterVisit& visit) override {
     py::gil_scoped_acquire gil;
@@ -97,11 +98,20 @@ NbvSetupOptions setupOptions(const py::kwargs& kw) {
     if (!kw.contains(key)) return std::nullopt;
     return py::object(kw[key]);
   };
-  static const char* const known[] = {
-      "planner",   "planner_config",     "engine",           "backend",
-      "seed",      "register_views",     "perception",       "stop",
-      "budget_s",  "max_views",          "size_history",     "confirm_detections",
-      "release_left_out", "max_consecutive_dropped_frames"};
+  static const char* const known[] = {"planner",
+                                      "planner_config",
+                                      "engine",
+                                      "backend",
+                                      "seed",
+                                      "register_views",
+                                      "perception",
+                                      "stop",
+                                      "budget_s",
+                                      "max_views",
+                                      "size_history",
+                                      "confirm_detections",
+                                      "release_left_out",
+                                      "max_consecutive_dropped_frames"};
   for (const auto& [key, value] : kw) {
     const std::string name = py::str(key);
     if (std::find(std::begin(known), std::end(known), name) == std::end(known))
@@ -147,8 +157,9 @@ void bindSetup(py::module_& m) {
                                    "simulator's charges its modelled times).")
       .def("now_s", &host::nbv::LoopClock::now_s);
 
-  py::class_<ClusterTarget>(m, "ClusterTarget", "A cluster to visit: its tag or region, and "
-                                                "where to first look at it from.")
+  py::class_<ClusterTarget>(m, "ClusterTarget",
+                            "A cluster to visit: its tag or region, and "
+                            "where to first look at it from.")
       .def(py::init([](const py::object& T, const py::object& center, std::optional<int> tag_id,
                        const py::object& region_center) {
              ClusterTarget t;
@@ -162,8 +173,9 @@ void bindSetup(py::module_& m) {
            py::kw_only(), py::arg("T_world_start_camera"), py::arg("center_m"),
            py::arg("tag_id") = py::none(), py::arg("region_center_m") = py::none())
       .def_readonly("tag_id", &ClusterTarget::tag_id)
-      .def_property_readonly("T_world_start_camera",
-                             [](const ClusterTarget& t) { return poseToArray(t.T_world_start_camera); })
+      .def_property_readonly(
+          "T_world_start_camera",
+          [](const ClusterTarget& t) { return poseToArray(t.T_world_start_camera); })
       .def_property_readonly("center_m",
                              [](const ClusterTarget& t) { return vectorToArray(t.center_m); });
 
@@ -172,7 +184,8 @@ void bindSetup(py::module_& m) {
                        "planner, planner_config, engine, backend, seed, register_views, "
                        "perception, stop ('budget' | 'auto'), budget_s, max_views, size_history, "
                        "confirm_detections, release_left_out, max_consecutive_dropped_frames.")
-      .def(py::init([](const py::kwargs& kw) { return std::make_unique<NbvSetup>(setupOptions(kw)); }))
+      .def(py::init(
+          [](const py::kwargs& kw) { return std::make_unique<NbvSetup>(setupOptions(kw)); }))
       .def_property_readonly("engine", &NbvSetup::engine)
       .def(
           "run_cluster",

@@ -80,8 +80,7 @@ void bindSim(py::module_& m) {
           "arm", [](trials::SimulatedRobot& r) -> host::nbv::Arm& { return r.arm(); },
           py::return_value_policy::reference_internal, "The simulated UR5 on its slider (fvp.Arm).")
       .def_property_readonly(
-          "clock",
-          [](trials::SimulatedRobot& r) -> host::nbv::LoopClock& { return r.loopClock(); },
+          "clock", [](trials::SimulatedRobot& r) -> host::nbv::LoopClock& { return r.loopClock(); },
           py::return_value_policy::reference_internal,
           "The simulated clock as the loop's clock (fvp.LoopClock).")
       .def_property_readonly("targets", &trials::SimulatedRobot::clusterTargets,

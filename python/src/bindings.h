@@ -69,7 +69,7 @@ void bindSession(py::module_& m);           ///< MapEngine, MappingSession
 void bindPlanners(py::module_& m);          ///< Planner, info_gain
 void bindRobot(py::module_& m);             ///< Camera, Arm, CaptureResult, MoveResult
 void bindLoop(py::module_& m);              ///< LoopState, StopCondition, run_nbv
-void bindSetup(py::module_& m);  ///< LoopClock, ClusterTarget, NbvSetup (cluster, tour)
+void bindSetup(py::module_& m);             ///< LoopClock, ClusterTarget, NbvSetup (cluster, tour)
 void bindSim(py::module_& m);               ///< fvp.sim: Trial, run_trial
 
 }  // namespace fvp::python

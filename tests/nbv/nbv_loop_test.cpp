@@ -81,28 +81,25 @@ class FakeArm : public Arm {
   Eigen::Isometry3d pose_ = renderedFrame(1).T_world_camera;
 };
 
-/// Offers one candidate per iteration, 1 cm along x from the current pose.
+/// Offers one candidate per iteration, 1 cm along x from the current pose, ranked when
+/// reachable.
 class FakePlanner : public planner::ViewPlanner {
  public:
   std::string_view name() const override { return "fake"; }
   std::string configJson() const override { return "{}"; }
-  planner::PlanStep planAndMove(map::MapEngine&, const Eigen::Isometry3d& T_now,
-                                const planner::ReachabilityFn& reachable,
-                                const planner::MoveToPoseFn& move) override {
-    planner::PlanStep step;
+  std::optional<planner::Ranking> rank(map::MapEngine&, const Eigen::Isometry3d& T_now,
+                                       const planner::ReachabilityFn& reachable, std::size_t round,
+                                       planner::PlanStep&) override {
+    if (round > 0) return std::nullopt;
+    planner::Ranking ranking;
     planner::Candidate c;
     c.T_world_camera = T_now;
     c.T_world_camera.translation().x() += 0.01;
-    step.candidates.push_back(c);
-    if (reachable(c.T_world_camera)) {
-      ++step.move_attempts;
-      if (move(c.T_world_camera))
-        step.chosen = 0;
-      else
-        ++step.failed_moves;
-    }
+    c.reachable = reachable(c.T_world_camera);
+    ranking.candidates.push_back(c);
+    if (c.reachable) ranking.order.push_back(0);
     ++calls;
-    return step;
+    return ranking;
   }
   int calls = 0;
 };

@@ -161,12 +161,12 @@ TEST(FvpPlanner, AimsAtSizingTargetsOnlyWhenAskedAndScoresThemByWhatIsInView) {
   config.sizing_samples = 0;
   FvpPlanner off(config, 3);
   off.setSizingTargets({target});
-  for (const Candidate& c : off.planAndMove(*e, now, inShell, never).candidates)
+  for (const Candidate& c : planAndMove(off, *e, now, inShell, never).candidates)
     EXPECT_NE(c.kind, CandidateKind::kSizing) << "sizing_samples 0: none";
   config.sizing_samples = 60;
   FvpPlanner on(config, 3);
   on.setSizingTargets({target});
-  const PlanStep step = on.planAndMove(*e, now, inShell, never);
+  const PlanStep step = planAndMove(on, *e, now, inShell, never);
   std::size_t sizing = 0, scored = 0;
   for (const Candidate& c : step.candidates) {
     if (c.kind != CandidateKind::kSizing) continue;
@@ -180,7 +180,7 @@ TEST(FvpPlanner, AimsAtSizingTargetsOnlyWhenAskedAndScoresThemByWhatIsInView) {
   EXPECT_EQ(sizing, 60u);
   EXPECT_GT(scored, 0u);
   on.setSizingTargets({});
-  for (const Candidate& c : on.planAndMove(*e, now, inShell, never).candidates)
+  for (const Candidate& c : planAndMove(on, *e, now, inShell, never).candidates)
     EXPECT_NE(c.kind, CandidateKind::kSizing);
 }
 
@@ -196,7 +196,7 @@ TEST(FvpPlanner, ThresholdDecaysWhenEveryMoveFailsAndResetsOnSuccess) {
   const Eigen::Isometry3d now = Eigen::Isometry3d(Eigen::Translation3d(0.0, -0.3, 0.35));
 
   std::size_t calls = 0;
-  const PlanStep failed = planner.planAndMove(*e, now, inShell, [&](const Eigen::Isometry3d&) {
+  const PlanStep failed = planAndMove(planner, *e, now, inShell, [&](const Eigen::Isometry3d&) {
     ++calls;
     return false;
   });
@@ -210,8 +210,8 @@ TEST(FvpPlanner, ThresholdDecaysWhenEveryMoveFailsAndResetsOnSuccess) {
   // The second attempt succeeds: the threshold resets to u_t0 and the chosen candidate is
   // the second best by utility.
   int attempt = 0;
-  const PlanStep moved = planner.planAndMove(
-      *e, now, inShell, [&](const Eigen::Isometry3d&) { return ++attempt == 2; });
+  const PlanStep moved = planAndMove(planner, *e, now, inShell,
+                                     [&](const Eigen::Isometry3d&) { return ++attempt == 2; });
   ASSERT_TRUE(moved.moved());
   EXPECT_EQ(moved.move_attempts, 2u);
   EXPECT_EQ(moved.failed_moves, 1u);
@@ -237,8 +237,8 @@ TEST(FvpPlanner, OnlyCandidatesAboveTheThresholdAreTried) {
   FvpPlanner planner(config, 2);
   std::size_t calls = 0;
   const PlanStep step =
-      planner.planAndMove(*e, Eigen::Isometry3d(Eigen::Translation3d(0.0, -0.3, 0.35)), inShell,
-                          [&](const Eigen::Isometry3d&) { return ++calls, true; });
+      planAndMove(planner, *e, Eigen::Isometry3d(Eigen::Translation3d(0.0, -0.3, 0.35)), inShell,
+                  [&](const Eigen::Isometry3d&) { return ++calls, true; });
   EXPECT_EQ(calls, 0u);
   EXPECT_FALSE(step.moved());
   EXPECT_DOUBLE_EQ(planner.utilityThreshold(), 1.25);

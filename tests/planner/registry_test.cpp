@@ -13,10 +13,10 @@ namespace {
 class StayPlanner : public planner::ViewPlanner {
  public:
   std::string_view name() const override { return "stay"; }
-  planner::PlanStep planAndMove(map::MapEngine&, const Eigen::Isometry3d&,
-                                const planner::ReachabilityFn&,
-                                const planner::MoveToPoseFn&) override {
-    return {};
+  std::optional<planner::Ranking> rank(map::MapEngine&, const Eigen::Isometry3d&,
+                                       const planner::ReachabilityFn&, std::size_t,
+                                       planner::PlanStep&) override {
+    return std::nullopt;
   }
   std::string configJson() const override { return "{}"; }
 };

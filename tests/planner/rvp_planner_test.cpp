@@ -82,8 +82,8 @@ TEST(RvpPlanner, PlansMovesAndCountsFailures) {
   };
   int attempts = 0;
   const PlanStep step =
-      rvp.planAndMove(*e, Eigen::Isometry3d(Eigen::Translation3d(0, -0.3, 0.35)), shell,
-                      [&](const Eigen::Isometry3d&) { return ++attempts == 3; });
+      planAndMove(rvp, *e, Eigen::Isometry3d(Eigen::Translation3d(0, -0.3, 0.35)), shell,
+                  [&](const Eigen::Isometry3d&) { return ++attempts == 3; });
   ASSERT_TRUE(step.moved());
   EXPECT_EQ(step.move_attempts, 3u);
   EXPECT_EQ(step.failed_moves, 2u);
@@ -98,8 +98,8 @@ TEST(RvpPlanner, PlansMovesAndCountsFailures) {
   // Every move fails: all finite-utility candidates of the chosen set are tried once.
   std::size_t calls = 0;
   const PlanStep failed =
-      rvp.planAndMove(*e, Eigen::Isometry3d(Eigen::Translation3d(0, -0.3, 0.35)), shell,
-                      [&](const Eigen::Isometry3d&) { return ++calls, false; });
+      planAndMove(rvp, *e, Eigen::Isometry3d(Eigen::Translation3d(0, -0.3, 0.35)), shell,
+                  [&](const Eigen::Isometry3d&) { return ++calls, false; });
   EXPECT_FALSE(failed.moved());
   EXPECT_EQ(failed.failed_moves, calls);
   EXPECT_GT(calls, 0u);

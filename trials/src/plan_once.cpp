@@ -77,8 +77,8 @@ PlanRun planFromCaptures(const PlanOnceOptions& o, const std::vector<std::filesy
                              ") and no region_center_m is configured: no Cluster Region, "
                              "no map");
   const auto t_plan = std::chrono::steady_clock::now();
-  run.step = planner.planAndMove(
-      *session.map(), T_now, [](const Eigen::Isometry3d&) { return true; },
+  run.step = host::planner::planAndMove(
+      planner, *session.map(), T_now, [](const Eigen::Isometry3d&) { return true; },
       [&](const Eigen::Isometry3d&) {
         run.motions.push_back({{"status", "not_planned"}});
         return true;
@@ -118,8 +118,8 @@ PlanRun planInSimulation(const PlanOnceOptions& o, const std::string& engine,
   ArmController controller(arm, clock, *start);
   controller.setMap(mapped.map->coarseOcTree());
   const auto t_plan = std::chrono::steady_clock::now();
-  run.step = planner.planAndMove(
-      *mapped.map, controller.cameraPose(),
+  run.step = host::planner::planAndMove(
+      planner, *mapped.map, controller.cameraPose(),
       [&](const Eigen::Isometry3d& T) { return workspace.reachable(T); },
       [&](const Eigen::Isometry3d& T) {
         const MotionPlan plan = controller.moveToPose(T);

@@ -59,8 +59,10 @@ struct SimulatedRobot::Impl {
     if (!o.arm_config.empty()) arm_config = ArmConfig::fromYamlFile(o.arm_config);
     if (arm_config.workspace_cache_dir.empty()) arm_config.workspace_cache_dir = defaultCacheDir();
     arm = std::make_unique<ArmModel>(arm_config);
-    workspace = std::make_unique<WorkspaceTree>(loadWorkspaceTree(
-        *arm, [&o](const std::string& text) { if (o.on_warning) o.on_warning(text); }));
+    workspace =
+        std::make_unique<WorkspaceTree>(loadWorkspaceTree(*arm, [&o](const std::string& text) {
+          if (o.on_warning) o.on_warning(text);
+        }));
     clock = std::make_unique<SimClock>(SimClock::modeFromString(o.clock));
     loop_clock = std::make_unique<SimulatedLoopClock>(*clock);
     const auto start = ArmController::startConfiguration(*arm, world.startCameraPose());

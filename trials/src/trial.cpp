@@ -569,7 +569,8 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
   host::nbv::LoopClock& loop_clock = robot->loopClock();
   TrialLog log(*camera, options, wall_start);
   log.setClusterCenter(world->clusterCenter_m());
-  const std::unique_ptr<host::nbv::ClusterWork> work = setup->makeWork(robot->clusterTargets().front());
+  const std::unique_ptr<host::nbv::ClusterWork> work =
+      setup->makeWork(robot->clusterTargets().front());
   TrialParts parts(options, setup->engine(), *work);
   const ClusterOutcome outcome =
       scored(setup->runCluster({loop_camera, loop_arm, loop_clock}, *work, &log), parts,

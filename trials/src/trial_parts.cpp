@@ -709,7 +709,8 @@ void TrialParts::writeClusterFiles(const std::filesystem::path& dir,
   if (const host::map::MapEngine* map = session().map())
     extra("fine.ot", [&] { map->exportFine(dir / "fine.ot"); });
   const auto& sz = sizing_;
-  extra("surface.ply", [&] { host::writePlyPoints(dir / "surface.ply", session().surfacePoints()); });
+  extra("surface.ply",
+        [&] { host::writePlyPoints(dir / "surface.ply", session().surfacePoints()); });
   extra("mesh.ply", [&] {
     const host::tsdf::TriangleMesh mesh = session().surfaceMesh();
     host::writePlyMesh(dir / "mesh.ply", mesh.vertices_m, mesh.triangles,
@@ -737,9 +738,8 @@ void TrialParts::writeOutputs(nlohmann::json& result, const World& world,
   std::vector<PathRegion> regions;
   if (const auto& region = session().region())
     regions.push_back({region->center_m(), region->radius_m()});
-  const ReportFigures figures =
-      writeResultMapAndPath(result, world, session().map(), camera_path, regions,
-                            "Cluster Region", out_dir, warn, extra);
+  const ReportFigures figures = writeResultMapAndPath(
+      result, world, session().map(), camera_path, regions, "Cluster Region", out_dir, warn, extra);
   writeClusterFiles(out_dir, extra);
   extra("report.md", [&] {
     host::writeFileAtomically(out_dir / "report.md", "trial report",

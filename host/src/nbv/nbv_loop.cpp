@@ -133,7 +133,8 @@ NbvResult NbvLoop::run(const StopCondition& stop, LoopObserver* observer) {
       return moved.ok();
     };
     const auto t_plan = Clock::now();
-    const planner::PlanStep step = planner_.planAndMove(*map, arm_.cameraPose(), reachable, move);
+    const planner::PlanStep step =
+        planner::planAndMove(planner_, *map, arm_.cameraPose(), reachable, move);
     const double plan_s = std::max(0.0, secondsSince(t_plan) - move_wall_s);
     out.wall_s.planning += plan_s;
     out.wall_s.moving += move_wall_s;

@@ -98,8 +98,8 @@ NbvSetup::NbvSetup(NbvSetupOptions options) : options_(std::move(options)) {
                                 options_.engine + "'");
   options_.stop.validate();
   options_.perception.validate();
-  engine_ = options_.engine.empty() ? planners.at(options_.planner).default_engine
-                                    : options_.engine;
+  engine_ =
+      options_.engine.empty() ? planners.at(options_.planner).default_engine : options_.engine;
   // A missing backend or a bad planner config fails here, before anything moves.
   backend_ = map::createBackendFor(engine_, options_.backend);
   first_planner_ = planner::createPlanner(options_.planner, options_.planner_config,
@@ -144,9 +144,8 @@ ClusterRun NbvSetup::runCluster(const NbvRig& rig, ClusterWork& work, LoopObserv
     observers.add(&*guidance);  // after completion: it reads completion's sizing
     completion->holdWhile([&g = *guidance] { return g.waitingOnUnconfirmed(); });
     if (spec.completion.release_left_out)
-      completion->releaseWhen([&g = *guidance](const FruitletSnapshot& f) {
-        return g.leftOut(f.center_m);
-      });
+      completion->releaseWhen(
+          [&g = *guidance](const FruitletSnapshot& f) { return g.leftOut(f.center_m); });
     stop = stop || completion->stopCondition();
   } else if (spec.record_size_history) {
     completion.emplace(*work.session, observing_clock, options_.sizing, spec.completion);
@@ -210,8 +209,8 @@ TourResult NbvSetup::runTour(const NbvRig& rig, const std::vector<ClusterTarget>
     if (!rig.arm.cameraPose().isApprox(target.T_world_start_camera, 1e-9) &&
         !approach.moveToNext(rig.arm, rig.clock, visit, tour)) {
       visit.move_status = approach.lastMoveStatus();
-      visit.status = visit.move_status == "unreachable" ? VisitStatus::kUnreachable
-                                                        : VisitStatus::kMoveFailed;
+      visit.status =
+          visit.move_status == "unreachable" ? VisitStatus::kUnreachable : VisitStatus::kMoveFailed;
       if (observer) observer->onClusterSkipped(visit);
       tour.visits.push_back(std::move(visit));
       continue;

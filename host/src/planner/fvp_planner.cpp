@@ -74,75 +74,75 @@ void FvpPlanner::score(std::vector<Candidate>& candidates, const Eigen::Vector3d
   }
 }
 
-PlanStep FvpPlanner::planAndMove(map::MapEngine& map, const Eigen::Isometry3d& T_world_camera_now,
-                                 const ReachabilityFn& reachable, const MoveToPoseFn& move) {
-  PlanStep step;
+std::optional<Ranking> FvpPlanner::rank(map::MapEngine& map,
+                                        const Eigen::Isometry3d& T_world_camera_now,
+                                        const ReachabilityFn& reachable, std::size_t round,
+                                        PlanStep& step) {
+  if (round >= static_cast<std::size_t>(config_.max_sampling_rounds)) return std::nullopt;
   auto t = Clock::now();
-  // The snapshot holds until new scans arrive (planning again after failed moves reuses it).
-  if (!refreshed_ || gain_.snapshotScans() != map.scanCount()) {
-    gain_.refresh(map);
-    refreshed_ = true;
+  if (round == 0) {
+    // The snapshot holds until new scans arrive (planning again after failed moves reuses it).
+    if (!refreshed_ || gain_.snapshotScans() != map.scanCount()) {
+      gain_.refresh(map);
+      refreshed_ = true;
+    }
+    addTiming(step.timings_s, "snapshot", since(t));
+    t = Clock::now();
+    if (frontiers_map_ != &map || frontiers_scans_ != map.scanCount()) {
+      frontiers_ = map.frontiers();
+      frontiers_map_ = &map;
+      frontiers_scans_ = map.scanCount();
+    }
+    addTiming(step.timings_s, "frontiers", since(t));
   }
-  addTiming(step.timings_s, "snapshot", since(t));
+  ++step.sampling_rounds;
   t = Clock::now();
-  if (frontiers_map_ != &map || frontiers_scans_ != map.scanCount()) {
-    frontiers_ = map.frontiers();
-    frontiers_map_ = &map;
-    frontiers_scans_ = map.scanCount();
+  Ranking ranking;
+  std::vector<Candidate>& candidates = ranking.candidates;
+  candidates = sampler_.sampleRoi(frontiers_, config_.roi_samples, reachable);
+  std::vector<Candidate> exploration =
+      sampler_.sampleExploration(frontiers_, config_.exploration_samples, reachable);
+  candidates.insert(candidates.end(), exploration.begin(), exploration.end());
+  if (config_.sizing_samples > 0 && !sizing_targets_.empty()) {
+    std::vector<Candidate> sizing =
+        sampler_.sampleSizing(sizing_targets_, config_.sizing_samples, reachable);
+    candidates.insert(candidates.end(), sizing.begin(), sizing.end());
   }
-  const std::vector<map::FrontierVoxel>& frontiers = frontiers_;
-  addTiming(step.timings_s, "frontiers", since(t));
-
-  for (int round = 0; round < config_.max_sampling_rounds; ++round) {
-    ++step.sampling_rounds;
-    t = Clock::now();
-    std::vector<Candidate> candidates =
-        sampler_.sampleRoi(frontiers, config_.roi_samples, reachable);
-    std::vector<Candidate> exploration =
-        sampler_.sampleExploration(frontiers, config_.exploration_samples, reachable);
-    candidates.insert(candidates.end(), exploration.begin(), exploration.end());
-    if (config_.sizing_samples > 0 && !sizing_targets_.empty()) {
-      std::vector<Candidate> sizing =
-          sampler_.sampleSizing(sizing_targets_, config_.sizing_samples, reachable);
-      candidates.insert(candidates.end(), sizing.begin(), sizing.end());
-    }
-    if (config_.camera_clearance_m > 0.0)
-      for (Candidate& c : candidates)
-        if (c.reachable && gain_.occupiedWithin(c.position_m(), config_.camera_clearance_m)) {
-          c.reachable = false;
-          ++step.rejected_clearance;
-        }
-    addTiming(step.timings_s, "sample", since(t));
-    t = Clock::now();
-    EvaluateStats stats;
-    score(candidates, T_world_camera_now.translation(), &stats);
-    const double scoring_s = since(t);
-    if (config_.embree_cull) addTiming(step.timings_s, "cull", stats.cull_s);
-    addTiming(step.timings_s, "info_gain", scoring_s - stats.cull_s);
-    step.culled_rays += stats.culled;
-    step.gain_rays += stats.rays;
-
-    // Algorithm 1, lines 6-14: the heap as a sort by utility (ties by index: deterministic).
-    std::vector<std::size_t> order(candidates.size());
-    std::iota(order.begin(), order.end(), 0);
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-      return candidates[a].utility > candidates[b].utility;
-    });
-    step.candidates = std::move(candidates);
-    for (std::size_t i : order) {
-      const Candidate& c = step.candidates[i];
-      if (!c.reachable || !(c.utility > u_t_)) break;
-      ++step.move_attempts;
-      if (move(c.T_world_camera)) {
-        step.chosen = i;
-        u_t_ = config_.utility_threshold;  // line 16
-        return step;
+  if (config_.camera_clearance_m > 0.0)
+    for (Candidate& c : candidates)
+      if (c.reachable && gain_.occupiedWithin(c.position_m(), config_.camera_clearance_m)) {
+        c.reachable = false;
+        ++step.rejected_clearance;
       }
-      ++step.failed_moves;
-    }
-    u_t_ *= config_.threshold_decay;  // line 18
+  addTiming(step.timings_s, "sample", since(t));
+  t = Clock::now();
+  EvaluateStats stats;
+  score(candidates, T_world_camera_now.translation(), &stats);
+  const double scoring_s = since(t);
+  if (config_.embree_cull) addTiming(step.timings_s, "cull", stats.cull_s);
+  addTiming(step.timings_s, "info_gain", scoring_s - stats.cull_s);
+  step.culled_rays += stats.culled;
+  step.gain_rays += stats.rays;
+
+  // Algorithm 1, lines 6-14: the heap as a sort by utility (ties by index: deterministic),
+  // cut where the candidates stop being worth a move.
+  std::vector<std::size_t> order(candidates.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return candidates[a].utility > candidates[b].utility;
+  });
+  for (std::size_t i : order) {
+    if (!candidates[i].reachable || !(candidates[i].utility > u_t_)) break;
+    ranking.order.push_back(i);
   }
-  return step;
+  return ranking;
+}
+
+void FvpPlanner::roundDone(bool moved) {
+  if (moved)
+    u_t_ = config_.utility_threshold;  // line 16
+  else
+    u_t_ *= config_.threshold_decay;  // line 18
 }
 
 std::string FvpPlanner::configJson() const {

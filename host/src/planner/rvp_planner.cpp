@@ -81,9 +81,11 @@ double RvpPlanner::explorationGain(const Eigen::Isometry3d& T) const {
 
 namespace fvp::host::planner {
 
-PlanStep RvpPlanner::planAndMove(map::MapEngine& map, const Eigen::Isometry3d& T_world_camera_now,
-                                 const ReachabilityFn& reachable, const MoveToPoseFn& move) {
-  PlanStep step;
+std::optional<Ranking> RvpPlanner::rank(map::MapEngine& map,
+                                        const Eigen::Isometry3d& T_world_camera_now,
+                                        const ReachabilityFn& reachable, std::size_t round,
+                                        PlanStep& step) {
+  if (round > 0) return std::nullopt;  // one round an iteration
   step.sampling_rounds = 1;
   auto t = Clock::now();
   if (snapshot_.snapshotScans() != map.scanCount() || snapshot_.snapshotBytes() == 0)
@@ -152,26 +154,22 @@ PlanStep RvpPlanner::planAndMove(map::MapEngine& map, const Eigen::Isometry3d& T
   double best_roi = -std::numeric_limits<double>::infinity();
   for (const auto& c : roi) best_roi = std::max(best_roi, c.utility);
   const bool use_roi = best_roi > config_.roi_utility_threshold;
-  step.candidates = use_roi ? roi : exploration;
+  Ranking ranking;
+  ranking.candidates = use_roi ? roi : exploration;
   const auto& other = use_roi ? exploration : roi;
-  const std::size_t chosen_set = step.candidates.size();
-  step.candidates.insert(step.candidates.end(), other.begin(), other.end());
+  const std::size_t chosen_set = ranking.candidates.size();
+  ranking.candidates.insert(ranking.candidates.end(), other.begin(), other.end());
   std::vector<std::size_t> order(chosen_set);
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return step.candidates[a].utility > step.candidates[b].utility;
+    return ranking.candidates[a].utility > ranking.candidates[b].utility;
   });
   for (std::size_t i : order) {
-    const Candidate& c = step.candidates[i];
+    const Candidate& c = ranking.candidates[i];
     if (!c.reachable || !std::isfinite(c.utility)) break;
-    ++step.move_attempts;
-    if (move(c.T_world_camera)) {
-      step.chosen = i;
-      return step;
-    }
-    ++step.failed_moves;
+    ranking.order.push_back(i);
   }
-  return step;
+  return ranking;
 }
 
 }  // namespace fvp::host::planner

@@ -100,10 +100,10 @@ struct ClusterWork {
 /// What running the loop on one cluster gave.
 struct ClusterRun {
   NbvResult run;
-  double start_s = 0.0;                ///< the run's clock when the cluster's loop began
-  sizing::SizingResult sizing;         ///< the cluster sized after its loop
-  double sizing_wall_s = 0.0;          ///< that sizing's wall time
-  double sizing_during_loop_s = 0.0;   ///< the stop's sizings after each view, summed
+  double start_s = 0.0;                      ///< the run's clock when the cluster's loop began
+  sizing::SizingResult sizing;               ///< the cluster sized after its loop
+  double sizing_wall_s = 0.0;                ///< that sizing's wall time
+  double sizing_during_loop_s = 0.0;         ///< the stop's sizings after each view, summed
   std::vector<SizingSnapshot> size_history;  ///< with kAuto or record_size_history
   /// With kAuto, what the sizing guidance did: views aimed at fruitlets the stop waited for
   /// and targets it gave up on.
@@ -157,8 +157,8 @@ class TourObserver : public LoopObserver {
 };
 
 struct TourResult {
-  std::vector<ClusterVisit> visits;  ///< in visit order
-  double transit_s = 0.0;            ///< the clock spent moving between clusters
+  std::vector<ClusterVisit> visits;                   ///< in visit order
+  double transit_s = 0.0;                             ///< the clock spent moving between clusters
   std::map<std::string, std::size_t> transit_motion;  ///< MoveStatus name -> count
   /// The map the last sized cluster handed on (its coarse map covers the whole tour).
   std::unique_ptr<map::MapEngine> map;

@@ -23,8 +23,13 @@ class FvpPlanner : public ViewPlanner {
   FvpPlanner(const PlannerConfig& config, std::uint64_t seed, accel::Backend* backend = nullptr);
 
   std::string_view name() const override { return "fvp"; }
-  PlanStep planAndMove(map::MapEngine& map, const Eigen::Isometry3d& T_world_camera_now,
-                       const ReachabilityFn& reachable, const MoveToPoseFn& move) override;
+  /// Algorithm 1's rounds: up to max_sampling_rounds; ranks the reachable candidates whose
+  /// utility exceeds the current threshold.
+  std::optional<Ranking> rank(map::MapEngine& map, const Eigen::Isometry3d& T_world_camera_now,
+                              const ReachabilityFn& reachable, std::size_t round,
+                              PlanStep& step) override;
+  /// Resets the threshold after a move (line 16), decays it after a round without (line 18).
+  void roundDone(bool moved) override;
   std::string configJson() const override;
   /// With sizing_samples > 0, each sampling round also aims that many candidates at these
   /// (scored by the fraction of the fruitlet the map predicts in view, when it reaches the

@@ -31,8 +31,11 @@ class RvpPlanner : public ViewPlanner {
  public:
   RvpPlanner(const RvpConfig& config, std::uint64_t seed);
   std::string_view name() const override { return "rvp"; }
-  PlanStep planAndMove(map::MapEngine& map, const Eigen::Isometry3d& T_world_camera_now,
-                       const ReachabilityFn& reachable, const MoveToPoseFn& move) override;
+  /// One round: the ROI set when its best utility exceeds the threshold, else exploration,
+  /// its reachable candidates of finite utility ranked.
+  std::optional<Ranking> rank(map::MapEngine& map, const Eigen::Isometry3d& T_world_camera_now,
+                              const ReachabilityFn& reachable, std::size_t round,
+                              PlanStep& step) override;
   std::string configJson() const override { return config_.toJson(); }
 
   /// The ROI contour targets of the map (fine grid indices' centres), sorted.

@@ -1,9 +1,10 @@
-// The one interface the trial loop drives a viewpoint planner through (docs/design.md section 6):
+// The one interface the loop drives a viewpoint planner through (docs/design.md section 6):
 // FVP (ours, Algorithm 1 over ROI-targeted + exploration candidates scored by paper Eq. 1-3)
 // and RVP (Zaenker et al. 2020) both implement it, so `fvp run --planner fvp|rvp` and
-// `fvp plan` share one path. The arm is reached through two callbacks, so the host planner
-// does not depend on robot/: a cheap reachability filter (the workspace tree) and the move
-// itself (IK + motion planning + execution), whose failure is an expected outcome.
+// `fvp plan` share one path. A planner ranks views; the loop (planAndMove) tries the moves.
+// The arm is reached through two callbacks, so the host planner does not depend on robot/: a
+// cheap reachability filter (the workspace tree) and the move itself (IK + motion planning +
+// execution), whose failure is an expected outcome.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -68,21 +69,45 @@ struct PlanStep {
   bool moved() const { return chosen.has_value(); }
 };
 
+/// One sampling round, scored: every candidate, and those the planner would move to, best first
+/// (its own threshold applied).
+struct Ranking {
+  std::vector<Candidate> candidates;
+  std::vector<std::size_t> order;  ///< indices into candidates
+};
+
+/// Planners rank, the loop acts (OMPL's planners return paths and leave execution to the
+/// caller): a planner samples and scores views; planAndMove (below) tries the moves, in one
+/// place for every planner, and counts them.
 class ViewPlanner {
  public:
   virtual ~ViewPlanner() = default;
   /// "fvp" or "rvp".
   virtual std::string_view name() const = 0;
-  /// One planning iteration on the current maps: sample, score, and try moves in order of
-  /// utility until one succeeds or the planner's own rule gives up for this iteration.
-  /// T_world_camera_now is the camera pose the motion cost is measured from.
-  virtual PlanStep planAndMove(map::MapEngine& map, const Eigen::Isometry3d& T_world_camera_now,
-                               const ReachabilityFn& reachable, const MoveToPoseFn& move) = 0;
+  /// Sampling round `round` (0, 1, ...) of a planning iteration on the current maps, or
+  /// nothing when the planner's rule gives up for this iteration. Round 0 refreshes what
+  /// the planner keeps of the maps. T_world_camera_now is the pose the motion cost is
+  /// measured from; reachable is the arm's cheap filter. The round's timings and counts go
+  /// into step (sampling_rounds, rejected_clearance, rays, timings_s).
+  virtual std::optional<Ranking> rank(map::MapEngine& map,
+                                      const Eigen::Isometry3d& T_world_camera_now,
+                                      const ReachabilityFn& reachable, std::size_t round,
+                                      PlanStep& step) = 0;
+  /// How the round's moves went: moved to one of its ranked views, or none (FVP decays
+  /// its utility threshold then, Algorithm 1 line 18).
+  virtual void roundDone(bool moved) { (void)moved; }
   /// The planner's configuration as JSON text (printed into every result).
   virtual std::string configJson() const = 0;
   /// The fruitlets the automatic stop still waits for, after each sizing (sizing_target.h).
   /// Planners that cannot aim at them ignore them (the default).
   virtual void setSizingTargets(std::vector<SizingTarget> targets) { (void)targets; }
 };
+
+/// One planning iteration: the planner's rounds, each round's ranked views tried in order
+/// until a move succeeds (Algorithm 1, lines 6-18). PlanStep::candidates are the last
+/// round's; move_attempts and failed_moves count every move tried.
+PlanStep planAndMove(ViewPlanner& planner, map::MapEngine& map,
+                     const Eigen::Isometry3d& T_world_camera_now, const ReachabilityFn& reachable,
+                     const MoveToPoseFn& move);
 
 }  // namespace fvp::host::planner
