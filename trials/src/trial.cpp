@@ -33,7 +33,6 @@
 #include "fvp/host/session/mapping_session.h"
 #include "fvp/host/session/session_report.h"
 #include "fvp/robot/arm_model.h"
-#include "fvp/robot/sim/arm_controller.h"
 #include "fvp/robot/sim/simulated_arm.h"
 #include "fvp/robot/sim/simulated_camera.h"
 #include "fvp/robot/sim/simulated_loop_clock.h"
@@ -505,14 +504,14 @@ struct Trial::Impl {
     workspace = std::make_unique<WorkspaceTree>(
         loadWorkspaceTree(*arm, [this](const std::string& text) { warn(text); }));
     clock = std::make_unique<SimClock>(SimClock::modeFromString(options.clock));
-    const auto start = ArmController::startConfiguration(*arm, world->startCameraPose());
+    const auto start = SimulatedArm::startConfiguration(*arm, world->startCameraPose());
     if (!start)
       throw std::runtime_error("world seed " + std::to_string(options.seed) +
                                ": the start view is out of the arm's reach");
-    controller = std::make_unique<ArmController>(*arm, *clock, *start);
+    sim_arm = std::make_unique<SimulatedArm>(*arm, *workspace, *clock, *start);
     // A fixed clock is for runs that repeat: then the moves must repeat too.
     if (clock->mode() == SimClock::Mode::kFixed)
-      controller->setReproducibleMotionPlanning(options.seed);
+      sim_arm->setReproducibleMotionPlanning(options.seed);
     pose_errors = std::make_unique<PoseErrorModel>(world->config(), options.seed);
     wind = std::make_unique<WindModel>(*world, options.seed);
     segmentation = std::make_unique<SegmentationModel>(world->config(), options.seed);
@@ -521,7 +520,6 @@ struct Trial::Impl {
         SimulatedErrors{pose_errors->enabled() ? pose_errors.get() : nullptr,
                         wind->enabled() ? wind.get() : nullptr,
                         segmentation->enabled() ? segmentation.get() : nullptr});
-    sim_arm = std::make_unique<SimulatedArm>(*controller, *workspace);
   }
 
   // Cluster k's files go to out_dir/cluster_K (a world has at most 8 clusters).
@@ -636,7 +634,6 @@ struct Trial::Impl {
   std::unique_ptr<ArmModel> arm;
   std::unique_ptr<WorkspaceTree> workspace;
   std::unique_ptr<SimClock> clock;
-  std::unique_ptr<ArmController> controller;
   std::unique_ptr<PoseErrorModel> pose_errors;
   std::unique_ptr<WindModel> wind;
   std::unique_ptr<SegmentationModel> segmentation;
