@@ -68,6 +68,7 @@ void bindPerceptionSizing(py::module_& m);  ///< PerceptionConfig, size_captures
 void bindSession(py::module_& m);           ///< MapEngine, MappingSession
 void bindPlanners(py::module_& m);          ///< Planner, info_gain
 void bindRobot(py::module_& m);             ///< Camera, Arm, CaptureResult, MoveResult
+void bindPlannedArm(py::module_& m);        ///< PlannedArm, ArmModel, WorkspaceTree, drivers
 void bindLoop(py::module_& m);              ///< LoopState, StopCondition, run_nbv
 void bindSetup(py::module_& m);             ///< LoopClock, ClusterTarget, NbvSetup (cluster, tour)
 void bindSim(py::module_& m);               ///< fvp.sim: Trial, run_trial

@@ -10,6 +10,7 @@ PYBIND11_MODULE(fvp, m) {
   fvp::python::bindSession(m);
   fvp::python::bindPlanners(m);
   fvp::python::bindRobot(m);
+  fvp::python::bindPlannedArm(m);
   fvp::python::bindLoop(m);
   fvp::python::bindSetup(m);
   fvp::python::bindSim(m);

@@ -5,7 +5,6 @@
 #include <stdexcept>
 
 #include "fvp/robot/arm_model.h"
-#include "fvp/robot/sim/arm_controller.h"
 #include "fvp/robot/sim/pose_error_model.h"
 #include "fvp/robot/sim/segmentation_model.h"
 #include "fvp/robot/sim/sim_clock.h"
@@ -65,13 +64,13 @@ struct SimulatedRobot::Impl {
         }));
     clock = std::make_unique<SimClock>(SimClock::modeFromString(o.clock));
     loop_clock = std::make_unique<SimulatedLoopClock>(*clock);
-    const auto start = ArmController::startConfiguration(*arm, world.startCameraPose());
+    const auto start = SimulatedArm::startConfiguration(*arm, world.startCameraPose());
     if (!start)
       throw std::runtime_error("world seed " + std::to_string(o.seed) +
                                ": the start view is out of the arm's reach");
-    controller = std::make_unique<ArmController>(*arm, *clock, *start);
+    sim_arm = std::make_unique<SimulatedArm>(*arm, *workspace, *clock, *start);
     // A fixed clock is for runs that repeat: then the moves must repeat too.
-    if (clock->mode() == SimClock::Mode::kFixed) controller->setReproducibleMotionPlanning(o.seed);
+    if (clock->mode() == SimClock::Mode::kFixed) sim_arm->setReproducibleMotionPlanning(o.seed);
     pose_errors = std::make_unique<PoseErrorModel>(world.config(), o.seed);
     wind = std::make_unique<WindModel>(world, o.seed);
     segmentation = std::make_unique<SegmentationModel>(world.config(), o.seed);
@@ -80,7 +79,6 @@ struct SimulatedRobot::Impl {
         SimulatedErrors{pose_errors->enabled() ? pose_errors.get() : nullptr,
                         wind->enabled() ? wind.get() : nullptr,
                         segmentation->enabled() ? segmentation.get() : nullptr});
-    sim_arm = std::make_unique<SimulatedArm>(*controller, *workspace);
   }
 
   World world;
@@ -91,7 +89,6 @@ struct SimulatedRobot::Impl {
   std::unique_ptr<WorkspaceTree> workspace;
   std::unique_ptr<SimClock> clock;
   std::unique_ptr<SimulatedLoopClock> loop_clock;
-  std::unique_ptr<ArmController> controller;
   std::unique_ptr<PoseErrorModel> pose_errors;
   std::unique_ptr<WindModel> wind;
   std::unique_ptr<SegmentationModel> segmentation;

@@ -33,7 +33,6 @@
 #include "fvp/host/session/mapping_session.h"
 #include "fvp/host/session/session_report.h"
 #include "fvp/robot/arm_model.h"
-#include "fvp/robot/sim/arm_controller.h"
 #include "fvp/robot/sim/simulated_arm.h"
 #include "fvp/robot/sim/simulated_camera.h"
 #include "fvp/robot/sim/simulated_loop_clock.h"

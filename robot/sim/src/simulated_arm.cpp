@@ -1,49 +1,25 @@
 #include "fvp/robot/sim/simulated_arm.h"
 
-#include "fvp/host/map/map_engine.h"
-
 namespace fvp::robot::sim {
-namespace {
 
-host::nbv::MoveStatus toMoveStatus(MotionStatus status) {
-  using host::nbv::MoveStatus;
-  switch (status) {
-    case MotionStatus::kSuccess:
-      return MoveStatus::kSuccess;
-    case MotionStatus::kNoIk:
-      return MoveStatus::kNoIk;
-    case MotionStatus::kNoCollisionFreeIk:
-      return MoveStatus::kNoCollisionFreeIk;
-    case MotionStatus::kStartInvalid:
-      return MoveStatus::kStartInvalid;
-    case MotionStatus::kNoPath:
-      return MoveStatus::kNoPath;
-    case MotionStatus::kTimeout:
-      return MoveStatus::kTimeout;
+SimulatedArm::SimulatedArm(const ArmModel& arm, const Reachability& reachability, SimClock& clock,
+                           const JointVector& start)
+    : joint_state_(start),
+      executor_(clock, joint_state_),
+      arm_(arm, reachability, joint_state_, executor_) {
+  // Before the executor charges the motion: the order of the charges is the order of
+  // the clock's sums, which fixed-clock runs repeat bit for bit.
+  arm_.setPlanningObserver([&clock](const MotionPlan& plan) {
+    clock.chargeCompute(ClockStage::kMotionPlanning, plan.planning_wall_s);
+  });
+}
+
+std::optional<JointVector> SimulatedArm::startConfiguration(
+    const ArmModel& arm, const Eigen::Isometry3d& T_world_camera) {
+  for (const JointVector& q : arm.inverse(T_world_camera, arm.homeConfiguration())) {
+    if (!arm.selfOrStaticCollision(arm.linkCapsules(q))) return q;
   }
-  return MoveStatus::kNoPath;
-}
-
-}  // namespace
-
-SimulatedArm::SimulatedArm(ArmController& controller, const WorkspaceTree& workspace)
-    : controller_(controller), workspace_(workspace) {}
-
-Eigen::Isometry3d SimulatedArm::cameraPose() const {
-  return controller_.cameraPose();
-}
-
-bool SimulatedArm::reachable(const Eigen::Isometry3d& T_world_camera) const {
-  return workspace_.reachable(T_world_camera);
-}
-
-host::nbv::MoveResult SimulatedArm::moveTo(const Eigen::Isometry3d& T_world_camera) {
-  const MotionPlan plan = controller_.moveToPose(T_world_camera);
-  return {toMoveStatus(plan.status), plan.planning_wall_s};
-}
-
-std::size_t SimulatedArm::updateObstacles(host::map::MapEngine& map) {
-  return controller_.setMap(map.coarseOcTree());
+  return std::nullopt;
 }
 
 }  // namespace fvp::robot::sim

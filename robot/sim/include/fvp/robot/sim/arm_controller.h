@@ -1,50 +1,52 @@
-// The simulated arm controller: plans with MotionPlanner and "executes" by advancing the
-// simulated clock by the trajectory's duration and setting the joints (and so the camera
-// pose) to the trajectory's end. Planning wall time is charged as motion_planning.
+// The simulated arm without a viewpoint planner's reachability filter, for code that plans
+// single moves and wants the plans (fvp plan, tests, benchmarks): a SimulatedArm (PlannedArm
+// over the simulated driver: planning time charged as motion_planning, the trajectory's
+// duration as motion, the joints set to its end) whose reachability is exact IK.
 #pragma once
 
 #include <Eigen/Geometry>
 #include <optional>
 
-#include "fvp/robot/arm_collision_checker.h"
-#include "fvp/robot/motion_planner.h"
-#include "fvp/robot/sim/sim_clock.h"
+#include "fvp/robot/ik_reachability.h"
+#include "fvp/robot/sim/simulated_arm.h"
 
 namespace fvp::robot::sim {
 
 class ArmController {
  public:
   /// `arm` and `clock` must outlive the controller.
-  ArmController(const ArmModel& arm, SimClock& clock, const JointVector& start);
+  ArmController(const ArmModel& arm, SimClock& clock, const JointVector& start)
+      : reachability_(arm), arm_(arm, reachability_, clock, start) {}
 
-  /// The start configuration for a world's start view: its IK solution nearest the arm's
-  /// home configuration that is free of self and static collision; none when unreachable.
+  /// SimulatedArm::startConfiguration.
   static std::optional<JointVector> startConfiguration(const ArmModel& arm,
-                                                       const Eigen::Isometry3d& T_world_camera);
+                                                       const Eigen::Isometry3d& T_world_camera) {
+    return SimulatedArm::startConfiguration(arm, T_world_camera);
+  }
 
   /// The coarse map planning avoids from now on (copied), less the voxels the arm itself
   /// occupies now (ArmCollisionChecker::setMapFreeAt); returns how many those were.
   std::size_t setMap(const octomap::OcTree& coarse_map) {
-    return checker_.setMapFreeAt(coarse_map, joints_);
+    return arm_.planned().setMap(coarse_map);
   }
   /// Plans to the camera pose, charges the planning time, and on success charges and
   /// "executes" the motion. Never throws for planning failures.
-  MotionPlan moveToPose(const Eigen::Isometry3d& T_world_camera);
+  MotionPlan moveToPose(const Eigen::Isometry3d& T_world_camera) {
+    return arm_.planned().moveToPose(T_world_camera).plan;
+  }
 
-  /// Motion planning as MotionPlanner::setReproducible (fvp run --clock fixed): the same
-  /// moves on any machine and under any load.
-  void setReproducibleMotionPlanning(std::uint64_t seed) { planner_.setReproducible(seed); }
+  void setReproducibleMotionPlanning(std::uint64_t seed) {
+    arm_.setReproducibleMotionPlanning(seed);
+  }
 
-  const JointVector& joints() const { return joints_; }
-  Eigen::Isometry3d cameraPose() const { return arm_.T_world_camera(joints_); }
-  const ArmCollisionChecker& checker() const { return checker_; }
+  JointVector joints() const { return arm_.joints(); }
+  Eigen::Isometry3d cameraPose() const { return arm_.cameraPose(); }
+  const ArmCollisionChecker& checker() const { return arm_.planned().checker(); }
+  SimulatedArm& arm() { return arm_; }
 
  private:
-  const ArmModel& arm_;
-  SimClock& clock_;
-  ArmCollisionChecker checker_;
-  MotionPlanner planner_;
-  JointVector joints_;
+  IkReachability reachability_;
+  SimulatedArm arm_;
 };
 
 }  // namespace fvp::robot::sim

@@ -1,29 +1,55 @@
-// The simulated UR5 on its slider as the next-best-view loop's arm: reachability from the
-// workspace tree, moves by IK + OMPL + instant execution charged to the simulated clock,
-// obstacles from the loop's coarse map.
+// The simulated UR5 on its slider as the next-best-view loop's arm: the real-robot PlannedArm
+// (reachability, IK + OMPL against the loop's coarse map) over a simulated driver, whose
+// executor charges each trajectory's duration to the simulated clock and sets the joints to
+// its end. Planning time is charged as motion_planning after every plan, failed ones too.
 #pragma once
 
-#include "fvp/host/nbv/arm.h"
-#include "fvp/robot/sim/arm_controller.h"
-#include "fvp/robot/workspace_tree.h"
+#include <optional>
+
+#include "fvp/robot/planned_arm.h"
+#include "fvp/robot/sim/sim_clock.h"
+#include "fvp/robot/sim/simulated_joint_state.h"
+#include "fvp/robot/sim/simulated_trajectory_executor.h"
 
 namespace fvp::robot::sim {
 
 class SimulatedArm : public host::nbv::Arm {
  public:
-  /// controller and workspace must outlive the arm.
-  SimulatedArm(ArmController& controller, const WorkspaceTree& workspace);
+  /// `arm`, `reachability` and `clock` must outlive the simulated arm; it starts at `start`.
+  SimulatedArm(const ArmModel& arm, const Reachability& reachability, SimClock& clock,
+               const JointVector& start);
 
-  Eigen::Isometry3d cameraPose() const override;
-  bool reachable(const Eigen::Isometry3d& T_world_camera) const override;
-  host::nbv::MoveResult moveTo(const Eigen::Isometry3d& T_world_camera) override;
+  /// The start configuration for a world's start view: its IK solution nearest the arm's
+  /// home configuration that is free of self and static collision; none when unreachable.
+  static std::optional<JointVector> startConfiguration(const ArmModel& arm,
+                                                       const Eigen::Isometry3d& T_world_camera);
+
+  Eigen::Isometry3d cameraPose() const override { return arm_.cameraPose(); }
+  bool reachable(const Eigen::Isometry3d& T_world_camera) const override {
+    return arm_.reachable(T_world_camera);
+  }
+  host::nbv::MoveResult moveTo(const Eigen::Isometry3d& T_world_camera) override {
+    return arm_.moveTo(T_world_camera);
+  }
   /// The collision checker's map becomes the coarse map, with the voxels the arm occupies
   /// where it stands freed (returns how many).
-  std::size_t updateObstacles(host::map::MapEngine& map) override;
+  std::size_t updateObstacles(host::map::MapEngine& map) override {
+    return arm_.updateObstacles(map);
+  }
+
+  /// Motion planning as MotionPlanner::setReproducible (fvp run --clock fixed): the same
+  /// moves on any machine and under any load.
+  void setReproducibleMotionPlanning(std::uint64_t seed) {
+    arm_.setReproducibleMotionPlanning(seed);
+  }
+  JointVector joints() const { return joint_state_.jointPositions(); }
+  PlannedArm& planned() { return arm_; }
+  const PlannedArm& planned() const { return arm_; }
 
  private:
-  ArmController& controller_;
-  const WorkspaceTree& workspace_;
+  SimulatedJointState joint_state_;
+  SimulatedTrajectoryExecutor executor_;
+  PlannedArm arm_;
 };
 
 }  // namespace fvp::robot::sim

@@ -1,0 +1,101 @@
+#include "fvp/robot/planned_arm.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "fvp/host/map/map_engine.h"
+
+namespace fvp::robot {
+
+host::nbv::MoveStatus toMoveStatus(MotionStatus status) {
+  using host::nbv::MoveStatus;
+  switch (status) {
+    case MotionStatus::kSuccess:
+      return MoveStatus::kSuccess;
+    case MotionStatus::kNoIk:
+      return MoveStatus::kNoIk;
+    case MotionStatus::kNoCollisionFreeIk:
+      return MoveStatus::kNoCollisionFreeIk;
+    case MotionStatus::kStartInvalid:
+      return MoveStatus::kStartInvalid;
+    case MotionStatus::kNoPath:
+      return MoveStatus::kNoPath;
+    case MotionStatus::kTimeout:
+      return MoveStatus::kTimeout;
+  }
+  return MoveStatus::kNoPath;
+}
+
+PlannedArm::PlannedArm(const ArmModel& arm, const Reachability& reachability,
+                       JointStateSource& joint_state, TrajectoryExecutor& executor,
+                       double goal_tolerance)
+    : arm_(arm),
+      reachability_(reachability),
+      joint_state_(joint_state),
+      executor_(executor),
+      goal_tolerance_(goal_tolerance),
+      checker_(arm),
+      planner_(checker_) {
+  if (!(goal_tolerance > 0.0) || !std::isfinite(goal_tolerance))
+    throw std::invalid_argument("PlannedArm: the goal tolerance must be positive and finite");
+}
+
+JointVector PlannedArm::joints() const {
+  const JointVector q = joint_state_.jointPositions();
+  // A source with no reading yet is a setup error: planning from NaN would mean nothing.
+  if (!q.allFinite())
+    throw std::runtime_error("PlannedArm: the joint state source gave a joint that is not finite");
+  return q;
+}
+
+Eigen::Isometry3d PlannedArm::cameraPose() const {
+  return arm_.T_world_camera(joints());
+}
+
+bool PlannedArm::reachable(const Eigen::Isometry3d& T_world_camera) const {
+  return reachability_.reachable(T_world_camera);
+}
+
+host::nbv::MoveResult PlannedArm::moveTo(const Eigen::Isometry3d& T_world_camera) {
+  return moveToPose(T_world_camera).result();
+}
+
+PlannedMove PlannedArm::moveToPose(const Eigen::Isometry3d& T_world_camera) {
+  PlannedMove move;
+  move.plan = planner_.moveToPose(joints(), T_world_camera);
+  if (observer_) observer_(move.plan);
+  move.status = toMoveStatus(move.plan.status);
+  if (!move.plan.ok()) return move;
+  move.execution = executor_.execute(move.plan.trajectory);
+  switch (move.execution.status) {
+    case ExecutionStatus::kRefused:
+      move.status = host::nbv::MoveStatus::kRefused;
+      return move;
+    case ExecutionStatus::kFailed:
+      move.status = host::nbv::MoveStatus::kExecutionFailed;
+      return move;
+    case ExecutionStatus::kDone:
+      break;
+  }
+  // "Done" is the driver's word; the joints say whether the arm is where it was sent.
+  const JointVector error = joints() - move.plan.trajectory.waypoints().back();
+  if (error.cwiseAbs().maxCoeff() > goal_tolerance_) {
+    move.status = host::nbv::MoveStatus::kExecutionFailed;
+    move.execution.status = ExecutionStatus::kFailed;
+    move.execution.detail = "the executor reported done, but a joint is " +
+                            std::to_string(error.cwiseAbs().maxCoeff()) +
+                            " (rad or m) from the trajectory's end";
+  }
+  return move;
+}
+
+std::size_t PlannedArm::setMap(const octomap::OcTree& coarse_map) {
+  return checker_.setMapFreeAt(coarse_map, joints());
+}
+
+std::size_t PlannedArm::updateObstacles(host::map::MapEngine& map) {
+  return setMap(map.coarseOcTree());
+}
+
+}  // namespace fvp::robot

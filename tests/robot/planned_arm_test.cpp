@@ -1,0 +1,235 @@
+// PlannedArm, the real-robot arm, over a fake driver: an executor that records every
+// trajectory and moves, refuses, fails halfway or claims a move it did not make; the joint
+// state it moves. Planning is reproducible (seeded, check budgets), so every case is
+// deterministic.
+#include <gtest/gtest.h>
+#include <octomap/OcTree.h>
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+#include "fvp/robot/ik_reachability.h"
+#include "fvp/robot/planned_arm.h"
+#include "fvp/robot/sim/simulated_arm.h"
+
+namespace fvp::robot {
+namespace {
+
+using host::nbv::MoveStatus;
+
+class FakeJointState : public JointStateSource {
+ public:
+  explicit FakeJointState(const JointVector& q) : q(q) {}
+  JointVector jointPositions() const override { return q; }
+  JointVector q;
+};
+
+class RecordingExecutor : public TrajectoryExecutor {
+ public:
+  enum class Mode { kMove, kRefuse, kFailHalfway, kClaimDone };
+  RecordingExecutor(FakeJointState& joints, Mode mode) : joints_(joints), mode(mode) {}
+
+  ExecutionResult execute(const Trajectory& trajectory) override {
+    trajectories.push_back(trajectory);
+    starts.push_back(joints_.q);
+    switch (mode) {
+      case Mode::kMove:
+        joints_.q = trajectory.position(trajectory.duration_s());
+        return {ExecutionStatus::kDone, {}};
+      case Mode::kRefuse:
+        return {ExecutionStatus::kRefused, "operator said no"};
+      case Mode::kFailHalfway:
+        joints_.q = trajectory.position(0.5 * trajectory.duration_s());
+        return {ExecutionStatus::kFailed, "protective stop"};
+      case Mode::kClaimDone:
+        return {ExecutionStatus::kDone, {}};
+    }
+    return {};
+  }
+
+  std::vector<Trajectory> trajectories;
+  std::vector<JointVector> starts;  ///< the joints when each trajectory was handed over
+
+ private:
+  FakeJointState& joints_;
+
+ public:
+  Mode mode;
+};
+
+/// The fake robot: model, reachability, joint state, executor and the arm over them.
+struct FakeRobot {
+  explicit FakeRobot(RecordingExecutor::Mode mode)
+      : model(ArmConfig{}),
+        reachability(model),
+        joints(model.homeConfiguration()),
+        executor(joints, mode),
+        arm(model, reachability, joints, executor) {
+    arm.setReproducibleMotionPlanning(17);
+  }
+  /// A pose the arm reaches from home: the camera of another configuration.
+  Eigen::Isometry3d reachableGoal() const {
+    JointVector target = model.homeConfiguration();
+    target[0] = -0.3;
+    target[1] = 0.4;
+    return model.T_world_camera(target);
+  }
+
+  ArmModel model;
+  IkReachability reachability;
+  FakeJointState joints;
+  RecordingExecutor executor;
+  PlannedArm arm;
+};
+
+double rotationError_rad(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  return Eigen::AngleAxisd(a.rotation().transpose() * b.rotation()).angle();
+}
+
+TEST(PlannedArm, AReachablePoseMovesAlongATrajectoryFromTheCurrentJointsToTheGoal) {
+  FakeRobot robot(RecordingExecutor::Mode::kMove);
+  const JointVector start = robot.joints.q;
+  const Eigen::Isometry3d goal = robot.reachableGoal();
+  ASSERT_TRUE(robot.arm.reachable(goal));
+  int plans_observed = 0;
+  robot.arm.setPlanningObserver([&](const MotionPlan&) { ++plans_observed; });
+
+  const host::nbv::MoveResult moved = robot.arm.moveTo(goal);
+  ASSERT_EQ(moved.status, MoveStatus::kSuccess);
+  EXPECT_GT(moved.planning_wall_s, 0.0);
+  EXPECT_EQ(plans_observed, 1);
+  ASSERT_EQ(robot.executor.trajectories.size(), 1u);
+  const Trajectory& trajectory = robot.executor.trajectories[0];
+  EXPECT_EQ(trajectory.waypoints().front(), start);
+  EXPECT_EQ(trajectory.position(0.0), start);
+  EXPECT_GT(trajectory.duration_s(), 0.0);
+  const Eigen::Isometry3d T_end = robot.model.T_world_camera(trajectory.waypoints().back());
+  EXPECT_LT((T_end.translation() - goal.translation()).norm(), 1e-6);
+  EXPECT_LT(rotationError_rad(T_end, goal), 1e-6);
+  // The arm reports where the joint state says it is: at the goal.
+  EXPECT_LT((robot.arm.cameraPose().translation() - goal.translation()).norm(), 1e-6);
+  EXPECT_LT(rotationError_rad(robot.arm.cameraPose(), goal), 1e-6);
+}
+
+TEST(PlannedArm, ARefusedTrajectoryIsRefusedAndTheArmStaysWhereItWas) {
+  FakeRobot robot(RecordingExecutor::Mode::kRefuse);
+  const JointVector start = robot.joints.q;
+  const Eigen::Isometry3d T_before = robot.arm.cameraPose();
+  const PlannedMove move = robot.arm.moveToPose(robot.reachableGoal());
+  EXPECT_EQ(move.status, MoveStatus::kRefused);
+  EXPECT_TRUE(move.plan.ok());
+  EXPECT_EQ(move.execution.detail, "operator said no");
+  EXPECT_EQ(robot.executor.trajectories.size(), 1u);
+  EXPECT_EQ(robot.arm.joints(), start);
+  EXPECT_TRUE(robot.arm.cameraPose().isApprox(T_before, 0.0));
+  EXPECT_EQ(move.result().status, MoveStatus::kRefused);
+  EXPECT_EQ(move.result().planning_wall_s, move.plan.planning_wall_s);
+}
+
+TEST(PlannedArm, AnExecutionThatStopsShortFails) {
+  FakeRobot robot(RecordingExecutor::Mode::kFailHalfway);
+  EXPECT_EQ(robot.arm.moveTo(robot.reachableGoal()).status, MoveStatus::kExecutionFailed);
+  // The next plan starts where the arm stopped.
+  robot.executor.mode = RecordingExecutor::Mode::kMove;
+  const JointVector stopped = robot.joints.q;
+  EXPECT_EQ(robot.arm.moveTo(robot.reachableGoal()).status, MoveStatus::kSuccess);
+  ASSERT_EQ(robot.executor.trajectories.size(), 2u);
+  EXPECT_EQ(robot.executor.trajectories[1].waypoints().front(), stopped);
+}
+
+TEST(PlannedArm, DoneWithoutReachingTheEndIsAnExecutionFailure) {
+  FakeRobot robot(RecordingExecutor::Mode::kClaimDone);
+  const PlannedMove move = robot.arm.moveToPose(robot.reachableGoal());
+  EXPECT_EQ(move.status, MoveStatus::kExecutionFailed);
+  EXPECT_EQ(move.execution.status, ExecutionStatus::kFailed);
+  EXPECT_NE(move.execution.detail.find("trajectory's end"), std::string::npos);
+}
+
+TEST(PlannedArm, PlanningFailuresAreStatusesAndNothingIsExecuted) {
+  FakeRobot robot(RecordingExecutor::Mode::kMove);
+  int plans_observed = 0;
+  robot.arm.setPlanningObserver([&](const MotionPlan&) { ++plans_observed; });
+  Eigen::Isometry3d far = robot.arm.cameraPose();
+  far.translation().y() += 3.0;
+  EXPECT_FALSE(robot.arm.reachable(far));
+  EXPECT_EQ(robot.arm.moveTo(far).status, MoveStatus::kNoIk);
+
+  // A wall of voxels through the home camera position, the arm away along the slider:
+  // solutions exist, all collide.
+  const Eigen::Isometry3d goal = robot.model.T_world_camera(robot.model.homeConfiguration());
+  robot.joints.q[0] = 0.4;
+  const JointVector start = robot.joints.q;
+  octomap::OcTree wall(0.02);
+  for (double x = -0.2; x <= 0.2; x += 0.01)
+    for (double z = -0.2; z <= 0.2; z += 0.01)
+      wall.updateNode(goal.translation().x() + x, goal.translation().y(),
+                      goal.translation().z() + z, true);
+  EXPECT_EQ(robot.arm.setMap(wall), 0u);  // the arm stands clear of the wall
+  EXPECT_EQ(robot.arm.moveTo(goal).status, MoveStatus::kNoCollisionFreeIk);
+  EXPECT_EQ(plans_observed, 2);
+  EXPECT_TRUE(robot.executor.trajectories.empty());
+  EXPECT_EQ(robot.arm.joints(), start);
+}
+
+TEST(PlannedArm, TheMapIsFreedWhereTheArmStands) {
+  FakeRobot robot(RecordingExecutor::Mode::kMove);
+  // Voxels at the camera itself (stereo noise on the lens): freed, so planning can start.
+  const Eigen::Vector3d p_camera = robot.arm.cameraPose().translation();
+  octomap::OcTree map(0.01);
+  map.updateNode(p_camera.x(), p_camera.y(), p_camera.z(), true);
+  EXPECT_GE(robot.arm.setMap(map), 1u);
+  EXPECT_TRUE(robot.arm.checker().isValid(robot.arm.joints()));
+  EXPECT_EQ(robot.arm.moveTo(robot.reachableGoal()).status, MoveStatus::kSuccess);
+}
+
+TEST(PlannedArm, MisconfigurationThrows) {
+  FakeRobot robot(RecordingExecutor::Mode::kMove);
+  EXPECT_THROW(PlannedArm(robot.model, robot.reachability, robot.joints, robot.executor, 0.0),
+               std::invalid_argument);
+  robot.joints.q[3] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(robot.arm.cameraPose(), std::runtime_error);
+  EXPECT_THROW(robot.arm.moveTo(robot.reachableGoal()), std::runtime_error);
+}
+
+TEST(PlannedArm, StatusNamesAndSampleTimes) {
+  EXPECT_STREQ(toString(ExecutionStatus::kRefused), "refused");
+  EXPECT_EQ(toMoveStatus(MotionStatus::kTimeout), MoveStatus::kTimeout);
+  const ArmModel model{ArmConfig{}};
+  JointVector end = model.homeConfiguration();
+  end[2] += 1.0;
+  const Trajectory trajectory({model.homeConfiguration(), end}, model.maxVelocity(),
+                              model.maxAcceleration());
+  const std::vector<double> t = sampleTimes_s(trajectory, 0.05);
+  ASSERT_GE(t.size(), 3u);
+  EXPECT_EQ(t.front(), 0.0);
+  EXPECT_EQ(t.back(), trajectory.duration_s());
+  for (std::size_t i = 1; i < t.size(); ++i) {
+    EXPECT_GT(t[i], t[i - 1]);
+    EXPECT_LE(t[i] - t[i - 1], 0.05 + 1e-12);
+  }
+  EXPECT_EQ(sampleTimes_s(Trajectory({end}, model.maxVelocity(), model.maxAcceleration()), 0.1),
+            std::vector<double>{0.0});
+  EXPECT_THROW(sampleTimes_s(trajectory, 0.0), std::invalid_argument);
+}
+
+TEST(SimulatedArm, ChargesPlanningThenMotionAndMovesTheJoints) {
+  const ArmModel model{ArmConfig{}};
+  const IkReachability reachability(model);
+  sim::SimClock clock(sim::SimClock::Mode::kFixed, 0.2, 0.1);
+  sim::SimulatedArm arm(model, reachability, clock, model.homeConfiguration());
+  arm.setReproducibleMotionPlanning(5);
+  JointVector target = model.homeConfiguration();
+  target[0] = 0.2;
+  target[4] = 0.5;
+  clock.beginIteration();
+  const PlannedMove move = arm.planned().moveToPose(model.T_world_camera(target));
+  ASSERT_EQ(move.status, MoveStatus::kSuccess);
+  EXPECT_TRUE(move.execution.done());
+  EXPECT_EQ(clock.now_s(), 0.1 + move.plan.trajectory.duration_s());
+  EXPECT_EQ(arm.joints(), move.plan.trajectory.waypoints().back());
+}
+
+}  // namespace
+}  // namespace fvp::robot
