@@ -7,7 +7,7 @@
 #include "commands.h"
 #include "fvp/accel/backend.h"
 #include "fvp/host/map/map_engine_registry.h"
-#include "fvp/host/session/capture_sizing.h"
+#include "fvp/host/report/capture_set_report.h"
 
 namespace fvp::apps {
 

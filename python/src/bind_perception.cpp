@@ -5,7 +5,7 @@
 #include "bindings.h"
 #include "conversions.h"
 #include "fvp/host/perception/perception_pipeline.h"
-#include "fvp/host/session/capture_sizing.h"
+#include "fvp/host/report/capture_set_report.h"
 
 namespace fvp::python {
 

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "fvp/host/core/gnuplot.h"
-#include "trial_parts.h"
+#include "trial_report.h"
 
 namespace fvp::trials {
 namespace {

@@ -31,7 +31,7 @@
 #include "fvp/host/planner/view_planner.h"
 #include "fvp/host/report/viewer_scene.h"
 #include "fvp/host/session/mapping_session.h"
-#include "fvp/host/session/session_report.h"
+#include "fvp/host/report/session_report.h"
 #include "fvp/robot/arm_model.h"
 #include "fvp/robot/sim/simulated_arm.h"
 #include "fvp/robot/sim/simulated_camera.h"

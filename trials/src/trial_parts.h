@@ -1,7 +1,8 @@
 // The parts of one simulated trial that change with the planner and the pipeline stages:
 // the per-view mapping session (perception -> maps -> TSDF), the viewpoint planner, the
-// views kept for sizing, the sizing and scoring against ground truth, and the files a
-// trial writes. trial.cpp holds the loop and the clock; this holds what the loop drives.
+// views kept for sizing, the sizing and scoring against ground truth, and a cluster's files
+// (report.md and the figures: trial_report.h). trial.cpp holds the loop and the clock; this
+// holds what the loop drives.
 #pragma once
 
 #include <Eigen/Core>
@@ -21,6 +22,7 @@
 #include "fvp/robot/sim/world.h"
 #include "fvp/robot/workspace_tree.h"
 #include "fvp/trials/trial.h"
+#include "trial_report.h"  // ExtraWriter; and for trial.cpp, the report's writers
 
 namespace fvp::accel {
 class Backend;
@@ -33,25 +35,6 @@ namespace fvp::trials {
 /// warn, without its "warning: " prefix.
 robot::WorkspaceTree loadWorkspaceTree(const robot::ArmModel& arm,
                                        const std::function<void(const std::string&)>& warn);
-
-/// Writes an extra (a map, a cloud, the report, the view images) after result.json: the
-/// caller's writer turns a failure into a warning naming `file`, so the result stands.
-using ExtraWriter =
-    std::function<void(const std::string& file, const std::function<void()>& write)>;
-
-/// A tree trial's files into out_dir, each atomically: result.json first, then the shared
-/// coarse map (coarse.bt, when a cluster was mapped), the camera path over the tree and
-/// report.md. The clusters' own files were written as each was finished (cluster_K/).
-void writeTreeOutputs(nlohmann::json& result, const robot::sim::World& world,
-                      const host::map::MapEngine* map,
-                      const std::vector<Eigen::Vector3d>& camera_path,
-                      const std::filesystem::path& out_dir,
-                      const std::function<void(const std::string&)>& warn,
-                      const ExtraWriter& extra);
-
-/// The view's left image as the small PNG of the report (views/NNN.png), encoded: kept in
-/// memory during the loop and written after result.json, so a full disk cannot cost the trial.
-std::string encodeViewImage(int index, const host::StereoFrame& frame);
 
 /// The ground truth of the world's fruitlets with these indices (a cluster's).
 std::vector<host::eval::GroundTruthFruitlet> groundTruthOf(const robot::sim::World& world,
@@ -96,32 +79,5 @@ class TrialParts {
   const host::nbv::ClusterWork& work_;
   host::sizing::SizingResult sizing_;  ///< of the last score
 };
-
-/// Which figures a trial's report shows (drawn into its directory beside report.md).
-struct ReportFigures {
-  bool path = false;   ///< path.png: the camera path
-  bool sizes = false;  ///< sizes.png: estimated against true sizes
-};
-/// report.md of a one-cluster trial, from its result.json (what writeOutputs writes).
-std::string trialReportMarkdown(const nlohmann::json& result, const ReportFigures& figures);
-/// report.md of a tree trial, from its result.json (what writeTreeOutputs writes).
-std::string treeReportMarkdown(const nlohmann::json& result, const ReportFigures& figures);
-
-/// A Cluster Region drawn on the camera-path figure.
-struct PathRegion {
-  Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
-  double radius_m = 0.0;
-};
-/// The gnuplot script of path.png: top and side views of the camera positions (path, in
-/// capture order, coloured by it), each view's viewing direction from result["view_log"]
-/// as a 3 cm arrow, the start and last views marked, the fruitlets and the regions.
-std::string cameraPathScript(const std::vector<Eigen::Vector3d>& fruitlets,
-                             const std::vector<Eigen::Vector3d>& path, const nlohmann::json& result,
-                             const std::vector<PathRegion>& regions,
-                             const std::string& region_title);
-/// sizes.png: our estimator's size against the true size of each matched fruitlet (one
-/// colour a cluster in a tree), with y = x and a +-0.5 mm band. False, and no file, when
-/// no fruitlet matched; std::runtime_error when gnuplot cannot draw it.
-bool plotSizeScatter(const nlohmann::json& result, const std::filesystem::path& png);
 
 }  // namespace fvp::trials

@@ -1,16 +1,19 @@
-// `fvp size`: the sizing pipeline on stored captures (docs/capture-format.md), from the
-// simulator or a real robot: every capture directory of a set, in name order, through the
-// per-view mapping session (perception, Cluster Region from the AprilTag, maps, TSDF), then
-// the sizing chain; scored against ground_truth.json when the set has one.
+// Sizing on stored captures (docs/capture-format.md), from the simulator or a real robot:
+// every capture directory of a set, in name order, through the per-view mapping session
+// (perception, Cluster Region from the AprilTag, maps, TSDF), then the sizing chain. No
+// scoring and no files here: `fvp size` scores against ground_truth.json and writes its
+// outputs in the reporting layer (fvp/host/report/capture_set_report.h).
 #pragma once
 
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "fvp/host/perception/perception_pipeline.h"
+#include "fvp/host/session/mapping_session.h"
 #include "fvp/host/sizing/fruitlet_sizer.h"
 
 namespace fvp::accel {
@@ -24,9 +27,11 @@ struct CaptureSizingOptions {
   PerceptionConfig perception;
   sizing::SizingEstimator estimator = sizing::SizingEstimator::kOurs;
   std::string engine = "grid";    ///< map engine (grid needs backend)
-  std::filesystem::path out_dir;  ///< fruitlets.json, surface.ply, mesh.ply, clusters.ply
-  /// Called with each warning as it happens; every warning is also in the result's
-  /// "warnings" list.
+  /// Where sizeCaptureSet writes fruitlets.json, surface.ply, mesh.ply, clusters.ply
+  /// (sizeCaptures writes nothing).
+  std::filesystem::path out_dir;
+  /// sizeCaptureSet calls it with each warning as it happens; every warning is also in the
+  /// result's "warnings" list.
   std::function<void(const std::string&)> on_warning;
 };
 
@@ -39,12 +44,28 @@ struct CaptureSizingOptions {
 std::vector<std::filesystem::path> listCaptures(const std::filesystem::path& dir,
                                                 std::vector<std::string>* skipped = nullptr);
 
-/// Sizes the set and writes fruitlets.json (centres, sizes, per-image sizes, estimator,
-/// counted events, warnings; with ground truth: the match, MAE and MAPE of both
-/// estimators), then surface.ply, mesh.ply and clusters.ply into options.out_dir, which is
-/// checked (and cleared of those files) before the first capture is read. Returns
-/// fruitlets.json's object.
-nlohmann::json sizeCaptureSet(const std::filesystem::path& captures_dir,
-                              const CaptureSizingOptions& options, accel::Backend* backend);
+/// What sizeCaptures made of a set: the session (its maps, TSDF and views, in capture order),
+/// its sizing, and what the captures said.
+struct SizedCaptureSet {
+  std::unique_ptr<MappingSession> session;
+  sizing::SizingResult sized;
+  /// Per capture: {"capture", "tag_detected", "fruitlet_pixels", "roi_points",
+  /// "dropped_disparities"}.
+  nlohmann::json captures = nlohmann::json::array();
+  /// The first ground_truth.json among the captures and its path; empty when none has one
+  /// (the session reads it, the reporting layer scores against it).
+  std::string ground_truth_json, ground_truth_source;
+};
+
+/// The views of these captures must fit in the memory there is: throws (checkMemoryFor)
+/// before any view is read.
+void checkCaptureSetFitsInMemory(const std::vector<std::filesystem::path>& dirs);
+
+/// Reads the captures in order through one mapping session (TSDF on) and sizes the fruitlets
+/// with options' estimator. Each warning (a capture without fruitlet pixels, no tag seen) goes
+/// to warn as it happens.
+SizedCaptureSet sizeCaptures(const std::vector<std::filesystem::path>& dirs,
+                             const CaptureSizingOptions& options, accel::Backend* backend,
+                             const std::function<void(const std::string&)>& warn);
 
 }  // namespace fvp::host

@@ -1,4 +1,4 @@
-#include "fvp/host/session/session_report.h"
+#include "fvp/host/report/session_report.h"
 
 #include <iomanip>
 #include <map>
