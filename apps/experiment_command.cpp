@@ -14,6 +14,7 @@
 #include "fvp/host/map/map_engine_registry.h"
 #include "fvp/trials/experiment.h"
 #include "fvp/trials/sensitivity_report.h"
+#include "trial_cli.h"
 
 namespace fvp::apps {
 
@@ -96,37 +97,7 @@ void addExperimentCommand(CLI::App& app) {
                   "GROUP=FACTOR: the world's pose, stereo, wind, segmentation, light or all errors "
                   "times FACTOR (a sweep point; written to OUT/world.yaml)")
       ->check(errorScaleText());
-  cmd->add_option("--budget-s", opt->experiment.trial.budget_s, "simulated budget per trial, s")
-      ->check(finiteNumber())
-      ->check(positiveNumber())
-      ->capture_default_str();
-  cmd->add_option("--backend", opt->experiment.trial.backend, "cpu | opencl | vulkan | auto")
-      ->capture_default_str();
-  cmd->add_option("--engine", opt->experiment.trial.engine,
-                  "map engine for every planner (default: each planner's own)")
-      ->check(CLI::IsMember(mapEngineNames()));
-  cmd->add_option(
-         "--stop", opt->experiment.trial.stop,
-         "budget: run the whole budget (the paper) | auto: stop once the cluster's sizes have "
-         "settled, the budget being the cap")
-      ->check(CLI::IsMember({"budget", "auto"}))
-      ->capture_default_str();
-  cmd->add_flag("--confirm-detections,!--no-confirm-detections",
-                opt->experiment.trial.confirm_detections,
-                "with --stop auto: look again at detections sized by a sphere fit to less than "
-                "a hemisphere before a cluster is done (the default; docs/nbv-loop.md)");
-  cmd->add_flag("--release-left-out,!--no-release-left-out", opt->experiment.trial.release_left_out,
-                "with --stop auto: a fruitlet the planner has looked for twice in vain no longer "
-                "holds the stop (the default; docs/nbv-loop.md)");
-  cmd->add_flag("--register-views", opt->experiment.trial.register_views,
-                "align each view to the earlier ones before fusing it (a counter-measure to "
-                "pose errors)");
-  cmd->add_flag("--size-history", opt->experiment.trial.record_size_history,
-                "size after every view and keep each sizing in result.json (size_history; always "
-                "with --stop auto; not charged to the clock)");
-  cmd->add_option("--clock", opt->experiment.trial.clock, "wall | fixed")
-      ->check(CLI::IsMember({"wall", "fixed"}))
-      ->capture_default_str();
+  addTrialOptions(cmd, opt->experiment.trial);
   cmd->add_option("--max-views", opt->max_views,
                   "stop each trial after this many views (0: no limit)")
       ->check(decimalUnsigned());

@@ -11,6 +11,7 @@
 #include "fvp/host/map/map_engine_registry.h"
 #include "fvp/host/planner/planner_registry.h"
 #include "fvp/trials/trial.h"
+#include "trial_cli.h"
 
 namespace fvp::apps {
 
@@ -37,39 +38,9 @@ void addRunCommand(CLI::App& app) {
   cmd->add_option("--arm", opt->arm,
                   "arm config YAML (default: built-in, robot/config/arm_default.yaml)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--budget-s", opt->trial.budget_s, "simulated time budget, seconds")
-      ->check(finiteNumber())
-      ->check(positiveNumber())
-      ->capture_default_str();
-  cmd->add_option("--backend", opt->trial.backend, "compute backend: cpu | opencl | vulkan | auto")
-      ->capture_default_str();
-  cmd->add_option("--engine", opt->trial.engine,
-                  "map engine: grid | octomap (default: grid for fvp, octomap for rvp)")
-      ->check(CLI::IsMember(mapEngineNames()));
   cmd->add_option("--max-views", opt->max_views, "stop after this many views (0: no limit)")
       ->check(decimalUnsigned());
-  cmd->add_option(
-         "--stop", opt->trial.stop,
-         "budget: run the whole budget (the paper) | auto: stop once the cluster's sizes have "
-         "settled, the budget being the cap")
-      ->check(CLI::IsMember({"budget", "auto"}))
-      ->capture_default_str();
-  cmd->add_flag("--confirm-detections,!--no-confirm-detections", opt->trial.confirm_detections,
-                "with --stop auto: look again at detections sized by a sphere fit to less than "
-                "a hemisphere before a cluster is done (the default; docs/nbv-loop.md)");
-  cmd->add_flag("--release-left-out,!--no-release-left-out", opt->trial.release_left_out,
-                "with --stop auto: a fruitlet the planner has looked for twice in vain no longer "
-                "holds the stop (the default; docs/nbv-loop.md)");
-  cmd->add_flag("--register-views", opt->trial.register_views,
-                "align each view to the earlier ones before fusing it (a counter-measure to "
-                "pose errors)");
-  cmd->add_flag("--size-history", opt->trial.record_size_history,
-                "size after every view and keep each sizing in result.json (size_history; always "
-                "with --stop auto; not charged to the clock)");
-  cmd->add_option("--clock", opt->trial.clock,
-                  "simulated clock: wall (charge measured compute time) | fixed (a constant)")
-      ->check(CLI::IsMember({"wall", "fixed"}))
-      ->capture_default_str();
+  addTrialOptions(cmd, opt->trial);
   cmd->add_option("--out", opt->out, "output directory")->required()->check(nonEmptyPath());
   FVP_ON_RUN(cmd, [opt] {
     trials::TrialOptions trial = opt->trial;

@@ -27,8 +27,12 @@ trials::TrialOptions trialOptions(const std::string& planner, std::uint64_t seed
   o.seed = seed;
   o.budget_s = budget_s;
   o.max_views = max_views;
-  o.clock = clock;
-  o.stop = stop;
+  o.clock = robot::sim::SimClock::modeFromString(clock);
+  const auto rule = host::nbv::stopRuleFromString(stop);
+  if (!rule)
+    throw std::invalid_argument("stop: expected one of " + host::nbv::stopRuleNames() + ", got '" +
+                                stop + "'");
+  o.stop = *rule;
   o.confirm_detections = confirm_detections;
   o.release_left_out = release_left_out;
   o.record_size_history = size_history;
@@ -68,7 +72,7 @@ void bindSim(py::module_& m) {
              o.seed = seed;
              o.world_config = world_config;
              o.arm_config = arm_config;
-             o.clock = clock;
+             o.clock = robot::sim::SimClock::modeFromString(clock);
              return std::make_unique<trials::SimulatedRobot>(o);
            }),
            py::kw_only(), py::arg("seed") = 1, py::arg("world_config") = "",

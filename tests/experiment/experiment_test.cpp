@@ -539,10 +539,11 @@ TEST(Experiment, ResumeWithAChangedSettingIsRefusedNamingIt) {
     change(r);
     return errorOf([&] { runExperiment(r, counting, nullptr); });
   };
-  const std::string clock = refused([](auto& r) { r.trial.clock = "fixed"; });
+  const std::string clock =
+      refused([](auto& r) { r.trial.clock = robot::sim::SimClock::Mode::kFixed; });
   EXPECT_NE(clock.find("clock wall, this run asks for fixed"), std::string::npos) << clock;
   EXPECT_NE(refused([](auto& r) { r.trial.max_views = 3; }).find("max_views"), std::string::npos);
-  const std::string stop = refused([](auto& r) { r.trial.stop = "auto"; });
+  const std::string stop = refused([](auto& r) { r.trial.stop = host::nbv::StopRule::kAuto; });
   EXPECT_NE(stop.find("stop budget, this run asks for auto"), std::string::npos) << stop;
   EXPECT_EQ(manifest["stop"], "budget");
   const std::string registration = refused([](auto& r) { r.trial.register_views = true; });
@@ -605,7 +606,7 @@ TEST(Experiment, MergeRefusesShardsWithDifferentSettingsNamingThem) {
   ExperimentOptions s0 = options(a, 2), s1 = options(b, 2);
   s0.shard_count = s1.shard_count = 2;
   s1.shard_index = 1;
-  s1.trial.clock = "fixed";
+  s1.trial.clock = robot::sim::SimClock::Mode::kFixed;
   runExperiment(s0, fakeTrial, nullptr);
   runExperiment(s1, fakeTrial, nullptr);
   const fs::path merged = freshDir("clock_merged");

@@ -35,7 +35,7 @@ class ViewerInBrowser : public ::testing::Test {
     TrialOptions o;
     o.seed = 7;
     o.backend = "cpu";
-    o.clock = "fixed";
+    o.clock = robot::sim::SimClock::Mode::kFixed;
     o.max_views = 4;
     o.out_dir = *dir_ / "trial";
     result_ = new nlohmann::json(runTrial(o));

@@ -38,7 +38,7 @@ class TreeTrial : public ::testing::Test {
     o.seed = kSeed;
     o.world_config = dir_ / "tree.yaml";
     o.backend = "cpu";
-    o.clock = "fixed";
+    o.clock = robot::sim::SimClock::Mode::kFixed;
     o.max_views = 2;
     return o;
   }

@@ -23,6 +23,7 @@
 #include "fvp/host/core/interrupt.h"
 #include "fvp/host/core/output_directory.h"
 #include "fvp/host/map/map_engine_registry.h"
+#include "fvp/host/planner/planner_registry.h"
 #include "fvp/robot/sim/world_config.h"
 #include "number_text.h"
 
@@ -101,14 +102,15 @@ ExperimentManifest manifestOf(const ExperimentOptions& o) {
   ExperimentManifest m;
   m.kind = "run";
   m.budget_s = o.trial.budget_s;
-  m.clock = o.trial.clock;
-  m.stop = o.trial.stop;
+  m.clock = robot::sim::SimClock::modeName(o.trial.clock);
+  m.stop = host::nbv::toString(o.trial.stop);
   m.max_views = o.trial.max_views.value_or(0);
   m.register_views = o.trial.register_views;
   // Switches of the automatic stop: nothing under the budget stop, recorded as off there so
   // that budget experiments from before they existed still resume and merge.
-  m.confirm_detections = o.trial.stop == "auto" && o.trial.confirm_detections;
-  m.release_left_out = o.trial.stop == "auto" && o.trial.release_left_out;
+  const bool automatic = o.trial.stop == host::nbv::StopRule::kAuto;
+  m.confirm_detections = automatic && o.trial.confirm_detections;
+  m.release_left_out = automatic && o.trial.release_left_out;
   m.error_scale = o.error_scale;
   m.world_config = stampOf(o.trial.world_config, "world config");
   m.planner_config = stampOf(o.trial.planner_config, "planner config");
@@ -154,12 +156,6 @@ void checkOptions(const ExperimentOptions& o) {
     throw std::invalid_argument(
         "experiment: max_views must be at least 1 when set (unset: no "
         "limit; --max-views 0)");
-  if (o.trial.clock != "wall" && o.trial.clock != "fixed")
-    throw std::invalid_argument("experiment: --clock must be wall or fixed, not '" + o.trial.clock +
-                                "'");
-  if (o.trial.stop != "budget" && o.trial.stop != "auto")
-    throw std::invalid_argument("experiment: --stop must be budget or auto, not '" + o.trial.stop +
-                                "'");
   if (!o.trial.engine.empty() && !host::map::MapEngineRegistry::instance().contains(o.trial.engine))
     throw std::invalid_argument("experiment: --engine must be one of " +
                                 host::map::MapEngineRegistry::instance().knownNames() + ", not '" +
@@ -246,45 +242,56 @@ nlohmann::json pool(const std::vector<const nlohmann::json*>& trials, const char
           {"wall_s_per_trial", opt(n > 0, n ? wall / double(n) : 0.0)}};
 }
 
-/// The gnuplot script of Figure 7: ground truth, RVP and FVP sizes (matched fruitlets), box
-/// plots with means.
+/// The gnuplot script of Figure 7: ground truth and each planner's sizes (matched fruitlets;
+/// planners in registry order, named by their labels), box plots with means. The ground truth
+/// is the first planner's trials' (every planner sees the same worlds).
 std::string sizesFigureScript(const std::vector<nlohmann::json>& trials) {
+  const auto& registry = host::planner::PlannerRegistry::instance();
+  std::vector<std::string> columns = {"GT"};
   std::map<std::string, std::vector<double>> sizes;
-  for (const auto& t : trials) {
-    const std::string planner = t.at("planner").get<std::string>();
-    if (trialRowKey(t) != planner) continue;  // engine ablations are not in the figure
-    for (const auto& f : t.at("fruitlets")) {
-      if (planner == "fvp") sizes["GT"].push_back(f.at("gt_size_mm").get<double>());
-      if (f.at("matched").get<bool>())
-        sizes[planner == "fvp" ? "FVP" : "RVP"].push_back(f.at("est_size_mm").get<double>());
+  std::string truth_from;
+  for (const std::string& planner : registry.names())
+    for (const auto& t : trials) {
+      if (t.at("planner").get<std::string>() != planner) continue;
+      if (trialRowKey(t) != planner) continue;  // engine ablations are not in the figure
+      const std::string& label = registry.at(planner).label;
+      if (columns.back() != label) columns.push_back(label);
+      if (truth_from.empty()) truth_from = planner;
+      for (const auto& f : t.at("fruitlets")) {
+        if (planner == truth_from) sizes["GT"].push_back(f.at("gt_size_mm").get<double>());
+        if (f.at("matched").get<bool>()) sizes[label].push_back(f.at("est_size_mm").get<double>());
+      }
     }
-  }
   if (sizes["GT"].empty())
     for (const auto& t : trials)
       for (const auto& f : t.at("fruitlets"))
         sizes["GT"].push_back(f.at("gt_size_mm").get<double>());
+  static const char* const colours[] = {"#7f7f7f", "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728"};
   std::ostringstream gp;
   gp << "set terminal pngcairo size 900,600 font 'DejaVu Sans,12'\n"
      << "set title 'Fruitlet sizes: ground truth and matched estimates (x: mean, line: median)'\n"
      << "set ylabel 'size (mm)'\nset style fill solid 0.35 border -1\nset style boxplot "
-        "nooutliers\nset style data boxplot\nset boxwidth 0.5\nset grid ytics\n"
-     << "set xtics ('GT' 1, 'RVP' 2, 'FVP' 3)\nset xrange [0.4:3.6]\nunset key\n";
-  const char* order[] = {"GT", "RVP", "FVP"};
-  for (int i = 0; i < 3; ++i) {
+        "nooutliers\nset style data boxplot\nset boxwidth 0.5\nset grid ytics\nset xtics (";
+  for (std::size_t i = 0; i < columns.size(); ++i)
+    gp << (i ? ", " : "") << host::gnuplotQuoted(columns[i]) << " " << i + 1;
+  gp << ")\nset xrange [0.4:" << columns.size() + 0.6 << "]\nunset key\n";
+  for (std::size_t i = 0; i < columns.size(); ++i) {
     gp << "$d" << i << " << EOD\n";
-    for (double v : sizes[order[i]]) gp << v << "\n";
-    if (sizes[order[i]].empty()) gp << "NaN\n";
+    for (double v : sizes[columns[i]]) gp << v << "\n";
+    if (sizes[columns[i]].empty()) gp << "NaN\n";
     gp << "EOD\n";
   }
   gp << "$means << EOD\n";
-  for (int i = 0; i < 3; ++i) {
+  for (std::size_t i = 0; i < columns.size(); ++i) {
     double sum = 0;
-    for (double v : sizes[order[i]]) sum += v;
-    gp << i + 1 << " " << (sizes[order[i]].empty() ? NAN : sum / sizes[order[i]].size()) << "\n";
+    for (double v : sizes[columns[i]]) sum += v;
+    gp << i + 1 << " " << (sizes[columns[i]].empty() ? NAN : sum / sizes[columns[i]].size())
+       << "\n";
   }
-  gp << "EOD\nplot $d0 using (1):1 lc rgb '#7f7f7f', $d1 using (2):1 lc rgb '#ff7f0e', "
-        "$d2 using (3):1 lc rgb '#1f77b4', $means using 1:2 with points pt 2 ps 2.5 lw 2 lc rgb "
-        "'black'\n";
+  gp << "EOD\nplot ";
+  for (std::size_t i = 0; i < columns.size(); ++i)
+    gp << "$d" << i << " using (" << i + 1 << "):1 lc rgb '" << colours[i % 5] << "', ";
+  gp << "$means using 1:2 with points pt 2 ps 2.5 lw 2 lc rgb 'black'\n";
   return gp.str();
 }
 

@@ -11,6 +11,7 @@
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/host/core/gnuplot.h"
 #include "fvp/host/core/output_directory.h"
+#include "fvp/host/planner/planner_registry.h"
 #include "fvp/trials/experiment.h"
 #include "fvp/trials/experiment_directory.h"
 #include "number_text.h"
@@ -20,7 +21,8 @@ namespace fs = std::filesystem;
 namespace {
 
 std::string seriesName(const SensitivityPoint& p) {
-  std::string name = p.planner == "fvp" ? "FVP" : p.planner == "rvp" ? "RVP" : p.planner;
+  const auto& planners = host::planner::PlannerRegistry::instance();
+  std::string name = planners.contains(p.planner) ? planners.at(p.planner).label : p.planner;
   return name + (p.registered ? " + registration" : "");
 }
 

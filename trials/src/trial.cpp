@@ -29,9 +29,9 @@
 #include "fvp/host/nbv/sizing_guidance.h"
 #include "fvp/host/planner/planner_registry.h"
 #include "fvp/host/planner/view_planner.h"
+#include "fvp/host/report/session_report.h"
 #include "fvp/host/report/viewer_scene.h"
 #include "fvp/host/session/mapping_session.h"
-#include "fvp/host/report/session_report.h"
 #include "fvp/robot/arm_model.h"
 #include "fvp/robot/sim/simulated_arm.h"
 #include "fvp/robot/sim/simulated_camera.h"
@@ -94,16 +94,10 @@ void validate(const TrialOptions& o) {
                                 ", got '" + o.planner + "'");
   if (!(o.budget_s > 0.0) || !std::isfinite(o.budget_s))
     throw std::invalid_argument("trial option 'budget_s': expected a positive number of seconds");
-  if (o.clock != "wall" && o.clock != "fixed")
-    throw std::invalid_argument("trial option 'clock': expected wall or fixed, got '" + o.clock +
-                                "'");
   if (!o.engine.empty() && !host::map::MapEngineRegistry::instance().contains(o.engine))
     throw std::invalid_argument("trial option 'engine': expected one of " +
                                 host::map::MapEngineRegistry::instance().knownNames() + ", got '" +
                                 o.engine + "'");
-  if (o.stop != "budget" && o.stop != "auto")
-    throw std::invalid_argument("trial option 'stop': expected budget or auto, got '" + o.stop +
-                                "'");
   if (o.max_views && *o.max_views < 1)
     throw std::invalid_argument("trial option 'max_views': expected at least 1");
 }
@@ -368,7 +362,7 @@ host::nbv::NbvSetupOptions setupOptions(const TrialOptions& o) {
   s.backend = o.backend;
   s.planner_seed = o.seed;  // cluster k: seed + k (one cluster: the trial's seed)
   s.register_views = o.register_views;
-  s.stop.rule = *host::nbv::stopRuleFromString(o.stop);
+  s.stop.rule = o.stop;
   s.stop.budget_s = o.budget_s;
   s.stop.max_views = o.max_views;
   s.stop.record_size_history = o.record_size_history;
@@ -524,17 +518,19 @@ ClusterOutcome Trial::Impl::scored(host::nbv::ClusterRun run, TrialParts& cluste
   out.sizing_during_loop_s = run.sizing_during_loop_s;
   out.sizing = cluster_parts.score(std::move(run.sizing), setup->options().sizing.estimator, *world,
                                    cluster.fruitlet_indices);
-  if (options.stop == "auto" || options.record_size_history)
+  const bool automatic = options.stop == host::nbv::StopRule::kAuto;
+  if (automatic || options.record_size_history)
     out.size_history =
         sizeHistoryJson(run.size_history, *world, cluster.fruitlet_indices, run.start_s);
-  if (options.stop == "auto")
+  if (automatic)
     out.guidance_events = {{"sizing_views", run.sizing_views},
                            {"sizing_targets_dropped", run.sizing_targets_dropped}};
   return out;
 }
 
 nlohmann::json Trial::Impl::stopJson() const {
-  if (options.stop != "auto") return {{"rule", "budget"}};
+  if (options.stop != host::nbv::StopRule::kAuto)
+    return {{"rule", host::nbv::toString(options.stop)}};
   const host::nbv::ClusterCompletionConfig& c = setup->options().stop.completion;
   return {{"rule", "auto"},
           {"stable_views", c.stable_views},

@@ -44,9 +44,9 @@ TrialParts::TrialParts(const TrialOptions& options, const std::string& engine,
 
 nlohmann::json TrialParts::configJson(const host::sizing::SizingConfig& sizing_config) const {
   return {{"engine", engine_},
-          {"clock", options_.clock},
+          {"clock", robot::sim::SimClock::modeName(options_.clock)},
           {"fine_map_extent", host::map::toString(work_.map_config.fine_map_extent)},
-          {"stop", options_.stop},
+          {"stop", host::nbv::toString(options_.stop)},
           {"sizing",
            {{"estimator", host::sizing::toString(sizing_config.estimator)},
             {"min_support_area_fraction", sizing_config.min_support_area_fraction},

@@ -6,9 +6,9 @@
 #include <stdexcept>
 
 #include "fvp/host/core/output_directory.h"
+#include "fvp/host/report/session_report.h"
 #include "fvp/host/report/view_overlay.h"
 #include "fvp/host/report/viewer_page.h"
-#include "fvp/host/report/session_report.h"
 
 namespace fvp::trials {
 

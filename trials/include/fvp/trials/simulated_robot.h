@@ -17,11 +17,11 @@
 #include "fvp/host/nbv/loop_clock.h"
 #include "fvp/host/nbv/nbv_setup.h"
 #include "fvp/robot/arm_config.h"
+#include "fvp/robot/sim/sim_clock.h"
 
 namespace fvp::robot::sim {
 class World;
 class SimulatedCamera;
-class SimClock;
 }  // namespace fvp::robot::sim
 
 namespace fvp::trials {
@@ -32,7 +32,7 @@ struct SimulatedRobotOptions {
   std::filesystem::path arm_config;    ///< empty: the built-in arm
   /// "wall": compute charged as measured; "fixed": as constants, and motion planning
   /// reproducible (the same run on any machine).
-  std::string clock = "wall";
+  robot::sim::SimClock::Mode clock = robot::sim::SimClock::Mode::kWall;
   /// Each warning (a rebuilt workspace cache), as it happens.
   std::function<void(const std::string&)> on_warning;
 };

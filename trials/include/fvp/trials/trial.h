@@ -13,6 +13,9 @@
 #include <optional>
 #include <string>
 
+#include "fvp/host/nbv/nbv_setup.h"
+#include "fvp/robot/sim/sim_clock.h"
+
 namespace fvp::host::nbv {
 class Arm;
 class Camera;
@@ -38,10 +41,11 @@ struct TrialOptions {
   std::string backend = "auto";      ///< cpu | opencl | vulkan | auto
   std::string engine;                ///< grid | octomap; empty: the planner's default
   std::optional<int> max_views;      ///< stop after this many views (tests)
-  std::string clock = "wall";        ///< wall | fixed
+  /// wall: compute charged as measured; fixed: as constants (runs repeat exactly).
+  robot::sim::SimClock::Mode clock = robot::sim::SimClock::Mode::kWall;
   /// budget: the paper's protocol (budget_s, max_views); auto: also stop once the cluster's
   /// sizes have settled (host/nbv/cluster_completion.h), budget_s being the cap.
-  std::string stop = "budget";
+  host::nbv::StopRule stop = host::nbv::StopRule::kBudget;
   /// Size the cluster after every view and keep each sizing, scored, in result.json's
   /// size_history (always with stop auto). Under stop budget it is an observation for the
   /// accuracy-against-time figure, not part of the loop: not charged to the clock.

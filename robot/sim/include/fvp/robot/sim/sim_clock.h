@@ -34,6 +34,8 @@ class SimClock {
            double fixed_stage_time_s = kDefaultFixedStageTimeS);
   /// "wall" or "fixed" (fvp run --clock); throws std::invalid_argument otherwise.
   static Mode modeFromString(const std::string& mode);
+  /// "wall" or "fixed".
+  static const char* modeName(Mode mode);
 
   /// Opens the next iteration's record (charges before the first call open one).
   void beginIteration();
