@@ -42,9 +42,11 @@ inline void addTrialOptions(CLI::App* cmd, trials::TrialOptions& trial) {
   cmd->add_flag("--release-left-out,!--no-release-left-out", trial.release_left_out,
                 "with --stop auto: a fruitlet the planner has looked for twice in vain no longer "
                 "holds the stop (the default; docs/nbv-loop.md)");
-  cmd->add_flag("--register-views", trial.register_views,
-                "align each view to the earlier ones before fusing it (a counter-measure to "
-                "pose errors)");
+  cmd->add_flag_function(
+      "--register-views,!--no-register-views",
+      [&trial](std::int64_t count) { trial.register_views = count > 0; },
+      "align each view to the earlier ones before fusing it (a counter-measure to pose errors; "
+      "default: as the world config's run_register_views says, on for the field preset)");
   cmd->add_flag("--size-history", trial.record_size_history,
                 "size after every view and keep each sizing in result.json (size_history; always "
                 "with --stop auto; not charged to the clock)");

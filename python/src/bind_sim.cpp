@@ -17,9 +17,9 @@ namespace {
 trials::TrialOptions trialOptions(const std::string& planner, std::uint64_t seed, double budget_s,
                                   const std::optional<int>& max_views, const std::string& clock,
                                   const std::string& stop, bool confirm_detections,
-                                  bool release_left_out, bool size_history, bool register_views,
-                                  const std::string& backend, const std::string& engine,
-                                  const std::string& world_config,
+                                  bool release_left_out, bool size_history,
+                                  std::optional<bool> register_views, const std::string& backend,
+                                  const std::string& engine, const std::string& world_config,
                                   const std::string& planner_config, const std::string& arm_config,
                                   const std::string& out_dir) {
   trials::TrialOptions o;
@@ -53,7 +53,7 @@ trials::TrialOptions trialOptions(const std::string& planner, std::uint64_t seed
       py::arg("planner") = "fvp", py::arg("seed") = 1, py::arg("budget_s") = 180.0,             \
       py::arg("max_views") = py::none(), py::arg("clock") = "wall", py::arg("stop") = "budget", \
       py::arg("confirm_detections") = true, py::arg("release_left_out") = true,                 \
-      py::arg("size_history") = false, py::arg("register_views") = false,                       \
+      py::arg("size_history") = false, py::arg("register_views") = py::none(),                  \
       py::arg("backend") = "auto", py::arg("engine") = "", py::arg("world_config") = "",        \
       py::arg("planner_config") = "", py::arg("arm_config") = "", py::arg("out_dir") = ""
 
@@ -96,10 +96,10 @@ void bindSim(py::module_& m) {
       .def(py::init([](const std::string& planner, std::uint64_t seed, double budget_s,
                        std::optional<int> max_views, const std::string& clock,
                        const std::string& stop, bool confirm_detections, bool release_left_out,
-                       bool size_history, bool register_views, const std::string& backend,
-                       const std::string& engine, const std::string& world_config,
-                       const std::string& planner_config, const std::string& arm_config,
-                       const std::string& out_dir) {
+                       bool size_history, std::optional<bool> register_views,
+                       const std::string& backend, const std::string& engine,
+                       const std::string& world_config, const std::string& planner_config,
+                       const std::string& arm_config, const std::string& out_dir) {
              return std::make_unique<trials::Trial>(
                  trialOptions(planner, seed, budget_s, max_views, clock, stop, confirm_detections,
                               release_left_out, size_history, register_views, backend, engine,
@@ -132,10 +132,10 @@ void bindSim(py::module_& m) {
       "run_trial",
       [](const std::string& planner, std::uint64_t seed, double budget_s,
          std::optional<int> max_views, const std::string& clock, const std::string& stop,
-         bool confirm_detections, bool release_left_out, bool size_history, bool register_views,
-         const std::string& backend, const std::string& engine, const std::string& world_config,
-         const std::string& planner_config, const std::string& arm_config,
-         const std::string& out_dir) {
+         bool confirm_detections, bool release_left_out, bool size_history,
+         std::optional<bool> register_views, const std::string& backend, const std::string& engine,
+         const std::string& world_config, const std::string& planner_config,
+         const std::string& arm_config, const std::string& out_dir) {
         const trials::TrialOptions o =
             trialOptions(planner, seed, budget_s, max_views, clock, stop, confirm_detections,
                          release_left_out, size_history, register_views, backend, engine,

@@ -85,3 +85,16 @@ def test_automatic_stop_switches_default_on():
     result = fvp.sim.Trial(seed=2, clock="fixed", stop="auto", max_views=1).run()
     assert result["stop"]["confirm_detections"] is True
     assert result["stop"]["release_left_out"] is True
+
+
+def test_the_field_preset_runs_with_view_registration_unless_told_otherwise():
+    # The preset carries the run setting it is meant to be run with (run_register_views: 1);
+    # an explicit keyword (--register-views / --no-register-views) decides over it.
+    import os
+    field = os.path.join(os.environ.get("FVP_SOURCE_DIR", "."),
+                         "robot/sim/config/world_field.yaml")
+    quick = dict(max_views=1, clock="fixed", backend="cpu")
+    assert fvp.sim.run_trial(world_config=field, **quick)["register_views"] is True
+    assert fvp.sim.run_trial(world_config=field, register_views=False,
+                             **quick)["register_views"] is False
+    assert fvp.sim.run_trial(**quick)["register_views"] is False

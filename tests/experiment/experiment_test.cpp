@@ -512,7 +512,7 @@ TEST(Experiment, ShardTextIsParsedStrictly) {
 TEST(Experiment, ResumeWithAChangedSettingIsRefusedNamingIt) {
   const fs::path out = freshDir("changed_setting");
   const fs::path world = freshDir("changed_setting_world.yaml");
-  writeText(world, "fruitlets: 5\n");
+  writeText(world, "max_fruitlets: 5\n");
   ExperimentOptions o = options(out, 2);
   o.trial.world_config = world;
   runExperiment(o, fakeTrial, nullptr);
@@ -520,7 +520,7 @@ TEST(Experiment, ResumeWithAChangedSettingIsRefusedNamingIt) {
   EXPECT_EQ(manifest["kind"], "run");
   EXPECT_EQ(manifest["budget_s"], 180.0);
   EXPECT_EQ(manifest["world_config"]["path"], fs::absolute(world).string());
-  EXPECT_EQ(manifest["world_config"]["fnv1a64"], fnv1a64Hex("fruitlets: 5\n"));
+  EXPECT_EQ(manifest["world_config"]["fnv1a64"], fnv1a64Hex("max_fruitlets: 5\n"));
   EXPECT_EQ(manifest["planner_config"]["path"], "");
   ExperimentOptions resume = o;
   resume.resume = true;
@@ -573,12 +573,12 @@ TEST(Experiment, ResumeWithAChangedSettingIsRefusedNamingIt) {
             }).find("arm_config built-in defaults"),
             std::string::npos);
   // An edited config file under the same path is caught by its hash.
-  writeText(world, "fruitlets: 6\n");
+  writeText(world, "max_fruitlets: 6\n");
   EXPECT_NE(refused([](auto&) {})
                 .find("world_config " + fs::absolute(world).string() + " (fnv1a64 " +
-                      fnv1a64Hex("fruitlets: 5\n") + ")"),
+                      fnv1a64Hex("max_fruitlets: 5\n") + ")"),
             std::string::npos);
-  writeText(world, "fruitlets: 5\n");
+  writeText(world, "max_fruitlets: 5\n");
   EXPECT_EQ(refused([](auto&) {}), "");  // the same settings resume
   EXPECT_EQ(calls, 0);
 }

@@ -105,7 +105,7 @@ ExperimentManifest manifestOf(const ExperimentOptions& o) {
   m.clock = robot::sim::SimClock::modeName(o.trial.clock);
   m.stop = host::nbv::toString(o.trial.stop);
   m.max_views = o.trial.max_views.value_or(0);
-  m.register_views = o.trial.register_views;
+  m.register_views = registerViewsOf(o.trial);
   // Switches of the automatic stop: nothing under the budget stop, recorded as off there so
   // that budget experiments from before they existed still resume and merge.
   const bool automatic = o.trial.stop == host::nbv::StopRule::kAuto;

@@ -57,12 +57,11 @@ struct PlanRun {
 // the camera where the last view was taken. The robot's own planner makes the move, so every
 // candidate counts as reachable and the best one is chosen.
 PlanRun planFromCaptures(const PlanOnceOptions& o, const std::vector<std::filesystem::path>& dirs,
-                         const host::PerceptionConfig& perception, const std::string& engine,
-                         const host::map::MapConfig& map_config, accel::Backend* backend,
-                         host::planner::ViewPlanner& planner) {
+                         const host::PerceptionConfig& perception, host::nbv::ClusterWork& work) {
   PlanRun run;
   const auto t_map = std::chrono::steady_clock::now();
-  host::MappingSession session(perception, engine, map_config, backend);
+  host::MappingSession& session = *work.session;
+  host::planner::ViewPlanner& planner = *work.planner;
   Eigen::Isometry3d T_now = Eigen::Isometry3d::Identity();
   for (const auto& dir : dirs) {
     const host::Capture capture = host::readCapture(dir);
@@ -182,14 +181,22 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
   std::vector<std::filesystem::path> capture_dirs;
   if (from_captures) capture_dirs = host::listCaptures(o.captures_dir);
 
-  const std::unique_ptr<accel::Backend> backend = host::map::createBackendFor(engine, o.backend);
-  const std::unique_ptr<host::planner::ViewPlanner> planner =
-      host::planner::createPlanner(o.planner, o.planner_config, o.seed, backend.get());
-  const host::map::MapConfig map_config = host::planner::plannerMapConfig(o.planner, engine);
+  // The library's setup: the backend, the planner (seeded as a trial's) and, from captures,
+  // the session the views are mapped into.
+  host::nbv::NbvSetupOptions setup_options;
+  setup_options.planner = o.planner;
+  setup_options.planner_config = o.planner_config;
+  setup_options.engine = engine;
+  setup_options.backend = o.backend;
+  setup_options.planner_seed = o.seed;
+  setup_options.perception = perception;
+  host::nbv::NbvSetup setup(setup_options);
+  accel::Backend* backend = setup.backend();
+  const std::unique_ptr<host::nbv::ClusterWork> work = setup.makeWork({});
+  const host::map::MapConfig& map_config = work->map_config;
   const PlanRun run = from_captures
-                          ? planFromCaptures(o, capture_dirs, perception, engine, map_config,
-                                             backend.get(), *planner)
-                          : planInSimulation(o, engine, map_config, backend.get(), *planner);
+                          ? planFromCaptures(o, capture_dirs, perception, *work)
+                          : planInSimulation(o, engine, map_config, backend, *work->planner);
   const host::planner::PlanStep& step = run.step;
 
   std::vector<Eigen::Vector3f> positions;
@@ -201,7 +208,7 @@ nlohmann::json planOnce(const PlanOnceOptions& o) {
       {"chosen", step.chosen ? nlohmann::json(*step.chosen) : nlohmann::json()},
       {"candidates", candidates},
       {"timings_s", timings},
-      {"config", nlohmann::json::parse(planner->configJson())},
+      {"config", nlohmann::json::parse(work->planner->configJson())},
       {"planner", o.planner},
       {"seed", o.seed},
       {"views", from_captures ? int(capture_dirs.size()) : o.views},

@@ -361,7 +361,7 @@ host::nbv::NbvSetupOptions setupOptions(const TrialOptions& o) {
   s.engine = o.engine;
   s.backend = o.backend;
   s.planner_seed = o.seed;  // cluster k: seed + k (one cluster: the trial's seed)
-  s.register_views = o.register_views;
+  s.register_views = o.register_views.value_or(false);
   s.stop.rule = o.stop;
   s.stop.budget_s = o.budget_s;
   s.stop.max_views = o.max_views;
@@ -378,6 +378,7 @@ struct Trial::Impl {
 
   explicit Impl(TrialOptions opts) : options(std::move(opts)) {
     validate(options);
+    options.register_views = registerViewsOf(options);
     if (!options.out_dir.empty()) {
       host::prepareOutputDirectory(options.out_dir, "trial output directory");
       lock.emplace(options.out_dir, "trial output directory");
@@ -547,7 +548,7 @@ nlohmann::json Trial::Impl::stopJson() const {
 void Trial::Impl::describeRun(nlohmann::json& result, const TrialLog& log,
                               const std::vector<Eigen::Vector3d>& camera_path) const {
   result["clock"] = nlohmann::json::parse(robot->clock().toJson());
-  result["register_views"] = options.register_views;
+  result["register_views"] = *options.register_views;
   result["view_log"] = log.views();
   result["plan_log"] = log.plans();
   nlohmann::json path = nlohmann::json::array();
@@ -591,7 +592,7 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
   for (auto& [key, value] : outcome.sizing.items()) result[key] = value;
   result["events"] = eventsJson(run.events);
   result["events"].update(outcome.guidance_events);
-  if (options.register_views)
+  if (*options.register_views)
     result["anchor_offset"] = anchorOffsetJson(parts.session(), log.trueAnchorShift());
   result["wall_breakdown_s"] = {{"rendering", camera->totalRenderSeconds()},
                                 {"perception", run.wall_s.perception},
@@ -713,7 +714,7 @@ void Trial::Impl::recordCluster(const host::nbv::ClusterVisit& visit, TrialParts
                                 nlohmann::json& entry, TourRecord& tour) {
   const std::size_t k = visit.index;
   entry["approaches_without_tag"] = visit.run->approaches_without_tag;
-  if (options.register_views)
+  if (*options.register_views)
     entry["anchor_offset"] = anchorOffsetJson(cluster_parts.session(), log.trueAnchorShift());
   entry["status"] = host::nbv::toString(visit.status);
   ++tour.cluster_status[entry["status"].get<std::string>()];
@@ -860,6 +861,14 @@ nlohmann::json Trial::run() {
 
 nlohmann::json Trial::run(host::nbv::Camera& camera, host::nbv::Arm& arm) {
   return impl_->run(camera, arm);
+}
+
+bool registerViewsOf(const TrialOptions& options) {
+  if (options.register_views) return *options.register_views;
+  const WorldConfig world = options.world_config.empty()
+                                ? WorldConfig{}
+                                : WorldConfig::fromYamlFile(options.world_config);
+  return world.run_register_views != 0;
 }
 
 nlohmann::json runTrial(const TrialOptions& options) {

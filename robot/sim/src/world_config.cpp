@@ -85,6 +85,7 @@ const std::vector<KeySpec>& keySpecs() {
       {"segmentation_false_blobs", &WorldConfig::segmentation_false_blobs, 0.0, 20.0},
       // Ten times the flash saturates every lit surface: no camera would be exposed so.
       {"sun_strength", &WorldConfig::sun_strength, 0.0, 10.0},
+      {"run_register_views", &WorldConfig::run_register_views, 0, 1},
   };
   return specs;
 }

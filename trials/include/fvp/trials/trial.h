@@ -53,7 +53,8 @@ struct TrialOptions {
   /// Align each view to the earlier ones before fusing it (MappingSession::
   /// enableViewRegistration; docs/sizing.md "Registering views"): the counter-measure to
   /// pose errors. Off: the paper's fusion at the told poses.
-  bool register_views = false;
+  /// none: as the world config says (run_register_views; the field preset: on).
+  std::optional<bool> register_views;
   /// With stop auto: look again at unconfirmed detections (dropped by the hemisphere rule
   /// alone) before a cluster is done (host::nbv::ClusterCompletionConfig::confirm_detections).
   bool confirm_detections = true;
@@ -105,6 +106,10 @@ class Trial {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// Whether the trial registers views: the option when set, else the world config's
+/// run_register_views (reads the world config; throws for a bad one).
+bool registerViewsOf(const TrialOptions& options);
 
 /// A short, readable summary of a result.json object: sizes against ground truth, views,
 /// simulated and wall time (what `fvp run` and scripts/demo print).

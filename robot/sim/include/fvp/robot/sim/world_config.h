@@ -99,6 +99,10 @@ struct WorldConfig {
   /// flash's at its full-scale distance (0: the flash alone); its direction is drawn per
   /// trial, and the sky adds kSkyToSunRatio of it as diffuse light.
   double sun_strength = 0.0;
+  /// How the world is meant to be run, not how it is built: 1 = with view registration
+  /// (`fvp run --register-views`), what a preset with pose errors needs; a run that says
+  /// --register-views or --no-register-views decides itself.
+  int run_register_views = 0;
 
   /// Reads a YAML file; missing keys keep their defaults; unknown keys, wrong types and
   /// out-of-range values throw std::invalid_argument naming the file and the key.
