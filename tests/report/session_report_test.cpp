@@ -7,8 +7,8 @@
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 
-#include "fvp/host/report/view_overlay.h"
 #include "fvp/host/report/session_report.h"
+#include "fvp/host/report/view_overlay.h"
 #include "small_intrinsics.h"
 
 namespace fvp::host {

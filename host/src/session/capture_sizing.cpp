@@ -85,8 +85,8 @@ SizedCaptureSet sizeCaptures(const std::vector<std::filesystem::path>& dirs,
                              const CaptureSizingOptions& options, accel::Backend* backend,
                              const std::function<void(const std::string&)>& warn) {
   SizedCaptureSet set;
-  set.session =
-      std::make_unique<MappingSession>(options.perception, options.engine, map::MapConfig{}, backend);
+  set.session = std::make_unique<MappingSession>(options.perception, options.engine,
+                                                 map::MapConfig{}, backend);
   MappingSession& session = *set.session;
   session.enableTsdf();
   for (const auto& dir : dirs) {

@@ -26,7 +26,7 @@ struct CaptureSizingOptions {
   /// The tag, the Cluster Region (from the tag, or explicit) and segmentation thresholds.
   PerceptionConfig perception;
   sizing::SizingEstimator estimator = sizing::SizingEstimator::kOurs;
-  std::string engine = "grid";    ///< map engine (grid needs backend)
+  std::string engine = "grid";  ///< map engine (grid needs backend)
   /// Where sizeCaptureSet writes fruitlets.json, surface.ply, mesh.ply, clusters.ply
   /// (sizeCaptures writes nothing).
   std::filesystem::path out_dir;
