@@ -9,7 +9,7 @@
 
 #include "cli_checks.h"
 #include "commands.h"
-#include "fvp/host/nbv/nbv_setup.h"
+#include "fvp/host/nbv/stop_rule.h"
 #include "fvp/robot/sim/sim_clock.h"
 #include "fvp/trials/trial.h"
 

@@ -45,26 +45,6 @@ std::size_t nearestUnvisited(const std::vector<ClusterTarget>& targets,
 
 }  // namespace
 
-const char* toString(StopRule rule) {
-  switch (rule) {
-    case StopRule::kBudget:
-      return "budget";
-    case StopRule::kAuto:
-      return "auto";
-  }
-  return "unknown";
-}
-
-std::optional<StopRule> stopRuleFromString(std::string_view name) {
-  for (const StopRule rule : {StopRule::kBudget, StopRule::kAuto})
-    if (name == toString(rule)) return rule;
-  return std::nullopt;
-}
-
-std::string stopRuleNames() {
-  return std::string(toString(StopRule::kBudget)) + "," + toString(StopRule::kAuto);
-}
-
 const char* toString(VisitStatus status) {
   switch (status) {
     case VisitStatus::kSized:

@@ -43,10 +43,6 @@ SimClock::Mode SimClock::modeFromString(const std::string& mode) {
   throw std::invalid_argument("simulated clock: expected mode wall or fixed, got '" + mode + "'");
 }
 
-const char* SimClock::modeName(Mode mode) {
-  return mode == Mode::kFixed ? "fixed" : "wall";
-}
-
 void SimClock::beginIteration() {
   iterations_.emplace_back();
 }

@@ -13,7 +13,7 @@
 #include <optional>
 #include <string>
 
-#include "fvp/host/nbv/nbv_setup.h"
+#include "fvp/host/nbv/stop_rule.h"
 #include "fvp/robot/sim/sim_clock.h"
 
 namespace fvp::host::nbv {

@@ -22,6 +22,7 @@
 #include "fvp/host/nbv/cluster_completion.h"
 #include "fvp/host/nbv/loop_clock.h"
 #include "fvp/host/nbv/nbv_loop.h"
+#include "fvp/host/nbv/stop_rule.h"
 #include "fvp/host/perception/perception_pipeline.h"
 #include "fvp/host/planner/view_planner.h"
 #include "fvp/host/session/mapping_session.h"
@@ -32,18 +33,6 @@ class Backend;
 }
 
 namespace fvp::host::nbv {
-
-/// How each cluster's loop stops.
-enum class StopRule {
-  kBudget,  ///< the paper's protocol: the time budget (and max_views) only
-  kAuto,    ///< also once the cluster's sizes have settled (cluster_completion.h)
-};
-/// "budget" / "auto" (the CLI's --stop, result.json's stop.rule).
-const char* toString(StopRule rule);
-/// The rule of a name; nothing for an unknown name.
-std::optional<StopRule> stopRuleFromString(std::string_view name);
-/// "budget,auto", for messages.
-std::string stopRuleNames();
 
 struct StopSpec {
   StopRule rule = StopRule::kBudget;

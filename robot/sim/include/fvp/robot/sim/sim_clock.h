@@ -35,7 +35,7 @@ class SimClock {
   /// "wall" or "fixed" (fvp run --clock); throws std::invalid_argument otherwise.
   static Mode modeFromString(const std::string& mode);
   /// "wall" or "fixed".
-  static const char* modeName(Mode mode);
+  static const char* modeName(Mode mode) { return mode == Mode::kFixed ? "fixed" : "wall"; }
 
   /// Opens the next iteration's record (charges before the first call open one).
   void beginIteration();
