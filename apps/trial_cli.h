@@ -4,7 +4,6 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
-#include <map>
 #include <string>
 
 #include "cli_checks.h"
@@ -17,6 +16,8 @@ namespace fvp::apps {
 
 inline void addTrialOptions(CLI::App* cmd, trials::TrialOptions& trial) {
   using host::nbv::StopRule;
+  using host::nbv::stopRuleFromString;
+  using host::nbv::toString;
   using Mode = robot::sim::SimClock::Mode;
   cmd->add_option("--budget-s", trial.budget_s, "simulated time budget per cluster, seconds")
       ->check(finiteNumber())
@@ -28,14 +29,12 @@ inline void addTrialOptions(CLI::App* cmd, trials::TrialOptions& trial) {
                   "map engine: grid | octomap (default: each planner's own, grid for fvp, "
                   "octomap for rvp)")
       ->check(CLI::IsMember(mapEngineNames()));
-  const std::map<std::string, StopRule> stops = {
-      {host::nbv::toString(StopRule::kBudget), StopRule::kBudget},
-      {host::nbv::toString(StopRule::kAuto), StopRule::kAuto}};
-  cmd->add_option("--stop", trial.stop,
-                  "budget: run the whole budget (the paper) | auto: stop once the cluster's sizes "
-                  "have settled, the budget being the cap")
-      ->transform(CLI::CheckedTransformer(stops))
-      ->default_str(host::nbv::toString(trial.stop));
+  cmd->add_option_function<std::string>(
+         "--stop", [&trial](const std::string& name) { trial.stop = *stopRuleFromString(name); },
+         "budget: run the whole budget (the paper) | auto: stop once the cluster's sizes have "
+         "settled, the budget being the cap")
+      ->check(CLI::IsMember({toString(StopRule::kBudget), toString(StopRule::kAuto)}))
+      ->default_str(toString(trial.stop));
   cmd->add_flag("--confirm-detections,!--no-confirm-detections", trial.confirm_detections,
                 "with --stop auto: look again at detections sized by a sphere fit to less than "
                 "a hemisphere before a cluster is done (the default; docs/nbv-loop.md)");
@@ -50,12 +49,14 @@ inline void addTrialOptions(CLI::App* cmd, trials::TrialOptions& trial) {
   cmd->add_flag("--size-history", trial.record_size_history,
                 "size after every view and keep each sizing in result.json (size_history; always "
                 "with --stop auto; not charged to the clock)");
-  const std::map<std::string, Mode> clocks = {
-      {robot::sim::SimClock::modeName(Mode::kWall), Mode::kWall},
-      {robot::sim::SimClock::modeName(Mode::kFixed), Mode::kFixed}};
-  cmd->add_option("--clock", trial.clock,
-                  "simulated clock: wall (charge measured compute time) | fixed (a constant)")
-      ->transform(CLI::CheckedTransformer(clocks))
+  cmd->add_option_function<std::string>(
+         "--clock",
+         [&trial](const std::string& name) {
+           trial.clock = robot::sim::SimClock::modeFromString(name);
+         },
+         "simulated clock: wall (charge measured compute time) | fixed (a constant)")
+      ->check(CLI::IsMember({robot::sim::SimClock::modeName(Mode::kWall),
+                             robot::sim::SimClock::modeName(Mode::kFixed)}))
       ->default_str(robot::sim::SimClock::modeName(trial.clock));
 }
 

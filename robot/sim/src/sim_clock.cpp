@@ -37,12 +37,6 @@ SimClock::SimClock(Mode mode, double capture_time_s, double fixed_stage_time_s)
     throw std::invalid_argument("SimClock: capture and fixed stage times must be >= 0");
 }
 
-SimClock::Mode SimClock::modeFromString(const std::string& mode) {
-  if (mode == "wall") return Mode::kWall;
-  if (mode == "fixed") return Mode::kFixed;
-  throw std::invalid_argument("simulated clock: expected mode wall or fixed, got '" + mode + "'");
-}
-
 void SimClock::beginIteration() {
   iterations_.emplace_back();
 }

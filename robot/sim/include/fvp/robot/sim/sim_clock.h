@@ -6,6 +6,7 @@
 // charge is kept per iteration; the wall time of rendering and SGBM is recorded, not charged.
 #pragma once
 
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -33,7 +34,11 @@ class SimClock {
   SimClock(Mode mode, double capture_time_s = kDefaultCaptureTimeS,
            double fixed_stage_time_s = kDefaultFixedStageTimeS);
   /// "wall" or "fixed" (fvp run --clock); throws std::invalid_argument otherwise.
-  static Mode modeFromString(const std::string& mode);
+  static Mode modeFromString(const std::string& mode) {
+    if (mode == modeName(Mode::kWall)) return Mode::kWall;
+    if (mode == modeName(Mode::kFixed)) return Mode::kFixed;
+    throw std::invalid_argument("simulated clock: expected mode wall or fixed, got '" + mode + "'");
+  }
   /// "wall" or "fixed".
   static const char* modeName(Mode mode) { return mode == Mode::kFixed ? "fixed" : "wall"; }
 
