@@ -12,7 +12,9 @@
 #include <cstdlib>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
+#include "fvp/accel/backend_choice.h"
 #include "fvp/host/core/number_text.h"
 #include "fvp/trials/experiment_directory.h"
 
@@ -108,6 +110,33 @@ inline CLI::Validator shardText() {
 /// with the config (exit 1).
 inline CLI::Validator errorScaleText() {
   return parsedBy([](const std::string& t) { trials::parseErrorScale(t); }, "error scale");
+}
+
+/// An option taking one of an enum's names (nameOf(choice) for each of `choices`), parsed into
+/// `target`; its default is the target's name.
+template <typename Enum, typename Choices, typename NameOf>
+CLI::Option* addChoiceOption(CLI::App* cmd, const std::string& flag, Enum& target,
+                             const Choices& choices, NameOf nameOf, const std::string& help) {
+  std::vector<std::string> names;
+  for (const Enum choice : choices) names.emplace_back(nameOf(choice));
+  return cmd
+      ->add_option_function<std::string>(
+          flag,
+          [&target, choices, nameOf](const std::string& text) {
+            for (const Enum choice : choices)
+              if (std::string(nameOf(choice)) == text) target = choice;
+          },
+          help)
+      ->check(CLI::IsMember(names))
+      ->default_str(std::string(nameOf(target)));
+}
+
+/// --backend: a compute backend or auto, parsed into accel::BackendChoice.
+inline CLI::Option* addBackendOption(CLI::App* cmd, accel::BackendChoice& choice,
+                                     const std::string& help) {
+  return addChoiceOption(
+      cmd, "--backend", choice, accel::kBackendChoices,
+      [](accel::BackendChoice c) { return accel::toString(c); }, help);
 }
 
 }  // namespace fvp::apps

@@ -23,8 +23,7 @@ namespace {
 /// `fvp experiment`'s options: the runner's, and those the command turns into them.
 struct ExperimentCommandOptions {
   trials::ExperimentOptions experiment;
-  std::string planners = "fvp,rvp", shard, world, config, arm, out, error_scale;
-  int max_views = 0;
+  std::string planners = "fvp,rvp", shard, out, error_scale;
 };
 
 // Unused in the parse-only build of the CLI fuzz harness (FVP_ON_RUN).
@@ -50,12 +49,9 @@ struct ExperimentCommandOptions {
     host::prepareOutputDirectory(opt->out, "experiment: --out");
     lock.emplace(opt->out, "experiment: --out");
   }
-  o.trial.world_config = opt->error_scale.empty() ? std::filesystem::path(opt->world)
-                                                  : trials::writeScaledWorldConfig(
-                                                        opt->world, opt->error_scale, opt->out);
-  o.trial.planner_config = opt->config;
-  o.trial.arm_config = opt->arm;
-  if (opt->max_views > 0) o.trial.max_views = opt->max_views;
+  if (!opt->error_scale.empty())
+    o.trial.world_config =
+        trials::writeScaledWorldConfig(o.trial.world_config, opt->error_scale, opt->out);
   o.out_dir = opt->out;
   const bool tty = isatty(STDERR_FILENO);
   const auto progress = [tty](const std::string& line) {
@@ -89,18 +85,11 @@ void addExperimentCommand(CLI::App& app) {
   cmd->add_option("--first-seed", opt->experiment.first_seed, "seed of the first world")
       ->check(decimalUnsigned())
       ->capture_default_str();
-  cmd->add_option("--world", opt->world, "world config YAML")->check(CLI::ExistingFile);
-  cmd->add_option("--config", opt->config, "planner config YAML")->check(CLI::ExistingFile);
-  cmd->add_option("--arm", opt->arm, "arm config YAML (default: built-in)")
-      ->check(CLI::ExistingFile);
   cmd->add_option("--error-scale", opt->error_scale,
                   "GROUP=FACTOR: the world's pose, stereo, wind, segmentation, light or all errors "
                   "times FACTOR (a sweep point; written to OUT/world.yaml)")
       ->check(errorScaleText());
-  addTrialOptions(cmd, opt->experiment.trial);
-  cmd->add_option("--max-views", opt->max_views,
-                  "stop each trial after this many views (0: no limit)")
-      ->check(decimalUnsigned());
+  addTrialOptions(cmd, opt->experiment.trial, /*with_per_trial=*/false);
   cmd->add_option("--shard", opt->shard, "run shard i of n (0-based, 0 <= i < n), e.g. 0/4")
       ->check(shardText());
   cmd->add_flag("--resume", opt->experiment.resume, "skip trials already in trials.jsonl");

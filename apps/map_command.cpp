@@ -25,7 +25,7 @@ void addMapCommand(CLI::App& app) {
     int views = 5;
     double arc_deg = 90.0;
     std::string engine = "grid";
-    std::string backend = "auto";
+    accel::BackendChoice backend = accel::BackendChoice::kAuto;
     std::string out;
   };
   auto opt = optionStorage<Options>();
@@ -52,9 +52,7 @@ void addMapCommand(CLI::App& app) {
   cmd->add_option("--engine", opt->engine, "map engine: grid | octomap")
       ->check(CLI::IsMember(mapEngineNames()))
       ->capture_default_str();
-  cmd->add_option("--backend", opt->backend,
-                  "compute backend for the grid engine: cpu | opencl | vulkan | auto")
-      ->capture_default_str();
+  addBackendOption(cmd, opt->backend, "compute backend for the grid engine");
   cmd->add_option("--out", opt->out, "output directory")->required()->check(nonEmptyPath());
   FVP_ON_RUN(cmd, [opt] {
     using robot::sim::WorldConfig;

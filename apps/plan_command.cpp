@@ -29,7 +29,7 @@ void addPlanCommand(CLI::App& app) {
       ->check(decimalUnsigned())
       ->check(CLI::Range(1, 360))
       ->capture_default_str();
-  cmd->add_option("--backend", opt->backend, "cpu | opencl | vulkan | auto")->capture_default_str();
+  addBackendOption(cmd, opt->backend, "compute backend");
   cmd->add_option("--engine", opt->engine, "grid | octomap (default: the planner's)")
       ->check(CLI::IsMember(mapEngineNames()));
   cmd->add_option("--world", *world, "world config YAML")->check(CLI::ExistingFile);

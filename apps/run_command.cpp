@@ -8,8 +8,6 @@
 
 #include "cli_checks.h"
 #include "commands.h"
-#include "fvp/host/map/map_engine_registry.h"
-#include "fvp/host/planner/planner_registry.h"
 #include "fvp/trials/trial.h"
 #include "trial_cli.h"
 
@@ -18,37 +16,17 @@ namespace fvp::apps {
 void addRunCommand(CLI::App& app) {
   struct Options {
     trials::TrialOptions trial;
-    std::string world, config, arm, out;
-    int max_views = 0;
+    std::string out;
   };
   auto opt = optionStorage<Options>();
   auto* cmd = app.add_subcommand("run",
                                  "Run one simulated trial; write result.json, report.md and "
                                  "viewer.html (the trial in 3-D) to --out");
-  cmd->add_option("--planner", opt->trial.planner, "viewpoint planner: fvp | rvp")
-      ->check(CLI::IsMember(plannerNames()))
-      ->capture_default_str();
-  cmd->add_option("--seed", opt->trial.seed, "world seed")
-      ->check(decimalUnsigned())
-      ->capture_default_str();
-  cmd->add_option("--world", opt->world, "world config YAML (default: built-in defaults)")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--config", opt->config, "planner config YAML (default: the planner's)")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--arm", opt->arm,
-                  "arm config YAML (default: built-in, robot/config/arm_default.yaml)")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--max-views", opt->max_views, "stop after this many views (0: no limit)")
-      ->check(decimalUnsigned());
-  addTrialOptions(cmd, opt->trial);
+  addTrialOptions(cmd, opt->trial, /*with_per_trial=*/true);
   cmd->add_option("--out", opt->out, "output directory")->required()->check(nonEmptyPath());
   FVP_ON_RUN(cmd, [opt] {
     trials::TrialOptions trial = opt->trial;
-    trial.world_config = opt->world;
-    trial.planner_config = opt->config;
-    trial.arm_config = opt->arm;
     trial.out_dir = opt->out;
-    if (opt->max_views > 0) trial.max_views = opt->max_views;
     const bool tty = isatty(STDERR_FILENO);
     trial.on_progress = [tty](const trials::TrialProgress& p) {
       std::cerr << (tty ? "\r" : "") << "view " << p.views << "  sim " << std::fixed

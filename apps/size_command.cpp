@@ -13,7 +13,8 @@ namespace fvp::apps {
 
 void addSizeCommand(CLI::App& app) {
   struct Options {
-    std::string captures, out, sizing = "ours", engine = "grid", backend = "auto", config;
+    std::string captures, out, sizing = "ours", engine = "grid", config;
+    accel::BackendChoice backend = accel::BackendChoice::kAuto;
   };
   auto opt = optionStorage<Options>();
   auto* cmd =
@@ -30,7 +31,7 @@ void addSizeCommand(CLI::App& app) {
   cmd->add_option("--engine", opt->engine, "map engine: grid | octomap")
       ->check(CLI::IsMember(mapEngineNames()))
       ->capture_default_str();
-  cmd->add_option("--backend", opt->backend, "cpu | opencl | vulkan | auto")->capture_default_str();
+  addBackendOption(cmd, opt->backend, "compute backend for the grid engine");
   cmd->add_option("--config", opt->config,
                   "perception config YAML: the tag (family, id, size), the Cluster Region "
                   "(offset and radius, or an explicit centre) and HSV thresholds "

@@ -11,7 +11,7 @@ namespace fvp::apps {
 
 void addTraverseCommand(CLI::App& app) {
   struct Options {
-    std::string backend = "auto";
+    accel::BackendChoice backend = accel::BackendChoice::kAuto;
     int side_voxels = 160;
     float voxel_size_m = 0.001f;
     std::size_t rays = 100000;
@@ -24,7 +24,7 @@ void addTraverseCommand(CLI::App& app) {
       app.add_subcommand("traverse",
                          "Run the batched voxel ray traversal kernel on a synthetic canopy grid, "
                          "check it against the cpu reference and report voxel steps per second");
-  cmd->add_option("--backend", opt->backend, "cpu | opencl | vulkan | auto")->capture_default_str();
+  addBackendOption(cmd, opt->backend, "compute backend");
   cmd->add_option("--side-voxels", opt->side_voxels, "grid side in voxels")
       ->check(decimalUnsigned())
       ->check(CLI::Range(8, 1024))

@@ -1,63 +1,104 @@
-// The options of a simulated trial, declared once for `fvp run` and `fvp experiment` (the
-// Python keywords are checked against them: python/tests/test_trial_options.py). Names are
-// parsed into the run specification's types here; nothing after parsing compares them.
+// The options of a simulated trial, generated from its settings (trials/trial_fields.h) for
+// `fvp run` and `fvp experiment`: each setting's flag, help, checks and default come from the
+// one list that also makes Python's keywords and result.json's settings. Names are parsed into
+// the run specification's types here; nothing after parsing compares them.
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "cli_checks.h"
 #include "commands.h"
+#include "fvp/accel/backend_choice.h"
 #include "fvp/host/nbv/stop_rule.h"
 #include "fvp/robot/sim/sim_clock.h"
-#include "fvp/trials/trial.h"
+#include "fvp/trials/trial_fields.h"
 
 namespace fvp::apps {
 
-inline void addTrialOptions(CLI::App* cmd, trials::TrialOptions& trial) {
-  using host::nbv::StopRule;
-  using host::nbv::stopRuleFromString;
-  using host::nbv::toString;
-  using Mode = robot::sim::SimClock::Mode;
-  cmd->add_option("--budget-s", trial.budget_s, "simulated time budget per cluster, seconds")
-      ->check(finiteNumber())
-      ->check(positiveNumber())
-      ->capture_default_str();
-  cmd->add_option("--backend", trial.backend, "compute backend: cpu | opencl | vulkan | auto")
-      ->capture_default_str();
-  cmd->add_option("--engine", trial.engine,
-                  "map engine: grid | octomap (default: each planner's own, grid for fvp, "
-                  "octomap for rvp)")
-      ->check(CLI::IsMember(mapEngineNames()));
-  cmd->add_option_function<std::string>(
-         "--stop", [&trial](const std::string& name) { trial.stop = *stopRuleFromString(name); },
-         "budget: run the whole budget (the paper) | auto: stop once the cluster's sizes have "
-         "settled, the budget being the cap")
-      ->check(CLI::IsMember({toString(StopRule::kBudget), toString(StopRule::kAuto)}))
-      ->default_str(toString(trial.stop));
-  cmd->add_flag("--confirm-detections,!--no-confirm-detections", trial.confirm_detections,
-                "with --stop auto: look again at detections sized by a sphere fit to less than "
-                "a hemisphere before a cluster is done (the default; docs/nbv-loop.md)");
-  cmd->add_flag("--release-left-out,!--no-release-left-out", trial.release_left_out,
-                "with --stop auto: a fruitlet the planner has looked for twice in vain no longer "
-                "holds the stop (the default; docs/nbv-loop.md)");
-  cmd->add_flag_function(
-      "--register-views,!--no-register-views",
-      [&trial](std::int64_t count) { trial.register_views = count > 0; },
-      "align each view to the earlier ones before fusing it (a counter-measure to pose errors; "
-      "default: as the world config's run_register_views says, on for the field preset)");
-  cmd->add_flag("--size-history", trial.record_size_history,
-                "size after every view and keep each sizing in result.json (size_history; always "
-                "with --stop auto; not charged to the clock)");
-  cmd->add_option_function<std::string>(
-         "--clock",
-         [&trial](const std::string& name) {
-           trial.clock = robot::sim::SimClock::modeFromString(name);
-         },
-         "simulated clock: wall (charge measured compute time) | fixed (a constant)")
-      ->check(CLI::IsMember({robot::sim::SimClock::modeName(Mode::kWall),
-                             robot::sim::SimClock::modeName(Mode::kFixed)}))
-      ->default_str(robot::sim::SimClock::modeName(trial.clock));
+/// Adds one trial setting to a command: the setting's type decides the option's kind.
+class TrialOptionAdder {
+ public:
+  TrialOptionAdder(CLI::App* cmd, bool with_per_trial) : cmd_(cmd), per_trial_(with_per_trial) {}
+
+  template <typename T>
+  void operator()(const host::nbv::RunField& field, T& member) {
+    if (field.per_trial && !per_trial_) return;
+    add(std::string(field.flag), std::string(field.help), field.vocabulary, member);
+  }
+
+ private:
+  using Vocabulary = host::nbv::FieldVocabulary;
+
+  void add(const std::string& flag, const std::string& help, Vocabulary vocabulary,
+           std::string& name) {
+    auto* option = cmd_->add_option(flag, name, help);
+    if (vocabulary == Vocabulary::kPlanner)
+      option->check(CLI::IsMember(plannerNames()))->capture_default_str();
+    if (vocabulary == Vocabulary::kMapEngine) option->check(CLI::IsMember(mapEngineNames()));
+  }
+  void add(const std::string& flag, const std::string& help, Vocabulary,
+           std::filesystem::path& path) {
+    cmd_->add_option_function<std::string>(
+            flag, [&path](const std::string& text) { path = text; }, help)
+        ->check(CLI::ExistingFile);
+  }
+  void add(const std::string& flag, const std::string& help, Vocabulary, std::uint64_t& value) {
+    cmd_->add_option(flag, value, help)->check(decimalUnsigned())->capture_default_str();
+  }
+  void add(const std::string& flag, const std::string& help, Vocabulary, double& value) {
+    cmd_->add_option(flag, value, help)
+        ->check(finiteNumber())
+        ->check(positiveNumber())
+        ->capture_default_str();
+  }
+  void add(const std::string& flag, const std::string& help, Vocabulary,
+           std::optional<int>& value) {
+    cmd_->add_option_function<int>(
+            flag, [&value](int n) { value = n > 0 ? std::optional<int>(n) : std::nullopt; }, help)
+        ->check(decimalUnsigned());
+  }
+  void add(const std::string& flag, const std::string& help, Vocabulary, bool& value) {
+    cmd_->add_flag(flag + ",!--no-" + flag.substr(2), value,
+                   help + " (default: " + (value ? "on" : "off") + ")");
+  }
+  void add(const std::string& flag, const std::string& help, Vocabulary,
+           std::optional<bool>& value) {
+    cmd_->add_flag_function(
+        flag + ",!--no-" + flag.substr(2), [&value](std::int64_t count) { value = count > 0; },
+        help);
+  }
+  void add(const std::string& flag, const std::string& help, Vocabulary,
+           accel::BackendChoice& choice) {
+    addChoiceOption(
+        cmd_, flag, choice, accel::kBackendChoices,
+        [](accel::BackendChoice c) { return accel::toString(c); }, help);
+  }
+  void add(const std::string& flag, const std::string& help, Vocabulary,
+           host::nbv::StopRule& rule) {
+    addChoiceOption(
+        cmd_, flag, rule, host::nbv::kStopRules,
+        [](host::nbv::StopRule r) { return host::nbv::toString(r); }, help);
+  }
+  void add(const std::string& flag, const std::string& help, Vocabulary,
+           robot::sim::SimClock::Mode& mode) {
+    using Mode = robot::sim::SimClock::Mode;
+    addChoiceOption(cmd_, flag, mode, std::vector<Mode>{Mode::kWall, Mode::kFixed},
+                    robot::sim::SimClock::modeName, help);
+  }
+
+  CLI::App* cmd_;
+  bool per_trial_;
+};
+
+/// The trial's settings as options of `cmd`. with_per_trial: also the planner and the seed
+/// (`fvp run`; `fvp experiment` takes lists of them instead).
+inline void addTrialOptions(CLI::App* cmd, trials::TrialOptions& trial, bool with_per_trial) {
+  trials::visitTrialFields(trial, TrialOptionAdder(cmd, with_per_trial));
 }
 
 }  // namespace fvp::apps

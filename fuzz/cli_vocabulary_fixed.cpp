@@ -1,17 +1,16 @@
-// The registries' names for the parse-only command-line harness, which links no registry:
-// the experiment files' copy (trials/experiment_directory.h), which fvp_experiment_test
-// holds equal to the registries.
+// The registries' names for the parse-only command-line harness, which links no registry: the
+// built-in entries (a planner added later is parsed as an unknown name here, which the
+// harness's inputs exercise anyway).
 #include "commands.h"
-#include "fvp/trials/experiment_directory.h"
 
 namespace fvp::apps {
 
 std::vector<std::string> plannerNames() {
-  return trials::experimentPlanners();
+  return {"fvp", "rvp"};
 }
 
 std::vector<std::string> mapEngineNames() {
-  return trials::experimentEngines();
+  return {"grid", "octomap"};
 }
 
 }  // namespace fvp::apps

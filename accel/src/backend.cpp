@@ -161,24 +161,34 @@ std::vector<BackendInfo> probeBackends() {
   return infos;
 }
 
-std::unique_ptr<Backend> createBackend(std::string_view name) {
-  if (name == "auto") {
-    for (BackendKind kind : {BackendKind::kOpenCl, BackendKind::kVulkan}) {
-      try {
-        auto backend = createBackend(kind);
-        if (isGpu(*backend)) return backend;
-      } catch (const BackendUnavailable&) {
-        // auto means "best available": an absent GPU backend is expected here.
-      }
+std::unique_ptr<Backend> createBackend(BackendChoice choice) {
+  switch (choice) {
+    case BackendChoice::kCpu:
+      return createBackend(BackendKind::kCpu);
+    case BackendChoice::kOpenCl:
+      return createBackend(BackendKind::kOpenCl);
+    case BackendChoice::kVulkan:
+      return createBackend(BackendKind::kVulkan);
+    case BackendChoice::kAuto:
+      break;
+  }
+  for (BackendKind kind : {BackendKind::kOpenCl, BackendKind::kVulkan}) {
+    try {
+      auto backend = createBackend(kind);
+      if (isGpu(*backend)) return backend;
+    } catch (const BackendUnavailable&) {
+      // auto means "best available": an absent GPU backend is expected here.
     }
-    return detail::createCpuBackend();
   }
-  auto kind = parseBackendKind(name);
-  if (!kind) {
-    throw std::invalid_argument("unknown backend '" + std::string(name) +
-                                "': expected cpu, opencl, vulkan or auto");
-  }
-  return createBackend(*kind);
+  return detail::createCpuBackend();
+}
+
+std::unique_ptr<Backend> createBackend(std::string_view name) {
+  const auto choice = parseBackendChoice(name);
+  if (!choice)
+    throw std::invalid_argument("unknown backend '" + std::string(name) + "': expected one of " +
+                                backendChoiceNames());
+  return createBackend(*choice);
 }
 
 }  // namespace fvp::accel

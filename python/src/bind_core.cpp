@@ -19,7 +19,11 @@ std::unique_ptr<accel::Backend> backendFor(const std::string& name, const std::s
                                   "' needs a compute backend");
     return nullptr;
   }
-  return host::map::createBackendFor(engine, name);
+  const auto choice = accel::parseBackendChoice(name);
+  if (!choice)
+    throw std::invalid_argument("backend: expected one of none, " + accel::backendChoiceNames() +
+                                ", got '" + name + "'");
+  return host::map::createBackendFor(engine, *choice);
 }
 
 void bindCore(py::module_& m) {

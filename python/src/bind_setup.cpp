@@ -2,13 +2,14 @@
 // with the budget or the automatic stop, through a user's camera, arm and clock.
 #include <pybind11/stl.h>
 
-#include <algorithm>
 #include <optional>
 
 #include "bindings.h"
 #include "conversions.h"
 #include "fvp/host/eval/sizing_score.h"
 #include "fvp/host/nbv/nbv_setup.h"
+#include "fvp/host/nbv/run_fields.h"
+#include "run_keywords.h"
 
 namespace fvp::python {
 namespace {
@@ -94,51 +95,10 @@ class PyTourObserver : public host::nbv::TourObserver {
 
 NbvSetupOptions setupOptions(const py::kwargs& kw) {
   NbvSetupOptions o;
-  const auto get = [&](const char* key) -> std::optional<py::object> {
-    if (!kw.contains(key)) return std::nullopt;
-    return py::object(kw[key]);
-  };
-  static const char* const known[] = {"planner",
-                                      "planner_config",
-                                      "engine",
-                                      "backend",
-                                      "seed",
-                                      "register_views",
-                                      "perception",
-                                      "stop",
-                                      "budget_s",
-                                      "max_views",
-                                      "size_history",
-                                      "confirm_detections",
-                                      "release_left_out",
-                                      "max_consecutive_dropped_frames"};
-  for (const auto& [key, value] : kw) {
-    const std::string name = py::str(key);
-    if (std::find(std::begin(known), std::end(known), name) == std::end(known))
-      throw py::type_error("NbvSetup: unexpected keyword argument '" + name + "'");
-  }
-  if (auto v = get("planner")) o.planner = v->cast<std::string>();
-  if (auto v = get("planner_config")) o.planner_config = v->cast<std::string>();
-  if (auto v = get("engine")) o.engine = v->cast<std::string>();
-  if (auto v = get("backend")) o.backend = v->cast<std::string>();
-  if (auto v = get("seed")) o.planner_seed = v->cast<std::uint64_t>();
-  if (auto v = get("register_views")) o.register_views = v->cast<bool>();
-  if (auto v = get("perception")) o.perception = v->cast<host::PerceptionConfig>();
-  if (auto v = get("stop")) {
-    const std::string name = v->cast<std::string>();
-    const auto rule = host::nbv::stopRuleFromString(name);
-    if (!rule)
-      throw py::value_error("NbvSetup: stop: expected one of " + host::nbv::stopRuleNames() +
-                            ", got '" + name + "'");
-    o.stop.rule = *rule;
-  }
-  if (auto v = get("budget_s")) o.stop.budget_s = v->cast<double>();
-  if (auto v = get("max_views"); v && !v->is_none()) o.stop.max_views = v->cast<int>();
-  if (auto v = get("size_history")) o.stop.record_size_history = v->cast<bool>();
-  if (auto v = get("confirm_detections")) o.stop.completion.confirm_detections = v->cast<bool>();
-  if (auto v = get("release_left_out")) o.stop.completion.release_left_out = v->cast<bool>();
-  if (auto v = get("max_consecutive_dropped_frames"))
-    o.loop.max_consecutive_dropped_frames = v->cast<int>();
+  RunKeywords keywords(kw, "NbvSetup");
+  host::nbv::visitSetupFields(o, keywords);
+  if (auto v = keywords.takeObject("perception")) o.perception = v->cast<host::PerceptionConfig>();
+  keywords.finish();
   return o;
 }
 
@@ -179,11 +139,14 @@ void bindSetup(py::module_& m) {
       .def_property_readonly("center_m",
                              [](const ClusterTarget& t) { return vectorToArray(t.center_m); });
 
-  py::class_<NbvSetup>(m, "NbvSetup",
-                       "The one place a run is assembled (host/nbv/nbv_setup.h). Keywords: "
-                       "planner, planner_config, engine, backend, seed, register_views, "
-                       "perception, stop ('budget' | 'auto'), budget_s, max_views, size_history, "
-                       "confirm_detections, release_left_out, max_consecutive_dropped_frames.")
+  static const std::string doc =
+      "The one place a run is assembled (host/nbv/nbv_setup.h). Keywords:\n" +
+      keywordDoc(
+          NbvSetupOptions{},
+          [](const NbvSetupOptions& o, auto&& visit) { host::nbv::visitSetupFields(o, visit); },
+          [](const auto& value) { return host::nbv::settingJson(value); }) +
+      "  perception (default: the built-in): fvp.PerceptionConfig for every cluster\n";
+  py::class_<NbvSetup>(m, "NbvSetup", doc.c_str())
       .def(py::init(
           [](const py::kwargs& kw) { return std::make_unique<NbvSetup>(setupOptions(kw)); }))
       .def_property_readonly("engine", &NbvSetup::engine)

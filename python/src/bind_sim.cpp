@@ -10,52 +10,37 @@
 #include "fvp/robot/sim/simulated_camera.h"
 #include "fvp/trials/simulated_robot.h"
 #include "fvp/trials/trial.h"
+#include "fvp/trials/trial_fields.h"
+#include "run_keywords.h"
 
 namespace fvp::python {
 namespace {
 
-trials::TrialOptions trialOptions(const std::string& planner, std::uint64_t seed, double budget_s,
-                                  const std::optional<int>& max_views, const std::string& clock,
-                                  const std::string& stop, bool confirm_detections,
-                                  bool release_left_out, bool size_history,
-                                  std::optional<bool> register_views, const std::string& backend,
-                                  const std::string& engine, const std::string& world_config,
-                                  const std::string& planner_config, const std::string& arm_config,
-                                  const std::string& out_dir) {
+/// fvp run's settings as keywords (trials/trial_fields.h), and out_dir.
+trials::TrialOptions trialOptions(const py::kwargs& kw, const char* owner) {
   trials::TrialOptions o;
-  o.planner = planner;
-  o.seed = seed;
-  o.budget_s = budget_s;
-  o.max_views = max_views;
-  o.clock = robot::sim::SimClock::modeFromString(clock);
-  const auto rule = host::nbv::stopRuleFromString(stop);
-  if (!rule)
-    throw std::invalid_argument("stop: expected one of " + host::nbv::stopRuleNames() + ", got '" +
-                                stop + "'");
-  o.stop = *rule;
-  o.confirm_detections = confirm_detections;
-  o.release_left_out = release_left_out;
-  o.record_size_history = size_history;
-  o.register_views = register_views;
-  o.backend = backend;
-  o.engine = engine;
-  o.world_config = world_config;
-  o.planner_config = planner_config;
-  o.arm_config = arm_config;
-  o.out_dir = out_dir;
+  RunKeywords keywords(kw, owner);
+  trials::visitTrialFields(o, keywords);
+  keywords.take("out_dir", o.out_dir);
+  keywords.finish();
   // Warnings stay in result["warnings"]; Python callers read them there.
   return o;
 }
 
-// The keyword arguments of fvp run, in one place for Trial and run_trial.
-#define FVP_TRIAL_ARGS                                                                          \
-  py::kw_only(),                                                                                \
-      py::arg("planner") = "fvp", py::arg("seed") = 1, py::arg("budget_s") = 180.0,             \
-      py::arg("max_views") = py::none(), py::arg("clock") = "wall", py::arg("stop") = "budget", \
-      py::arg("confirm_detections") = true, py::arg("release_left_out") = true,                 \
-      py::arg("size_history") = false, py::arg("register_views") = py::none(),                  \
-      py::arg("backend") = "auto", py::arg("engine") = "", py::arg("world_config") = "",        \
-      py::arg("planner_config") = "", py::arg("arm_config") = "", py::arg("out_dir") = ""
+/// The keywords' docstring: every setting with its default.
+std::string trialKeywordDoc() {
+  return keywordDoc(
+             trials::TrialOptions{},
+             [](const trials::TrialOptions& o, auto&& visit) {
+               trials::visitTrialFields(o, visit);
+             },
+             [](const auto& value) {
+               using trials::settingJson;
+               return settingJson(value);
+             }) +
+         "  out_dir (default: \"\"): where result.json and the trial's files go (empty: "
+         "nothing is written)\n";
+}
 
 }  // namespace
 
@@ -90,22 +75,14 @@ void bindSim(py::module_& m) {
       .def_property_readonly("targets", &trials::SimulatedRobot::clusterTargets,
                              "The world's clusters as fvp.ClusterTarget, in the world's order.");
 
-  py::class_<trials::Trial>(sim, "Trial",
-                            "One simulated trial, built and not yet run (fvp run's options "
-                            "as keywords). Its camera and arm are the simulator's.")
-      .def(py::init([](const std::string& planner, std::uint64_t seed, double budget_s,
-                       std::optional<int> max_views, const std::string& clock,
-                       const std::string& stop, bool confirm_detections, bool release_left_out,
-                       bool size_history, std::optional<bool> register_views,
-                       const std::string& backend, const std::string& engine,
-                       const std::string& world_config, const std::string& planner_config,
-                       const std::string& arm_config, const std::string& out_dir) {
-             return std::make_unique<trials::Trial>(
-                 trialOptions(planner, seed, budget_s, max_views, clock, stop, confirm_detections,
-                              release_left_out, size_history, register_views, backend, engine,
-                              world_config, planner_config, arm_config, out_dir));
-           }),
-           FVP_TRIAL_ARGS)
+  static const std::string trial_doc =
+      "One simulated trial, built and not yet run (fvp run's settings as keywords). Its camera "
+      "and arm are the simulator's. Keywords:\n" +
+      trialKeywordDoc();
+  py::class_<trials::Trial>(sim, "Trial", trial_doc.c_str())
+      .def(py::init([](const py::kwargs& kw) {
+        return std::make_unique<trials::Trial>(trialOptions(kw, "fvp.sim.Trial"));
+      }))
       .def_property_readonly(
           "camera", [](trials::Trial& t) -> host::nbv::Camera& { return t.simulatedCamera(); },
           py::return_value_policy::reference_internal,
@@ -128,18 +105,12 @@ void bindSim(py::module_& m) {
           "Runs the loop through camera and arm (default: the simulator's), scores against the "
           "world and returns result.json's object. A trial runs once.");
 
+  static const std::string run_doc =
+      "fvp run as a function: result.json's object. Keywords:\n" + trialKeywordDoc();
   sim.def(
       "run_trial",
-      [](const std::string& planner, std::uint64_t seed, double budget_s,
-         std::optional<int> max_views, const std::string& clock, const std::string& stop,
-         bool confirm_detections, bool release_left_out, bool size_history,
-         std::optional<bool> register_views, const std::string& backend, const std::string& engine,
-         const std::string& world_config, const std::string& planner_config,
-         const std::string& arm_config, const std::string& out_dir) {
-        const trials::TrialOptions o =
-            trialOptions(planner, seed, budget_s, max_views, clock, stop, confirm_detections,
-                         release_left_out, size_history, register_views, backend, engine,
-                         world_config, planner_config, arm_config, out_dir);
+      [](const py::kwargs& kw) {
+        const trials::TrialOptions o = trialOptions(kw, "fvp.sim.run_trial");
         nlohmann::json result;
         {
           py::gil_scoped_release release;
@@ -147,7 +118,7 @@ void bindSim(py::module_& m) {
         }
         return jsonToPython(result);
       },
-      FVP_TRIAL_ARGS, "fvp run as a function: result.json's object.");
+      run_doc.c_str());
   m.attr("run_trial") = sim.attr("run_trial");
 }
 

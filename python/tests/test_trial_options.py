@@ -35,10 +35,14 @@ def run_options(fvp_exe):
     return names
 
 
+def keyword_defaults(function):
+    """The keywords of a function whose keywords are generated from the run's settings, and
+    their defaults, from its docstring's lines "  key (default: value): help"."""
+    return dict(re.findall(r"^  (\w+) \(default: (.*?)\): ", function.__doc__, re.M))
+
+
 def keywords(function):
-    """The keyword arguments of a pybind11 function, from its signature line."""
-    signature = function.__doc__.splitlines()[0]
-    return set(re.findall(r"(\w+): [\w.\[\]]+(?: = [^,)]+)?", signature)) - {"self"}
+    return set(keyword_defaults(function))
 
 
 def keyword_for(option):
@@ -49,7 +53,7 @@ def test_every_run_option_has_a_keyword(fvp_exe):
     options = run_options(fvp_exe)
     # The parse found the options (a changed help layout would make this test vacuous).
     assert {"--planner", "--seed", "--stop", "--confirm-detections", "--out"} <= options
-    for function in (fvp.sim.Trial.__init__, fvp.sim.run_trial):
+    for function in (fvp.sim.Trial, fvp.sim.run_trial):
         missing = sorted(o for o in options - NOT_KEYWORDS.keys()
                          if keyword_for(o) not in keywords(function))
         assert not missing, f"{function.__qualname__}: no keyword for {missing}"
@@ -62,9 +66,9 @@ def test_exceptions_are_still_options(fvp_exe):
 
 
 def test_automatic_stop_switches_default_as_the_cli(fvp_exe):
-    signature = fvp.sim.Trial.__init__.__doc__.splitlines()[0]
-    assert "confirm_detections: bool = True" in signature
-    assert "release_left_out: bool = True" in signature
+    defaults = keyword_defaults(fvp.sim.Trial)
+    assert defaults["confirm_detections"] == "true"
+    assert defaults["release_left_out"] == "true"
     help_text = subprocess.run([fvp_exe, "run", "--help"], check=True, capture_output=True,
                                text=True).stdout
     # The CLI's flags are on unless negated (TrialOptions' defaults).
@@ -98,3 +102,40 @@ def test_the_field_preset_runs_with_view_registration_unless_told_otherwise():
     assert fvp.sim.run_trial(world_config=field, register_views=False,
                              **quick)["register_views"] is False
     assert fvp.sim.run_trial(**quick)["register_views"] is False
+
+
+def test_result_settings_are_the_keywords():
+    # One list makes the keywords and result.json's settings: the same keys, and a trial's
+    # settings read back as keywords give the same settings.
+    result = fvp.sim.run_trial(seed=2, clock="fixed", max_views=1, backend="cpu")
+    settings = result["settings"]
+    assert set(settings) == keywords(fvp.sim.Trial) - {"out_dir"}
+    assert settings["clock"] == "fixed" and settings["backend"] == "cpu"
+    assert settings["max_views"] == 1 and settings["stop"] == "budget"
+    again = fvp.sim.run_trial(**{k: v for k, v in settings.items() if v is not None})
+    assert again["settings"] == settings
+
+
+def test_bad_keywords_name_themselves():
+    with pytest.raises(TypeError, match="unexpected keyword argument 'budget'"):
+        fvp.sim.Trial(budget=10)
+    with pytest.raises(ValueError, match="stop: expected one of budget, auto, got 'soon'"):
+        fvp.sim.Trial(stop="soon")
+    with pytest.raises(ValueError, match="backend: expected one of auto, cpu, opencl, vulkan"):
+        fvp.sim.run_trial(backend="gpu")
+    with pytest.raises(ValueError, match="budget_s: expected a number, got 'x'"):
+        fvp.sim.run_trial(budget_s="x")
+    with pytest.raises(ValueError, match="setting 'budget_s': expected a positive number"):
+        fvp.sim.run_trial(budget_s=-1.0)
+
+
+def test_the_setups_keywords_are_the_trials():
+    # fvp.NbvSetup's keywords come from the same descriptions: each is a trial keyword except
+    # those a trial sets itself (its perception, from the world) or the loop's own.
+    setup = keyword_defaults(fvp.NbvSetup)
+    assert set(setup) - keywords(fvp.sim.Trial) == {"perception",
+                                                   "max_consecutive_dropped_frames"}
+    with pytest.raises(TypeError, match="NbvSetup: unexpected keyword argument 'clock'"):
+        fvp.NbvSetup(clock="fixed")
+    with pytest.raises(ValueError, match="NbvSetup: max_views: expected an integer"):
+        fvp.NbvSetup(max_views=2.5)

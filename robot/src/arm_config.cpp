@@ -158,22 +158,10 @@ ArmConfig ArmConfig::fromYamlFile(const std::filesystem::path& path) {
 }
 
 std::string ArmConfig::toJson() const {
-  nlohmann::ordered_json json;
-  for (const KeySpec& spec : keySpecs()) {
-    std::visit(
-        [&](auto field) {
-          using T = std::decay_t<decltype(this->*field)>;
-          if constexpr (std::is_same_v<T, Eigen::Vector3d>) {
-            json[spec.name] = {(this->*field)[0], (this->*field)[1], (this->*field)[2]};
-          } else {
-            json[spec.name] = this->*field;
-          }
-        },
-        spec.member);
-  }
   // workspace_cache_dir is a path: any bytes (a YAML file's, $HOME's), not always UTF-8, which
   // JSON needs. Invalid bytes become U+FFFD instead of a type_error thrown at the end of a run.
-  return json.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
+  return host::yamlConfigJson(yamlKeys(), *this)
+      .dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
 }
 
 }  // namespace fvp::robot

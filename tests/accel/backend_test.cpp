@@ -148,6 +148,15 @@ TEST_P(BackendTest, MatchesCpuOnBoundaryCases) {
 
 FVP_INSTANTIATE_FOR_ALL_BACKENDS(BackendTest);
 
+TEST(BackendFactory, ChoiceNamesRoundTrip) {
+  for (const BackendChoice choice : kBackendChoices)
+    EXPECT_EQ(parseBackendChoice(toString(choice)), choice) << toString(choice);
+  EXPECT_FALSE(parseBackendChoice("gpu").has_value());
+  EXPECT_FALSE(parseBackendChoice("").has_value());
+  EXPECT_EQ(backendChoiceNames(), "auto, cpu, opencl, vulkan");
+  EXPECT_EQ(createBackend(BackendChoice::kCpu)->kind(), BackendKind::kCpu);
+}
+
 TEST(BackendFactory, NamesAndErrors) {
   EXPECT_EQ(parseBackendKind("opencl"), BackendKind::kOpenCl);
   EXPECT_FALSE(parseBackendKind("auto").has_value());
@@ -157,7 +166,7 @@ TEST(BackendFactory, NamesAndErrors) {
     FAIL() << "an unknown backend name must throw";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("cuda"), std::string::npos);
-    EXPECT_NE(std::string(e.what()).find("expected cpu, opencl, vulkan or auto"),
+    EXPECT_NE(std::string(e.what()).find("expected one of auto, cpu, opencl, vulkan"),
               std::string::npos);
   }
   // auto always yields a working backend: a GPU where there is one, else the reference.

@@ -542,7 +542,8 @@ const std::vector<BadInput>& cases() {
          return std::vector<std::string>{"merge", "--out", p(d / "merged"), p(d / "exp")};
        },
        1,
-       {"trials.jsonl: line 1: field 'engine': expected \"\" or a map engine (grid,octomap)"},
+       {"trials.jsonl: line 1: field 'engine': expected \"\" (the planner's own) or a map engine "
+        "name"},
        {"PWNED", "merged/trials.jsonl", "merged/accuracy_vs_time.png"}},
       {"ResumeTrialEngineInjection",
        [](const fs::path& d) {

@@ -34,7 +34,7 @@ class ViewerInBrowser : public ::testing::Test {
     fs::remove_all(*dir_);
     TrialOptions o;
     o.seed = 7;
-    o.backend = "cpu";
+    o.backend = accel::BackendChoice::kCpu;
     o.clock = robot::sim::SimClock::Mode::kFixed;
     o.max_views = 4;
     o.out_dir = *dir_ / "trial";

@@ -37,7 +37,7 @@ class TreeTrial : public ::testing::Test {
     TrialOptions o;
     o.seed = kSeed;
     o.world_config = dir_ / "tree.yaml";
-    o.backend = "cpu";
+    o.backend = accel::BackendChoice::kCpu;
     o.clock = robot::sim::SimClock::Mode::kFixed;
     o.max_views = 2;
     return o;

@@ -116,7 +116,7 @@ ExperimentManifest manifestOf(const ExperimentOptions& o) {
   m.planner_config = stampOf(o.trial.planner_config, "planner config");
   m.arm_config = stampOf(o.trial.arm_config, "arm config");
   m.engine = o.trial.engine;
-  m.backend = o.trial.backend;
+  m.backend = accel::toString(o.trial.backend);
   m.planners = o.planners;
   m.trials = o.trials;
   m.first_seed = o.first_seed;
@@ -137,12 +137,13 @@ void checkOptions(const ExperimentOptions& o) {
     throw std::invalid_argument("experiment: --shard i/n needs 0 <= i < n");
   if (o.planners.empty())
     throw std::invalid_argument("experiment: no planners given (--planners, e.g. fvp,rvp)");
-  const auto& known = experimentPlanners();
+  const auto& registry = host::planner::PlannerRegistry::instance();
   for (std::size_t i = 0; i < o.planners.size(); ++i) {
     const std::string& p = o.planners[i];
     if (p.empty()) throw std::invalid_argument("experiment: an empty planner name in --planners");
-    if (std::find(known.begin(), known.end(), p) == known.end())
-      throw std::invalid_argument("experiment: unknown planner '" + p + "' (expected fvp, rvp)");
+    if (!registry.contains(p))
+      throw std::invalid_argument("experiment: unknown planner '" + p + "' (expected one of " +
+                                  registry.knownNames() + ")");
     if (std::find(o.planners.begin(), o.planners.begin() + long(i), p) !=
         o.planners.begin() + long(i))
       throw std::invalid_argument("experiment: --planners lists '" + p +

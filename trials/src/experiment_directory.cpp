@@ -11,10 +11,15 @@
 #include <stdexcept>
 #include <utility>
 
+#include "fvp/accel/backend_choice.h"
+
 namespace fvp::trials {
 namespace {
 
 constexpr const char* kManifestFormat = "fvp-experiment-manifest";
+constexpr const char* kPlannerExpected = "a planner name (lower-case letters, digits and _)";
+constexpr const char* kEngineExpected =
+    "\"\" (the planner's own) or a map engine name (lower-case letters, digits and _)";
 
 /// A value for an error message: its JSON text, cut short.
 std::string shown(const nlohmann::json& value) {
@@ -66,20 +71,25 @@ void checkFruitlets(const nlohmann::json& trial, const char* key, const std::str
   }
 }
 
-bool knownOrEmpty(const std::vector<std::string>& known, const nlohmann::json& v) {
-  const std::string& s = v.get_ref<const std::string&>();
-  return s.empty() || std::find(known.begin(), known.end(), s) != known.end();
-}
-
 bool isIdentifier(const nlohmann::json& v) {
   if (!v.is_string() || v.get_ref<const std::string&>().empty()) return false;
   const std::string& s = v.get_ref<const std::string&>();
   return s.size() <= 64 && s.find_first_not_of("abcdefghijklmnopqrstuvwxyz_") == std::string::npos;
 }
 
-std::string defaultEngineOf(const std::string& planner) {
-  // As trial_parts.cpp's defaultEngine, which the trial runs on.
+/// The map engine the planners of trials written before result.json had "settings" ran on
+/// by default (a frozen record of those versions: later trials say what they asked for).
+std::string legacyDefaultEngineOf(const std::string& planner) {
   return planner == "rvp" ? "octomap" : "grid";
+}
+
+/// A registry name (a planner's or a map engine's): lower-case letters, digits and _, safe in
+/// file names and figure text. Whether a planner is registered is the runner's check.
+bool isRegistryName(const nlohmann::json& v) {
+  if (!v.is_string() || v.get_ref<const std::string&>().empty()) return false;
+  const std::string& s = v.get_ref<const std::string&>();
+  return s.size() <= 64 &&
+         s.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_") == std::string::npos;
 }
 
 std::string joined(const std::vector<std::string>& list) {
@@ -146,16 +156,6 @@ ConfigFileStamp readConfig(const nlohmann::json& o, const char* key, const std::
 
 }  // namespace
 
-const std::vector<std::string>& experimentPlanners() {
-  static const std::vector<std::string> planners{"fvp", "rvp"};
-  return planners;
-}
-
-const std::vector<std::string>& experimentEngines() {
-  static const std::vector<std::string> engines{"grid", "octomap"};
-  return engines;
-}
-
 const std::vector<std::string>& errorScaleGroups() {
   static const std::vector<std::string> groups{"pose",         "stereo", "wind",
                                                "segmentation", "light",  "all"};
@@ -210,16 +210,18 @@ void checkTrial(const nlohmann::json& trial, const std::string& where) {
     throw std::runtime_error(where + ": expected one trial's result (a JSON object), got " +
                              shown(trial));
   const nlohmann::json* planner = member(trial, "planner");
-  const auto& known = experimentPlanners();
-  if (!planner || !planner->is_string() ||
-      std::find(known.begin(), known.end(), planner->get<std::string>()) == known.end())
-    fieldError(where, "planner", "one of " + joined(known), planner);
+  if (!planner || !isRegistryName(*planner))
+    fieldError(where, "planner", kPlannerExpected, planner);
   const nlohmann::json* seed = member(trial, "seed");
   if (!seed || !isUnsigned(*seed)) fieldError(where, "seed", "an unsigned integer", seed);
   if (const nlohmann::json* engine = member(trial, "engine");
-      engine && (!engine->is_string() || !knownOrEmpty(experimentEngines(), *engine)))
-    fieldError(where, "engine", "\"\" or a map engine (" + joined(experimentEngines()) + ")",
-               engine);
+      engine && !(isRegistryName(*engine) || *engine == ""))
+    fieldError(where, "engine", kEngineExpected, engine);
+  if (const nlohmann::json* settings = member(trial, "settings")) {
+    const nlohmann::json* engine = settings->is_object() ? member(*settings, "engine") : nullptr;
+    if (!engine || !(isRegistryName(*engine) || *engine == ""))
+      fieldError(where, "settings.engine", kEngineExpected, engine);
+  }
   if (const nlohmann::json* reason = member(trial, "stop_reason"); reason && !isIdentifier(*reason))
     fieldError(where, "stop_reason", "a stop reason (lower-case letters and _)", reason);
   for (const char* key : {"views", "detections"})
@@ -235,9 +237,14 @@ void checkTrial(const nlohmann::json& trial, const std::string& where) {
 
 std::string trialRowKey(const nlohmann::json& trial) {
   std::string key = trial.at("planner").get<std::string>();
+  // The engine the trial asked for ("" : its planner's own), as its settings say.
+  if (const nlohmann::json* settings = member(trial, "settings")) {
+    const std::string asked = settings->at("engine").get<std::string>();
+    return asked.empty() ? key : key + "-" + asked;
+  }
   const nlohmann::json* engine = member(trial, "engine");
   const std::string e = engine ? engine->get<std::string>() : "";
-  if (!e.empty() && e != defaultEngineOf(key)) key += "-" + e;
+  if (!e.empty() && e != legacyDefaultEngineOf(key)) key += "-" + e;
   return key;
 }
 
@@ -420,21 +427,19 @@ ExperimentManifest readManifest(const std::filesystem::path& path) {
     return m;
   }
   m.engine = readString(j, "engine", where);
-  if (!knownOrEmpty(experimentEngines(), j["engine"]))
-    fieldError(where, "engine",
-               "\"\" (each planner's own) or a map engine (" + joined(experimentEngines()) + ")",
-               &j["engine"]);
+  if (!(isRegistryName(j["engine"]) || j["engine"] == ""))
+    fieldError(where, "engine", kEngineExpected, &j["engine"]);
   m.backend = readString(j, "backend", where);
-  if (m.backend != "auto" && m.backend != "cpu" && m.backend != "opencl" && m.backend != "vulkan")
-    fieldError(where, "backend", "one of auto, cpu, opencl, vulkan", &j["backend"]);
-  const std::string planners_expected = "a non-empty array of distinct planners (fvp, rvp)";
+  if (!accel::parseBackendChoice(m.backend))
+    fieldError(where, "backend", "one of " + accel::backendChoiceNames(), &j["backend"]);
+  const std::string planners_expected =
+      "a non-empty array of distinct planner names (lower-case letters, digits and _)";
   const nlohmann::json& planners = required(j, "planners", where, planners_expected);
   if (!planners.is_array() || planners.empty())
     fieldError(where, "planners", planners_expected, &planners);
-  const auto& known = experimentPlanners();
   for (const auto& p : planners) {
     const std::string name = p.is_string() ? p.get<std::string>() : "";
-    if (std::find(known.begin(), known.end(), name) == known.end() ||
+    if (!isRegistryName(p) ||
         std::find(m.planners.begin(), m.planners.end(), name) != m.planners.end())
       fieldError(where, "planners", planners_expected, &planners);
     m.planners.push_back(name);

@@ -40,6 +40,7 @@
 #include "fvp/robot/sim/world.h"
 #include "fvp/robot/workspace_tree.h"
 #include "fvp/trials/simulated_robot.h"
+#include "fvp/trials/trial_fields.h"
 #include "trial_parts.h"
 #include "trial_viewer.h"
 
@@ -85,21 +86,6 @@ nlohmann::json anchorOffsetJson(const host::MappingSession& session,
 /// R_world_camera as [w, x, y, z]; the camera looks along its z axis (OpenCV frame).
 nlohmann::json quaternionWxyz(const Eigen::Isometry3d& T) {
   return host::report::poseJson(T).at("quaternion_wxyz");
-}
-
-void validate(const TrialOptions& o) {
-  if (!host::planner::PlannerRegistry::instance().contains(o.planner))
-    throw std::invalid_argument("trial option 'planner': expected one of " +
-                                host::planner::PlannerRegistry::instance().knownNames() +
-                                ", got '" + o.planner + "'");
-  if (!(o.budget_s > 0.0) || !std::isfinite(o.budget_s))
-    throw std::invalid_argument("trial option 'budget_s': expected a positive number of seconds");
-  if (!o.engine.empty() && !host::map::MapEngineRegistry::instance().contains(o.engine))
-    throw std::invalid_argument("trial option 'engine': expected one of " +
-                                host::map::MapEngineRegistry::instance().knownNames() + ", got '" +
-                                o.engine + "'");
-  if (o.max_views && *o.max_views < 1)
-    throw std::invalid_argument("trial option 'max_views': expected at least 1");
 }
 
 /// The trial's per-view and per-iteration logs, view images and progress lines, from the
@@ -377,7 +363,8 @@ struct Trial::Impl {
   class TourRecorder;
 
   explicit Impl(TrialOptions opts) : options(std::move(opts)) {
-    validate(options);
+    // The setup's checks, before the output directory is touched.
+    setupOptions(options).validate();
     options.register_views = registerViewsOf(options);
     if (!options.out_dir.empty()) {
       host::prepareOutputDirectory(options.out_dir, "trial output directory");
@@ -576,6 +563,7 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
   for (const auto& T : run.camera_poses) camera_path.push_back(T.translation());
 
   nlohmann::json result;
+  result["settings"] = trialSettingsJson(options);
   result["planner"] = options.planner;
   result["seed"] = options.seed;
   result["engine"] = setup->engine();
@@ -808,6 +796,7 @@ void Trial::Impl::scoreSkippedClusters(TourRecord& tour, host::report::ViewerSce
 // the pooled metrics.
 nlohmann::json Trial::Impl::treeResult(TourRecord& tour, host::report::ViewerScene& scene) {
   nlohmann::json result;
+  result["settings"] = trialSettingsJson(options);
   result["planner"] = options.planner;
   result["seed"] = options.seed;
   result["engine"] = setup->engine();

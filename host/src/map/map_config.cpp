@@ -32,7 +32,8 @@ const std::vector<YamlKey<C>>& yamlKeys() {
        [](C& c, const YAML::Node& n, const std::string& where) {
          c.fine_map_extent =
              parseFineMapExtent(readScalar<std::string>(n, where, "a string"), where);
-       }},
+       },
+       [](const C& c) { return nlohmann::json(toString(c.fine_map_extent)); }},
       yamlField("sensor_max_range_m", &C::sensor_max_range_m),
       yamlField<C>(
           "prob_hit", [](C & c) -> auto& { return c.model.prob_hit; }),
@@ -90,6 +91,10 @@ void MapConfig::validate(const std::string& source) const {
                                 ": expected fewer than 4096 voxels per ray");
   }
   model.validate(source + ".model");
+}
+
+std::string MapConfig::toJson() const {
+  return yamlConfigJson(yamlKeys(), *this).dump();
 }
 
 MapConfig MapConfig::fromYamlFile(const std::filesystem::path& path) {

@@ -36,9 +36,9 @@ bool mapEngineNeedsBackend(std::string_view engine) {
 }
 
 std::unique_ptr<accel::Backend> createBackendFor(std::string_view engine,
-                                                 std::string_view backend_name) {
-  if (!mapEngineNeedsBackend(engine) && backend_name == "auto") return nullptr;
-  return accel::createBackend(backend_name);
+                                                 accel::BackendChoice backend) {
+  if (!mapEngineNeedsBackend(engine) && backend == accel::BackendChoice::kAuto) return nullptr;
+  return accel::createBackend(backend);
 }
 
 }  // namespace fvp::host::map

@@ -61,23 +61,30 @@ const char* toString(VisitStatus status) {
 
 void StopSpec::validate() const {
   if (!(budget_s > 0.0) || !std::isfinite(budget_s))
-    throw std::invalid_argument("stop 'budget_s': expected a positive number of seconds");
+    throw std::invalid_argument("setting 'budget_s': expected a positive number of seconds");
   if (max_views && *max_views < 1)
-    throw std::invalid_argument("stop 'max_views': expected at least 1");
+    throw std::invalid_argument("setting 'max_views': expected at least 1");
   completion.validate();
 }
 
-NbvSetup::NbvSetup(NbvSetupOptions options) : options_(std::move(options)) {
+void NbvSetupOptions::validate() const {
   const auto& planners = planner::PlannerRegistry::instance();
-  if (!planners.contains(options_.planner))
-    throw std::invalid_argument("planner: expected one of " + planners.knownNames() + ", got '" +
-                                options_.planner + "'");
+  if (!planners.contains(planner))
+    throw std::invalid_argument("setting 'planner': expected one of " + planners.knownNames() +
+                                ", got '" + planner + "'");
   const auto& engines = map::MapEngineRegistry::instance();
-  if (!options_.engine.empty() && !engines.contains(options_.engine))
-    throw std::invalid_argument("engine: expected one of " + engines.knownNames() + ", got '" +
-                                options_.engine + "'");
-  options_.stop.validate();
-  options_.perception.validate();
+  if (!engine.empty() && !engines.contains(engine))
+    throw std::invalid_argument("setting 'engine': expected one of " + engines.knownNames() +
+                                ", got '" + engine + "'");
+  stop.validate();
+  perception.validate();
+  if (loop.max_consecutive_dropped_frames < 1)
+    throw std::invalid_argument("setting 'max_consecutive_dropped_frames': expected at least 1");
+}
+
+NbvSetup::NbvSetup(NbvSetupOptions options) : options_(std::move(options)) {
+  options_.validate();
+  const auto& planners = planner::PlannerRegistry::instance();
   engine_ =
       options_.engine.empty() ? planners.at(options_.planner).default_engine : options_.engine;
   // A missing backend or a bad planner config fails here, before anything moves.

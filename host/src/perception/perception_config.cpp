@@ -53,6 +53,12 @@ const std::vector<YamlKey<C>>& yamlKeys() {
       {"hsv_fruitlet_hues_deg",
        [](C& c, const YAML::Node& n, const std::string& where) {
          c.segmentation.fruitlet_hues = hueRanges(n, where);
+       },
+       [](const C& c) {
+         nlohmann::json ranges = nlohmann::json::array();
+         for (const HueRange& r : c.segmentation.fruitlet_hues)
+           ranges.push_back({2.0 * r.min_h, 2.0 * r.max_h});
+         return ranges;
        }},
       yamlField<C>(
           "hsv_min_saturation", [](C & c) -> auto& { return c.segmentation.min_saturation; }),
@@ -63,6 +69,10 @@ const std::vector<YamlKey<C>>& yamlKeys() {
 }
 
 }  // namespace
+
+std::string PerceptionConfig::toJson() const {
+  return yamlConfigJson(yamlKeys(), *this).dump();
+}
 
 PerceptionConfig PerceptionConfig::fromYamlFile(const std::filesystem::path& path) {
   const std::string source = "perception config '" + path.string() + "'";

@@ -76,23 +76,7 @@ void PlannerConfig::validate(const std::string& source) const {
 }
 
 std::string PlannerConfig::toJson() const {
-  const nlohmann::ordered_json j = {{"roi_samples", roi_samples},
-                                    {"exploration_samples", exploration_samples},
-                                    {"sensor_min_m", sensor_min_m},
-                                    {"sensor_max_m", sensor_max_m},
-                                    {"max_d_m", max_d_m},
-                                    {"alpha_per_m", alpha_per_m},
-                                    {"utility_threshold", utility_threshold},
-                                    {"threshold_decay", threshold_decay},
-                                    {"max_sampling_rounds", max_sampling_rounds},
-                                    {"seed", seed},
-                                    {"camera_clearance_m", camera_clearance_m},
-                                    {"gain_mode", gain_mode},
-                                    {"frustum_rays_x", frustum_rays_x},
-                                    {"frustum_rays_y", frustum_rays_y},
-                                    {"embree_cull", embree_cull},
-                                    {"sizing_samples", sizing_samples}};
-  return j.dump();
+  return yamlConfigJson(yamlKeys(), *this).dump();
 }
 
 }  // namespace fvp::host::planner

@@ -66,18 +66,7 @@ void RvpConfig::validate(const std::string& source) const {
 }
 
 std::string RvpConfig::toJson() const {
-  const nlohmann::ordered_json j = {{"roi_samples", roi_samples},
-                                    {"exploration_samples", exploration_samples},
-                                    {"sensor_min_m", sensor_min_m},
-                                    {"sensor_max_m", sensor_max_m},
-                                    {"alpha_per_m", alpha_per_m},
-                                    {"roi_utility_threshold", roi_utility_threshold},
-                                    {"exploration_rays_x", exploration_rays_x},
-                                    {"exploration_rays_y", exploration_rays_y},
-                                    {"exploration_fov_x_deg", exploration_fov_x_deg},
-                                    {"exploration_box_half_m", exploration_box_half_m},
-                                    {"seed", seed}};
-  return j.dump();
+  return yamlConfigJson(yamlKeys(), *this).dump();
 }
 
 }  // namespace fvp::host::planner

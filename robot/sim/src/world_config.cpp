@@ -248,11 +248,7 @@ WorldConfig WorldConfig::withErrorsScaled(const std::string& group, double facto
 }
 
 std::string WorldConfig::toJson() const {
-  nlohmann::ordered_json json;
-  for (const KeySpec& spec : keySpecs()) {
-    std::visit([&](auto field) { json[spec.name] = this->*field; }, spec.member);
-  }
-  return json.dump();
+  return host::yamlConfigJson(yamlKeys(), *this).dump();
 }
 
 }  // namespace fvp::robot::sim

@@ -16,6 +16,7 @@
 #include <string_view>
 #include <vector>
 
+#include "fvp/accel/backend_choice.h"
 #include "fvp/accel/kernel.h"
 #include "fvp/accel/kernel_types.h"
 
@@ -146,9 +147,12 @@ std::vector<BackendInfo> probeBackends();
 /// Creates the named backend or throws BackendUnavailable saying what is missing.
 std::unique_ptr<Backend> createBackend(BackendKind kind);
 
-/// "cpu" | "opencl" | "vulkan" | "auto". auto picks a GPU device (OpenCL first, then
-/// Vulkan) when one exists, else the CPU reference. Throws std::invalid_argument for an
-/// unknown name and BackendUnavailable for an explicitly named backend that cannot run.
+/// The chosen backend. kAuto picks a GPU device (OpenCL first, then Vulkan) when one exists,
+/// else the CPU reference. Throws BackendUnavailable for an explicitly chosen backend that
+/// cannot run (never a silent fallback).
+std::unique_ptr<Backend> createBackend(BackendChoice choice);
+
+/// createBackend(parseBackendChoice(name)); throws std::invalid_argument for an unknown name.
 std::unique_ptr<Backend> createBackend(std::string_view name);
 
 }  // namespace fvp::accel

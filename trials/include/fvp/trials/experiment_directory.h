@@ -36,11 +36,6 @@ std::vector<nlohmann::json> readTrials(const std::filesystem::path& jsonl,
 /// finite positive number), matched (a bool) and est_size_mm (a finite number when matched).
 void checkTrial(const nlohmann::json& trial, const std::string& where);
 
-/// The planners an experiment knows ("fvp", "rvp").
-const std::vector<std::string>& experimentPlanners();
-/// The map engines a trial line or a manifest may name ("grid", "octomap": the built-in
-/// entries of host::map::MapEngineRegistry, which a test holds equal).
-const std::vector<std::string>& experimentEngines();
 /// The error groups of --error-scale (robot::sim::WorldConfig::errorGroups(), held equal by
 /// a test): pose, stereo, wind, segmentation, light, all.
 const std::vector<std::string>& errorScaleGroups();

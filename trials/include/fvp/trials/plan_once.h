@@ -10,13 +10,15 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "fvp/accel/backend_choice.h"
+
 namespace fvp::trials {
 
 struct PlanOnceOptions {
   std::string planner = "fvp";  ///< fvp | rvp
   std::uint64_t seed = 1;
   int views = 5;  ///< K views over a 90 degree arc around the cluster
-  std::string backend = "auto";
+  accel::BackendChoice backend = accel::BackendChoice::kAuto;
   std::string engine;  ///< empty: the planner's default
   std::filesystem::path world_config, planner_config;
   std::filesystem::path out_dir;  ///< plan.json, candidates.ply

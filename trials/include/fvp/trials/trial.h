@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 
+#include "fvp/accel/backend_choice.h"
 #include "fvp/host/nbv/stop_rule.h"
 #include "fvp/robot/sim/sim_clock.h"
 
@@ -38,9 +39,9 @@ struct TrialOptions {
   std::filesystem::path planner_config;  ///< empty: the planner's default config
   std::filesystem::path arm_config;  ///< empty: the built-in arm (robot/config/arm_default.yaml)
   double budget_s = 180.0;           ///< simulated seconds (paper: 180)
-  std::string backend = "auto";      ///< cpu | opencl | vulkan | auto
-  std::string engine;                ///< grid | octomap; empty: the planner's default
-  std::optional<int> max_views;      ///< stop after this many views (tests)
+  accel::BackendChoice backend = accel::BackendChoice::kAuto;
+  std::string engine;            ///< grid | octomap; empty: the planner's default
+  std::optional<int> max_views;  ///< stop after this many views (tests)
   /// wall: compute charged as measured; fixed: as constants (runs repeat exactly).
   robot::sim::SimClock::Mode clock = robot::sim::SimClock::Mode::kWall;
   /// budget: the paper's protocol (budget_s, max_views); auto: also stop once the cluster's

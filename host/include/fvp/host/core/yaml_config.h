@@ -13,6 +13,7 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -188,13 +189,27 @@ inline Eigen::Vector3d readVector3(const YAML::Node& node, const std::string& wh
           readScalar<double>(node[2], where, expected)};
 }
 
-/// One key of a config file: its name and how its value is read into the config (`where`
-/// names the source and the key for errors).
+/// One key of a config file: its name, how its value is read into the config (`where` names
+/// the source and the key for errors) and how the config's value is written as JSON (the
+/// config's toJson: each config lists its keys once, for both).
 template <typename Config>
 struct YamlKey {
   const char* name;
   std::function<void(Config& config, const YAML::Node& value, const std::string& where)> read;
+  std::function<nlohmann::json(const Config& config)> write;
 };
+
+/// A config value as JSON: 3-vectors as [x, y, z], an unset optional as null.
+template <typename T>
+nlohmann::json yamlValueJson(const T& value) {
+  if constexpr (std::is_same_v<T, Eigen::Vector3d>) {
+    return nlohmann::json::array({value.x(), value.y(), value.z()});
+  } else if constexpr (std::is_same_v<T, std::optional<Eigen::Vector3d>>) {
+    return value ? yamlValueJson(*value) : nlohmann::json(nullptr);
+  } else {
+    return value;
+  }
+}
 
 /// A value of type T from a node: integers, finite numbers, booleans, strings, 3-vectors and
 /// optional 3-vectors.
@@ -219,18 +234,23 @@ T readYamlValue(const YAML::Node& node, const std::string& where) {
 /// The key that reads its value into config.*member.
 template <typename Config, typename T>
 YamlKey<Config> yamlField(const char* name, T Config::*member) {
-  return {name, [member](Config& c, const YAML::Node& n, const std::string& where) {
+  return {name,
+          [member](Config& c, const YAML::Node& n, const std::string& where) {
             c.*member = readYamlValue<T>(n, where);
-          }};
+          },
+          [member](const Config& c) { return yamlValueJson(c.*member); }};
 }
 
 /// The key that reads its value into field(config), a member of a member.
 template <typename Config, typename Field>
 YamlKey<Config> yamlField(const char* name, Field field) {
-  return {name, [field](Config& c, const YAML::Node& n, const std::string& where) {
+  return {name,
+          [field](Config& c, const YAML::Node& n, const std::string& where) {
             auto& target = field(c);
             target = readYamlValue<std::decay_t<decltype(target)>>(n, where);
-          }};
+          },
+          // field only selects a member: reading through it changes nothing.
+          [field](const Config& c) { return yamlValueJson(field(const_cast<Config&>(c))); }};
 }
 
 /// Reads the file's keys into config (missing keys keep config's values): each key by its
@@ -245,6 +265,19 @@ void readYamlConfig(const std::filesystem::path& path, const std::string& source
     const std::string key = keyString(item.first, source);
     findKeySpec(keys, key, source).read(config, item.second, source + ": key '" + key + "'");
   }
+}
+
+/// The config as JSON, one member per key of its table, in the table's order (a config's
+/// toJson; result.json's config). Throws std::logic_error for a key with no writer.
+template <typename Config>
+nlohmann::ordered_json yamlConfigJson(const std::vector<YamlKey<Config>>& keys,
+                                      const Config& config) {
+  nlohmann::ordered_json json = nlohmann::ordered_json::object();
+  for (const auto& key : keys) {
+    if (!key.write) throw std::logic_error(std::string("config key '") + key.name + "': no writer");
+    json[key.name] = key.write(config);
+  }
+  return json;
 }
 
 /// The names of a key table, in its order.

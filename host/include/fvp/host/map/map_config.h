@@ -45,6 +45,8 @@ struct MapConfig {
   /// their defaults. Unknown keys, wrong types and out-of-range values throw
   /// std::invalid_argument naming the file and the key.
   static MapConfig fromYamlFile(const std::filesystem::path& path);
+  /// The file's keys as JSON, from the same key table (reading it as YAML gives this config).
+  std::string toJson() const;
 };
 
 }  // namespace fvp::host::map

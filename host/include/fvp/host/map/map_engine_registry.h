@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include "fvp/accel/backend_choice.h"
 #include "fvp/host/core/cluster_region.h"
 #include "fvp/host/core/named_registry.h"
 #include "fvp/host/map/map_config.h"
@@ -44,9 +45,9 @@ class MapEngineRegistry : public NamedRegistry<MapEngineEntry> {
 
 /// Whether the named engine needs a compute backend (throws for an unknown name).
 bool mapEngineNeedsBackend(std::string_view engine);
-/// The backend a run on this engine uses: backend_name ("cpu", "opencl", "vulkan", "auto")
-/// when the engine needs one or a backend is named (not "auto"), else none (null).
+/// The backend a run on this engine uses: the chosen one when the engine needs one or a
+/// backend is named (not kAuto), else none (null).
 std::unique_ptr<accel::Backend> createBackendFor(std::string_view engine,
-                                                 std::string_view backend_name);
+                                                 accel::BackendChoice backend);
 
 }  // namespace fvp::host::map

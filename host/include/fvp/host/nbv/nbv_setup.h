@@ -17,6 +17,7 @@
 #include <string_view>
 #include <vector>
 
+#include "fvp/accel/backend_choice.h"
 #include "fvp/host/nbv/arm.h"
 #include "fvp/host/nbv/camera.h"
 #include "fvp/host/nbv/cluster_completion.h"
@@ -65,7 +66,7 @@ struct NbvSetupOptions {
   std::string planner = "fvp";           ///< a PlannerRegistry name
   std::filesystem::path planner_config;  ///< empty: the planner's defaults
   std::string engine;                    ///< a MapEngineRegistry name; empty: the planner's
-  std::string backend = "auto";          ///< cpu | opencl | vulkan | auto (accel/backend.h)
+  accel::BackendChoice backend = accel::BackendChoice::kAuto;
   /// Cluster k of a tour (its index in the targets) seeds its planner with planner_seed + k.
   std::uint64_t planner_seed = 1;
   /// Align each view to the earlier ones before fusing it (MappingSession::
@@ -77,6 +78,9 @@ struct NbvSetupOptions {
   sizing::SizingConfig sizing;
   StopSpec stop;
   NbvLoopOptions loop;
+  /// Checks every setting without creating anything; throws std::invalid_argument naming the
+  /// bad one ("setting 'planner': expected one of fvp,rvp, got 'x'").
+  void validate() const;
 };
 
 /// One cluster's mapping session and planner: what the loop fills and the sizing reads.

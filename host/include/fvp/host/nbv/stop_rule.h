@@ -2,6 +2,7 @@
 // command line's parse-only build (fuzz/cli_fuzzer.cpp) parses it without the loop.
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -13,6 +14,8 @@ enum class StopRule {
   kAuto,    ///< also once the cluster's sizes have settled (cluster_completion.h)
 };
 
+inline constexpr std::array<StopRule, 2> kStopRules = {StopRule::kBudget, StopRule::kAuto};
+
 /// "budget" / "auto" (the CLI's --stop, result.json's stop.rule).
 inline const char* toString(StopRule rule) {
   return rule == StopRule::kAuto ? "auto" : "budget";
@@ -20,7 +23,7 @@ inline const char* toString(StopRule rule) {
 
 /// The rule of a name; nothing for an unknown name.
 inline std::optional<StopRule> stopRuleFromString(std::string_view name) {
-  for (const StopRule rule : {StopRule::kBudget, StopRule::kAuto})
+  for (const StopRule rule : kStopRules)
     if (name == toString(rule)) return rule;
   return std::nullopt;
 }
