@@ -76,6 +76,29 @@ void Backend::download(const DeviceBuffer& buf, void* dst, std::size_t size_byte
   ++downloads_;
 }
 
+void Backend::uploadRanges(DeviceBuffer& buf, const void* src_image,
+                           std::span<const ByteRange> ranges) {
+  std::vector<ByteRange> nonempty;
+  std::size_t bytes = 0;
+  for (const ByteRange& r : ranges) {
+    checkRange(buf, r.size_bytes, r.offset_bytes, "uploadRanges");
+    if (!r.size_bytes) continue;
+    nonempty.push_back(r);
+    bytes += r.size_bytes;
+  }
+  if (nonempty.empty()) return;
+  uploadRangesBytes(buf, src_image, nonempty);
+  upload_bytes_ += bytes;
+  ++uploads_;
+}
+
+void Backend::uploadRangesBytes(DeviceBuffer& buf, const void* src_image,
+                                std::span<const ByteRange> ranges) {
+  const auto* image = static_cast<const std::uint8_t*>(src_image);
+  for (const ByteRange& r : ranges)
+    uploadBytes(buf, image + r.offset_bytes, r.size_bytes, r.offset_bytes);
+}
+
 TransferCounters Backend::transfers() const {
   return {upload_bytes_.load(), download_bytes_.load(), uploads_.load(), downloads_.load()};
 }

@@ -164,6 +164,16 @@ class OpenClBackend final : public Backend {
                      std::size_t offset_bytes) override {
     FVP_CL(queue_.enqueueReadBuffer(clBuf(buf), CL_TRUE, offset_bytes, size_bytes, dst));
   }
+  // Non-blocking writes on the in-order queue and one wait: the host image stays alive
+  // until finish() returns.
+  void uploadRangesBytes(DeviceBuffer& buf, const void* src_image,
+                         std::span<const ByteRange> ranges) override {
+    const auto* image = static_cast<const std::uint8_t*>(src_image);
+    for (const ByteRange& r : ranges)
+      FVP_CL(queue_.enqueueWriteBuffer(clBuf(buf), CL_FALSE, r.offset_bytes, r.size_bytes,
+                                       image + r.offset_bytes));
+    FVP_CL(queue_.finish());
+  }
 
   void dispatchKernel(const KernelDescriptor& kernel, const void* params,
                       std::span<DeviceBuffer* const> buffers, std::uint32_t item_count) override {

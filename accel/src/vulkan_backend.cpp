@@ -174,6 +174,33 @@ class VulkanBackend final : public Backend {
     });
   }
 
+  // Every range packed into the staging buffer, then one copy command with a region per
+  // range and one submission: a submission and fence wait cost ~0.3-0.5 ms on an H100.
+  void uploadRangesBytes(DeviceBuffer& buf, const void* src_image,
+                         std::span<const ByteRange> ranges) override {
+    const VkBuffer& dst = vkBuf(buf);
+    const auto* image = static_cast<const std::uint8_t*>(src_image);
+    if (dst.mapped()) {
+      for (const ByteRange& r : ranges)
+        std::memcpy(dst.mapped() + r.offset_bytes, image + r.offset_bytes, r.size_bytes);
+      return;
+    }
+    std::size_t total = 0;
+    for (const ByteRange& r : ranges) total += r.size_bytes;
+    const VkBuffer& staging = stagingBuffer(staging_upload_, total, Placement::kStagingUpload);
+    std::vector<vk::BufferCopy> regions;
+    regions.reserve(ranges.size());
+    std::size_t packed = 0;
+    for (const ByteRange& r : ranges) {
+      std::memcpy(staging.mapped() + packed, image + r.offset_bytes, r.size_bytes);
+      regions.emplace_back(packed, r.offset_bytes, r.size_bytes);
+      packed += r.size_bytes;
+    }
+    submit([&](const vk::raii::CommandBuffer& cmd) {
+      cmd.copyBuffer(staging.get(), dst.get(), regions);
+    });
+  }
+
   void downloadBytes(const DeviceBuffer& buf, void* dst, std::size_t size_bytes,
                      std::size_t offset_bytes) override {
     const VkBuffer& src = vkBuf(buf);

@@ -4,6 +4,7 @@
 
 #include "backend_fixture.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <random>
 #include <string>
@@ -57,6 +58,32 @@ TEST_P(BackendTest, UploadDownloadRoundTripsAndChecksRanges) {
   EXPECT_THROW(backend_->upload(*buf, patch, sizeof(patch), 999 * sizeof(float)),
                std::out_of_range);
   EXPECT_THROW(backend_->download(*buf, back, 4001), std::out_of_range);
+}
+
+// The planner's snapshot update: scattered ranges of a host image in one transfer, bytes
+// outside them untouched, on the staging path (discrete GPUs) as on mapped memory.
+TEST_P(BackendTest, UploadRangesCopiesOnlyTheRangesInOneTransfer) {
+  const std::uint64_t seed = fvp::testing::freshSeed();
+  SCOPED_TRACE(fvp::testing::replayHint(seed));
+  std::mt19937_64 rng(seed);
+  std::vector<std::uint8_t> device_was(100000), image(device_was.size());
+  for (auto& b : device_was) b = static_cast<std::uint8_t>(rng());
+  for (auto& b : image) b = static_cast<std::uint8_t>(rng());
+  auto buf = backend_->createBufferFrom(device_was);
+  std::vector<ByteRange> ranges;
+  std::vector<std::uint8_t> want = device_was;
+  for (int i = 0; i < 200; ++i) {
+    const std::size_t offset = rng() % image.size();
+    const std::size_t size = std::min<std::size_t>(rng() % 300, image.size() - offset);
+    ranges.push_back({offset, size});  // overlapping and empty ones included
+    std::copy_n(image.begin() + offset, size, want.begin() + offset);
+  }
+  backend_->resetTransfers();
+  backend_->uploadRanges(*buf, image.data(), ranges);
+  EXPECT_EQ(backend_->transfers().uploads, 1u);
+  EXPECT_EQ(backend_->downloadAll<std::uint8_t>(*buf), want);
+  const ByteRange outside[] = {{99990, 11}};
+  EXPECT_THROW(backend_->uploadRanges(*buf, image.data(), outside), std::out_of_range);
 }
 
 TEST_P(BackendTest, TraverseRejectsShortBuffers) {

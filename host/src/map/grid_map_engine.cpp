@@ -50,6 +50,25 @@ void GridMapEngine::placeFineMap() {
   fine_ = std::make_unique<FineLevel>(backend_, config(), region());
   distance_max_d_m_ = -1.0;
   scene_change_[1] = 0;
+  log_change_[1] = 0;
+}
+
+void GridMapEngine::syncChangeLogs() {
+  for (MapLevel level : {MapLevel::kCoarse, MapLevel::kFine}) {
+    const BrickLayer& bricks =
+        level == MapLevel::kCoarse ? coarse_.bricks() : fine_->layer.bricks();
+    std::uint64_t& synced = log_change_[level == MapLevel::kCoarse ? 0 : 1];
+    if (synced == bricks.changeCount()) continue;
+    // The layer stamps allocated bricks; the log counts bricks of the grid's table.
+    const auto& stamps = bricks.brickChangeStamps();
+    const auto& coords = bricks.brickCoords();
+    std::vector<int> changed;
+    for (std::size_t b = 0; b < stamps.size(); ++b)
+      if (stamps[b] > synced)
+        changed.push_back(bricks.brickIndex(coords[3 * b], coords[3 * b + 1], coords[3 * b + 2]));
+    changeLog(level).markBricks(changed);
+    synced = bricks.changeCount();
+  }
 }
 
 void GridMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
@@ -138,6 +157,14 @@ void GridMapEngine::updateRoiDistance(double max_d_m) {
   const double voxel = fine_->layer.geometry().voxel_size_m;
   const int radius_vox = std::max(1, static_cast<int>(std::ceil(max_d_m / voxel)));
   fine_->distance.compute(radius_vox);
+  // d_i enters what readers derive from the fine map (the gain snapshot's weights).
+  const BrickLayer& bricks = fine_->layer.bricks();
+  std::vector<int> changed;
+  for (std::uint32_t b : fine_->distance.changedBricks()) {
+    const int* c = &bricks.brickCoords()[3 * std::size_t(b)];
+    changed.push_back(bricks.brickIndex(c[0], c[1], c[2]));
+  }
+  changeLog(MapLevel::kFine).markBricks(changed);
   distance_max_d_m_ = max_d_m;
 }
 

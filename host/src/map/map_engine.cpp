@@ -27,6 +27,19 @@ void MapEngine::moveToRegion(const ClusterRegion& region) {
   region_ = region;
   scenes_[1] = SceneState{};  // the fine scene described the old region's voxels
   placeFineMap();
+  change_logs_[1] = BrickChangeLog(gridGeometry(MapLevel::kFine));  // a new epoch
+}
+
+BrickChangeLog& MapEngine::changeLog(MapLevel level) {
+  BrickChangeLog& log = change_logs_[level == MapLevel::kCoarse ? 0 : 1];
+  // Placed here, not in the constructor: the lattice comes from the engine (virtual).
+  if (log.brickCount() == 0) log.reset(gridGeometry(level));
+  return log;
+}
+
+BrickChanges MapEngine::changesSince(MapLevel level, const ChangeCursor& since) {
+  syncChangeLogs();
+  return changeLog(level).changesSince(since);
 }
 
 const OccupiedVoxelScene& MapEngine::occupiedScene(MapLevel level) {

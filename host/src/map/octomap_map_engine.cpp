@@ -455,13 +455,20 @@ void OctomapMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
   shards.clear();
   const std::vector<std::uint64_t> coarse_sorted = sortedUnion(std::move(coarse_updates));
   const std::vector<std::uint64_t> fine_sorted = sortedUnion(std::move(fine_updates));
+  // Every updated voxel of a grid goes to the change log (readers refresh its brick).
+  BrickChangeLog& coarse_log = changeLog(MapLevel::kCoarse);
+  BrickChangeLog& fine_log = changeLog(MapLevel::kFine);
+  std::array<int, 3> index;
   for (const std::uint64_t entry : coarse_sorted) {
-    coarse_->updateNode(keyOfTreeOrder(entry), updateOfTreeOrder(entry) != kUpdateFree,
-                        /*lazy_eval=*/true);
+    const octomap::OcTreeKey key = keyOfTreeOrder(entry);
+    coarse_->updateNode(key, updateOfTreeOrder(entry) != kUpdateFree, /*lazy_eval=*/true);
+    if (inGrid(coarse_grid_, key_offset_, key, index)) coarse_log.markVoxel(index);
   }
   for (const std::uint64_t entry : fine_sorted) {
     const UpdateKind update = updateOfTreeOrder(entry);
-    fine_->updateNodeAndRoi(keyOfTreeOrder(entry), update != kUpdateFree,
+    const octomap::OcTreeKey key = keyOfTreeOrder(entry);
+    if (inGrid(fine_grid_, key_offset_, key, index)) fine_log.markVoxel(index);
+    fine_->updateNodeAndRoi(key, update != kUpdateFree,
                             update == kUpdateRoiHit ? RoiOcTree::RoiUpdate::kHit
                             : update == kUpdateHit  ? RoiOcTree::RoiUpdate::kMiss
                                                     : RoiOcTree::RoiUpdate::kNone,
@@ -471,6 +478,8 @@ void OctomapMapEngine::integrateScan(const Eigen::Vector3d& sensor_origin_m,
   coarse_->prune();
   fine_->updateInnerOccupancy();
   fine_->prune();
+  coarse_log.commitVoxels();
+  fine_log.commitVoxels();
   stats.coarse_voxels_updated = coarse_sorted.size();
   stats.fine_voxels_updated = fine_sorted.size();
 }
@@ -613,6 +622,9 @@ void OctomapMapEngine::updateRoiDistance(double max_d_m) {
   // The grid engine's window radius: the same cap in voxels on both engines.
   const int radius_vox = std::max(1, static_cast<int>(std::ceil(max_d_m / voxel)));
   const auto& dims = fine_grid_.dims;
+  // The previous field, to record in the change log the voxels whose d_i this one changes.
+  const std::vector<float> previous =
+      distance_max_d_m_ == max_d_m ? std::move(distance_vox_) : std::vector<float>{};
   distance_vox_.assign(static_cast<std::size_t>(fine_grid_.voxelCount()),
                        static_cast<float>(radius_vox));
 
@@ -649,8 +661,24 @@ void OctomapMapEngine::updateRoiDistance(double max_d_m) {
               fvp_edt_distance_vox(static_cast<unsigned int>(sq), radius_vox);
         }
   }
+  recordDistanceChanges(previous);
   distance_max_d_m_ = max_d_m;
   distance_scans_ = scanCount();
+}
+
+void OctomapMapEngine::recordDistanceChanges(const std::vector<float>& previous) {
+  BrickChangeLog& log = changeLog(MapLevel::kFine);
+  if (previous.size() != distance_vox_.size()) {  // first field or a new cap
+    log.markAll();
+    return;
+  }
+  const auto& dims = fine_grid_.dims;
+  std::size_t i = 0;
+  for (int z = 0; z < dims[2]; ++z)
+    for (int y = 0; y < dims[1]; ++y)
+      for (int x = 0; x < dims[0]; ++x, ++i)
+        if (distance_vox_[i] != previous[i]) log.markVoxel({x, y, z});
+  log.commitVoxels();
 }
 
 double OctomapMapEngine::roiDistance_m(const std::array<int, 3>& fine_index) const {

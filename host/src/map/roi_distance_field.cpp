@@ -53,6 +53,16 @@ std::vector<char> RoiDistanceField::roiHalo(int radius_vox) const {
 
 void RoiDistanceField::compute(int radius_vox) {
   BrickLayer& bricks = layer_.bricks();
+  // The previous distances, to tell readers which bricks this computation changed.
+  std::vector<float> previous;
+  const int previous_radius_vox = computed_ ? radius_vox_ : -1;
+  if (computed_) {
+    std::lock_guard<std::mutex> lock(mirror_mutex_);
+    downloadMirrorLocked();
+    previous = std::move(mirror_);
+    mirror_.clear();
+    mirror_ready_.store(false, std::memory_order_release);
+  }
   // The channel costs 4 bytes per slot: added when first needed.
   if (!distance_) distance_ = bricks.addChannel("roi_distance_vox", sizeof(float), 0u);
   std::vector<char> near = roiHalo(radius_vox);
@@ -103,8 +113,34 @@ void RoiDistanceField::compute(int radius_vox) {
   computed_change_ = bricks.changeCount();
   computed_layout_ = bricks.layoutVersion();
   std::lock_guard<std::mutex> lock(mirror_mutex_);
-  mirror_ready_.store(false, std::memory_order_release);
-  mirror_.clear();  // downloaded on the first read
+  mirror_.clear();
+  downloadMirrorLocked();
+  findChangedBricks(previous, previous_radius_vox);
+}
+
+void RoiDistanceField::downloadMirrorLocked() const {
+  if (mirror_.empty()) {
+    mirror_.resize(computed_slots_);
+    const BrickLayer& bricks = layer_.bricks();
+    bricks.backend().download(bricks.channel(*distance_), mirror_.data(),
+                              mirror_.size() * sizeof(float));
+  }
+  mirror_ready_.store(true, std::memory_order_release);
+}
+
+void RoiDistanceField::findChangedBricks(const std::vector<float>& previous,
+                                         int previous_radius_vox) {
+  changed_bricks_.clear();
+  const std::size_t bricks = computed_slots_ / accel::kBrickVoxels;
+  for (std::size_t b = 0; b < bricks; ++b) {
+    bool changed = previous_radius_vox != radius_vox_;
+    // Slots allocated since the previous computation read the cap before it.
+    for (std::size_t slot = b * accel::kBrickVoxels;
+         !changed && slot < (b + 1) * accel::kBrickVoxels; ++slot)
+      changed =
+          mirror_[slot] != (slot < previous.size() ? previous[slot] : float(previous_radius_vox));
+    if (changed) changed_bricks_.push_back(static_cast<std::uint32_t>(b));
+  }
 }
 
 float RoiDistanceField::distanceVoxAt(const std::array<int, 3>& index) const {
@@ -117,12 +153,7 @@ float RoiDistanceField::distanceVoxAt(const std::array<int, 3>& index) const {
   // The snapshot reads every voxel: once the mirror is down, no lock.
   if (!mirror_ready_.load(std::memory_order_acquire)) {
     std::lock_guard<std::mutex> lock(mirror_mutex_);
-    if (mirror_.empty()) {
-      mirror_.resize(computed_slots_);
-      bricks.backend().download(bricks.channel(*distance_), mirror_.data(),
-                                mirror_.size() * sizeof(float));
-    }
-    mirror_ready_.store(true, std::memory_order_release);
+    downloadMirrorLocked();
   }
   return mirror_[static_cast<std::size_t>(slot)];
 }

@@ -1,6 +1,7 @@
 #include "fvp/host/planner/info_gain_evaluator.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -86,9 +87,121 @@ const char* InfoGainEvaluator::walkDevice() const {
   return backend_ ? accel::toString(backend_->kind()).data() : "host";
 }
 
+namespace {
+
+bool sameGrid(const map::GridGeometry& a, const map::GridGeometry& b) {
+  return a.voxel_size_m == b.voxel_size_m && a.first_voxel == b.first_voxel && a.dims == b.dims;
+}
+
+// Ranges closer than this are sent as one: a transfer (an enqueued write, a copy region)
+// costs about what copying a few KB does, and the bytes between two ranges of the host
+// image equal what the device holds anyway.
+constexpr std::size_t kMergeGapBytes = 4096;
+
+/// The byte ranges of a dense snapshot (x fastest, voxels_per_word voxels to a 32-bit word)
+/// that the given bricks occupy: per brick and z plane, its first row's first word to its
+/// last row's last; sorted and merged.
+std::vector<accel::ByteRange> brickRanges(const map::GridGeometry& grid,
+                                          const std::array<int, 3>& bricks_per_axis,
+                                          const std::vector<int>& bricks, int voxels_per_word) {
+  constexpr int e = map::BrickChangeLog::kBrickEdge;
+  const std::size_t dx = grid.dims[0], dy = grid.dims[1];
+  std::vector<accel::ByteRange> ranges;
+  ranges.reserve(bricks.size() * e);
+  for (int id : bricks) {
+    const int bx = id % bricks_per_axis[0], by = (id / bricks_per_axis[0]) % bricks_per_axis[1],
+              bz = id / (bricks_per_axis[0] * bricks_per_axis[1]);
+    for (int z = bz * e; z < std::min(bz * e + e, grid.dims[2]); ++z) {
+      const std::size_t first = bx * e + dx * (by * e + dy * z);
+      const std::size_t last = std::min(bx * e + e, grid.dims[0]) - 1 +
+                               dx * (std::min(by * e + e, grid.dims[1]) - 1 + dy * z);
+      const std::size_t w0 = first / voxels_per_word, w1 = last / voxels_per_word + 1;
+      ranges.push_back({w0 * sizeof(std::uint32_t), (w1 - w0) * sizeof(std::uint32_t)});
+    }
+  }
+  std::sort(ranges.begin(), ranges.end(),
+            [](const auto& a, const auto& b) { return a.offset_bytes < b.offset_bytes; });
+  std::vector<accel::ByteRange> merged;
+  for (const accel::ByteRange& r : ranges) {
+    if (!merged.empty() &&
+        r.offset_bytes <= merged.back().offset_bytes + merged.back().size_bytes + kMergeGapBytes) {
+      const std::size_t end = std::max(merged.back().offset_bytes + merged.back().size_bytes,
+                                       r.offset_bytes + r.size_bytes);
+      merged.back().size_bytes = end - merged.back().offset_bytes;
+    } else {
+      merged.push_back(r);
+    }
+  }
+  return merged;
+}
+
+/// Bricks per axis of a grid (brick_change_log.h).
+std::array<int, 3> bricksPerAxis(const map::GridGeometry& grid) {
+  constexpr int e = map::BrickChangeLog::kBrickEdge;
+  return {(grid.dims[0] + e - 1) / e, (grid.dims[1] + e - 1) / e, (grid.dims[2] + e - 1) / e};
+}
+
+/// Calls f(index) for every voxel of a brick (brick_change_log.h id) of the grid.
+template <typename F>
+void forVoxelsOfBrick(const map::GridGeometry& grid, const std::array<int, 3>& bricks_per_axis,
+                      int id, F&& f) {
+  constexpr int e = map::BrickChangeLog::kBrickEdge;
+  const int bx = id % bricks_per_axis[0], by = (id / bricks_per_axis[0]) % bricks_per_axis[1],
+            bz = id / (bricks_per_axis[0] * bricks_per_axis[1]);
+  for (int z = bz * e; z < std::min(bz * e + e, grid.dims[2]); ++z)
+    for (int y = by * e; y < std::min(by * e + e, grid.dims[1]); ++y)
+      for (int x = bx * e; x < std::min(bx * e + e, grid.dims[0]); ++x)
+        f(std::array<int, 3>{x, y, z});
+}
+
+}  // namespace
+
 double InfoGainEvaluator::refresh(map::MapEngine& map) {
   const auto start = std::chrono::steady_clock::now();
   map.updateRoiDistance(config_.max_d_m);
+  const auto distance_done = std::chrono::steady_clock::now();
+  const map::BrickChanges fine = map.changesSince(map::MapLevel::kFine, fine_cursor_);
+  const map::BrickChanges coarse = map.changesSince(map::MapLevel::kCoarse, coarse_cursor_);
+  // The cursors' epochs already tell another map or region; the grids are checked too,
+  // since everything below indexes them.
+  const bool same = ready_ && !fine.all && !coarse.all &&
+                    sameGrid(fine_, map.gridGeometry(map::MapLevel::kFine)) &&
+                    sameGrid(coarse_, map.gridGeometry(map::MapLevel::kCoarse)) &&
+                    region_center_m_ == map.region().center_m() &&
+                    region_radius_m_ == map.region().radius_m();
+  last_refresh_ = SnapshotRefreshStats{};
+  if (same) {
+    updateBricks(map, fine.bricks, coarse.bricks);
+  } else {
+    rebuild(map);
+  }
+  coarse_scene_ = config_.embree_cull ? &map.occupiedScene(map::MapLevel::kCoarse) : nullptr;
+  fine_cursor_ = fine.now;
+  coarse_cursor_ = coarse.now;
+  ready_ = true;
+  snapshot_scans_ = map.scanCount();
+  const auto end = std::chrono::steady_clock::now();
+  last_refresh_.distance_s = std::chrono::duration<double>(distance_done - start).count();
+  last_refresh_.snapshot_s = std::chrono::duration<double>(end - distance_done).count();
+  return std::chrono::duration<double>(end - start).count();
+}
+
+std::uint16_t InfoGainEvaluator::computeFineCode(const map::MapEngine& map,
+                                                 const fvp_region& region,
+                                                 const std::array<int, 3>& index) const {
+  if (!fvp_region_contains(&region, index[0], index[1], index[2])) return 0;
+  const map::VoxelState s = map.fineState(fine_.voxelCenter_m(index));
+  std::uint16_t code = kInRegion;
+  if (s.occupancy == map::VoxelClass::kOccupied) {
+    code |= kOccupied;
+  } else if (s.occupancy == map::VoxelClass::kUnknown) {
+    const double w = roiProximityWeight(map.roiDistance_m(index), config_.max_d_m);
+    code |= static_cast<std::uint16_t>(std::lround(w * kWeightScale));
+  }
+  return code;
+}
+
+void InfoGainEvaluator::rebuild(const map::MapEngine& map) {
   fine_ = map.gridGeometry(map::MapLevel::kFine);
   coarse_ = map.gridGeometry(map::MapLevel::kCoarse);
   region_center_m_ = map.region().center_m();
@@ -106,35 +219,79 @@ double InfoGainEvaluator::refresh(map::MapEngine& map) {
   // Codes per voxel first (z slices in parallel: the engines' const reads are thread-safe),
   // then packed two to a word.
   const fvp_region region = map::regionInGrid(fine_, map.region());
-  const map::MapEngine& reader = map;
   std::vector<std::uint16_t> codes(static_cast<std::size_t>(fine_.voxelCount()), 0);
 #pragma omp parallel for schedule(dynamic, 1)
   for (int z = 0; z < fine_.dims[2]; ++z)
     for (int y = 0; y < fine_.dims[1]; ++y)
-      for (int x = 0; x < fine_.dims[0]; ++x) {
-        if (!fvp_region_contains(&region, x, y, z)) continue;
-        const std::array<int, 3> index{x, y, z};
-        const map::VoxelState s = reader.fineState(fine_.voxelCenter_m(index));
-        std::uint16_t code = kInRegion;
-        if (s.occupancy == map::VoxelClass::kOccupied) {
-          code |= kOccupied;
-        } else if (s.occupancy == map::VoxelClass::kUnknown) {
-          const double w = roiProximityWeight(reader.roiDistance_m(index), config_.max_d_m);
-          code |= static_cast<std::uint16_t>(std::lround(w * kWeightScale));
-        }
-        codes[x + std::size_t(fine_.dims[0]) * (y + std::size_t(fine_.dims[1]) * z)] = code;
-      }
+      for (int x = 0; x < fine_.dims[0]; ++x)
+        codes[x + std::size_t(fine_.dims[0]) * (y + std::size_t(fine_.dims[1]) * z)] =
+            computeFineCode(map, region, {x, y, z});
   fine_words_.assign(accel::gainFineWords(fine_.params()), 0u);
   for (std::size_t i = 0; i < codes.size(); ++i)
     fine_words_[i >> 1] |= std::uint32_t{codes[i]} << ((i & 1) * 16);
-  coarse_scene_ = config_.embree_cull ? &map.occupiedScene(map::MapLevel::kCoarse) : nullptr;
   if (backend_) {
     fine_device_ = backend_->createBufferFrom(fine_words_);
     coarse_device_ = backend_->createBufferFrom(coarse_words_);
+    last_refresh_.upload_bytes = snapshotBytes();
+    last_refresh_.upload_ranges = 2;
   }
-  ready_ = true;
-  snapshot_scans_ = map.scanCount();
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  last_refresh_.full = true;
+  const auto bricks = [](const map::GridGeometry& g) {
+    const std::array<int, 3> n = bricksPerAxis(g);
+    return std::size_t(n[0]) * n[1] * n[2];
+  };
+  last_refresh_.fine_bricks = bricks(fine_);
+  last_refresh_.coarse_bricks = bricks(coarse_);
+}
+
+void InfoGainEvaluator::updateBricks(const map::MapEngine& map, const std::vector<int>& fine_bricks,
+                                     const std::vector<int>& coarse_bricks) {
+  const std::array<int, 3> fine_per_axis = bricksPerAxis(fine_);
+  const std::array<int, 3> coarse_per_axis = bricksPerAxis(coarse_);
+  const fvp_region region = map::regionInGrid(fine_, map.region());
+  // Grid dimensions are whole bricks and a brick's rows start at multiples of 8 voxels, so
+  // no two bricks share a word: bricks are rewritten in parallel without races.
+#pragma omp parallel for schedule(dynamic, 4)
+  for (std::ptrdiff_t k = 0; k < std::ptrdiff_t(fine_bricks.size()); ++k)
+    forVoxelsOfBrick(fine_, fine_per_axis, fine_bricks[k], [&](const std::array<int, 3>& v) {
+      const std::size_t i =
+          v[0] + std::size_t(fine_.dims[0]) * (v[1] + std::size_t(fine_.dims[1]) * v[2]);
+      const unsigned shift = (i & 1) * 16;
+      std::uint32_t& word = fine_words_[i >> 1];
+      word = (word & ~(0xFFFFu << shift)) | std::uint32_t{computeFineCode(map, region, v)} << shift;
+    });
+#pragma omp parallel for schedule(dynamic, 4)
+  for (std::ptrdiff_t k = 0; k < std::ptrdiff_t(coarse_bricks.size()); ++k)
+    forVoxelsOfBrick(coarse_, coarse_per_axis, coarse_bricks[k], [&](const std::array<int, 3>& v) {
+      const std::size_t i =
+          v[0] + std::size_t(coarse_.dims[0]) * (v[1] + std::size_t(coarse_.dims[1]) * v[2]);
+      const unsigned shift = (i & 3) * 8;
+      const bool occupied = map.coarseClass(coarse_.voxelCenter_m(v)) == map::VoxelClass::kOccupied;
+      std::uint32_t& word = coarse_words_[i >> 2];
+      word = (word & ~(0xFFu << shift)) | std::uint32_t{occupied} << shift;
+    });
+  last_refresh_.full = false;
+  last_refresh_.fine_bricks = fine_bricks.size();
+  last_refresh_.coarse_bricks = coarse_bricks.size();
+  if (!backend_) return;
+  const auto send = [&](accel::DeviceBuffer& device, const std::vector<std::uint32_t>& words,
+                        const std::vector<accel::ByteRange>& ranges) {
+    backend_->uploadRanges(device, words.data(), ranges);
+    for (const accel::ByteRange& r : ranges) last_refresh_.upload_bytes += r.size_bytes;
+    last_refresh_.upload_ranges += ranges.size();
+  };
+  send(*fine_device_, fine_words_, brickRanges(fine_, fine_per_axis, fine_bricks, 2));
+  send(*coarse_device_, coarse_words_, brickRanges(coarse_, coarse_per_axis, coarse_bricks, 4));
+}
+
+std::vector<std::uint32_t> InfoGainEvaluator::deviceFineWords() const {
+  return backend_ && fine_device_ ? backend_->downloadAll<std::uint32_t>(*fine_device_)
+                                  : std::vector<std::uint32_t>{};
+}
+
+std::vector<std::uint32_t> InfoGainEvaluator::deviceCoarseWords() const {
+  return backend_ && coarse_device_ ? backend_->downloadAll<std::uint32_t>(*coarse_device_)
+                                    : std::vector<std::uint32_t>{};
 }
 
 InfoGainEvaluator::RayCensus InfoGainEvaluator::census(const Eigen::Vector3d& from_m,

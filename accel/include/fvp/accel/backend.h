@@ -58,6 +58,12 @@ class DeviceBuffer {
   std::size_t size_bytes_;
 };
 
+/// A contiguous byte range of a buffer (Backend::uploadRanges).
+struct ByteRange {
+  std::size_t offset_bytes = 0;
+  std::size_t size_bytes = 0;
+};
+
 /// Bytes and calls between host and device through Backend::upload / download.
 struct TransferCounters {
   std::uint64_t upload_bytes = 0, download_bytes = 0;
@@ -81,6 +87,11 @@ class Backend {
               std::size_t offset_bytes = 0);
   void download(const DeviceBuffer& buf, void* dst, std::size_t size_bytes,
                 std::size_t offset_bytes = 0);
+  /// Sparse update of a buffer the host mirrors: copies each range of the host image
+  /// (src_image + offset) to the same offset of buf, as one transfer (one staging copy and
+  /// one submission on Vulkan, one wait on OpenCL) however many ranges there are. Counts as
+  /// one upload. Throws std::out_of_range if a range does not fit the buffer.
+  void uploadRanges(DeviceBuffer& buf, const void* src_image, std::span<const ByteRange> ranges);
   /// What upload() and download() moved since construction or resetTransfers() (buffer
   /// creation from host data counts as an upload).
   TransferCounters transfers() const;
@@ -127,6 +138,9 @@ class Backend {
                            std::size_t offset_bytes) = 0;
   virtual void downloadBytes(const DeviceBuffer& buf, void* dst, std::size_t size_bytes,
                              std::size_t offset_bytes) = 0;
+  /// Ranges are checked and non-empty. The default copies them one by one (uploadBytes).
+  virtual void uploadRangesBytes(DeviceBuffer& buf, const void* src_image,
+                                 std::span<const ByteRange> ranges);
   /// Runs item_count > 0 work items; arguments are checked (Backend::dispatch). Buffers
   /// unused by this dispatch are null.
   virtual void dispatchKernel(const KernelDescriptor& kernel, const void* params,

@@ -51,6 +51,8 @@ class GridMapEngine final : public MapEngine {
                      const std::vector<accel::ScanPoint>& points, ScanStats& stats) override;
   void refreshScene(MapLevel level, OccupiedVoxelScene& scene, bool fresh) override;
   void placeFineMap() override;
+  /// Records the bricks the layers stamped since the last sync in the change logs.
+  void syncChangeLogs() override;
 
  private:
   /// Writes the coarse voxels of bricks changed after change count `since` into tree.
@@ -74,6 +76,7 @@ class GridMapEngine final : public MapEngine {
   std::unique_ptr<octomap::OcTree> coarse_tree_;
   std::uint64_t coarse_tree_change_ = 0;    ///< coarse change count the tree reflects
   std::uint64_t scene_change_[2] = {0, 0};  ///< change count each level's scene reflects
+  std::uint64_t log_change_[2] = {0, 0};    ///< change count each level's change log reflects
 };
 
 }  // namespace fvp::host::map

@@ -18,6 +18,7 @@
 
 #include "fvp/host/core/cluster_region.h"
 #include "fvp/host/core/labeled_clouds.h"
+#include "fvp/host/map/brick_change_log.h"
 #include "fvp/host/map/frontier_voxel.h"
 #include "fvp/host/map/grid_geometry.h"
 #include "fvp/host/map/map_config.h"
@@ -84,6 +85,13 @@ class MapEngine {
   /// only the bricks whose voxels changed.
   const OccupiedVoxelScene& occupiedScene(MapLevel level);
 
+  /// The bricks (8^3 voxels, brick_change_log.h) of one map whose voxels' class, ROI or
+  /// (fine map) d_i as of the last updateRoiDistance() may differ from what they were at
+  /// cursor `since`, so that a copy derived from the map (the planner's gain snapshot) is
+  /// updated rather than rebuilt. `all` for a cursor of another map or Cluster Region, or
+  /// the default cursor. Pass the returned `now` next time.
+  BrickChanges changesSince(MapLevel level, const ChangeCursor& since);
+
   // ---- Reads the planner needs, with the same results on both engines ----
 
   /// Paper Eq. 1's d_i over the fine grid: Euclidean distance between voxel centres to the
@@ -112,6 +120,12 @@ class MapEngine {
   virtual void refreshScene(MapLevel level, OccupiedVoxelScene& scene, bool fresh);
   /// Builds an empty fine map (and what derives from it) over region().
   virtual void placeFineMap() = 0;
+  /// Where engines record what integrateScan and updateRoiDistance changed (a brick of
+  /// voxels that may not have changed may be recorded; one that did must be).
+  BrickChangeLog& changeLog(MapLevel level);
+  /// Brings the change logs up to date before changesSince() reads them, for engines that
+  /// track changes elsewhere first (the grid engine's brick stamps).
+  virtual void syncChangeLogs() {}
 
  private:
   struct SceneState {
@@ -122,6 +136,7 @@ class MapEngine {
   ClusterRegion region_;
   std::size_t scans_ = 0;
   SceneState scenes_[2];
+  BrickChangeLog change_logs_[2];  ///< coarse, fine; placed on first use
 };
 
 /// Throws std::invalid_argument unless engine is registered (map_engine_registry.h) and has

@@ -95,6 +95,10 @@ class OctomapMapEngine : public MapEngine {
   octomap::OcTreeKey fineKey(const std::array<int, 3>& index) const;
 
  private:
+  /// Records in the fine change log the voxels whose d_i differs from previous (the field
+  /// before the last updateRoiDistance(); every brick when it had another size or cap).
+  void recordDistanceChanges(const std::vector<float>& previous);
+
   GridGeometry coarse_grid_;
   GridGeometry fine_grid_;
   fvp_region fine_region_{};

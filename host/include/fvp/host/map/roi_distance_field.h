@@ -37,10 +37,17 @@ class RoiDistanceField {
   float distanceVoxAt(const std::array<int, 3>& index) const;
   /// The same, dense over the grid (x fastest): for tests against brute force.
   std::vector<float> dense() const;
+  /// Allocated bricks where the last compute() changed some voxel's distance from what the
+  /// one before gave (every allocated brick after the first compute or a new radius).
+  const std::vector<std::uint32_t>& changedBricks() const { return changed_bricks_; }
 
  private:
   /// Per brick of the grid: whether it lies within the radius of a brick holding ROI.
   std::vector<char> roiHalo(int radius_vox) const;
+  /// The host mirror of the current distances, downloaded if not yet; callers hold the lock.
+  void downloadMirrorLocked() const;
+  /// Compares the new distances (mirror_) with the previous ones per allocated brick.
+  void findChangedBricks(const std::vector<float>& previous, int previous_radius_vox);
 
   OccupancyLayer& layer_;
   std::optional<BrickLayer::ChannelId> distance_;
@@ -51,6 +58,7 @@ class RoiDistanceField {
   mutable std::mutex mirror_mutex_;
   mutable std::vector<float> mirror_;
   mutable std::atomic<bool> mirror_ready_{false};
+  std::vector<std::uint32_t> changed_bricks_;
 };
 
 }  // namespace fvp::host::map

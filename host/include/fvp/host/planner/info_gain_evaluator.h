@@ -1,8 +1,14 @@
 // Information gain of viewpoint candidates (paper Eq. 1-2, docs/design.md section 6) over a
-// compact read-only snapshot of the maps, rebuilt once per planning iteration:
+// compact read-only snapshot of the maps, refreshed once per planning iteration:
 // 2 bytes per fine voxel (in-region bit, occupied bit, Eq. 1 weight quantised to 1/8192)
 // and 1 byte per coarse voxel (occupied), instead of the maps' 8-byte integration voxels,
 // because the gain walks are memory bound.
+//
+// A refresh rewrites only the 8^3-voxel bricks the map reports changed since the last one
+// (MapEngine::changesSince: the bricks a scan touched, and on the fine map those whose d_i
+// moved) and uploads only the words those bricks occupy; a different map, region or grid
+// rebuilds it whole. Both paths compute every voxel's code with the same function, so an
+// updated snapshot equals a fresh build byte for byte (tests/planner/snapshot_refresh_test).
 //
 // One ray from the camera centre to the target. The coarse map is walked from the camera to
 // where the ray enters the Cluster Region sphere: an occupied coarse voxel there blocks the
@@ -35,6 +41,7 @@
 #include <vector>
 
 #include "fvp/accel/kernel_types.h"
+#include "fvp/host/map/brick_change_log.h"
 #include "fvp/host/map/grid_geometry.h"
 
 namespace fvp::accel {
@@ -81,6 +88,17 @@ struct EvaluateStats {
   double walk_s = 0.0;     ///< wall time of the walks (with transfers)
 };
 
+/// What the last InfoGainEvaluator::refresh() did, for reports and benchmarks.
+struct SnapshotRefreshStats {
+  bool full = true;               ///< rebuilt whole (first refresh, another map or region)
+  std::size_t fine_bricks = 0;    ///< fine bricks rewritten (all of them when full)
+  std::size_t coarse_bricks = 0;  ///< coarse bricks rewritten
+  std::size_t upload_bytes = 0;   ///< bytes sent to the backend's device (0 without one)
+  std::size_t upload_ranges = 0;  ///< byte ranges they were sent in (one transfer per map)
+  double distance_s = 0.0;        ///< wall time of the map's ROI distance update
+  double snapshot_s = 0.0;        ///< wall time of the snapshot itself (codes + upload)
+};
+
 struct GainResult {
   double ig = 0.0;
   std::uint32_t region_voxels = 0;  ///< N_c (summed over rays in frustum mode)
@@ -98,8 +116,17 @@ class InfoGainEvaluator {
   const InfoGainConfig& config() const { return config_; }
 
   /// After each integration: the ROI distance field (map.updateRoiDistance(max_d_m)) and
-  /// the snapshot. Returns the wall time it took, seconds.
+  /// the snapshot, updated from the bricks that changed since the last refresh of the same
+  /// map. Returns the wall time it took, seconds.
   double refresh(map::MapEngine& map);
+  const SnapshotRefreshStats& lastRefresh() const { return last_refresh_; }
+  /// The snapshot in the kernel's layout (kernels/fvp_info_gain.h): fine codes and coarse
+  /// occupancy, 32-bit words, dense over each grid, x fastest.
+  std::span<const std::uint32_t> fineWords() const { return fine_words_; }
+  std::span<const std::uint32_t> coarseWords() const { return coarse_words_; }
+  /// The same as the backend's device holds them (downloaded); empty without a backend.
+  std::vector<std::uint32_t> deviceFineWords() const;
+  std::vector<std::uint32_t> deviceCoarseWords() const;
   /// IG of every query (the same result for any backend and thread count).
   /// Throws std::logic_error before the first refresh(). With embree_cull, the map given
   /// to refresh() must outlive the calls (its coarse Embree scene is queried).
@@ -140,6 +167,15 @@ class InfoGainEvaluator {
   static constexpr double kWeightScale = 8192.0;  ///< weight 1 = 8192
 
  private:
+  /// The whole snapshot from the map; a new device copy.
+  void rebuild(const map::MapEngine& map);
+  /// Rewrites the given bricks (brick_change_log.h ids) of each grid and uploads the words
+  /// they occupy.
+  void updateBricks(const map::MapEngine& map, const std::vector<int>& fine_bricks,
+                    const std::vector<int>& coarse_bricks);
+  /// The snapshot code of one fine voxel (both paths use it: the same bits by construction).
+  std::uint16_t computeFineCode(const map::MapEngine& map, const fvp_region& region,
+                                const std::array<int, 3>& index) const;
   /// The info_gain kernel over segments (on the backend, or here without one).
   void walk(std::span<const accel::GainSegment> segments, accel::GainResultRaw* results) const;
   std::uint16_t fineCode(std::size_t i) const {
@@ -162,6 +198,9 @@ class InfoGainEvaluator {
   std::unique_ptr<accel::DeviceBuffer> fine_device_, coarse_device_;
   mutable std::unique_ptr<accel::DeviceBuffer> segment_device_, result_device_;
   const map::OccupiedVoxelScene* coarse_scene_ = nullptr;  ///< embree_cull only
+  // Where the snapshot stands in each map's change log (map::MapEngine::changesSince).
+  map::ChangeCursor fine_cursor_, coarse_cursor_;
+  SnapshotRefreshStats last_refresh_;
 };
 
 /// Eq. 1: the weight of an unknown voxel at distance d_m from the nearest known ROI.
