@@ -1,5 +1,6 @@
 #include "fvp/accel/backend.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -79,15 +80,28 @@ void Backend::download(const DeviceBuffer& buf, void* dst, std::size_t size_byte
 void Backend::uploadRanges(DeviceBuffer& buf, const void* src_image,
                            std::span<const ByteRange> ranges) {
   std::vector<ByteRange> nonempty;
-  std::size_t bytes = 0;
   for (const ByteRange& r : ranges) {
     checkRange(buf, r.size_bytes, r.offset_bytes, "uploadRanges");
-    if (!r.size_bytes) continue;
-    nonempty.push_back(r);
-    bytes += r.size_bytes;
+    if (r.size_bytes) nonempty.push_back(r);
   }
   if (nonempty.empty()) return;
-  uploadRangesBytes(buf, src_image, nonempty);
+  // Sorted and merged: the backends get disjoint ranges (Vulkan's vkCmdCopyBuffer forbids
+  // overlapping destination regions), and the byte count is what is sent.
+  std::sort(nonempty.begin(), nonempty.end(),
+            [](const ByteRange& a, const ByteRange& b) { return a.offset_bytes < b.offset_bytes; });
+  std::vector<ByteRange> disjoint{nonempty.front()};
+  for (std::size_t i = 1; i < nonempty.size(); ++i) {
+    ByteRange& last = disjoint.back();
+    const std::size_t last_end = last.offset_bytes + last.size_bytes;
+    if (nonempty[i].offset_bytes <= last_end)
+      last.size_bytes =
+          std::max(last_end, nonempty[i].offset_bytes + nonempty[i].size_bytes) - last.offset_bytes;
+    else
+      disjoint.push_back(nonempty[i]);
+  }
+  std::size_t bytes = 0;
+  for (const ByteRange& r : disjoint) bytes += r.size_bytes;
+  uploadRangesBytes(buf, src_image, disjoint);
   upload_bytes_ += bytes;
   ++uploads_;
 }

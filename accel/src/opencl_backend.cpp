@@ -169,9 +169,14 @@ class OpenClBackend final : public Backend {
   void uploadRangesBytes(DeviceBuffer& buf, const void* src_image,
                          std::span<const ByteRange> ranges) override {
     const auto* image = static_cast<const std::uint8_t*>(src_image);
-    for (const ByteRange& r : ranges)
-      FVP_CL(queue_.enqueueWriteBuffer(clBuf(buf), CL_FALSE, r.offset_bytes, r.size_bytes,
-                                       image + r.offset_bytes));
+    try {
+      for (const ByteRange& r : ranges)
+        FVP_CL(queue_.enqueueWriteBuffer(clBuf(buf), CL_FALSE, r.offset_bytes, r.size_bytes,
+                                         image + r.offset_bytes));
+    } catch (...) {
+      queue_.finish();  // writes already queued read the caller's image: wait before it goes
+      throw;
+    }
     FVP_CL(queue_.finish());
   }
 

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <map>
 #include <optional>
+#include <set>
 #include <sstream>
 
 #include "fvp/host/core/gnuplot.h"
@@ -17,6 +18,7 @@
 #include "fvp/robot/sim/world_config.h"
 #include "fvp/trials/experiment.h"
 #include "fvp/trials/sensitivity_report.h"
+#include "fvp/trials/trial_fields.h"
 
 namespace fvp::trials {
 namespace {
@@ -442,9 +444,9 @@ TEST(Experiment, TextFromExperimentFilesIsCheckedAgainstItsSchema) {
   fs::create_directories(dir);
   ExperimentManifest m;
   m.kind = "run";
-  m.budget_s = 180;
-  m.clock = "fixed";
-  m.backend = "cpu";
+  m.settings.budget_s = 180;
+  m.settings.clock = robot::sim::SimClock::Mode::kFixed;
+  m.settings.backend = accel::BackendChoice::kCpu;
   m.planners = {"fvp"};
   m.trials = 1;
   const auto refused = [&](const char* field, const nlohmann::json& value) {
@@ -751,20 +753,72 @@ TEST(Experiment, SchemaErrorsNameTheFileTheLineAndTheField) {
   nlohmann::json manifest = nlohmann::json::parse(slurp(out / "manifest.json"));
   manifest.erase("stop");
   writeText(out / "manifest.json", manifest.dump());
-  EXPECT_EQ(readManifest(out / "manifest.json").stop, "budget");
+  EXPECT_EQ(readManifest(out / "manifest.json").settings.stop, host::nbv::StopRule::kBudget);
   manifest["stop"] = "never";
   writeText(out / "manifest.json", manifest.dump());
   EXPECT_NE(errorOf([&] {
               readManifest(out / "manifest.json");
-            }).find("manifest.json: field 'stop': expected \"budget\" or \"auto\""),
+            }).find("manifest.json: field 'stop': expected one of \"budget\", \"auto\""),
             std::string::npos);
   manifest["stop"] = "budget";
+  // Format 1 wrote 0 for no view cap; format 2 writes null.
+  manifest["max_views"] = 0;
+  writeText(out / "manifest.json", manifest.dump());
+  EXPECT_FALSE(readManifest(out / "manifest.json").settings.max_views.has_value());
+  manifest["max_views"] = nullptr;
+  writeText(out / "manifest.json", manifest.dump());
+  EXPECT_FALSE(readManifest(out / "manifest.json").settings.max_views.has_value());
+  manifest["max_views"] = -2;
+  writeText(out / "manifest.json", manifest.dump());
+  EXPECT_NE(errorOf([&] { readManifest(out / "manifest.json"); }).find("field 'max_views'"),
+            std::string::npos);
+  manifest["max_views"] = 4;
   manifest["budget_s"] = "x";
   writeText(out / "manifest.json", manifest.dump());
   EXPECT_NE(errorOf([&] {
               readManifest(out / "manifest.json");
             }).find("manifest.json: field 'budget_s': expected a finite positive number"),
             std::string::npos);
+}
+
+TEST(Experiment, TheManifestRecordsEveryTrialSettingButThePerTrialOnes) {
+  // Written and read through the trial's settings list (trials/trial_fields.h): a setting
+  // added there is recorded, read back and compared with no change here.
+  ExperimentManifest m;
+  m.settings.budget_s = 90;
+  m.settings.max_views = 3;
+  m.settings.stop = host::nbv::StopRule::kAuto;
+  m.settings.backend = accel::BackendChoice::kVulkan;
+  m.settings.record_size_history = true;
+  m.settings.register_views = true;
+  m.planners = {"fvp"};
+  m.trials = 1;
+  const nlohmann::ordered_json j = m.toJson();
+  std::set<std::string> keys;
+  for (const auto& [key, value] : j.items()) keys.insert(key);
+  const TrialOptions defaults;
+  visitTrialFields(defaults, [&](const host::nbv::RunField& field, const auto&) {
+    EXPECT_EQ(keys.count(std::string(field.key)), field.per_trial ? 0u : 1u) << field.key;
+  });
+  const fs::path dir = freshDir("manifest_fields");
+  fs::create_directories(dir);
+  writeText(dir / "manifest.json", j.dump(2));
+  const ExperimentManifest read = readManifest(dir / "manifest.json");
+  EXPECT_EQ(read.toJson(), j);
+  EXPECT_FALSE(mergeDifference(m, read).has_value());
+  // Each recorded setting is compared: a changed one is named.
+  ExperimentManifest other = read;
+  other.settings.record_size_history = false;
+  ASSERT_TRUE(mergeDifference(read, other).has_value());
+  EXPECT_EQ(mergeDifference(read, other)->setting, "size_history");
+  // The backend picks the device: recorded, never compared; the engine only on resume.
+  other = read;
+  other.settings.backend = accel::BackendChoice::kCpu;
+  other.settings.engine = "octomap";
+  EXPECT_FALSE(mergeDifference(read, other).has_value());
+  ASSERT_TRUE(resumeDifference(read, other).has_value());
+  EXPECT_EQ(resumeDifference(read, other)->setting, "engine");
+  EXPECT_EQ(resumeDifference(read, other)->old_value, "(each planner's own)");
 }
 
 TEST(Experiment, ABadTrialResultIsNotAppended) {

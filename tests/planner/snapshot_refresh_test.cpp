@@ -12,6 +12,7 @@
 #include "fvp/accel/backend.h"
 #include "fvp/host/map/brick_change_log.h"
 #include "fvp/host/map/map_engine.h"
+#include "fvp/host/map/octomap_map_engine.h"
 #include "fvp/host/planner/info_gain_evaluator.h"
 
 namespace fvp::host::planner {
@@ -139,6 +140,49 @@ TEST(SnapshotRefresh, AnotherRegionOrMapRebuildsWhole) {
     evaluator.refresh(*other);
     EXPECT_TRUE(evaluator.lastRefresh().full);
     expectSameAsFreshBuild(evaluator, *other, "another map");
+  }
+}
+
+TEST(SnapshotRefresh, SeveralScansBetweenRefreshesAndAMoveWithoutAScan) {
+  auto cpu = accel::createBackend(accel::BackendKind::kCpu);
+  for (const char* engine : {"grid", "octomap"}) {
+    SCOPED_TRACE(engine);
+    auto map = map::createMapEngine(engine, smallConfig(), kRegion, cpu.get());
+    const auto world = map::testing::makeWorld(5, kRegion.center_m(), 5);
+    std::mt19937_64 rng(5);
+    InfoGainEvaluator evaluator(InfoGainConfig{}, cpu.get());
+    map->integrate(randomView(world, kRegion, rng));
+    evaluator.refresh(*map);
+    for (int i = 0; i < 3; ++i) map->integrate(randomView(world, kRegion, rng));
+    evaluator.refresh(*map);
+    EXPECT_FALSE(evaluator.lastRefresh().full);
+    expectSameAsFreshBuild(evaluator, *map, "three scans, one refresh");
+    // A moved region with no scan since: the scan count is the same, the snapshot is not.
+    map->moveToRegion(ClusterRegion({0.02, 0.01, 0.2}, 0.03));
+    evaluator.refresh(*map);
+    EXPECT_TRUE(evaluator.lastRefresh().full);
+    expectSameAsFreshBuild(evaluator, *map, "moved, no scan");
+  }
+}
+
+/// An engine of a program's own that records no changes (the octomap engine with its change
+/// recording disowned): every refresh must rebuild.
+class UnrecordedOctomapEngine : public map::OctomapMapEngine {
+ public:
+  using OctomapMapEngine::OctomapMapEngine;
+  bool recordsBrickChanges() const override { return false; }
+};
+
+TEST(SnapshotRefresh, AnEngineThatRecordsNoChangesIsRebuiltEveryTime) {
+  UnrecordedOctomapEngine map(smallConfig(), kRegion);
+  const auto world = map::testing::makeWorld(7, kRegion.center_m(), 5);
+  std::mt19937_64 rng(7);
+  InfoGainEvaluator evaluator{InfoGainConfig{}};
+  for (int v = 0; v < 2; ++v) {
+    map.integrate(randomView(world, kRegion, rng));
+    evaluator.refresh(map);
+    EXPECT_TRUE(evaluator.lastRefresh().full) << "view " << v;
+    expectSameAsFreshBuild(evaluator, map, "view " + std::to_string(v));
   }
 }
 

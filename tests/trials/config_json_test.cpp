@@ -19,11 +19,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// The JSON written as a config file (JSON is YAML's flow style); null keys left out, as a
-/// file leaves an unset key out.
+/// The JSON written as a config file (JSON is YAML's flow style).
 fs::path asConfigFile(const std::string& json, const std::string& name) {
-  nlohmann::ordered_json j = nlohmann::ordered_json::parse(json);
-  for (auto it = j.begin(); it != j.end();) it = it->is_null() ? j.erase(it) : std::next(it);
+  const nlohmann::ordered_json j = nlohmann::ordered_json::parse(json);
   const fs::path path = fs::temp_directory_path() / ("fvp_config_json_" + name + ".yaml");
   std::ofstream(path) << j.dump(2);
   return path;
@@ -55,6 +53,13 @@ TEST(ConfigJson, EachConfigReadsBackWhatItWrites) {
   });
   expectRoundTrip<robot::ArmConfig>("arm", [](auto& c) { c.slider_travel_m = 2.5; });
   expectRoundTrip<robot::sim::WorldConfig>("world", [](auto& c) { c.cluster_count = 3; });
+}
+
+TEST(ConfigJson, AnUnsetOptionalIsLeftOutAsAFileLeavesItOut) {
+  const auto j = nlohmann::json::parse(host::PerceptionConfig{}.toJson());
+  EXPECT_FALSE(j.contains("region_center_m"));
+  EXPECT_TRUE(j.contains("region_offset_tag_m"));
+  expectRoundTrip<host::PerceptionConfig>("perception_tag", [](auto& c) { c.tag.tag_id = 3; });
 }
 
 TEST(ConfigJson, KeysAreTheFilesKeysInTheirOrder) {

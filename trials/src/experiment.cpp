@@ -101,22 +101,17 @@ namespace {
 ExperimentManifest manifestOf(const ExperimentOptions& o) {
   ExperimentManifest m;
   m.kind = "run";
-  m.budget_s = o.trial.budget_s;
-  m.clock = robot::sim::SimClock::modeName(o.trial.clock);
-  m.stop = host::nbv::toString(o.trial.stop);
-  m.max_views = o.trial.max_views.value_or(0);
-  m.register_views = registerViewsOf(o.trial);
+  m.settings = o.trial;
+  m.settings.register_views = registerViewsOf(o.trial);
   // Switches of the automatic stop: nothing under the budget stop, recorded as off there so
   // that budget experiments from before they existed still resume and merge.
   const bool automatic = o.trial.stop == host::nbv::StopRule::kAuto;
-  m.confirm_detections = automatic && o.trial.confirm_detections;
-  m.release_left_out = automatic && o.trial.release_left_out;
+  m.settings.confirm_detections = automatic && o.trial.confirm_detections;
+  m.settings.release_left_out = automatic && o.trial.release_left_out;
   m.error_scale = o.error_scale;
-  m.world_config = stampOf(o.trial.world_config, "world config");
-  m.planner_config = stampOf(o.trial.planner_config, "planner config");
-  m.arm_config = stampOf(o.trial.arm_config, "arm config");
-  m.engine = o.trial.engine;
-  m.backend = accel::toString(o.trial.backend);
+  m.configs = {{"world_config", stampOf(o.trial.world_config, "world config")},
+               {"planner_config", stampOf(o.trial.planner_config, "planner config")},
+               {"arm_config", stampOf(o.trial.arm_config, "arm config")}};
   m.planners = o.planners;
   m.trials = o.trials;
   m.first_seed = o.first_seed;

@@ -1,6 +1,7 @@
 #include "fvp/trials/experiment_directory.h"
 
 #include <algorithm>
+#include <array>
 #include <climits>
 #include <cmath>
 #include <fstream>
@@ -9,9 +10,11 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 #include <utility>
 
 #include "fvp/accel/backend_choice.h"
+#include "fvp/trials/trial_fields.h"
 
 namespace fvp::trials {
 namespace {
@@ -102,10 +105,6 @@ std::string shownConfig(const ConfigFileStamp& c) {
   return c.path.empty() ? "built-in defaults" : c.path + " (fnv1a64 " + c.fnv1a64 + ")";
 }
 
-std::string shownMaxViews(int v) {
-  return v == 0 ? "0 (no limit)" : std::to_string(v);
-}
-
 nlohmann::ordered_json configJson(const ConfigFileStamp& c) {
   return {{"path", c.path}, {"fnv1a64", c.fnv1a64}};
 }
@@ -152,6 +151,148 @@ ConfigFileStamp readConfig(const nlohmann::json& o, const char* key, const std::
   if (c.path.empty() ? !c.fnv1a64.empty() : !hex || !isAbsolutePath(c.path))
     fieldError(where, key, expected + " (an absolute path)", &v);
   return c;
+}
+
+/// Calls visit(field, member) for each setting a manifest records: the trial's settings but
+/// the per-trial planner and seed.
+template <class Options, class Visitor>
+void visitManifestSettings(Options& settings, Visitor&& visit) {
+  visitTrialFields(settings, [&visit](const host::nbv::RunField& field, auto& value) {
+    if (!field.per_trial) visit(field, value);
+  });
+}
+
+/// Settings a manifest may lack: added after format 1 began (absent: off), and in a merged
+/// manifest of format 1 the run's own engine and backend.
+bool mayBeAbsent(std::string_view key, bool merged) {
+  for (const std::string_view k : {"stop", "register_views", "confirm_detections",
+                                   "release_left_out", "arm_config", "size_history"})
+    if (key == k) return true;
+  return merged && (key == "engine" || key == "backend");
+}
+
+/// Reads each setting of a manifest by its type, with an error naming the file and the field.
+class ManifestSettingsReader {
+ public:
+  ManifestSettingsReader(const nlohmann::json& j, std::string where, bool merged)
+      : j_(j), where_(std::move(where)), merged_(merged) {}
+
+  template <typename T>
+  void operator()(const host::nbv::RunField& field, T& value) {
+    const std::string key(field.key);
+    const nlohmann::json* v = member(j_, key.c_str());
+    if (!v && mayBeAbsent(key, merged_)) return setOff(value);
+    if (field.vocabulary == host::nbv::FieldVocabulary::kConfigFile) {
+      configs_[key] = readConfig(j_, key.c_str(), where_);
+      if constexpr (std::is_same_v<T, std::filesystem::path>) value = configs_[key].path;
+      return;
+    }
+    read(key, v, value);
+  }
+  const std::map<std::string, ConfigFileStamp>& configs() const { return configs_; }
+
+ private:
+  template <typename T>
+  static void setOff(T& value) {
+    if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, std::optional<bool>>) value = false;
+  }
+  template <typename Enum, typename Choices, typename NameOf>
+  void readChoice(const std::string& key, const nlohmann::json* v, Enum& value,
+                  const Choices& choices, NameOf nameOf) const {
+    std::string names;
+    for (const Enum c : choices) {
+      names += (names.empty() ? "\"" : ", \"") + std::string(nameOf(c)) + "\"";
+      if (v && v->is_string() && v->get<std::string>() == nameOf(c)) return void(value = c);
+    }
+    fieldError(where_, key, "one of " + names, v);
+  }
+  void read(const std::string& key, const nlohmann::json* v, double& value) const {
+    if (!v || !isFinite(*v) || !(v->get<double>() > 0))
+      fieldError(where_, key, "a finite positive number", v);
+    value = v->get<double>();
+  }
+  void read(const std::string& key, const nlohmann::json* v, std::optional<int>& value) const {
+    // Format 1 wrote 0 for no limit.
+    const std::string expected = "a non-negative integer or null (no limit)";
+    if (v && v->is_null()) return void(value.reset());
+    if (!v || !isUnsigned(*v) || v->get<std::uint64_t>() > INT_MAX)
+      fieldError(where_, key, expected, v);
+    value = v->get<int>() > 0 ? std::optional<int>(v->get<int>()) : std::nullopt;
+  }
+  void read(const std::string& key, const nlohmann::json* v, bool& value) const {
+    if (!v || !v->is_boolean()) fieldError(where_, key, "true or false", v);
+    value = v->get<bool>();
+  }
+  void read(const std::string& key, const nlohmann::json* v, std::optional<bool>& value) const {
+    // null: not resolved (the runner writes register_views resolved; a hand-made manifest
+    // may not).
+    if (v && v->is_null()) return void(value.reset());
+    bool b = false;
+    read(key, v, b);
+    value = b;
+  }
+  void read(const std::string& key, const nlohmann::json* v, std::string& value) const {
+    if (!v || !(isRegistryName(*v) || *v == "")) fieldError(where_, key, kEngineExpected, v);
+    value = v->get<std::string>();
+  }
+  void read(const std::string& key, const nlohmann::json* v, accel::BackendChoice& value) const {
+    readChoice(key, v, value, accel::kBackendChoices,
+               [](accel::BackendChoice c) { return accel::toString(c); });
+  }
+  void read(const std::string& key, const nlohmann::json* v, host::nbv::StopRule& value) const {
+    readChoice(key, v, value, host::nbv::kStopRules,
+               [](host::nbv::StopRule r) { return std::string_view(host::nbv::toString(r)); });
+  }
+  void read(const std::string& key, const nlohmann::json* v,
+            robot::sim::SimClock::Mode& value) const {
+    using Mode = robot::sim::SimClock::Mode;
+    readChoice(key, v, value, std::array<Mode, 2>{Mode::kWall, Mode::kFixed},
+               [](Mode m) { return std::string_view(robot::sim::SimClock::modeName(m)); });
+  }
+  void read(const std::string&, const nlohmann::json*, std::filesystem::path&) const {}
+  // The per-trial seed is never in a manifest (visitManifestSettings leaves it out).
+  void read(const std::string&, const nlohmann::json*, std::uint64_t&) const {}
+
+  const nlohmann::json& j_;
+  std::string where_;
+  bool merged_;
+  std::map<std::string, ConfigFileStamp> configs_;
+};
+
+/// A setting of a manifest: what is compared (a config by its hash) and how it is shown.
+struct SettingValue {
+  std::string key;
+  nlohmann::json compared;
+  std::string shown;
+};
+
+std::vector<SettingValue> settingValues(const ExperimentManifest& m) {
+  std::vector<SettingValue> out;
+  visitManifestSettings(m.settings, [&](const host::nbv::RunField& field, const auto& value) {
+    const std::string key(field.key);
+    if (field.vocabulary == host::nbv::FieldVocabulary::kConfigFile) {
+      const ConfigFileStamp stamp = m.configs.count(key) ? m.configs.at(key) : ConfigFileStamp{};
+      out.push_back({key, stamp.fnv1a64, shownConfig(stamp)});
+      return;
+    }
+    const nlohmann::json j = settingJson(value);
+    std::string shown = j.is_string() ? j.get<std::string>() : j.dump();
+    if (j.is_null()) shown = "none (no limit)";
+    if (key == "engine" && shown.empty()) shown = "(each planner's own)";
+    out.push_back({key, j, std::move(shown)});
+  });
+  return out;
+}
+
+/// The first setting (in the list's order) that is compared and differs.
+std::optional<ManifestDifference> settingsDifference(
+    const ExperimentManifest& a, const ExperimentManifest& b,
+    const std::function<bool(std::string_view)>& compared) {
+  const std::vector<SettingValue> va = settingValues(a), vb = settingValues(b);
+  for (std::size_t i = 0; i < va.size(); ++i)
+    if (compared(va[i].key) && va[i].compared != vb[i].compared)
+      return ManifestDifference{va[i].key, va[i].shown, vb[i].shown};
+  return std::nullopt;
 }
 
 }  // namespace
@@ -313,23 +454,18 @@ nlohmann::ordered_json ExperimentManifest::toJson() const {
   j["format"] = kManifestFormat;
   j["version"] = kFormatVersion;
   j["kind"] = kind;
-  j["budget_s"] = budget_s;
-  j["clock"] = clock;
-  j["stop"] = stop;
-  j["max_views"] = max_views;
-  j["register_views"] = register_views;
-  j["confirm_detections"] = confirm_detections;
-  j["release_left_out"] = release_left_out;
+  visitManifestSettings(settings, [&](const host::nbv::RunField& field, const auto& value) {
+    const std::string key(field.key);
+    if (field.vocabulary == host::nbv::FieldVocabulary::kConfigFile)
+      j[key] = configJson(configs.count(key) ? configs.at(key) : ConfigFileStamp{});
+    else
+      j[key] = settingJson(value);
+  });
   j["error_scale"] = error_scale;
-  j["world_config"] = configJson(world_config);
-  j["planner_config"] = configJson(planner_config);
-  j["arm_config"] = configJson(arm_config);
   if (kind == "merged") {
     j["sources"] = sources;
     return j;
   }
-  j["engine"] = engine;
-  j["backend"] = backend;
   j["planners"] = planners;
   j["trials"] = trials;
   j["first_seed"] = first_seed;
@@ -380,42 +516,10 @@ ExperimentManifest readManifest(const std::filesystem::path& path) {
   m.kind = readString(j, "kind", where);
   if (m.kind != "run" && m.kind != "merged")
     fieldError(where, "kind", "\"run\" or \"merged\"", &j["kind"]);
-  const nlohmann::json& budget = required(j, "budget_s", where, "a finite positive number");
-  if (!isFinite(budget) || budget.get<double>() <= 0)
-    fieldError(where, "budget_s", "a finite positive number", &budget);
-  m.budget_s = budget.get<double>();
-  m.clock = readString(j, "clock", where);
-  if (m.clock != "wall" && m.clock != "fixed")
-    fieldError(where, "clock", "\"wall\" or \"fixed\"", &j["clock"]);
-  // Manifests written before the automatic stop existed ran on the budget alone.
-  if (member(j, "stop")) {
-    m.stop = readString(j, "stop", where);
-    if (m.stop != "budget" && m.stop != "auto")
-      fieldError(where, "stop", "\"budget\" or \"auto\"", &j["stop"]);
-  }
-  m.max_views =
-      int(readUnsigned(j, "max_views", where, INT_MAX, "a non-negative integer (0: no limit)"));
-  // Manifests written before view registration existed fused at the told poses.
-  if (member(j, "register_views")) {
-    if (!j["register_views"].is_boolean())
-      fieldError(where, "register_views", "true or false", &j["register_views"]);
-    m.register_views = j["register_views"].get<bool>();
-  }
-  if (member(j, "confirm_detections")) {
-    if (!j["confirm_detections"].is_boolean())
-      fieldError(where, "confirm_detections", "true or false", &j["confirm_detections"]);
-    m.confirm_detections = j["confirm_detections"].get<bool>();
-  }
-  if (member(j, "release_left_out")) {
-    if (!j["release_left_out"].is_boolean())
-      fieldError(where, "release_left_out", "true or false", &j["release_left_out"]);
-    m.release_left_out = j["release_left_out"].get<bool>();
-  }
+  ManifestSettingsReader reader(j, where, m.kind == "merged");
+  visitManifestSettings(m.settings, reader);
+  m.configs = reader.configs();
   if (member(j, "error_scale")) m.error_scale = readErrorScale(j, where);
-  m.world_config = readConfig(j, "world_config", where);
-  m.planner_config = readConfig(j, "planner_config", where);
-  // Manifests written before --arm existed ran the built-in arm.
-  if (member(j, "arm_config")) m.arm_config = readConfig(j, "arm_config", where);
   if (m.kind == "merged") {
     const nlohmann::json& sources = required(j, "sources", where, "an array of directories");
     if (!sources.is_array()) fieldError(where, "sources", "an array of directories", &sources);
@@ -426,12 +530,6 @@ ExperimentManifest readManifest(const std::filesystem::path& path) {
     }
     return m;
   }
-  m.engine = readString(j, "engine", where);
-  if (!(isRegistryName(j["engine"]) || j["engine"] == ""))
-    fieldError(where, "engine", kEngineExpected, &j["engine"]);
-  m.backend = readString(j, "backend", where);
-  if (!accel::parseBackendChoice(m.backend))
-    fieldError(where, "backend", "one of " + accel::backendChoiceNames(), &j["backend"]);
   const std::string planners_expected =
       "a non-empty array of distinct planner names (lower-case letters, digits and _)";
   const nlohmann::json& planners = required(j, "planners", where, planners_expected);
@@ -462,39 +560,14 @@ ExperimentManifest readManifest(const std::filesystem::path& path) {
 
 std::optional<ManifestDifference> mergeDifference(const ExperimentManifest& a,
                                                   const ExperimentManifest& b) {
-  if (a.budget_s != b.budget_s)
-    return ManifestDifference{"budget_s", nlohmann::json(a.budget_s).dump(),
-                              nlohmann::json(b.budget_s).dump()};
-  if (a.clock != b.clock) return ManifestDifference{"clock", a.clock, b.clock};
-  if (a.stop != b.stop) return ManifestDifference{"stop", a.stop, b.stop};
-  if (a.register_views != b.register_views)
-    return ManifestDifference{"register_views", a.register_views ? "true" : "false",
-                              b.register_views ? "true" : "false"};
-  if (a.confirm_detections != b.confirm_detections)
-    return ManifestDifference{"confirm_detections", a.confirm_detections ? "true" : "false",
-                              b.confirm_detections ? "true" : "false"};
-  if (a.release_left_out != b.release_left_out)
-    return ManifestDifference{"release_left_out", a.release_left_out ? "true" : "false",
-                              b.release_left_out ? "true" : "false"};
-  if (a.max_views != b.max_views)
-    return ManifestDifference{"max_views", shownMaxViews(a.max_views), shownMaxViews(b.max_views)};
-  if (a.world_config.fnv1a64 != b.world_config.fnv1a64)
-    return ManifestDifference{"world_config", shownConfig(a.world_config),
-                              shownConfig(b.world_config)};
-  if (a.planner_config.fnv1a64 != b.planner_config.fnv1a64)
-    return ManifestDifference{"planner_config", shownConfig(a.planner_config),
-                              shownConfig(b.planner_config)};
-  if (a.arm_config.fnv1a64 != b.arm_config.fnv1a64)
-    return ManifestDifference{"arm_config", shownConfig(a.arm_config), shownConfig(b.arm_config)};
-  return std::nullopt;
+  return settingsDifference(
+      a, b, [](std::string_view key) { return key != "engine" && key != "backend"; });
 }
 
 std::optional<ManifestDifference> resumeDifference(const ExperimentManifest& old,
                                                    const ExperimentManifest& now) {
-  if (auto d = mergeDifference(old, now)) return d;
-  const auto engine = [](const std::string& e) { return e.empty() ? "(each planner's own)" : e; };
-  if (old.engine != now.engine)
-    return ManifestDifference{"engine", engine(old.engine), engine(now.engine)};
+  if (auto d = settingsDifference(old, now, [](std::string_view key) { return key != "backend"; }))
+    return d;
   if (old.planners != now.planners)
     return ManifestDifference{"planners", joined(old.planners), joined(now.planners)};
   if (old.trials != now.trials)

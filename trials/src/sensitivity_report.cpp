@@ -86,7 +86,7 @@ std::vector<SensitivityPoint> readSensitivityPoints(const std::vector<fs::path>&
       SensitivityPoint p;
       p.group = group;
       p.factor = factor;
-      p.registered = m.register_views;
+      p.registered = m.settings.register_views.value_or(false);
       p.planner = planner;
       p.trials = row.value("trials", 0);
       p.match_percent = row.value("match_percent", 0.0);

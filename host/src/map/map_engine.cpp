@@ -39,7 +39,12 @@ BrickChangeLog& MapEngine::changeLog(MapLevel level) {
 
 BrickChanges MapEngine::changesSince(MapLevel level, const ChangeCursor& since) {
   syncChangeLogs();
-  return changeLog(level).changesSince(since);
+  BrickChanges changes = changeLog(level).changesSince(since);
+  if (!recordsBrickChanges()) {
+    changes.all = true;
+    changes.bricks.clear();
+  }
+  return changes;
 }
 
 const OccupiedVoxelScene& MapEngine::occupiedScene(MapLevel level) {

@@ -81,13 +81,10 @@ std::optional<Ranking> FvpPlanner::rank(map::MapEngine& map,
   if (round >= static_cast<std::size_t>(config_.max_sampling_rounds)) return std::nullopt;
   auto t = Clock::now();
   if (round == 0) {
-    // The snapshot holds until new scans arrive (planning again after failed moves reuses it).
-    double distance_s = 0.0;
-    if (!refreshed_ || gain_.snapshotScans() != map.scanCount()) {
-      gain_.refresh(map);
-      refreshed_ = true;
-      distance_s = gain_.lastRefresh().distance_s;
-    }
+    // Updated from what changed (nothing after failed moves; the whole of it for a moved
+    // region or a new map, which a scan count alone would miss).
+    gain_.refresh(map);
+    const double distance_s = gain_.lastRefresh().distance_s;
     // The map's ROI distance field apart from the snapshot: two costs, two owners.
     addTiming(step.timings_s, "roi_distance", distance_s);
     addTiming(step.timings_s, "snapshot", since(t) - distance_s);

@@ -249,9 +249,11 @@ void InfoGainEvaluator::updateBricks(const map::MapEngine& map, const std::vecto
   const std::array<int, 3> fine_per_axis = bricksPerAxis(fine_);
   const std::array<int, 3> coarse_per_axis = bricksPerAxis(coarse_);
   const fvp_region region = map::regionInGrid(fine_, map.region());
-  // Grid dimensions are whole bricks and a brick's rows start at multiples of 8 voxels, so
-  // no two bricks share a word: bricks are rewritten in parallel without races.
-#pragma omp parallel for schedule(dynamic, 4)
+  // With x dimensions of whole bricks a brick's rows start at multiples of 8 voxels, so no
+  // two bricks share a word: bricks are rewritten in parallel without races (else serially).
+  const bool fine_parallel = fine_.dims[0] % map::BrickChangeLog::kBrickEdge == 0;
+  const bool coarse_parallel = coarse_.dims[0] % map::BrickChangeLog::kBrickEdge == 0;
+#pragma omp parallel for schedule(dynamic, 4) if (fine_parallel)
   for (std::ptrdiff_t k = 0; k < std::ptrdiff_t(fine_bricks.size()); ++k)
     forVoxelsOfBrick(fine_, fine_per_axis, fine_bricks[k], [&](const std::array<int, 3>& v) {
       const std::size_t i =
@@ -260,7 +262,7 @@ void InfoGainEvaluator::updateBricks(const map::MapEngine& map, const std::vecto
       std::uint32_t& word = fine_words_[i >> 1];
       word = (word & ~(0xFFFFu << shift)) | std::uint32_t{computeFineCode(map, region, v)} << shift;
     });
-#pragma omp parallel for schedule(dynamic, 4)
+#pragma omp parallel for schedule(dynamic, 4) if (coarse_parallel)
   for (std::ptrdiff_t k = 0; k < std::ptrdiff_t(coarse_bricks.size()); ++k)
     forVoxelsOfBrick(coarse_, coarse_per_axis, coarse_bricks[k], [&](const std::array<int, 3>& v) {
       const std::size_t i =

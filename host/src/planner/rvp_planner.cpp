@@ -88,11 +88,9 @@ std::optional<Ranking> RvpPlanner::rank(map::MapEngine& map,
   if (round > 0) return std::nullopt;  // one round an iteration
   step.sampling_rounds = 1;
   auto t = Clock::now();
-  double distance_s = 0.0;
-  if (snapshot_.snapshotScans() != map.scanCount() || snapshot_.snapshotBytes() == 0) {
-    snapshot_.refresh(map);
-    distance_s = snapshot_.lastRefresh().distance_s;
-  }
+  // Updated from what changed (the whole of it for a moved region or a new map).
+  snapshot_.refresh(map);
+  const double distance_s = snapshot_.lastRefresh().distance_s;
   // The map's ROI distance field apart from the snapshot: two costs, two owners.
   step.timings_s.emplace_back("roi_distance", distance_s);
   step.timings_s.emplace_back("snapshot", since(t) - distance_s);

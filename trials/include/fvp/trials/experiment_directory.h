@@ -1,18 +1,21 @@
 // The files of an experiment directory (`fvp experiment` / `fvp merge`, docs/experiment.md)
 // and their contract, read and checked: trials.jsonl (one finished trial a line) and
-// manifest.json (the settings that define the experiment's rows). Depends on nlohmann_json
-// and the standard library only (library fvp_experiment_directory), so that a fuzzing
-// harness can link the readers alone.
+// manifest.json (the settings that define the experiment's rows). Links nlohmann_json and the
+// standard library only (library fvp_experiment_directory; the settings list and its types
+// are header-only), so that a fuzzing harness can link the readers alone.
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "fvp/trials/trial.h"
 
 namespace fvp::trials {
 
@@ -73,24 +76,25 @@ struct ConfigFileStamp {
 /// merge` (kind "merged"). Row-defining settings are those that change what a trial
 /// measures; trials with different ones must not be pooled into one Table 1 row.
 struct ExperimentManifest {
-  static constexpr int kFormatVersion = 1;
+  /// 2: the settings written through the trial's settings list (max_views null for no
+  /// limit, size_history added). 1 is read too.
+  static constexpr int kFormatVersion = 2;
   std::string kind = "run";  ///< "run" (fvp experiment) or "merged" (fvp merge)
-  // Row-defining: resume and merge refuse a difference.
-  double budget_s = 0;
-  std::string clock;
-  std::string stop = "budget";      ///< budget | auto (absent in a manifest: budget)
-  int max_views = 0;                ///< 0: no limit
-  bool register_views = false;      ///< --register-views (absent in a manifest: false)
-  bool confirm_detections = false;  ///< --confirm-detections (absent in a manifest: false)
-  bool release_left_out = false;    ///< --release-left-out (absent in a manifest: false)
+  /// The trials' settings: every setting of trials/trial_fields.h but the per-trial planner
+  /// and seed, written and read through that list under their keys. register_views is
+  /// resolved; under stop budget the automatic stop's switches are recorded false (they do
+  /// nothing there). Row-defining (resume and merge refuse a difference) except the engine
+  /// (resume only: the row key shows it) and the backend (recorded only: it picks the compute
+  /// device, not what a trial measures). Settings added after format 1 read as off when
+  /// absent (stop budget, no view registration, switches off, the built-in arm).
+  TrialOptions settings;
+  /// The config files of the settings (world_config, planner_config, arm_config), by key.
+  std::map<std::string, ConfigFileStamp> configs;
   /// --error-scale GROUP=FACTOR, or empty; the world config's hash already tells runs apart,
   /// this names the sweep point (absent in a manifest: empty).
   std::string error_scale;
-  ConfigFileStamp world_config, planner_config, arm_config;
   // The run's own plan (kind "run" only). Resume refuses a difference; merge does not
-  // compare them (shards differ in them by design; the engine is in the row key).
-  std::string engine;  ///< the --engine override; empty: each planner's default
-  std::string backend;
+  // compare them (shards differ in them by design).
   std::vector<std::string> planners;
   int trials = 0;
   std::uint64_t first_seed = 0;
@@ -116,9 +120,9 @@ struct ManifestDifference {
 std::optional<ManifestDifference> resumeDifference(const ExperimentManifest& old,
                                                    const ExperimentManifest& now);
 
-/// The first row-defining setting in which two experiments differ (what merge refuses):
-/// budget_s, clock, stop, max_views, world_config, planner_config, arm_config (configs by
-/// content hash).
+/// The first row-defining setting in which two experiments differ (what merge refuses): every
+/// setting but the engine and the backend, in the settings list's order (configs by content
+/// hash).
 std::optional<ManifestDifference> mergeDifference(const ExperimentManifest& a,
                                                   const ExperimentManifest& b);
 

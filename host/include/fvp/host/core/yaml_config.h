@@ -268,14 +268,17 @@ void readYamlConfig(const std::filesystem::path& path, const std::string& source
 }
 
 /// The config as JSON, one member per key of its table, in the table's order (a config's
-/// toJson; result.json's config). Throws std::logic_error for a key with no writer.
+/// toJson; result.json's config); an unset optional is left out, as a file leaves it out, so
+/// that the JSON read as the config's YAML gives the config. Throws std::logic_error for a key
+/// with no writer.
 template <typename Config>
 nlohmann::ordered_json yamlConfigJson(const std::vector<YamlKey<Config>>& keys,
                                       const Config& config) {
   nlohmann::ordered_json json = nlohmann::ordered_json::object();
   for (const auto& key : keys) {
     if (!key.write) throw std::logic_error(std::string("config key '") + key.name + "': no writer");
-    json[key.name] = key.write(config);
+    nlohmann::json value = key.write(config);
+    if (!value.is_null()) json[key.name] = std::move(value);
   }
   return json;
 }

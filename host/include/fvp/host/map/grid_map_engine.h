@@ -53,6 +53,7 @@ class GridMapEngine final : public MapEngine {
   void placeFineMap() override;
   /// Records the bricks the layers stamped since the last sync in the change logs.
   void syncChangeLogs() override;
+  bool recordsBrickChanges() const override { return true; }
 
  private:
   /// Writes the coarse voxels of bricks changed after change count `since` into tree.

@@ -126,6 +126,9 @@ class MapEngine {
   /// Brings the change logs up to date before changesSince() reads them, for engines that
   /// track changes elsewhere first (the grid engine's brick stamps).
   virtual void syncChangeLogs() {}
+  /// Whether the engine records its changes in changeLog(). An engine that does not (a
+  /// program's own) gets `all` from changesSince(): a stale copy is never kept.
+  virtual bool recordsBrickChanges() const { return false; }
 
  private:
   struct SceneState {

@@ -53,6 +53,9 @@ class OctomapMapEngine : public MapEngine {
   ~OctomapMapEngine() override;
 
   std::string_view engineName() const override { return "octomap"; }
+  /// integrateScan and updateRoiDistance record their changes (a subclass that changes voxels
+  /// elsewhere must mark them in changeLog() too).
+  bool recordsBrickChanges() const override { return true; }
 
   const GridGeometry& gridGeometry(MapLevel level) const override {
     return level == MapLevel::kCoarse ? coarse_grid_ : fine_grid_;

@@ -33,7 +33,7 @@ struct PerceptionConfig {
   /// centre in the world frame) and the HSV segmentation thresholds; unknown keys, wrong
   /// types and non-finite numbers are errors naming the file and the key.
   static PerceptionConfig fromYamlFile(const std::filesystem::path& path);
-  /// The user-facing keys as JSON, from the same key table (an unset region_center_m: null).
+  /// The user-facing keys as JSON, from the same key table (an unset region_center_m left out).
   std::string toJson() const;
 };
 

@@ -48,17 +48,13 @@ class FvpPlanner : public ViewPlanner {
   void score(std::vector<Candidate>& candidates, const Eigen::Vector3d& camera_m,
              EvaluateStats* stats = nullptr) const;
   /// Rebuilds the distance field and the gain snapshot; returns its wall time.
-  double refresh(map::MapEngine& map) {
-    refreshed_ = true;
-    return gain_.refresh(map);
-  }
+  double refresh(map::MapEngine& map) { return gain_.refresh(map); }
 
  private:
   PlannerConfig config_;
   ViewpointSampler sampler_;
   InfoGainEvaluator gain_;
   double u_t_;
-  bool refreshed_ = false;
   // The frontiers hold until new scans arrive (planning again after failed moves reuses
   // them): which map and scan count they were extracted from.
   std::vector<map::FrontierVoxel> frontiers_;
