@@ -171,7 +171,73 @@ bool mayBeAbsent(std::string_view key, bool merged) {
   return merged && (key == "engine" || key == "backend");
 }
 
-/// Reads each setting of a manifest by its type, with an error naming the file and the field.
+// A manifest setting's value by its type; `where` names the file for errors.
+template <typename Enum, typename Choices, typename NameOf>
+void readChoiceSetting(const std::string& where, const std::string& key, const nlohmann::json* v,
+                       Enum& value, const Choices& choices, NameOf nameOf) {
+  std::string names;
+  for (const Enum c : choices) {
+    names += (names.empty() ? "\"" : ", \"") + std::string(nameOf(c)) + "\"";
+    if (v && v->is_string() && v->get<std::string>() == nameOf(c)) return void(value = c);
+  }
+  fieldError(where, key, "one of " + names, v);
+}
+void readSetting(const std::string& where, const std::string& key, const nlohmann::json* v,
+                 double& value) {
+  if (!v || !isFinite(*v) || !(v->get<double>() > 0))
+    fieldError(where, key, "a finite positive number", v);
+  value = v->get<double>();
+}
+void readSetting(const std::string& where, const std::string& key, const nlohmann::json* v,
+                 std::optional<int>& value) {
+  // Format 1 wrote 0 for no limit.
+  if (v && v->is_null()) return void(value.reset());
+  if (!v || !isUnsigned(*v) || v->get<std::uint64_t>() > INT_MAX)
+    fieldError(where, key, "a non-negative integer or null (no limit)", v);
+  value = v->get<int>() > 0 ? std::optional<int>(v->get<int>()) : std::nullopt;
+}
+void readSetting(const std::string& where, const std::string& key, const nlohmann::json* v,
+                 bool& value) {
+  if (!v || !v->is_boolean()) fieldError(where, key, "true or false", v);
+  value = v->get<bool>();
+}
+void readSetting(const std::string& where, const std::string& key, const nlohmann::json* v,
+                 std::optional<bool>& value) {
+  // null: not resolved (the runner writes register_views resolved; a hand-made manifest may
+  // not).
+  if (v && v->is_null()) return void(value.reset());
+  bool b = false;
+  readSetting(where, key, v, b);
+  value = b;
+}
+void readSetting(const std::string& where, const std::string& key, const nlohmann::json* v,
+                 std::string& value) {
+  if (!v || !(isRegistryName(*v) || *v == "")) fieldError(where, key, kEngineExpected, v);
+  value = v->get<std::string>();
+}
+void readSetting(const std::string& where, const std::string& key, const nlohmann::json* v,
+                 accel::BackendChoice& value) {
+  readChoiceSetting(where, key, v, value, accel::kBackendChoices,
+                    [](accel::BackendChoice c) { return accel::toString(c); });
+}
+void readSetting(const std::string& where, const std::string& key, const nlohmann::json* v,
+                 host::nbv::StopRule& value) {
+  readChoiceSetting(where, key, v, value, host::nbv::kStopRules,
+                    [](host::nbv::StopRule r) { return std::string_view(host::nbv::toString(r)); });
+}
+void readSetting(const std::string& where, const std::string& key, const nlohmann::json* v,
+                 robot::sim::SimClock::Mode& value) {
+  using Mode = robot::sim::SimClock::Mode;
+  readChoiceSetting(where, key, v, value, std::array<Mode, 2>{Mode::kWall, Mode::kFixed},
+                    [](Mode m) { return std::string_view(robot::sim::SimClock::modeName(m)); });
+}
+// Config files are read as stamps (ManifestSettingsReader); the per-trial seed is never in a
+// manifest (visitManifestSettings leaves it out).
+void readSetting(const std::string&, const std::string&, const nlohmann::json*,
+                 std::filesystem::path&) {}
+void readSetting(const std::string&, const std::string&, const nlohmann::json*, std::uint64_t&) {}
+
+/// Reads each setting of a manifest (readSetting by its type; config files as stamps).
 class ManifestSettingsReader {
  public:
   ManifestSettingsReader(const nlohmann::json& j, std::string where, bool merged)
@@ -181,78 +247,21 @@ class ManifestSettingsReader {
   void operator()(const host::nbv::RunField& field, T& value) {
     const std::string key(field.key);
     const nlohmann::json* v = member(j_, key.c_str());
-    if (!v && mayBeAbsent(key, merged_)) return setOff(value);
+    if (!v && mayBeAbsent(key, merged_)) {
+      if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, std::optional<bool>>)
+        value = false;  // a switch added after format 1: off
+      return;
+    }
     if (field.vocabulary == host::nbv::FieldVocabulary::kConfigFile) {
       configs_[key] = readConfig(j_, key.c_str(), where_);
       if constexpr (std::is_same_v<T, std::filesystem::path>) value = configs_[key].path;
       return;
     }
-    read(key, v, value);
+    readSetting(where_, key, v, value);
   }
   const std::map<std::string, ConfigFileStamp>& configs() const { return configs_; }
 
  private:
-  template <typename T>
-  static void setOff(T& value) {
-    if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, std::optional<bool>>) value = false;
-  }
-  template <typename Enum, typename Choices, typename NameOf>
-  void readChoice(const std::string& key, const nlohmann::json* v, Enum& value,
-                  const Choices& choices, NameOf nameOf) const {
-    std::string names;
-    for (const Enum c : choices) {
-      names += (names.empty() ? "\"" : ", \"") + std::string(nameOf(c)) + "\"";
-      if (v && v->is_string() && v->get<std::string>() == nameOf(c)) return void(value = c);
-    }
-    fieldError(where_, key, "one of " + names, v);
-  }
-  void read(const std::string& key, const nlohmann::json* v, double& value) const {
-    if (!v || !isFinite(*v) || !(v->get<double>() > 0))
-      fieldError(where_, key, "a finite positive number", v);
-    value = v->get<double>();
-  }
-  void read(const std::string& key, const nlohmann::json* v, std::optional<int>& value) const {
-    // Format 1 wrote 0 for no limit.
-    const std::string expected = "a non-negative integer or null (no limit)";
-    if (v && v->is_null()) return void(value.reset());
-    if (!v || !isUnsigned(*v) || v->get<std::uint64_t>() > INT_MAX)
-      fieldError(where_, key, expected, v);
-    value = v->get<int>() > 0 ? std::optional<int>(v->get<int>()) : std::nullopt;
-  }
-  void read(const std::string& key, const nlohmann::json* v, bool& value) const {
-    if (!v || !v->is_boolean()) fieldError(where_, key, "true or false", v);
-    value = v->get<bool>();
-  }
-  void read(const std::string& key, const nlohmann::json* v, std::optional<bool>& value) const {
-    // null: not resolved (the runner writes register_views resolved; a hand-made manifest
-    // may not).
-    if (v && v->is_null()) return void(value.reset());
-    bool b = false;
-    read(key, v, b);
-    value = b;
-  }
-  void read(const std::string& key, const nlohmann::json* v, std::string& value) const {
-    if (!v || !(isRegistryName(*v) || *v == "")) fieldError(where_, key, kEngineExpected, v);
-    value = v->get<std::string>();
-  }
-  void read(const std::string& key, const nlohmann::json* v, accel::BackendChoice& value) const {
-    readChoice(key, v, value, accel::kBackendChoices,
-               [](accel::BackendChoice c) { return accel::toString(c); });
-  }
-  void read(const std::string& key, const nlohmann::json* v, host::nbv::StopRule& value) const {
-    readChoice(key, v, value, host::nbv::kStopRules,
-               [](host::nbv::StopRule r) { return std::string_view(host::nbv::toString(r)); });
-  }
-  void read(const std::string& key, const nlohmann::json* v,
-            robot::sim::SimClock::Mode& value) const {
-    using Mode = robot::sim::SimClock::Mode;
-    readChoice(key, v, value, std::array<Mode, 2>{Mode::kWall, Mode::kFixed},
-               [](Mode m) { return std::string_view(robot::sim::SimClock::modeName(m)); });
-  }
-  void read(const std::string&, const nlohmann::json*, std::filesystem::path&) const {}
-  // The per-trial seed is never in a manifest (visitManifestSettings leaves it out).
-  void read(const std::string&, const nlohmann::json*, std::uint64_t&) const {}
-
   const nlohmann::json& j_;
   std::string where_;
   bool merged_;
