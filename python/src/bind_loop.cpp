@@ -53,6 +53,9 @@ py::dict nbvResultToDict(const host::nbv::NbvResult& r) {
   events["iterations_without_move"] = e.iterations_without_move;
   events["move_attempts"] = e.move_attempts;
   events["failed_moves"] = e.failed_moves;
+  events["goal_checks"] = e.goal_checks;
+  events["candidates_rejected_no_ik"] = e.rejected_no_ik;
+  events["candidates_rejected_no_collision_free_ik"] = e.rejected_no_collision_free_ik;
   events["dropped_frames"] = e.dropped_frames;
   events["views_without_tag"] = e.views_without_tag;
   events["motion_status"] = e.motion_status;
@@ -64,6 +67,7 @@ py::dict nbvResultToDict(const host::nbv::NbvResult& r) {
   wall["mapping"] = w.mapping;
   wall["tsdf"] = w.tsdf;
   wall["planning"] = w.planning;
+  wall["goal_check"] = w.goal_check;
   wall["motion_planning"] = w.motion_planning;
   wall["moving"] = w.moving;
   d["wall_s"] = wall;

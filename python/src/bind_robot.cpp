@@ -48,7 +48,8 @@ MoveResult toMoveResult(const py::object& out) {
 }
 
 /// A Python subclass of fvp.Arm: camera_pose() -> (4, 4), reachable(T) -> bool,
-/// move_to(T) -> MoveResult | MoveStatus | bool, and optionally update_obstacles(map) -> int.
+/// move_to(T) -> MoveResult | MoveStatus | bool, and optionally update_obstacles(map) -> int
+/// and check_goal(T) -> GoalCheck (the loop then checks ranked views with it before moving).
 class PyArm : public host::nbv::Arm {
  public:
   Eigen::Isometry3d cameraPose() const override {
@@ -63,6 +64,18 @@ class PyArm : public host::nbv::Arm {
   MoveResult moveTo(const Eigen::Isometry3d& T_world_camera) override {
     py::gil_scoped_acquire gil;
     return toMoveResult(method("move_to")(poseToArray(T_world_camera)));
+  }
+  bool checksGoals() const override {
+    py::gil_scoped_acquire gil;
+    return static_cast<bool>(py::get_override(static_cast<const Arm*>(this), "check_goal"));
+  }
+  host::planner::GoalCheck checkGoal(const Eigen::Isometry3d& T_world_camera) const override {
+    py::gil_scoped_acquire gil;
+    const py::object out = method("check_goal")(poseToArray(T_world_camera));
+    if (!py::isinstance<host::planner::GoalCheck>(out))
+      throw std::invalid_argument("fvp.Arm.check_goal: expected a GoalCheck, got " +
+                                  std::string(py::str(py::type::of(out))));
+    return out.cast<host::planner::GoalCheck>();
   }
   std::size_t updateObstacles(host::map::MapEngine& map) override {
     py::gil_scoped_acquire gil;
@@ -130,10 +143,18 @@ void bindRobot(py::module_& m) {
           },
           py::arg("T_world_camera"));
 
+  py::enum_<host::planner::GoalCheck> goal_check(
+      m, "GoalCheck", "Whether the arm has a collision-free IK solution for a camera pose.");
+  for (const host::planner::GoalCheck g :
+       {host::planner::GoalCheck::kFeasible, host::planner::GoalCheck::kNoIk,
+        host::planner::GoalCheck::kNoCollisionFreeIk})
+    goal_check.value(host::planner::toString(g), g);
+
   py::class_<host::nbv::Arm, PyArm>(
       m, "Arm",
       "Subclass it: camera_pose() -> (4, 4); reachable(T) -> bool; move_to(T) -> MoveResult | "
-      "MoveStatus | bool; optionally update_obstacles(map) -> int.")
+      "MoveStatus | bool; optionally update_obstacles(map) -> int and check_goal(T) -> "
+      "GoalCheck (IK and collision only: ranked views it turns down are not moved to).")
       .def(py::init<>())
       .def("camera_pose", [](const host::nbv::Arm& a) { return poseToArray(a.cameraPose()); })
       .def(
@@ -153,7 +174,16 @@ void bindRobot(py::module_& m) {
       .def(
           "update_obstacles",
           [](host::nbv::Arm& a, host::map::MapEngine& map) { return a.updateObstacles(map); },
-          py::arg("map"));
+          py::arg("map"))
+      .def(
+          "check_goal",
+          [](const host::nbv::Arm& a, const py::handle& T) {
+            const Eigen::Isometry3d pose = poseFromArray(T, "Arm.check_goal T_world_camera");
+            py::gil_scoped_release release;
+            return a.checkGoal(pose);
+          },
+          py::arg("T_world_camera"))
+      .def_property_readonly("checks_goals", &host::nbv::Arm::checksGoals);
 }
 
 }  // namespace fvp::python

@@ -41,6 +41,9 @@ class DelegatingArm(fvp.Arm):
     def update_obstacles(self, map):
         return self.inner.update_obstacles(map)
 
+    def check_goal(self, T_world_camera):
+        return self.inner.check_goal(T_world_camera)
+
 
 class ClusterLog:
     """A tour observer: which clusters started and finished, in order."""

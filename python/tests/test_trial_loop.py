@@ -51,6 +51,9 @@ class DelegatingArm(fvp.Arm):
     def update_obstacles(self, map):
         return self.inner.update_obstacles(map)
 
+    def check_goal(self, T_world_camera):
+        return self.inner.check_goal(T_world_camera)
+
 
 def test_python_camera_and_arm_match_fvp_run(fvp_exe, tmp_path):
     out = tmp_path / "cli"

@@ -241,6 +241,17 @@ MotionPlan MotionPlanner::moveToPose(const JointVector& current,
   return plan;
 }
 
+MotionStatus MotionPlanner::goalStatus(const JointVector& current,
+                                       const Eigen::Isometry3d& T_world_camera) const {
+  const std::vector<JointVector> solutions = checker_.arm().inverse(T_world_camera, current);
+  if (solutions.empty()) return MotionStatus::kNoIk;
+  // moveToPose keeps a solution when it is valid and distinct from those kept: while none is
+  // kept every solution is distinct, so it keeps one exactly when one is valid.
+  const bool any_valid = std::any_of(solutions.begin(), solutions.end(),
+                                     [&](const JointVector& q) { return checker_.isValid(q); });
+  return any_valid ? MotionStatus::kSuccess : MotionStatus::kNoCollisionFreeIk;
+}
+
 MotionPlan MotionPlanner::planToJoints(const JointVector& current, const JointVector& goal) const {
   return plan_(current, {goal}, 1.0);
 }

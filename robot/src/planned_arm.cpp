@@ -57,6 +57,21 @@ bool PlannedArm::reachable(const Eigen::Isometry3d& T_world_camera) const {
   return reachability_.reachable(T_world_camera);
 }
 
+host::planner::GoalCheck PlannedArm::checkGoal(const Eigen::Isometry3d& T_world_camera) const {
+  switch (planner_.goalStatus(joints(), T_world_camera)) {
+    case MotionStatus::kNoIk:
+      return host::planner::GoalCheck::kNoIk;
+    case MotionStatus::kNoCollisionFreeIk:
+      return host::planner::GoalCheck::kNoCollisionFreeIk;
+    case MotionStatus::kSuccess:
+    case MotionStatus::kStartInvalid:
+    case MotionStatus::kNoPath:
+    case MotionStatus::kTimeout:
+      break;
+  }
+  return host::planner::GoalCheck::kFeasible;
+}
+
 host::nbv::MoveResult PlannedArm::moveTo(const Eigen::Isometry3d& T_world_camera) {
   return moveToPose(T_world_camera).result();
 }

@@ -22,9 +22,12 @@ const StereoFrame& renderedFrame(std::size_t i) {
 class FakeClock : public LoopClock {
  public:
   double now_s() const override { return now_; }
-  void chargeCompute(LoopStage, double) override { ++compute_charges; }
+  void chargeCompute(LoopStage stage, double) override {
+    ++compute_charges;
+    if (stage == LoopStage::kGoalCheck) ++goal_check_charges;
+  }
   void advance(double s) { now_ += s; }
-  int compute_charges = 0;
+  int compute_charges = 0, goal_check_charges = 0;
 
  private:
   double now_ = 0.0;
@@ -74,6 +77,16 @@ class FakeArm : public Arm {
     return {MoveStatus::kSuccess, 0.0};
   }
   std::size_t updateObstacles(map::MapEngine&) override { return ++obstacle_updates; }
+  bool checksGoals() const override { return checks_goals; }
+  /// Every `reject_every`-th goal check (1-based) finds only IK solutions in collision.
+  planner::GoalCheck checkGoal(const Eigen::Isometry3d&) const override {
+    ++goal_checks;
+    return reject_every && goal_checks % reject_every == 0 ? planner::GoalCheck::kNoCollisionFreeIk
+                                                           : planner::GoalCheck::kFeasible;
+  }
+  bool checks_goals = false;
+  int reject_every = 0;
+  mutable int goal_checks = 0;
   int refuse_every = 0, moves = 0;
   std::size_t obstacle_updates = 0;
 
@@ -111,8 +124,9 @@ struct Rig {
   FakeCamera camera{clock};
   FakeArm arm;
   FakePlanner planner;
+  NbvLoopOptions options;
   NbvResult run(const StopCondition& stop) {
-    return NbvLoop(session, planner, camera, arm, clock).run(stop);
+    return NbvLoop(session, planner, camera, arm, clock, options).run(stop);
   }
 };
 
@@ -131,6 +145,37 @@ TEST(NbvLoop, CapturesAtTheArmsPoseUntilTheViewCountAndCountsEachStep) {
   EXPECT_EQ(r.camera_poses.size(), 3u);
   EXPECT_EQ(rig.arm.obstacle_updates, 2u);  // after each new view that was planned on
   EXPECT_EQ(r.events.obstacle_update_count, 1u + 2u);
+}
+
+TEST(NbvLoop, AViewTheGoalCheckTurnsDownIsNotMovedToAndEachBatchIsCharged) {
+  Rig rig;
+  rig.arm.checks_goals = true;
+  rig.arm.reject_every = 2;  // the second planning iteration's view has no free IK solution
+  const NbvResult r = rig.run(StopCondition::views(3));
+  EXPECT_EQ(r.views, 3);
+  EXPECT_EQ(r.events.planning_iterations, 3u);
+  EXPECT_EQ(r.events.goal_checks, 3u);
+  EXPECT_EQ(r.events.goal_check_batches, 3u);
+  EXPECT_EQ(r.events.rejected_no_collision_free_ik, 1u);
+  EXPECT_EQ(r.events.rejected_no_ik, 0u);
+  EXPECT_EQ(r.events.move_attempts, 2u);  // the turned-down view never reached moveTo
+  EXPECT_EQ(r.events.failed_moves, 0u);
+  EXPECT_EQ(rig.arm.moves, 2);
+  EXPECT_EQ(r.events.iterations_without_move, 1u);
+  EXPECT_EQ(rig.clock.goal_check_charges, 3);  // each batch a compute stage of its own
+}
+
+TEST(NbvLoop, NoGoalChecksWhenTheArmHasNoneOrTheyAreOff) {
+  Rig without;
+  without.run(StopCondition::views(2));
+  EXPECT_EQ(without.clock.goal_check_charges, 0);
+  Rig off;
+  off.arm.checks_goals = true;
+  off.options.goal_check_batch = 0;
+  const NbvResult r = off.run(StopCondition::views(2));
+  EXPECT_EQ(off.arm.goal_checks, 0);
+  EXPECT_EQ(r.events.goal_checks, 0u);
+  EXPECT_EQ(off.clock.goal_check_charges, 0);
 }
 
 TEST(NbvLoop, ARefusedMoveIsCountedAndPlannedAgainWithoutACapture) {

@@ -1,7 +1,10 @@
 // Planners rank, the loop acts: planAndMove tries each round's ranked views in order, counts
 // every move, tells the planner how each round went and stops at the first move that works.
+// With the arm's goal check, views it turns down are skipped before a move is tried and
+// counted apart from the failed moves.
 #include <gtest/gtest.h>
 
+#include <stdexcept>
 #include <vector>
 
 #include "fvp/host/core/cluster_region.h"
@@ -74,6 +77,92 @@ TEST(PlanAndMove, GivesUpWhenThePlannerHasNoRoundLeft) {
   EXPECT_EQ(step.failed_moves, 4u);
   EXPECT_EQ(planner.outcomes, (std::vector<bool>{false, false}));
   EXPECT_EQ(step.candidates.size(), 2u);  // the last round's
+}
+
+/// A goal check by the view's x: 1 has no IK, 2 only IK solutions in collision, the rest pass.
+/// Records the x of every pose it is asked about, batch by batch.
+struct ScriptedGoalCheck {
+  std::vector<std::vector<double>> batches;
+  GoalCheckFn fn() {
+    return [this](const std::vector<Eigen::Isometry3d>& poses) {
+      batches.emplace_back();
+      std::vector<GoalCheck> out;
+      for (const Eigen::Isometry3d& T : poses) {
+        const double x = T.translation().x();
+        batches.back().push_back(x);
+        out.push_back(x == 1.0   ? GoalCheck::kNoIk
+                      : x == 2.0 ? GoalCheck::kNoCollisionFreeIk
+                                 : GoalCheck::kFeasible);
+      }
+      return out;
+    };
+  }
+};
+
+TEST(PlanAndMove, ViewsTheGoalCheckTurnsDownAreNotTriedAndAreCountedApart) {
+  ScriptedPlanner planner(2, 4);  // round 0 ranks 3, 2, 1, 0
+  ScriptedGoalCheck check;
+  std::vector<double> tried;
+  const PlanStep step = planAndMove(
+      planner, someMap(), Eigen::Isometry3d::Identity(), {},
+      [&](const Eigen::Isometry3d& T) {
+        tried.push_back(T.translation().x());
+        return T.translation().x() == 0.0;
+      },
+      check.fn());
+  EXPECT_EQ(tried, (std::vector<double>{3, 0}));  // 2 and 1 never reach the arm's planner
+  EXPECT_EQ(step.move_attempts, 2u);
+  EXPECT_EQ(step.failed_moves, 1u);
+  EXPECT_EQ(step.rejected_no_ik, 1u);
+  EXPECT_EQ(step.rejected_no_collision_free_ik, 1u);
+  EXPECT_EQ(step.goal_checks, 4u);
+  EXPECT_EQ(step.goal_check_batches, 1u);
+  ASSERT_TRUE(step.moved());
+  EXPECT_DOUBLE_EQ(step.candidates[*step.chosen].T_world_camera.translation().x(), 0.0);
+  EXPECT_EQ(planner.outcomes, (std::vector<bool>{true}));
+}
+
+TEST(PlanAndMove, ChecksABatchAheadOfTheMovesAndNoFurther) {
+  ScriptedGoalCheck check;
+  ScriptedPlanner first_moves(1, 5);  // ranks 4, 3, 2, 1, 0; the first move works
+  const PlanStep moved = planAndMove(
+      first_moves, someMap(), Eigen::Isometry3d::Identity(), {},
+      [](const Eigen::Isometry3d&) { return true; }, check.fn(), 2);
+  EXPECT_EQ(check.batches, (std::vector<std::vector<double>>{{4, 3}}));
+  EXPECT_EQ(moved.goal_checks, 2u);
+
+  check.batches.clear();
+  ScriptedPlanner none_move(1, 5);
+  const PlanStep failed = planAndMove(
+      none_move, someMap(), Eigen::Isometry3d::Identity(), {},
+      [](const Eigen::Isometry3d&) { return false; }, check.fn(), 2);
+  EXPECT_EQ(check.batches, (std::vector<std::vector<double>>{{4, 3}, {2, 1}, {0}}));
+  EXPECT_EQ(failed.goal_check_batches, 3u);
+  EXPECT_EQ(failed.goal_checks, 5u);
+  EXPECT_EQ(failed.move_attempts, 3u);  // 4, 3 and 0: 2 and 1 turned down
+  EXPECT_EQ(failed.failed_moves, 3u);
+  EXPECT_FALSE(failed.moved());
+}
+
+TEST(PlanAndMove, WithoutAGoalCheckEveryRankedViewIsTried) {
+  ScriptedPlanner planner(1, 3);
+  const PlanStep step = planAndMove(planner, someMap(), Eigen::Isometry3d::Identity(), {},
+                                    [](const Eigen::Isometry3d&) { return false; });
+  EXPECT_EQ(step.move_attempts, 3u);
+  EXPECT_EQ(step.goal_checks, 0u);
+  EXPECT_EQ(step.rejected_no_ik + step.rejected_no_collision_free_ik, 0u);
+}
+
+TEST(PlanAndMove, AGoalCheckThatDoesNotAnswerForEveryPoseThrows) {
+  ScriptedPlanner planner(1, 3);
+  const GoalCheckFn mute = [](const std::vector<Eigen::Isometry3d>&) {
+    return std::vector<GoalCheck>{};
+  };
+  EXPECT_THROW(planAndMove(
+                   planner, someMap(), Eigen::Isometry3d::Identity(), {},
+                   [](const Eigen::Isometry3d&) { return false; }, mute),
+               std::runtime_error);
+  EXPECT_STREQ(toString(GoalCheck::kNoCollisionFreeIk), "no_collision_free_ik");
 }
 
 }  // namespace

@@ -2,6 +2,8 @@
 // 100-query one is in arm_heavy_test.cpp).
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include "fvp/robot/motion_planner.h"
 #include "fvp/robot/sim/arm_controller.h"
 #include "planning_queries.h"
@@ -70,6 +72,48 @@ TEST(MotionPlanner, ReportsStatusesWithoutThrowing) {
       1e-6);
   EXPECT_GT(plan.trajectory.duration_s(), 0.0);
   EXPECT_STREQ(toString(MotionStatus::kTimeout), "timeout");
+}
+
+TEST(MotionPlanner, GoalStatusIsMoveToPosesFirstStepWithoutPlanning) {
+  // Views of a generated world's cluster from the sensor range, on the world's full coarse
+  // map: a pose the goal check turns down fails moveToPose with the same status, and one it
+  // passes goes on to motion planning.
+  const ArmModel arm{ArmConfig{}};
+  const auto world = sim::World::generate(sim::WorldConfig{}, 3);
+  const Eigen::Vector3d c = world.clusterCenter_m();
+  const auto map =
+      sim::worldOccupancy(world, 0.01, Eigen::AlignedBox3d(c.array() - 0.6, c.array() + 0.6));
+  ArmCollisionChecker checker(arm);
+  checker.setMap(*map);
+  MotionPlanner planner(checker);
+  planner.setReproducible(11);
+  const auto start = ArmController::startConfiguration(arm, world.startCameraPose());
+  ASSERT_TRUE(start.has_value());
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int by_status[3] = {};
+  int planned = 0;
+  for (int i = 0; i < 80; ++i) {
+    const Eigen::Vector3d dir =
+        Eigen::Vector3d(unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5).normalized();
+    const Eigen::Isometry3d T = sim::lookAt(c - (0.2 + 0.3 * unit(rng)) * dir, c);
+    const MotionStatus check = planner.goalStatus(*start, T);
+    ASSERT_TRUE(check == MotionStatus::kSuccess || check == MotionStatus::kNoIk ||
+                check == MotionStatus::kNoCollisionFreeIk);
+    ++by_status[check == MotionStatus::kSuccess ? 0 : check == MotionStatus::kNoIk ? 1 : 2];
+    if (check != MotionStatus::kSuccess) {
+      EXPECT_EQ(planner.moveToPose(*start, T).status, check);
+    } else if (planned < 3) {  // OMPL is the slow part: a few suffice
+      ++planned;
+      const MotionStatus moved = planner.moveToPose(*start, T).status;
+      EXPECT_NE(moved, MotionStatus::kNoIk);
+      EXPECT_NE(moved, MotionStatus::kNoCollisionFreeIk);
+    }
+  }
+  // Every kind of answer was seen, or the test would prove little.
+  EXPECT_GT(by_status[0], 0);
+  EXPECT_GT(by_status[1], 0);
+  EXPECT_GT(by_status[2], 0);
 }
 
 TEST(ArmController, ChargesPlanningAndMotionToTheClock) {

@@ -10,14 +10,19 @@
 #include <stdexcept>
 #include <vector>
 
+#include "fvp/host/core/cluster_region.h"
+#include "fvp/host/map/map_engine.h"
+#include "fvp/host/planner/view_planner.h"
 #include "fvp/robot/ik_reachability.h"
 #include "fvp/robot/planned_arm.h"
 #include "fvp/robot/sim/simulated_arm.h"
+#include "fvp/robot/sim/world.h"
 
 namespace fvp::robot {
 namespace {
 
 using host::nbv::MoveStatus;
+using host::planner::GoalCheck;
 
 class FakeJointState : public JointStateSource {
  public:
@@ -171,6 +176,111 @@ TEST(PlannedArm, PlanningFailuresAreStatusesAndNothingIsExecuted) {
   EXPECT_EQ(plans_observed, 2);
   EXPECT_TRUE(robot.executor.trajectories.empty());
   EXPECT_EQ(robot.arm.joints(), start);
+}
+
+/// A wall of 1 cm voxels, 0.6 m square, across the camera's optical axis ahead_m in front of it.
+octomap::OcTree wallAcrossTheView(const Eigen::Isometry3d& T_world_camera, double ahead_m) {
+  octomap::OcTree wall(0.01);
+  for (double u = -0.3; u <= 0.3; u += 0.01)
+    for (double v = -0.3; v <= 0.3; v += 0.01) {
+      const Eigen::Vector3d p_world = T_world_camera * Eigen::Vector3d(u, v, ahead_m);
+      wall.updateNode(p_world.x(), p_world.y(), p_world.z(), true);
+    }
+  return wall;
+}
+
+/// The arm at a generated world's start view (the camera level, looking at the cluster); a
+/// wall across that view WALL_AHEAD_M in front of the camera; a view VIEW_AHEAD_M ahead,
+/// behind the wall (the flange, 6 cm behind the lens, and the wrist would stand in it), and
+/// one 5 cm back, in front of it.
+struct WallScene {
+  static constexpr double kWallAhead_m = 0.06, kViewAhead_m = 0.12;
+  explicit WallScene(FakeRobot& robot)
+      : T_start(sim::World::generate(sim::WorldConfig{}, 1).startCameraPose()),
+        behind(T_start * Eigen::Translation3d(0.0, 0.0, kViewAhead_m)),
+        in_front(T_start * Eigen::Translation3d(0.0, 0.0, -0.05)),
+        wall(wallAcrossTheView(T_start, kWallAhead_m)) {
+    const auto start = sim::SimulatedArm::startConfiguration(robot.model, T_start);
+    if (!start) throw std::logic_error("the start view of world 1 is out of reach");
+    robot.joints.q = *start;
+  }
+  Eigen::Isometry3d T_start, behind, in_front;
+  octomap::OcTree wall;
+};
+
+TEST(PlannedArm, TheGoalCheckTurnsDownAViewBehindAWallWithoutPlanningAndKeepsOneInFront) {
+  FakeRobot robot(RecordingExecutor::Mode::kMove);
+  const WallScene scene(robot);
+  int plans_observed = 0;
+  robot.arm.setPlanningObserver([&](const MotionPlan&) { ++plans_observed; });
+  Eigen::Isometry3d far = robot.arm.cameraPose();
+  far.translation().y() += 3.0;
+  EXPECT_TRUE(robot.arm.checksGoals());
+  // Without the wall both views have a goal.
+  ASSERT_EQ(robot.arm.checkGoal(scene.behind), GoalCheck::kFeasible);
+  ASSERT_EQ(robot.arm.checkGoal(scene.in_front), GoalCheck::kFeasible);
+  EXPECT_EQ(robot.arm.checkGoal(far), GoalCheck::kNoIk);
+  ASSERT_EQ(robot.arm.setMap(scene.wall), 0u);  // the arm stands clear of the wall
+  EXPECT_EQ(robot.arm.checkGoal(scene.behind), GoalCheck::kNoCollisionFreeIk);
+  EXPECT_EQ(robot.arm.checkGoal(scene.in_front), GoalCheck::kFeasible);
+  EXPECT_EQ(plans_observed, 0);  // nothing planned, nothing executed
+  EXPECT_TRUE(robot.executor.trajectories.empty());
+  // What the check said is what the moves find.
+  EXPECT_EQ(robot.arm.moveTo(scene.behind).status, MoveStatus::kNoCollisionFreeIk);
+  EXPECT_EQ(robot.arm.moveTo(scene.in_front).status, MoveStatus::kSuccess);
+}
+
+/// Ranks the views it is given, in that order, in one round.
+class FixedRanking : public host::planner::ViewPlanner {
+ public:
+  explicit FixedRanking(std::vector<Eigen::Isometry3d> views) : views_(std::move(views)) {}
+  std::string_view name() const override { return "fixed"; }
+  std::string configJson() const override { return "{}"; }
+  std::optional<host::planner::Ranking> rank(host::map::MapEngine&, const Eigen::Isometry3d&,
+                                             const host::planner::ReachabilityFn&,
+                                             std::size_t round, host::planner::PlanStep&) override {
+    if (round > 0) return std::nullopt;
+    host::planner::Ranking ranking;
+    for (const Eigen::Isometry3d& T : views_) {
+      ranking.order.push_back(ranking.candidates.size());
+      ranking.candidates.emplace_back().T_world_camera = T;
+    }
+    return ranking;
+  }
+
+ private:
+  std::vector<Eigen::Isometry3d> views_;
+};
+
+TEST(PlannedArm, PlanAndMoveSkipsTheViewBehindTheWallBeforeAnyMoveIsTried) {
+  FakeRobot robot(RecordingExecutor::Mode::kMove);
+  const WallScene scene(robot);
+  ASSERT_EQ(robot.arm.setMap(scene.wall), 0u);
+  std::vector<Eigen::Isometry3d> planned;
+  robot.arm.setPlanningObserver(
+      [&](const MotionPlan& plan) { planned.push_back(robot.model.T_world_camera(plan.goal)); });
+  FixedRanking planner({scene.behind, scene.in_front});  // the blocked view ranked first
+  host::map::MapConfig config;
+  config.observation_min_m = {-2.0, -2.0, 0.0};  // around the arm: the map is never read
+  config.observation_max_m = {2.0, 2.0, 2.5};
+  const auto map = host::map::createMapEngine(
+      "octomap", config, host::ClusterRegion(scene.in_front.translation(), 0.04), nullptr);
+  const host::planner::PlanStep step = host::planner::planAndMove(
+      planner, *map, robot.arm.cameraPose(), {},
+      [&](const Eigen::Isometry3d& T) { return robot.arm.moveTo(T).ok(); },
+      [&](const std::vector<Eigen::Isometry3d>& poses) {
+        std::vector<GoalCheck> out;
+        for (const Eigen::Isometry3d& T : poses) out.push_back(robot.arm.checkGoal(T));
+        return out;
+      });
+  ASSERT_TRUE(step.moved());
+  EXPECT_EQ(*step.chosen, 1u);
+  EXPECT_EQ(step.move_attempts, 1u);  // the blocked view never reached the motion planner
+  EXPECT_EQ(step.failed_moves, 0u);
+  EXPECT_EQ(step.rejected_no_collision_free_ik, 1u);
+  EXPECT_EQ(step.rejected_no_ik, 0u);
+  ASSERT_EQ(planned.size(), 1u);
+  EXPECT_LT((planned[0].translation() - scene.in_front.translation()).norm(), 1e-6);
 }
 
 TEST(PlannedArm, TheMapIsFreedWhereTheArmStands) {

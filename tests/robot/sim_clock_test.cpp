@@ -42,6 +42,10 @@ TEST(SimClock, FixedModeChargesConstantsAndKeepsTheMeasuredTime) {
   clock.chargeMotion(2.0);
   EXPECT_NEAR(clock.now_s(), 0.2 + 0.1 + 0.1 + 2.0, 1e-12);
   EXPECT_DOUBLE_EQ(clock.iterations()[0].measured_s[static_cast<int>(ClockStage::kMapping)], 3.7);
+  clock.chargeCompute(ClockStage::kGoalCheck, 0.002);  // a batch of goal checks: one stage
+  EXPECT_NEAR(clock.now_s(), 0.2 + 0.1 + 0.1 + 2.0 + 0.1, 1e-12);
+  EXPECT_DOUBLE_EQ(
+      nlohmann::json::parse(clock.toJson())["iterations"][0]["goal_check_s"].get<double>(), 0.1);
   EXPECT_THROW(clock.chargeCompute(ClockStage::kMotion, 1.0), std::invalid_argument);
   EXPECT_THROW(clock.chargeMotion(-1.0), std::invalid_argument);
 }

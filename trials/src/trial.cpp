@@ -302,6 +302,10 @@ nlohmann::json eventsJson(const host::nbv::NbvEvents& events) {
           {"move_attempts", events.move_attempts},
           {"failed_moves", events.failed_moves},
           {"candidates_rejected_clearance", events.rejected_clearance},
+          {"goal_checks", events.goal_checks},
+          {"goal_check_batches", events.goal_check_batches},
+          {"candidates_rejected_no_ik", events.rejected_no_ik},
+          {"candidates_rejected_no_collision_free_ik", events.rejected_no_collision_free_ik},
           {"gain_rays_culled", events.culled_rays},
           {"views_without_tag", events.views_without_tag},
           {"dropped_disparities", events.dropped_disparities},
@@ -587,6 +591,7 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
                                 {"mapping", run.wall_s.mapping},
                                 {"tsdf", run.wall_s.tsdf},
                                 {"planning", run.wall_s.planning},
+                                {"goal_check", run.wall_s.goal_check},
                                 {"motion_planning", run.wall_s.motion_planning},
                                 {"sizing", outcome.sizing_wall_s},
                                 {"sizing_during_loop", outcome.sizing_during_loop_s}};
@@ -733,6 +738,7 @@ void Trial::Impl::recordCluster(const host::nbv::ClusterVisit& visit, TrialParts
                          {"mapping", outcome.run.wall_s.mapping},
                          {"tsdf", outcome.run.wall_s.tsdf},
                          {"planning", outcome.run.wall_s.planning},
+                         {"goal_check", outcome.run.wall_s.goal_check},
                          {"motion_planning", outcome.run.wall_s.motion_planning},
                          {"sizing", outcome.sizing_wall_s},
                          {"sizing_during_loop", outcome.sizing_during_loop_s}});

@@ -313,8 +313,9 @@ void appendSimulatedBudget(std::ostringstream& md, const nlohmann::json& result)
      << (field(result, "clock").is_object() ? result["clock"].value("mode", "?") : "?")
      << "` mode), summed over the loop's iterations.\n\n| stage | simulated s |\n|---|---|\n";
   // The loop's order first, any other stage after it.
-  const std::vector<std::string> order = {"capture_s",         "mapping_s", "tsdf_s",  "planning_s",
-                                          "motion_planning_s", "motion_s",  "sizing_s"};
+  const std::vector<std::string> order = {"capture_s",  "mapping_s",    "tsdf_s",
+                                          "planning_s", "goal_check_s", "motion_planning_s",
+                                          "motion_s",   "sizing_s"};
   const auto row = [&](const std::string& key, double s) {
     md << "| " << key.substr(0, key.size() - (key.size() > 2 && key.ends_with("_s") ? 2 : 0))
        << " | " << fmt(s, 2) << " |\n";

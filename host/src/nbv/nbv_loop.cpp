@@ -1,6 +1,7 @@
 #include "fvp/host/nbv/nbv_loop.h"
 
 #include <chrono>
+#include <vector>
 
 namespace fvp::host::nbv {
 namespace {
@@ -42,6 +43,56 @@ NbvLoop::NbvLoop(MappingSession& session, planner::ViewPlanner& planner, Camera&
       arm_(arm),
       clock_(clock),
       options_(options) {}
+
+planner::PlanStep NbvLoop::planAndMove_(map::MapEngine& map, NbvResult& out, double& plan_s) {
+  NbvEvents& events = out.events;
+  // Planning is charged as its wall time less the moves it made (the arm's own time is
+  // the arm's to account for: a simulated arm charges the simulated clock itself) and the
+  // goal checks, each batch of which is a compute stage of its own.
+  double move_wall_s = 0.0, goal_check_wall_s = 0.0;
+  const planner::ReachabilityFn reachable = [&](const Eigen::Isometry3d& T) {
+    return arm_.reachable(T);
+  };
+  const planner::MoveToPoseFn move = [&](const Eigen::Isometry3d& T) {
+    const auto t_move = Clock::now();
+    const MoveResult moved = arm_.moveTo(T);
+    move_wall_s += secondsSince(t_move);
+    out.wall_s.motion_planning += moved.planning_wall_s;
+    ++events.motion_status[toString(moved.status)];
+    return moved.ok();
+  };
+  planner::GoalCheckFn check_goals;
+  if (arm_.checksGoals() && options_.goal_check_batch > 0) {
+    check_goals = [&](const std::vector<Eigen::Isometry3d>& poses) {
+      const auto t_check = Clock::now();
+      std::vector<planner::GoalCheck> statuses;
+      statuses.reserve(poses.size());
+      for (const Eigen::Isometry3d& T : poses) statuses.push_back(arm_.checkGoal(T));
+      const double check_s = secondsSince(t_check);
+      goal_check_wall_s += check_s;
+      clock_.chargeCompute(LoopStage::kGoalCheck, check_s);
+      return statuses;
+    };
+  }
+  const auto t_plan = Clock::now();
+  planner::PlanStep step = planner::planAndMove(planner_, map, arm_.cameraPose(), reachable, move,
+                                                check_goals, options_.goal_check_batch);
+  plan_s = std::max(0.0, secondsSince(t_plan) - move_wall_s - goal_check_wall_s);
+  out.wall_s.planning += plan_s;
+  out.wall_s.goal_check += goal_check_wall_s;
+  out.wall_s.moving += move_wall_s;
+  clock_.chargeCompute(LoopStage::kPlanning, plan_s);
+  ++events.planning_iterations;
+  events.move_attempts += step.move_attempts;
+  events.failed_moves += step.failed_moves;
+  events.rejected_clearance += step.rejected_clearance;
+  events.goal_checks += step.goal_checks;
+  events.goal_check_batches += step.goal_check_batches;
+  events.rejected_no_ik += step.rejected_no_ik;
+  events.rejected_no_collision_free_ik += step.rejected_no_collision_free_ik;
+  events.culled_rays += step.culled_rays;
+  return step;
+}
 
 NbvResult NbvLoop::run(const StopCondition& stop, LoopObserver* observer) {
   NbvResult out;
@@ -118,32 +169,8 @@ NbvResult NbvLoop::run(const StopCondition& stop, LoopObserver* observer) {
       out.wall_s.mapping += obstacles_s;
       clock_.chargeCompute(LoopStage::kMapping, obstacles_s);
     }
-    // Planning is charged as its wall time less the moves it made (the arm's own time is
-    // the arm's to account for: a simulated arm charges the simulated clock itself).
-    double move_wall_s = 0.0;
-    const planner::ReachabilityFn reachable = [&](const Eigen::Isometry3d& T) {
-      return arm_.reachable(T);
-    };
-    const planner::MoveToPoseFn move = [&](const Eigen::Isometry3d& T) {
-      const auto t_move = Clock::now();
-      const MoveResult moved = arm_.moveTo(T);
-      move_wall_s += secondsSince(t_move);
-      out.wall_s.motion_planning += moved.planning_wall_s;
-      ++events.motion_status[toString(moved.status)];
-      return moved.ok();
-    };
-    const auto t_plan = Clock::now();
-    const planner::PlanStep step =
-        planner::planAndMove(planner_, *map, arm_.cameraPose(), reachable, move);
-    const double plan_s = std::max(0.0, secondsSince(t_plan) - move_wall_s);
-    out.wall_s.planning += plan_s;
-    out.wall_s.moving += move_wall_s;
-    clock_.chargeCompute(LoopStage::kPlanning, plan_s);
-    ++events.planning_iterations;
-    events.move_attempts += step.move_attempts;
-    events.failed_moves += step.failed_moves;
-    events.rejected_clearance += step.rejected_clearance;
-    events.culled_rays += step.culled_rays;
+    double plan_s = 0.0;
+    const planner::PlanStep step = planAndMove_(*map, out, plan_s);
     if (observer) observer->onPlan({events.planning_iterations - 1, &step, plan_s, clock_.now_s()});
     // Without a move a new capture would see the same view: plan again (the planner's
     // threshold has decayed) until a move succeeds or the loop stops.

@@ -21,6 +21,8 @@ const char* toString(ClockStage stage) {
       return "motion";
     case ClockStage::kSizing:
       return "sizing";
+    case ClockStage::kGoalCheck:
+      return "goal_check";
   }
   return "unknown";
 }

@@ -16,6 +16,9 @@ void SimulatedLoopClock::chargeCompute(host::nbv::LoopStage stage, double wall_s
     case host::nbv::LoopStage::kSizing:
       clock_.chargeCompute(ClockStage::kSizing, wall_s);
       return;
+    case host::nbv::LoopStage::kGoalCheck:
+      clock_.chargeCompute(ClockStage::kGoalCheck, wall_s);
+      return;
   }
 }
 

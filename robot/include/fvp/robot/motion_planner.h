@@ -44,6 +44,13 @@ class MotionPlanner {
   explicit MotionPlanner(const ArmCollisionChecker& checker);
 
   MotionPlan moveToPose(const JointVector& current, const Eigen::Isometry3d& T_world_camera) const;
+  /// moveToPose's first step alone, without motion planning: kNoIk or kNoCollisionFreeIk
+  /// exactly when moveToPose from `current` on the same map would fail with that status,
+  /// else kSuccess (a collision-free goal exists; the motion may still fail). IK along the
+  /// travel and validity checks until the first valid solution: no OMPL, no query number
+  /// used, so reproducible planning's later queries are unchanged.
+  MotionStatus goalStatus(const JointVector& current,
+                          const Eigen::Isometry3d& T_world_camera) const;
 
   /// From now on every query is reproducible: OMPL's sampler, planner and path simplifier
   /// are seeded from seed and the query's number, and planning and simplification stop after

@@ -51,6 +51,10 @@ class PlannedArm : public host::nbv::Arm {
   Eigen::Isometry3d cameraPose() const override;
   bool reachable(const Eigen::Isometry3d& T_world_camera) const override;
   host::nbv::MoveResult moveTo(const Eigen::Isometry3d& T_world_camera) override;
+  bool checksGoals() const override { return true; }
+  /// MotionPlanner::goalStatus from the joints now, on the map of the last setMap: IK along
+  /// the travel and collision checks (self, static, FCL against the map), no OMPL.
+  host::planner::GoalCheck checkGoal(const Eigen::Isometry3d& T_world_camera) const override;
   /// setMap with the map's coarse octree.
   std::size_t updateObstacles(host::map::MapEngine& map) override;
 

@@ -6,6 +6,8 @@
 #include <cstddef>
 #include <string>
 
+#include "fvp/host/planner/goal_check.h"
+
 namespace fvp::host::map {
 class MapEngine;
 }
@@ -42,6 +44,18 @@ class Arm {
   virtual bool reachable(const Eigen::Isometry3d& T_world_camera) const = 0;
   /// Plans and executes a move of the camera to the pose (blocking).
   virtual MoveResult moveTo(const Eigen::Isometry3d& T_world_camera) = 0;
+  /// Whether the arm answers checkGoal; the loop asks only an arm that does (and charges the
+  /// checks to its clock). false: every ranked view goes straight to moveTo.
+  virtual bool checksGoals() const { return false; }
+  /// From where the arm is, on the map of the last updateObstacles: the part of moveTo that
+  /// needs no motion planning (IK, then one solution free of collision). kFeasible means
+  /// moveTo will plan a motion (which may still fail); the others mean moveTo would fail with
+  /// the MoveStatus of the same name. Much cheaper than a move (no motion planning, nothing
+  /// executed), so the loop checks the top of each ranking before it tries a move.
+  virtual planner::GoalCheck checkGoal(const Eigen::Isometry3d& T_world_camera) const {
+    (void)T_world_camera;
+    return planner::GoalCheck::kFeasible;
+  }
   /// Called after new views reached the map, before planning, so the arm avoids what the
   /// camera has seen. Returns a count for the log (the simulated arm: voxels it freed where
   /// it stands); 0 for an arm that does not use the map.

@@ -9,7 +9,8 @@ namespace fvp::host::nbv {
 
 /// The loop's own compute, which a simulated clock charges (measured or fixed).
 /// kSizing: sizing the cluster during the loop (the automatic stop's, cluster_completion.h).
-enum class LoopStage { kMapping, kTsdf, kPlanning, kSizing };
+/// kGoalCheck: one batch of the arm's goal checks of ranked views (Arm::checkGoal).
+enum class LoopStage { kMapping, kTsdf, kPlanning, kSizing, kGoalCheck };
 
 class LoopClock {
  public:

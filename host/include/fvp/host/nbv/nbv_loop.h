@@ -33,7 +33,7 @@ struct ViewEvent {
 struct PlanEvent {
   std::size_t iteration = 0;
   const planner::PlanStep* step = nullptr;
-  double planning_s = 0.0;  ///< planner wall time less the moves it made
+  double planning_s = 0.0;  ///< planner wall time less the moves and goal checks it made
   double now_s = 0.0;
 };
 
@@ -50,6 +50,9 @@ struct NbvLoopOptions {
   /// Frames dropped in a row after which the loop stops ("camera_failed"): a camera that
   /// never delivers must not spin the loop forever.
   int max_consecutive_dropped_frames = 10;
+  /// Ranked views the arm's goal check (Arm::checkGoal) is asked about per call, ahead of
+  /// the moves (planAndMove); 0: no goal checks, every ranked view goes to moveTo.
+  std::size_t goal_check_batch = planner::kDefaultGoalCheckBatch;
 };
 
 /// Counted expected events of a run (never errors).
@@ -57,6 +60,9 @@ struct NbvEvents {
   std::size_t planning_iterations = 0, iterations_without_move = 0, move_attempts = 0,
               failed_moves = 0, rejected_clearance = 0, culled_rays = 0, views_without_tag = 0,
               dropped_frames = 0, obstacle_update_count = 0;
+  /// The arm's goal checks (PlanStep): poses checked, calls, and ranked views turned down.
+  std::size_t goal_checks = 0, goal_check_batches = 0, rejected_no_ik = 0,
+              rejected_no_collision_free_ik = 0;
   std::int64_t dropped_disparities = 0, saturated_disparities = 0;
   std::map<std::string, std::size_t> motion_status;  ///< toString(MoveStatus) -> count
 };
@@ -64,7 +70,7 @@ struct NbvEvents {
 /// Wall time spent in the loop's parts, seconds.
 struct NbvWallTimes {
   double capture = 0.0, perception = 0.0, mapping = 0.0, tsdf = 0.0, planning = 0.0,
-         motion_planning = 0.0, moving = 0.0;
+         goal_check = 0.0, motion_planning = 0.0, moving = 0.0;
 };
 
 struct NbvResult {
@@ -88,6 +94,10 @@ class NbvLoop {
   NbvResult run(const StopCondition& stop, LoopObserver* observer = nullptr);
 
  private:
+  /// One planning iteration on the map: planAndMove with the arm's reachability, goal checks
+  /// and moves, charged to the clock and counted into out; plan_s is the planning's share.
+  planner::PlanStep planAndMove_(map::MapEngine& map, NbvResult& out, double& plan_s);
+
   MappingSession& session_;
   planner::ViewPlanner& planner_;
   Camera& camera_;

@@ -15,6 +15,7 @@
 #include <string_view>
 #include <vector>
 
+#include "fvp/host/planner/goal_check.h"
 #include "fvp/host/planner/sizing_target.h"
 
 namespace fvp::host::map {
@@ -58,6 +59,10 @@ struct PlanStep {
   std::optional<std::size_t> chosen;
   std::size_t move_attempts = 0;  ///< moveToPose calls this iteration
   std::size_t failed_moves = 0;   ///< of which failed
+  /// Ranked views the arm's goal check (goal_check.h) was asked about, in how many calls, and
+  /// those it turned down before a move was tried (not counted as move attempts).
+  std::size_t goal_checks = 0, goal_check_batches = 0;
+  std::size_t rejected_no_ik = 0, rejected_no_collision_free_ik = 0;
   std::size_t sampling_rounds = 0;
   /// Reachable candidates dropped before scoring because the camera body would stand in
   /// occupied space (counted, not sent to the motion planner).
@@ -105,9 +110,13 @@ class ViewPlanner {
 
 /// One planning iteration: the planner's rounds, each round's ranked views tried in order
 /// until a move succeeds (Algorithm 1, lines 6-18). PlanStep::candidates are the last
-/// round's; move_attempts and failed_moves count every move tried.
+/// round's; move_attempts and failed_moves count every move tried. With check_goals, the
+/// ranked views are first checked in batches of goal_check_batch, a batch ahead of the moves
+/// (the next one only when the moves of the last have all failed), and a view the check
+/// turns down is skipped: counted by its status, neither a move attempt nor a failed move.
 PlanStep planAndMove(ViewPlanner& planner, map::MapEngine& map,
                      const Eigen::Isometry3d& T_world_camera_now, const ReachabilityFn& reachable,
-                     const MoveToPoseFn& move);
+                     const MoveToPoseFn& move, const GoalCheckFn& check_goals = {},
+                     std::size_t goal_check_batch = kDefaultGoalCheckBatch);
 
 }  // namespace fvp::host::planner

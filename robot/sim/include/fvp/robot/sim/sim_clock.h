@@ -12,8 +12,19 @@
 
 namespace fvp::robot::sim {
 
-enum class ClockStage { kCapture, kMapping, kTsdf, kPlanning, kMotionPlanning, kMotion, kSizing };
-inline constexpr int kClockStages = 7;
+/// kGoalCheck: the arm's goal checks of ranked views (IK + collision, host::nbv::Arm::checkGoal),
+/// charged per batch; last, so the earlier stages keep their places in the records.
+enum class ClockStage {
+  kCapture,
+  kMapping,
+  kTsdf,
+  kPlanning,
+  kMotionPlanning,
+  kMotion,
+  kSizing,
+  kGoalCheck
+};
+inline constexpr int kClockStages = 8;
 const char* toString(ClockStage stage);
 
 struct IterationCharges {
@@ -45,8 +56,8 @@ class SimClock {
   /// Opens the next iteration's record (charges before the first call open one).
   void beginIteration();
   void chargeCapture();
-  /// A compute stage (mapping, TSDF, planning, motion planning, sizing for an automatic stop)
-  /// that took measured_wall_s.
+  /// A compute stage (mapping, TSDF, planning, motion planning, sizing for an automatic stop,
+  /// a batch of goal checks) that took measured_wall_s.
   void chargeCompute(ClockStage stage, double measured_wall_s);
   void chargeMotion(double duration_s);
   void recordUncharged(double rendering_wall_s, double sgbm_wall_s);

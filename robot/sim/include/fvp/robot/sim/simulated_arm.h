@@ -31,6 +31,10 @@ class SimulatedArm : public host::nbv::Arm {
   host::nbv::MoveResult moveTo(const Eigen::Isometry3d& T_world_camera) override {
     return arm_.moveTo(T_world_camera);
   }
+  bool checksGoals() const override { return arm_.checksGoals(); }
+  host::planner::GoalCheck checkGoal(const Eigen::Isometry3d& T_world_camera) const override {
+    return arm_.checkGoal(T_world_camera);
+  }
   /// The collision checker's map becomes the coarse map, with the voxels the arm occupies
   /// where it stands freed (returns how many).
   std::size_t updateObstacles(host::map::MapEngine& map) override {
