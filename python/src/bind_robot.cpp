@@ -2,6 +2,7 @@
 // trampolines call their Python methods); what a capture and a move return.
 #include <pybind11/stl.h>
 
+#include <limits>
 #include <stdexcept>
 
 #include "bindings.h"
@@ -49,7 +50,8 @@ MoveResult toMoveResult(const py::object& out) {
 
 /// A Python subclass of fvp.Arm: camera_pose() -> (4, 4), reachable(T) -> bool,
 /// move_to(T) -> MoveResult | MoveStatus | bool, and optionally update_obstacles(map) -> int
-/// and check_goal(T) -> GoalCheck (the loop then checks ranked views with it before moving).
+/// and check_goal(T) -> GoalReach | GoalCheck (the loop then checks ranked views with it
+/// before moving, and tries a batch by information per second where travel_s is given).
 class PyArm : public host::nbv::Arm {
  public:
   Eigen::Isometry3d cameraPose() const override {
@@ -69,13 +71,14 @@ class PyArm : public host::nbv::Arm {
     py::gil_scoped_acquire gil;
     return static_cast<bool>(py::get_override(static_cast<const Arm*>(this), "check_goal"));
   }
-  host::planner::GoalCheck checkGoal(const Eigen::Isometry3d& T_world_camera) const override {
+  host::planner::GoalReach checkGoal(const Eigen::Isometry3d& T_world_camera) const override {
     py::gil_scoped_acquire gil;
     const py::object out = method("check_goal")(poseToArray(T_world_camera));
-    if (!py::isinstance<host::planner::GoalCheck>(out))
-      throw std::invalid_argument("fvp.Arm.check_goal: expected a GoalCheck, got " +
-                                  std::string(py::str(py::type::of(out))));
-    return out.cast<host::planner::GoalCheck>();
+    if (py::isinstance<host::planner::GoalReach>(out)) return out.cast<host::planner::GoalReach>();
+    if (py::isinstance<host::planner::GoalCheck>(out))  // no travel time: ranked as planned
+      return {out.cast<host::planner::GoalCheck>()};
+    throw std::invalid_argument("fvp.Arm.check_goal: expected a GoalReach or a GoalCheck, got " +
+                                std::string(py::str(py::type::of(out))));
   }
   std::size_t updateObstacles(host::map::MapEngine& map) override {
     py::gil_scoped_acquire gil;
@@ -149,12 +152,28 @@ void bindRobot(py::module_& m) {
        {host::planner::GoalCheck::kFeasible, host::planner::GoalCheck::kNoIk,
         host::planner::GoalCheck::kNoCollisionFreeIk})
     goal_check.value(host::planner::toString(g), g);
+  py::class_<host::planner::GoalReach>(
+      m, "GoalReach",
+      "A goal check's answer: check (GoalCheck) and, when feasible, travel_s: the least the "
+      "move takes (the straight motion to the goal configuration, at the joints' limits); NaN "
+      "when unknown. The loop tries a checked batch by information per second with it.")
+      .def(py::init([](host::planner::GoalCheck check, double travel_s) {
+             return host::planner::GoalReach{check, travel_s};
+           }),
+           py::arg("check"), py::arg("travel_s") = std::numeric_limits<double>::quiet_NaN())
+      .def_readonly("check", &host::planner::GoalReach::check)
+      .def_readonly("travel_s", &host::planner::GoalReach::travel_s)
+      .def("__repr__", [](const host::planner::GoalReach& r) {
+        return std::string("GoalReach(") + host::planner::toString(r.check) +
+               ", travel_s=" + std::to_string(r.travel_s) + ")";
+      });
 
   py::class_<host::nbv::Arm, PyArm>(
       m, "Arm",
       "Subclass it: camera_pose() -> (4, 4); reachable(T) -> bool; move_to(T) -> MoveResult | "
       "MoveStatus | bool; optionally update_obstacles(map) -> int and check_goal(T) -> "
-      "GoalCheck (IK and collision only: ranked views it turns down are not moved to).")
+      "GoalReach | GoalCheck (IK and collision only: ranked views it turns down are not moved "
+      "to; a GoalReach's travel_s orders each checked batch by information per second).")
       .def(py::init<>())
       .def("camera_pose", [](const host::nbv::Arm& a) { return poseToArray(a.cameraPose()); })
       .def(

@@ -79,6 +79,23 @@ def test_a_reachable_pose_is_planned_executed_and_reached(model, workspace):
     np.testing.assert_array_equal(arm.joints(), robot.q)
 
 
+def test_the_goal_check_says_how_long_the_move_takes(model, workspace):
+    arm, robot, executor = make_arm(model, workspace)
+    assert arm.checks_goals
+    reach = arm.check_goal(goal_pose(model))
+    assert isinstance(reach, fvp.GoalReach)
+    assert reach.check == fvp.GoalCheck.feasible and reach.travel_s > 0
+    # Free space: the move is the straight motion the check timed.
+    arm.move_to(goal_pose(model))
+    times_s, _ = executor.trajectories[0]
+    assert times_s[-1] == pytest.approx(reach.travel_s, rel=1e-9)
+    far = goal_pose(model)
+    far[1, 3] += 3.0
+    out_of_reach = arm.check_goal(far)
+    assert out_of_reach.check == fvp.GoalCheck.no_ik and np.isnan(out_of_reach.travel_s)
+    assert np.isnan(fvp.GoalReach(fvp.GoalCheck.feasible).travel_s)
+
+
 def test_refusals_failures_and_planning_failures_are_statuses(model, workspace):
     arm, robot, executor = make_arm(model, workspace, fvp.ExecutionStatus.refused)
     before = arm.camera_pose()

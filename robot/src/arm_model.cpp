@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
+#include "fvp/robot/trajectory.h"
 #include "fvp/robot/ur5_kinematics.h"
 
 namespace fvp::robot {
@@ -181,10 +183,21 @@ std::vector<JointVector> ArmModel::inverse(const Eigen::Isometry3d& T_world_came
     inverseAt(T_world_camera, lower_[0] + t * (upper_[0] - lower_[0]), near, out);
   }
   inverseAt(T_world_camera, std::clamp(near[0], lower_[0], upper_[0]), near, out);
-  std::sort(out.begin(), out.end(), [&](const JointVector& a, const JointVector& b) {
-    return jointDistance(a, near) < jointDistance(b, near);
-  });
-  return out;
+  // The move's duration is set by its slowest joint, which the Euclidean joint distance does
+  // not see (a wrist turning 2 rad alone takes as long as the whole arm turning 2 rad).
+  std::vector<std::pair<std::pair<double, double>, std::size_t>> keyed;
+  keyed.reserve(out.size());
+  for (std::size_t i = 0; i < out.size(); ++i)
+    keyed.push_back({{travelTime_s(near, out[i]), jointDistance(near, out[i])}, i});
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<JointVector> sorted;
+  sorted.reserve(out.size());
+  for (const auto& k : keyed) sorted.push_back(out[k.second]);
+  return sorted;
+}
+
+double ArmModel::travelTime_s(const JointVector& from, const JointVector& to) const {
+  return Trajectory::restToRestDuration_s(from, to, max_velocity_, max_acceleration_);
 }
 
 bool ArmModel::reachableByIk(const Eigen::Isometry3d& T_world_camera) const {

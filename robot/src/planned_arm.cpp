@@ -57,19 +57,23 @@ bool PlannedArm::reachable(const Eigen::Isometry3d& T_world_camera) const {
   return reachability_.reachable(T_world_camera);
 }
 
-host::planner::GoalCheck PlannedArm::checkGoal(const Eigen::Isometry3d& T_world_camera) const {
-  switch (planner_.goalStatus(joints(), T_world_camera)) {
+host::planner::GoalReach PlannedArm::checkGoal(const Eigen::Isometry3d& T_world_camera) const {
+  using host::planner::GoalCheck;
+  const JointVector current = joints();
+  JointVector goal;
+  switch (planner_.goalStatus(current, T_world_camera, &goal)) {
     case MotionStatus::kNoIk:
-      return host::planner::GoalCheck::kNoIk;
+      return {GoalCheck::kNoIk};
     case MotionStatus::kNoCollisionFreeIk:
-      return host::planner::GoalCheck::kNoCollisionFreeIk;
+      return {GoalCheck::kNoCollisionFreeIk};
     case MotionStatus::kSuccess:
     case MotionStatus::kStartInvalid:
     case MotionStatus::kNoPath:
     case MotionStatus::kTimeout:
       break;
   }
-  return host::planner::GoalCheck::kFeasible;
+  // The goal moveToPose plans to first; the straight motion to it, the least the move takes.
+  return {GoalCheck::kFeasible, arm_.travelTime_s(current, goal)};
 }
 
 host::nbv::MoveResult PlannedArm::moveTo(const Eigen::Isometry3d& T_world_camera) {

@@ -17,35 +17,60 @@ void Trajectory::addPiece(double duration_s, const JointVector& q0, const JointV
   pieces_.push_back(p);
 }
 
+namespace {
+
+/// One rest-to-rest segment's normalised profile s(t) in [0, 1], which moves joint j by
+/// delta_j * s: its rate and acceleration bounded by the tightest joint; ramp up, cruise
+/// (zero when the peak rate is never reached), ramp down.
+struct SegmentProfile {
+  double a = 0.0, v_peak = 0.0, ramp_s = 0.0, cruise_s = 0.0;
+  bool moves = false;  ///< false for a zero-length segment, which takes no time
+  double duration_s() const { return 2.0 * ramp_s + cruise_s; }
+};
+
+SegmentProfile segmentProfile(const JointVector& delta, const JointVector& max_velocity,
+                              const JointVector& max_acceleration) {
+  double v = std::numeric_limits<double>::infinity(), a = v;
+  for (int j = 0; j < kArmJoints; ++j) {
+    if (delta[j] <= 0.0) continue;
+    v = std::min(v, max_velocity[j] / delta[j]);
+    a = std::min(a, max_acceleration[j] / delta[j]);
+  }
+  SegmentProfile p;
+  if (!std::isfinite(v)) return p;
+  p.moves = true;
+  p.a = a;
+  if (v * v / a >= 1.0) {  // triangular: the peak rate is never reached
+    p.ramp_s = std::sqrt(1.0 / a);
+    p.v_peak = a * p.ramp_s;
+  } else {
+    p.ramp_s = v / a;
+    p.v_peak = v;
+    p.cruise_s = 1.0 / v - v / a;
+  }
+  return p;
+}
+
+}  // namespace
+
+double Trajectory::restToRestDuration_s(const JointVector& from, const JointVector& to,
+                                        const JointVector& max_velocity,
+                                        const JointVector& max_acceleration) {
+  return segmentProfile((to - from).cwiseAbs(), max_velocity, max_acceleration).duration_s();
+}
+
 Trajectory::Trajectory(std::vector<JointVector> waypoints, const JointVector& max_velocity,
                        const JointVector& max_acceleration)
     : waypoints_(std::move(waypoints)) {
   if (waypoints_.empty()) throw std::invalid_argument("Trajectory: no waypoints");
   for (std::size_t i = 0; i + 1 < waypoints_.size(); ++i) {
     const JointVector d = waypoints_[i + 1] - waypoints_[i];
-    const JointVector delta = d.cwiseAbs();
-    // The normalised profile s(t) in [0, 1] moves joint j by delta_j * s: its rate and
-    // acceleration are bounded by the tightest joint.
-    double v = std::numeric_limits<double>::infinity(), a = v;
-    for (int j = 0; j < kArmJoints; ++j) {
-      if (delta[j] <= 0.0) continue;
-      v = std::min(v, max_velocity[j] / delta[j]);
-      a = std::min(a, max_acceleration[j] / delta[j]);
-    }
-    if (!std::isfinite(v)) continue;  // a zero-length segment takes no time
-    double ramp_s = 0.0, cruise_s = 0.0, v_peak = 0.0;
-    if (v * v / a >= 1.0) {  // triangular: the peak rate is never reached
-      ramp_s = std::sqrt(1.0 / a);
-      v_peak = a * ramp_s;
-    } else {
-      ramp_s = v / a;
-      v_peak = v;
-      cruise_s = 1.0 / v - v / a;
-    }
-    const double s_ramp = 0.5 * a * ramp_s * ramp_s;
-    addPiece(ramp_s, waypoints_[i], JointVector::Zero(), a * d);
-    addPiece(cruise_s, waypoints_[i] + s_ramp * d, v_peak * d, JointVector::Zero());
-    addPiece(ramp_s, waypoints_[i + 1] - s_ramp * d, v_peak * d, -a * d);
+    const SegmentProfile p = segmentProfile(d.cwiseAbs(), max_velocity, max_acceleration);
+    if (!p.moves) continue;
+    const double s_ramp = 0.5 * p.a * p.ramp_s * p.ramp_s;
+    addPiece(p.ramp_s, waypoints_[i], JointVector::Zero(), p.a * d);
+    addPiece(p.cruise_s, waypoints_[i] + s_ramp * d, p.v_peak * d, JointVector::Zero());
+    addPiece(p.ramp_s, waypoints_[i + 1] - s_ramp * d, p.v_peak * d, -p.a * d);
   }
 }
 

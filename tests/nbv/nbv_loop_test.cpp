@@ -79,10 +79,10 @@ class FakeArm : public Arm {
   std::size_t updateObstacles(map::MapEngine&) override { return ++obstacle_updates; }
   bool checksGoals() const override { return checks_goals; }
   /// Every `reject_every`-th goal check (1-based) finds only IK solutions in collision.
-  planner::GoalCheck checkGoal(const Eigen::Isometry3d&) const override {
+  planner::GoalReach checkGoal(const Eigen::Isometry3d&) const override {
     ++goal_checks;
-    return reject_every && goal_checks % reject_every == 0 ? planner::GoalCheck::kNoCollisionFreeIk
-                                                           : planner::GoalCheck::kFeasible;
+    return {reject_every && goal_checks % reject_every == 0 ? planner::GoalCheck::kNoCollisionFreeIk
+                                                            : planner::GoalCheck::kFeasible};
   }
   bool checks_goals = false;
   int reject_every = 0;

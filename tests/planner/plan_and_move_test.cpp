@@ -86,13 +86,13 @@ struct ScriptedGoalCheck {
   GoalCheckFn fn() {
     return [this](const std::vector<Eigen::Isometry3d>& poses) {
       batches.emplace_back();
-      std::vector<GoalCheck> out;
+      std::vector<GoalReach> out;
       for (const Eigen::Isometry3d& T : poses) {
         const double x = T.translation().x();
         batches.back().push_back(x);
-        out.push_back(x == 1.0   ? GoalCheck::kNoIk
-                      : x == 2.0 ? GoalCheck::kNoCollisionFreeIk
-                                 : GoalCheck::kFeasible);
+        out.push_back({x == 1.0   ? GoalCheck::kNoIk
+                       : x == 2.0 ? GoalCheck::kNoCollisionFreeIk
+                                  : GoalCheck::kFeasible});
       }
       return out;
     };
@@ -144,6 +144,62 @@ TEST(PlanAndMove, ChecksABatchAheadOfTheMovesAndNoFurther) {
   EXPECT_FALSE(failed.moved());
 }
 
+/// Ranks the views it is given (ig and x) in the order given, in one round.
+class GivenRanking : public ViewPlanner {
+ public:
+  explicit GivenRanking(std::vector<double> igs) : igs_(std::move(igs)) {}
+  std::string_view name() const override { return "given"; }
+  std::string configJson() const override { return "{}"; }
+  std::optional<Ranking> rank(map::MapEngine&, const Eigen::Isometry3d&, const ReachabilityFn&,
+                              std::size_t round, PlanStep&) override {
+    if (round > 0) return std::nullopt;
+    Ranking ranking;
+    for (std::size_t k = 0; k < igs_.size(); ++k) {
+      Candidate c;
+      c.ig = igs_[k];
+      c.T_world_camera.translation().x() = static_cast<double>(k);
+      ranking.candidates.push_back(c);
+      ranking.order.push_back(k);
+    }
+    return ranking;
+  }
+
+ private:
+  std::vector<double> igs_;
+};
+
+TEST(PlanAndMove, ACheckedBatchIsTriedByInformationPerSecond) {
+  // Views 0-3 (igs 4, 3, 2, 1) reached in 7, 1, 0.1 and 1 s; view 4 in the next batch.
+  // With 1 s of overhead a view: rates 0.5, 1.5, 1.82, 0.5, so 2, 1, then 0 and 3 as ranked.
+  GivenRanking planner({4.0, 3.0, 2.0, 1.0, 10.0});
+  const std::vector<double> travel_s{7.0, 1.0, 0.1, 1.0, 0.0};
+  const GoalCheckFn check = [&](const std::vector<Eigen::Isometry3d>& poses) {
+    std::vector<GoalReach> out;
+    for (const Eigen::Isometry3d& T : poses)
+      out.push_back(
+          {GoalCheck::kFeasible, travel_s.at(static_cast<std::size_t>(T.translation().x()))});
+    return out;
+  };
+  std::vector<double> tried;
+  const auto fail = [&](const Eigen::Isometry3d& T) {
+    tried.push_back(T.translation().x());
+    return false;
+  };
+  planAndMove(planner, someMap(), Eigen::Isometry3d::Identity(), {}, fail, check, 4, 1.0);
+  // The batch by rate; the next batch after it, never mixed in.
+  EXPECT_EQ(tried, (std::vector<double>{2, 1, 0, 3, 4}));
+  // Without the overhead (0: off) or without travel times, the planner's order.
+  tried.clear();
+  GivenRanking again({4.0, 3.0, 2.0, 1.0, 10.0});
+  planAndMove(again, someMap(), Eigen::Isometry3d::Identity(), {}, fail, check, 4, 0.0);
+  EXPECT_EQ(tried, (std::vector<double>{0, 1, 2, 3, 4}));
+  tried.clear();
+  GivenRanking unknown({4.0, 3.0, 2.0, 1.0, 10.0});
+  ScriptedGoalCheck no_times;
+  planAndMove(unknown, someMap(), Eigen::Isometry3d::Identity(), {}, fail, no_times.fn(), 4, 1.0);
+  EXPECT_EQ(tried, (std::vector<double>{0, 3, 4}));  // 1 and 2 turned down, as scripted
+}
+
 TEST(PlanAndMove, WithoutAGoalCheckEveryRankedViewIsTried) {
   ScriptedPlanner planner(1, 3);
   const PlanStep step = planAndMove(planner, someMap(), Eigen::Isometry3d::Identity(), {},
@@ -156,7 +212,7 @@ TEST(PlanAndMove, WithoutAGoalCheckEveryRankedViewIsTried) {
 TEST(PlanAndMove, AGoalCheckThatDoesNotAnswerForEveryPoseThrows) {
   ScriptedPlanner planner(1, 3);
   const GoalCheckFn mute = [](const std::vector<Eigen::Isometry3d>&) {
-    return std::vector<GoalCheck>{};
+    return std::vector<GoalReach>{};
   };
   EXPECT_THROW(planAndMove(
                    planner, someMap(), Eigen::Isometry3d::Identity(), {},

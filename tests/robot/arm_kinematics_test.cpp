@@ -1,6 +1,7 @@
 // Forward/inverse kinematics of the UR5 and the slider-mounted arm.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <iostream>
 #include <random>
 
@@ -134,10 +135,32 @@ TEST(ArmModel, InverseAlongTravelIsSortedAndOnlyWithinTravel) {
   const auto solutions = arm.inverse(T, home);
   ASSERT_FALSE(solutions.empty());
   EXPECT_LT((solutions.front() - home).norm(), 1e-6);  // the current configuration first
+  // Soonest reached first (the slowest joint's time), the joint distance breaking ties.
   for (std::size_t i = 1; i < solutions.size(); ++i) {
-    EXPECT_LE(jointDistance(solutions[i - 1], home), jointDistance(solutions[i], home) + 1e-12);
+    const double before_s = arm.travelTime_s(home, solutions[i - 1]);
+    const double after_s = arm.travelTime_s(home, solutions[i]);
+    EXPECT_LE(before_s, after_s);
+    if (before_s == after_s)
+      EXPECT_LE(jointDistance(solutions[i - 1], home), jointDistance(solutions[i], home));
     EXPECT_TRUE(arm.withinLimits(solutions[i]));
   }
+  // The order is the time's, not the distance's: a pose whose solutions the two rank apart.
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> angle(-1.5, 1.5);
+  int ranked_apart = 0;
+  for (int trial = 0; trial < 200 && ranked_apart == 0; ++trial) {
+    JointVector q = home;
+    for (int j = 1; j < kArmJoints; ++j) q[j] += angle(rng);
+    if (!arm.withinLimits(q)) continue;
+    const auto all = arm.inverse(arm.T_world_camera(q), home);
+    const auto by_distance =
+        std::min_element(all.begin(), all.end(), [&](const auto& a, const auto& b) {
+          return jointDistance(a, home) < jointDistance(b, home);
+        });
+    if (!all.empty() && arm.travelTime_s(home, *by_distance) > arm.travelTime_s(home, all.front()))
+      ++ranked_apart;
+  }
+  EXPECT_GT(ranked_apart, 0);
   // Far beyond the slider's reach: nothing.
   Eigen::Isometry3d far = T;
   far.translation().x() += 5.0;

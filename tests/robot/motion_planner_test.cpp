@@ -23,6 +23,9 @@ TEST(MotionPlanner, SucceedsOnRandomFeasibleQueriesInClutteredWorlds) {
   EXPECT_EQ(stats.feasible, 15);
   EXPECT_GE(stats.succeeded, 14);
   EXPECT_EQ(stats.path_invalid, 0);
+  // Both ways of reaching a goal were taken, and neither touched the map (path_invalid).
+  EXPECT_GT(stats.straight, 0);
+  EXPECT_LT(stats.straight, stats.succeeded);
 }
 
 TEST(MotionPlanner, BlendedTimingIsFasterAndStaysCollisionFree) {
@@ -66,6 +69,10 @@ TEST(MotionPlanner, ReportsStatusesWithoutThrowing) {
   checker.clearMap();
   const MotionPlan plan = planner.moveToPose(elsewhere, goal);
   ASSERT_EQ(plan.status, MotionStatus::kSuccess);
+  // Nothing in the way: the straight motion, as fast as the joints allow.
+  EXPECT_TRUE(plan.straight);
+  EXPECT_EQ(plan.trajectory.waypoints().size(), 2u);
+  EXPECT_DOUBLE_EQ(plan.trajectory.duration_s(), arm.travelTime_s(elsewhere, plan.goal));
   EXPECT_LT(
       (arm.T_world_camera(plan.trajectory.waypoints().back()).translation() - goal.translation())
           .norm(),

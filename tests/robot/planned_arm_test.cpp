@@ -23,6 +23,7 @@ namespace {
 
 using host::nbv::MoveStatus;
 using host::planner::GoalCheck;
+using host::planner::GoalReach;
 
 class FakeJointState : public JointStateSource {
  public:
@@ -217,17 +218,24 @@ TEST(PlannedArm, TheGoalCheckTurnsDownAViewBehindAWallWithoutPlanningAndKeepsOne
   far.translation().y() += 3.0;
   EXPECT_TRUE(robot.arm.checksGoals());
   // Without the wall both views have a goal.
-  ASSERT_EQ(robot.arm.checkGoal(scene.behind), GoalCheck::kFeasible);
-  ASSERT_EQ(robot.arm.checkGoal(scene.in_front), GoalCheck::kFeasible);
-  EXPECT_EQ(robot.arm.checkGoal(far), GoalCheck::kNoIk);
+  ASSERT_EQ(robot.arm.checkGoal(scene.behind).check, GoalCheck::kFeasible);
+  const GoalReach in_front = robot.arm.checkGoal(scene.in_front);
+  ASSERT_EQ(in_front.check, GoalCheck::kFeasible);
+  EXPECT_GT(in_front.travel_s, 0.0);  // a feasible answer says how long the move takes
+  EXPECT_EQ(robot.arm.checkGoal(far).check, GoalCheck::kNoIk);
+  EXPECT_TRUE(std::isnan(robot.arm.checkGoal(far).travel_s));
   ASSERT_EQ(robot.arm.setMap(scene.wall), 0u);  // the arm stands clear of the wall
-  EXPECT_EQ(robot.arm.checkGoal(scene.behind), GoalCheck::kNoCollisionFreeIk);
-  EXPECT_EQ(robot.arm.checkGoal(scene.in_front), GoalCheck::kFeasible);
+  EXPECT_EQ(robot.arm.checkGoal(scene.behind).check, GoalCheck::kNoCollisionFreeIk);
+  EXPECT_EQ(robot.arm.checkGoal(scene.in_front).check, GoalCheck::kFeasible);
   EXPECT_EQ(plans_observed, 0);  // nothing planned, nothing executed
   EXPECT_TRUE(robot.executor.trajectories.empty());
   // What the check said is what the moves find.
   EXPECT_EQ(robot.arm.moveTo(scene.behind).status, MoveStatus::kNoCollisionFreeIk);
   EXPECT_EQ(robot.arm.moveTo(scene.in_front).status, MoveStatus::kSuccess);
+  // Nothing between: the straight motion to the checked goal, in the time the check gave.
+  ASSERT_EQ(robot.executor.trajectories.size(), 1u);
+  EXPECT_EQ(robot.executor.trajectories.back().waypoints().size(), 2u);
+  EXPECT_DOUBLE_EQ(robot.executor.trajectories.back().duration_s(), in_front.travel_s);
 }
 
 /// Ranks the views it is given, in that order, in one round.
@@ -269,7 +277,7 @@ TEST(PlannedArm, PlanAndMoveSkipsTheViewBehindTheWallBeforeAnyMoveIsTried) {
       planner, *map, robot.arm.cameraPose(), {},
       [&](const Eigen::Isometry3d& T) { return robot.arm.moveTo(T).ok(); },
       [&](const std::vector<Eigen::Isometry3d>& poses) {
-        std::vector<GoalCheck> out;
+        std::vector<GoalReach> out;
         for (const Eigen::Isometry3d& T : poses) out.push_back(robot.arm.checkGoal(T));
         return out;
       });

@@ -24,6 +24,7 @@ using sim::SimClock;
 
 struct QueryStats {
   int feasible = 0, succeeded = 0, infeasible = 0, path_invalid = 0, blended = 0;
+  int straight = 0;  ///< successes by the straight joint-space motion (no sampling planner)
   int by_status[6] = {};
   std::vector<double> planning_s, path_length, motion_s, waypoints;
   std::vector<double> rest_to_rest_s;  ///< the same paths timed rest to rest
@@ -44,8 +45,8 @@ struct QueryStats {
         << " sampled poses had no collision-free IK; planning time mean " << mean(planning_s)
         << " s, median " << quantile(planning_s, 0.5) << " s, p95 " << quantile(planning_s, 0.95)
         << " s; joint-space path length mean " << mean(path_length) << ", waypoints mean "
-        << mean(waypoints) << "; motion time mean " << mean(motion_s) << " s (" << blended
-        << " blended; rest to rest " << mean(rest_to_rest_s) << " s)\n";
+        << mean(waypoints) << ", " << straight << " straight; motion time mean " << mean(motion_s)
+        << " s (" << blended << " blended; rest to rest " << mean(rest_to_rest_s) << " s)\n";
   }
 };
 
@@ -125,6 +126,8 @@ inline QueryStats runPlanningQueries(int worlds, int queries_per_world, std::uin
             Trajectory(plan.trajectory.waypoints(), arm.maxVelocity(), arm.maxAcceleration())
                 .duration_s());
         stats.blended += plan.trajectory.isBlended();
+        stats.straight += plan.straight;
+        if (plan.straight) EXPECT_EQ(plan.trajectory.waypoints().size(), 2u);
         const Eigen::Isometry3d reached = controller.cameraPose();
         EXPECT_LT((reached.translation() - T.translation()).norm(), 1e-6);
         EXPECT_LT((reached.linear() - T.linear()).norm(), 1e-6);

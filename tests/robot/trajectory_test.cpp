@@ -66,6 +66,12 @@ TEST(Trajectory, MinimumTimeForOneJoint) {
   b[1] = 10.0;  // long: trapezoid, 10/pi + pi/1.4
   const Trajectory long_move({a, b}, arm.maxVelocity(), arm.maxAcceleration());
   EXPECT_NEAR(long_move.duration_s(), 10.0 / std::numbers::pi + std::numbers::pi / 1.4, 1e-12);
+  // The duration without the trajectory: the same numbers.
+  b[1] = 0.5;
+  EXPECT_DOUBLE_EQ(Trajectory::restToRestDuration_s(a, b, arm.maxVelocity(), arm.maxAcceleration()),
+                   short_move.duration_s());
+  EXPECT_DOUBLE_EQ(arm.travelTime_s(b, a), short_move.duration_s());
+  EXPECT_EQ(arm.travelTime_s(a, a), 0.0);
   const Trajectory still({a}, arm.maxVelocity(), arm.maxAcceleration());
   EXPECT_EQ(still.duration_s(), 0.0);
   EXPECT_EQ(still.position(1.0), a);

@@ -65,7 +65,7 @@ planner::PlanStep NbvLoop::planAndMove_(map::MapEngine& map, NbvResult& out, dou
   if (arm_.checksGoals() && options_.goal_check_batch > 0) {
     check_goals = [&](const std::vector<Eigen::Isometry3d>& poses) {
       const auto t_check = Clock::now();
-      std::vector<planner::GoalCheck> statuses;
+      std::vector<planner::GoalReach> statuses;
       statuses.reserve(poses.size());
       for (const Eigen::Isometry3d& T : poses) statuses.push_back(arm_.checkGoal(T));
       const double check_s = secondsSince(t_check);
@@ -75,8 +75,9 @@ planner::PlanStep NbvLoop::planAndMove_(map::MapEngine& map, NbvResult& out, dou
     };
   }
   const auto t_plan = Clock::now();
-  planner::PlanStep step = planner::planAndMove(planner_, map, arm_.cameraPose(), reachable, move,
-                                                check_goals, options_.goal_check_batch);
+  planner::PlanStep step =
+      planner::planAndMove(planner_, map, arm_.cameraPose(), reachable, move, check_goals,
+                           options_.goal_check_batch, options_.view_overhead_s);
   plan_s = std::max(0.0, secondsSince(t_plan) - move_wall_s - goal_check_wall_s);
   out.wall_s.planning += plan_s;
   out.wall_s.goal_check += goal_check_wall_s;

@@ -1,6 +1,9 @@
 #include "fvp/host/planner/view_planner.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 
@@ -24,13 +27,13 @@ namespace {
 /// their statuses to checked.
 void checkNextBatch(const GoalCheckFn& check_goals, std::size_t batch,
                     const std::vector<Candidate>& candidates, const std::vector<std::size_t>& order,
-                    std::vector<GoalCheck>& checked, PlanStep& step) {
+                    std::vector<GoalReach>& checked, PlanStep& step) {
   const std::size_t first = checked.size();
   const std::size_t end = std::min(order.size(), first + std::max<std::size_t>(batch, 1));
   std::vector<Eigen::Isometry3d> poses;
   poses.reserve(end - first);
   for (std::size_t k = first; k < end; ++k) poses.push_back(candidates.at(order[k]).T_world_camera);
-  const std::vector<GoalCheck> statuses = check_goals(poses);
+  const std::vector<GoalReach> statuses = check_goals(poses);
   // A check that does not answer for every pose is a broken arm, not an expected outcome.
   if (statuses.size() != poses.size())
     throw std::runtime_error("planAndMove: the goal check answered " +
@@ -38,7 +41,39 @@ void checkNextBatch(const GoalCheckFn& check_goals, std::size_t batch,
                              std::to_string(poses.size()) + " poses");
   ++step.goal_check_batches;
   step.goal_checks += poses.size();
+  for (const GoalReach& answer : statuses) {
+    if (answer.check == GoalCheck::kNoIk) ++step.rejected_no_ik;
+    if (answer.check == GoalCheck::kNoCollisionFreeIk) ++step.rejected_no_collision_free_ik;
+  }
   checked.insert(checked.end(), statuses.begin(), statuses.end());
+}
+
+/// Within order[first, checked.size()) (a checked batch), the feasible views by information
+/// per second of the robot's time, ig / (travel_s + view_overhead_s), best first (ties keep
+/// the planner's order); the others after them. Left as ranked when a travel time is unknown.
+void rankBatchByInformationRate(const std::vector<Candidate>& candidates,
+                                std::vector<std::size_t>& order, std::vector<GoalReach>& checked,
+                                std::size_t first, double view_overhead_s) {
+  const std::size_t end = checked.size();
+  for (std::size_t k = first; k < end; ++k)
+    if (checked[k].feasible() && !std::isfinite(checked[k].travel_s)) return;
+  std::vector<std::size_t> by_rate(end - first);
+  std::iota(by_rate.begin(), by_rate.end(), first);
+  const auto rate = [&](std::size_t k) {
+    return checked[k].feasible()
+               ? candidates.at(order[k]).ig / (checked[k].travel_s + view_overhead_s)
+               : -std::numeric_limits<double>::infinity();
+  };
+  std::stable_sort(by_rate.begin(), by_rate.end(),
+                   [&](std::size_t a, std::size_t b) { return rate(a) > rate(b); });
+  std::vector<std::size_t> order_part;
+  std::vector<GoalReach> checked_part;
+  for (const std::size_t k : by_rate)
+    order_part.push_back(order[k]), checked_part.push_back(checked[k]);
+  std::copy(order_part.begin(), order_part.end(),
+            order.begin() + static_cast<std::ptrdiff_t>(first));
+  std::copy(checked_part.begin(), checked_part.end(),
+            checked.begin() + static_cast<std::ptrdiff_t>(first));
 }
 
 }  // namespace
@@ -46,25 +81,26 @@ void checkNextBatch(const GoalCheckFn& check_goals, std::size_t batch,
 PlanStep planAndMove(ViewPlanner& planner, map::MapEngine& map,
                      const Eigen::Isometry3d& T_world_camera_now, const ReachabilityFn& reachable,
                      const MoveToPoseFn& move, const GoalCheckFn& check_goals,
-                     std::size_t goal_check_batch) {
+                     std::size_t goal_check_batch, double view_overhead_s) {
   PlanStep step;
   for (std::size_t round = 0;; ++round) {
     std::optional<Ranking> ranking = planner.rank(map, T_world_camera_now, reachable, round, step);
     if (!ranking) break;
     step.candidates = std::move(ranking->candidates);
-    // Statuses of order[0, checked.size()): checked a batch at a time, only as far as the
+    // Answers for order[0, checked.size()): checked a batch at a time, only as far as the
     // moves get, so a round whose first view is reached pays for one batch.
-    std::vector<GoalCheck> checked;
-    for (std::size_t k = 0; k < ranking->order.size(); ++k) {
+    std::vector<std::size_t>& order = ranking->order;
+    std::vector<GoalReach> checked;
+    for (std::size_t k = 0; k < order.size(); ++k) {
       if (check_goals) {
-        if (k == checked.size())
-          checkNextBatch(check_goals, goal_check_batch, step.candidates, ranking->order, checked,
-                         step);
-        if (checked[k] == GoalCheck::kNoIk) ++step.rejected_no_ik;
-        if (checked[k] == GoalCheck::kNoCollisionFreeIk) ++step.rejected_no_collision_free_ik;
-        if (checked[k] != GoalCheck::kFeasible) continue;
+        if (k == checked.size()) {
+          checkNextBatch(check_goals, goal_check_batch, step.candidates, order, checked, step);
+          if (view_overhead_s > 0.0)
+            rankBatchByInformationRate(step.candidates, order, checked, k, view_overhead_s);
+        }
+        if (!checked[k].feasible()) continue;
       }
-      const std::size_t i = ranking->order[k];
+      const std::size_t i = order[k];
       ++step.move_attempts;
       if (move(step.candidates.at(i).T_world_camera)) {
         step.chosen = i;

@@ -38,7 +38,7 @@ inline constexpr double kDefaultCollisionPaddingM = 0.01;
 inline constexpr double kDefaultGroundZM = 0.0;
 inline constexpr int kDefaultIkSliderSamples = 25;
 inline constexpr const char* kDefaultPlanner = "RRTConnect";
-inline constexpr const char* kDefaultTrajectoryTiming = "rest_to_rest";
+inline constexpr const char* kDefaultTrajectoryTiming = "blended";
 inline constexpr double kDefaultPlanningTimeS = 1.0;
 inline constexpr double kDefaultSimplifyTimeS = 0.1;
 // About the checks planning_time_s and simplify_time_s allow at the measured rate of

@@ -56,10 +56,14 @@ class ArmModel {
   void inverseAt(const Eigen::Isometry3d& T_world_camera, double slider_m, const JointVector& near,
                  std::vector<JointVector>& out) const;
   /// Solutions over ik_slider_samples slider positions spread over the travel plus near's
-  /// own, sorted by joint-space distance to `near` (nearest first). Map collisions are
-  /// the caller's (ArmCollisionChecker) to check.
+  /// own, sorted by travelTime_s from `near` (soonest first; joint-space distance breaks
+  /// ties). Map collisions are the caller's (ArmCollisionChecker) to check.
   std::vector<JointVector> inverse(const Eigen::Isometry3d& T_world_camera,
                                    const JointVector& near) const;
+  /// The duration of the straight rest-to-rest motion between two configurations under the
+  /// joint limits (Trajectory's timing): what the slowest joint needs, the least a move
+  /// between them costs. The arm's "nearness" for choosing among IK solutions.
+  double travelTime_s(const JointVector& from, const JointVector& to) const;
   /// Whether any solution within limits and free of self/static collision exists.
   bool reachableByIk(const Eigen::Isometry3d& T_world_camera) const;
   /// A configuration near the middle of every joint range (slider centred, arm up).

@@ -1,10 +1,13 @@
-// moveToPose (docs/design.md section 7): IK along the slider's travel -> the valid, collision-free
-// solution nearest the current configuration -> OMPL (RRTConnect by default) in the 7-D
-// joint space with an ArmCollisionChecker behind OMPL's StateValidityChecker -> path
-// simplification -> a Trajectory within the velocity and acceleration limits. The nearest
-// solution gets a quarter of planning_time_s; when it cannot be reached (a goal in a pocket
-// of the map), every distinct valid solution becomes a goal state for the rest. Expected
-// failures come back as a MotionStatus; exceptions are for misconfiguration only.
+// moveToPose (docs/design.md section 7, docs/robot.md "Motion"): IK along the slider's travel
+// -> the valid, collision-free solution soonest reached from the current configuration
+// (ArmModel::travelTime_s) -> the straight joint-space motion when it is free, else OMPL
+// (RRTConnect by default) in the 7-D joint space with an ArmCollisionChecker behind OMPL's
+// StateValidityChecker -> path simplification -> a Trajectory within the velocity and
+// acceleration limits. The soonest solution gets a quarter of planning_time_s, sampled in a
+// box around the start and the goal; when it cannot be reached (a goal in a pocket of the
+// map), every distinct valid solution becomes a goal state for the rest, in the whole joint
+// space. Expected failures come back as a MotionStatus; exceptions are for misconfiguration
+// only.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -33,6 +36,7 @@ struct MotionPlan {
   Trajectory trajectory;                   ///< empty unless kSuccess
   double planning_wall_s = 0.0;            ///< IK + planning + simplification + timing
   int ik_solutions = 0;                    ///< within limits, before collision checks
+  bool straight = false;  ///< the straight joint-space motion, without a sampling planner
   std::uint64_t validity_checks = 0;
   bool ok() const { return status == MotionStatus::kSuccess; }
 };
@@ -49,8 +53,9 @@ class MotionPlanner {
   /// else kSuccess (a collision-free goal exists; the motion may still fail). IK along the
   /// travel and validity checks until the first valid solution: no OMPL, no query number
   /// used, so reproducible planning's later queries are unchanged.
-  MotionStatus goalStatus(const JointVector& current,
-                          const Eigen::Isometry3d& T_world_camera) const;
+  /// On kSuccess, *goal (when given) is the configuration moveToPose plans to first.
+  MotionStatus goalStatus(const JointVector& current, const Eigen::Isometry3d& T_world_camera,
+                          JointVector* goal = nullptr) const;
 
   /// From now on every query is reproducible: OMPL's sampler, planner and path simplifier
   /// are seeded from seed and the query's number, and planning and simplification stop after
@@ -62,10 +67,12 @@ class MotionPlanner {
   MotionPlan planToJoints(const JointVector& current, const JointVector& goal) const;
 
  private:
-  /// One OMPL query to any of `goals` (all valid) within a share of the budget (time_s, or
-  /// the same share of the reproducible check budget).
-  MotionPlan plan_(const JointVector& current, const std::vector<JointVector>& goals,
-                   double share) const;
+  /// The straight motion to the first goal it reaches freely, else one OMPL query to any of
+  /// `goals` (all valid) within a share of the budget (time_s, or the same share of the
+  /// reproducible check budget), sampling the whole joint space or (local) the box around
+  /// the start and the goals.
+  MotionPlan plan_(const JointVector& current, const std::vector<JointVector>& goals, double share,
+                   bool local) const;
 
   const ArmCollisionChecker& checker_;
   bool reproducible_ = false;

@@ -54,7 +54,7 @@ class PlannedArm : public host::nbv::Arm {
   bool checksGoals() const override { return true; }
   /// MotionPlanner::goalStatus from the joints now, on the map of the last setMap: IK along
   /// the travel and collision checks (self, static, FCL against the map), no OMPL.
-  host::planner::GoalCheck checkGoal(const Eigen::Isometry3d& T_world_camera) const override;
+  host::planner::GoalReach checkGoal(const Eigen::Isometry3d& T_world_camera) const override;
   /// setMap with the map's coarse octree.
   std::size_t updateObstacles(host::map::MapEngine& map) override;
 

@@ -29,6 +29,12 @@ class Trajectory {
   static Trajectory blended(std::vector<JointVector> waypoints, const JointVector& max_velocity,
                             const JointVector& max_acceleration);
 
+  /// The rest-to-rest duration of the straight motion between two configurations (what the
+  /// constructor gives for {from, to}), without building it: the time a move costs at least.
+  static double restToRestDuration_s(const JointVector& from, const JointVector& to,
+                                     const JointVector& max_velocity,
+                                     const JointVector& max_acceleration);
+
   double duration_s() const { return pieces_.empty() ? 0.0 : pieces_.back().end_s(); }
   const std::vector<JointVector>& waypoints() const { return waypoints_; }
   bool empty() const { return waypoints_.empty(); }

@@ -52,9 +52,10 @@ class Arm {
   /// moveTo will plan a motion (which may still fail); the others mean moveTo would fail with
   /// the MoveStatus of the same name. Much cheaper than a move (no motion planning, nothing
   /// executed), so the loop checks the top of each ranking before it tries a move.
-  virtual planner::GoalCheck checkGoal(const Eigen::Isometry3d& T_world_camera) const {
+  /// A feasible answer's travel_s is the least the move takes (GoalReach), NaN if unknown.
+  virtual planner::GoalReach checkGoal(const Eigen::Isometry3d& T_world_camera) const {
     (void)T_world_camera;
-    return planner::GoalCheck::kFeasible;
+    return {};
   }
   /// Called after new views reached the map, before planning, so the arm avoids what the
   /// camera has seen. Returns a count for the log (the simulated arm: voxels it freed where

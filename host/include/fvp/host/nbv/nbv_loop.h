@@ -53,6 +53,9 @@ struct NbvLoopOptions {
   /// Ranked views the arm's goal check (Arm::checkGoal) is asked about per call, ahead of
   /// the moves (planAndMove); 0: no goal checks, every ranked view goes to moveTo.
   std::size_t goal_check_batch = planner::kDefaultGoalCheckBatch;
+  /// A view's cost besides its move, for trying each checked batch by information per
+  /// second (planAndMove); 0: the planner's own order.
+  double view_overhead_s = planner::kDefaultViewOverheadS;
 };
 
 /// Counted expected events of a run (never errors).

@@ -5,8 +5,10 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <cstddef>
 #include <functional>
+#include <limits>
 #include <vector>
 
 namespace fvp::host::planner {
@@ -20,11 +22,20 @@ enum class GoalCheck {
 /// "feasible", "no_ik" or "no_collision_free_ik" (the latter two as MoveStatus names them).
 const char* toString(GoalCheck check);
 
+/// The answer for one pose: its check and, for a feasible one where the arm can tell, the
+/// seconds the move would take at least (the straight motion to the configuration the move
+/// would go to, timed to the joints' limits); NaN when unknown.
+struct GoalReach {
+  GoalCheck check = GoalCheck::kFeasible;
+  double travel_s = std::numeric_limits<double>::quiet_NaN();
+  bool feasible() const { return check == GoalCheck::kFeasible; }
+};
+
 /// Checks a batch of camera poses (T_world_camera, the left camera's optical frame) and
-/// returns one status per pose, in order. One call is one compute stage of the robot's: the
+/// returns one answer per pose, in order. One call is one compute stage of the robot's: the
 /// loop charges it to its clock.
 using GoalCheckFn =
-    std::function<std::vector<GoalCheck>(const std::vector<Eigen::Isometry3d>& T_world_cameras)>;
+    std::function<std::vector<GoalReach>(const std::vector<Eigen::Isometry3d>& T_world_cameras)>;
 
 /// Ranked views checked per call, ahead of the moves. Each call is charged as one compute
 /// stage (0.1 s on the fixed clock, its wall time on the wall clock), so a batch should hold
@@ -32,5 +43,11 @@ using GoalCheckFn =
 /// iterations of development trees 1-3 before the checks) and still cost far less than a
 /// fixed-clock stage in wall time (0.6 ms a check on 2 cores; docs/results.md).
 inline constexpr std::size_t kDefaultGoalCheckBatch = 16;
+
+/// What a view costs the robot besides its move, for ranking views by time
+/// (rankByInformationRate): the fixed clock's charges per view (capture 0.2 s, mapping 0.2 s,
+/// TSDF, sizing, planning, motion planning and a batch of goal checks 0.1 s each). A robot
+/// on two cores measured 0.64 s of compute a view plus its capture (issue 41), the same size.
+inline constexpr double kDefaultViewOverheadS = 0.9;
 
 }  // namespace fvp::host::planner

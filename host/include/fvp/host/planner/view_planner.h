@@ -114,9 +114,14 @@ class ViewPlanner {
 /// ranked views are first checked in batches of goal_check_batch, a batch ahead of the moves
 /// (the next one only when the moves of the last have all failed), and a view the check
 /// turns down is skipped: counted by its status, neither a move attempt nor a failed move.
+/// With view_overhead_s > 0 and the check's travel times, each checked batch is tried by
+/// information per second of the robot's time, ig / (travel_s + view_overhead_s): the
+/// planner's rule picks the views worth a move, the arm's time orders them
+/// (docs/nbv-loop.md, "Views ranked by time").
 PlanStep planAndMove(ViewPlanner& planner, map::MapEngine& map,
                      const Eigen::Isometry3d& T_world_camera_now, const ReachabilityFn& reachable,
                      const MoveToPoseFn& move, const GoalCheckFn& check_goals = {},
-                     std::size_t goal_check_batch = kDefaultGoalCheckBatch);
+                     std::size_t goal_check_batch = kDefaultGoalCheckBatch,
+                     double view_overhead_s = kDefaultViewOverheadS);
 
 }  // namespace fvp::host::planner

@@ -32,7 +32,7 @@ class SimulatedArm : public host::nbv::Arm {
     return arm_.moveTo(T_world_camera);
   }
   bool checksGoals() const override { return arm_.checksGoals(); }
-  host::planner::GoalCheck checkGoal(const Eigen::Isometry3d& T_world_camera) const override {
+  host::planner::GoalReach checkGoal(const Eigen::Isometry3d& T_world_camera) const override {
     return arm_.checkGoal(T_world_camera);
   }
   /// The collision checker's map becomes the coarse map, with the voxels the arm occupies
