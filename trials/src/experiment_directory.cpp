@@ -231,42 +231,33 @@ void readSetting(const std::string& where, const std::string& key, const nlohman
   readChoiceSetting(where, key, v, value, std::array<Mode, 2>{Mode::kWall, Mode::kFixed},
                     [](Mode m) { return std::string_view(robot::sim::SimClock::modeName(m)); });
 }
-// Config files are read as stamps (ManifestSettingsReader); the per-trial seed is never in a
+// Config files are read as stamps (readManifestSettings); the per-trial seed is never in a
 // manifest (visitManifestSettings leaves it out).
 void readSetting(const std::string&, const std::string&, const nlohmann::json*,
                  std::filesystem::path&) {}
 void readSetting(const std::string&, const std::string&, const nlohmann::json*, std::uint64_t&) {}
 
-/// Reads each setting of a manifest (readSetting by its type; config files as stamps).
-class ManifestSettingsReader {
- public:
-  ManifestSettingsReader(const nlohmann::json& j, std::string where, bool merged)
-      : j_(j), where_(std::move(where)), merged_(merged) {}
-
-  template <typename T>
-  void operator()(const host::nbv::RunField& field, T& value) {
+/// Reads each setting of a manifest into m.settings (readSetting by its type) and its config
+/// files' stamps into m.configs; `where` names the file for errors.
+void readManifestSettings(const nlohmann::json& j, const std::string& where, bool merged,
+                          ExperimentManifest& m) {
+  visitManifestSettings(m.settings, [&](const host::nbv::RunField& field, auto& value) {
+    using T = std::decay_t<decltype(value)>;
     const std::string key(field.key);
-    const nlohmann::json* v = member(j_, key.c_str());
-    if (!v && mayBeAbsent(key, merged_)) {
+    const nlohmann::json* v = member(j, key.c_str());
+    if (!v && mayBeAbsent(key, merged)) {
       if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, std::optional<bool>>)
         value = false;  // a switch added after format 1: off
       return;
     }
     if (field.vocabulary == host::nbv::FieldVocabulary::kConfigFile) {
-      configs_[key] = readConfig(j_, key.c_str(), where_);
-      if constexpr (std::is_same_v<T, std::filesystem::path>) value = configs_[key].path;
+      m.configs[key] = readConfig(j, key.c_str(), where);
+      if constexpr (std::is_same_v<T, std::filesystem::path>) value = m.configs[key].path;
       return;
     }
-    readSetting(where_, key, v, value);
-  }
-  const std::map<std::string, ConfigFileStamp>& configs() const { return configs_; }
-
- private:
-  const nlohmann::json& j_;
-  std::string where_;
-  bool merged_;
-  std::map<std::string, ConfigFileStamp> configs_;
-};
+    readSetting(where, key, v, value);
+  });
+}
 
 /// A setting of a manifest: what is compared (a config by its hash) and how it is shown.
 struct SettingValue {
@@ -525,9 +516,7 @@ ExperimentManifest readManifest(const std::filesystem::path& path) {
   m.kind = readString(j, "kind", where);
   if (m.kind != "run" && m.kind != "merged")
     fieldError(where, "kind", "\"run\" or \"merged\"", &j["kind"]);
-  ManifestSettingsReader reader(j, where, m.kind == "merged");
-  visitManifestSettings(m.settings, reader);
-  m.configs = reader.configs();
+  readManifestSettings(j, where, m.kind == "merged", m);
   if (member(j, "error_scale")) m.error_scale = readErrorScale(j, where);
   if (m.kind == "merged") {
     const nlohmann::json& sources = required(j, "sources", where, "an array of directories");
