@@ -284,9 +284,10 @@ MotionPlan MotionPlanner::moveToPose(const JointVector& current,
     plan.planning_wall_s = secondsSince(start);
     return plan;
   }
-  // The nearest solution first, for a share of the time: most plans take a few tens of ms.
-  // A goal in a pocket of the map cannot be reached at all, so then every distinct solution
-  // becomes a goal state of one more query for the rest of the time.
+  // The soonest solution first, in the local box, for a share of the time: most plans take a
+  // few tens of ms. A goal in a pocket of the map cannot be reached at all, so then every
+  // distinct solution becomes a goal state of one more query, in the whole joint space, for
+  // the rest of the time.
   plan = plan_(current, {goals.front()}, kNearestShare, /*local=*/true);
   if (!plan.ok() && plan.status != MotionStatus::kStartInvalid) {
     plan = plan_(current, goals, 1.0 - kNearestShare, /*local=*/false);

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numeric>
 #include <stdexcept>
 #include <string>
 
@@ -57,23 +56,25 @@ void rankBatchByInformationRate(const std::vector<Candidate>& candidates,
   const std::size_t end = checked.size();
   for (std::size_t k = first; k < end; ++k)
     if (checked[k].feasible() && !std::isfinite(checked[k].travel_s)) return;
-  std::vector<std::size_t> by_rate(end - first);
-  std::iota(by_rate.begin(), by_rate.end(), first);
-  const auto rate = [&](std::size_t k) {
-    return checked[k].feasible()
-               ? candidates.at(order[k]).ig / (checked[k].travel_s + view_overhead_s)
-               : -std::numeric_limits<double>::infinity();
+  // Each view with its answer and its rate, sorted together and written back in place.
+  struct Entry {
+    std::size_t candidate;
+    GoalReach answer;
+    double rate;
   };
-  std::stable_sort(by_rate.begin(), by_rate.end(),
-                   [&](std::size_t a, std::size_t b) { return rate(a) > rate(b); });
-  std::vector<std::size_t> order_part;
-  std::vector<GoalReach> checked_part;
-  for (const std::size_t k : by_rate)
-    order_part.push_back(order[k]), checked_part.push_back(checked[k]);
-  std::copy(order_part.begin(), order_part.end(),
-            order.begin() + static_cast<std::ptrdiff_t>(first));
-  std::copy(checked_part.begin(), checked_part.end(),
-            checked.begin() + static_cast<std::ptrdiff_t>(first));
+  std::vector<Entry> batch;
+  for (std::size_t k = first; k < end; ++k) {
+    const GoalReach& a = checked[k];
+    batch.push_back({order[k], a,
+                     a.feasible() ? candidates.at(order[k]).ig / (a.travel_s + view_overhead_s)
+                                  : -std::numeric_limits<double>::infinity()});
+  }
+  std::stable_sort(batch.begin(), batch.end(),
+                   [](const Entry& a, const Entry& b) { return a.rate > b.rate; });
+  for (std::size_t i = 0; i < batch.size(); ++i) {
+    order[first + i] = batch[i].candidate;
+    checked[first + i] = batch[i].answer;
+  }
 }
 
 }  // namespace

@@ -5,7 +5,6 @@
 #pragma once
 
 #include <Eigen/Geometry>
-#include <cmath>
 #include <cstddef>
 #include <functional>
 #include <limits>
@@ -45,7 +44,7 @@ using GoalCheckFn =
 inline constexpr std::size_t kDefaultGoalCheckBatch = 16;
 
 /// What a view costs the robot besides its move, for ranking views by time
-/// (rankByInformationRate): the fixed clock's charges per view (capture 0.2 s, mapping 0.2 s,
+/// (planAndMove, view_planner.h): the fixed clock's charges per view (capture 0.2 s, mapping 0.2 s,
 /// TSDF, sizing, planning, motion planning and a batch of goal checks 0.1 s each). A robot
 /// on two cores measured 0.64 s of compute a view plus its capture (issue 41), the same size.
 inline constexpr double kDefaultViewOverheadS = 0.9;
