@@ -67,6 +67,19 @@ inline CLI::Validator positiveNumber() {
       "POSITIVE", "positiveNumber");
 }
 
+/// A finite number of at least zero.
+inline CLI::Validator nonNegativeNumber() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        std::string copy = text;
+        if (std::string error = finiteNumber()(copy); !error.empty()) return error;
+        if (!(std::strtod(text.c_str(), nullptr) >= 0.0))
+          return "expected a number of at least 0, got '" + text + "'";
+        return {};
+      },
+      "NON_NEGATIVE", "nonNegativeNumber");
+}
+
 /// A path that is not empty: `--out ""` would write nowhere (the libraries take an empty
 /// directory to mean "no files") and report success.
 inline CLI::Validator nonEmptyPath() {

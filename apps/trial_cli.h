@@ -28,7 +28,14 @@ class TrialOptionAdder {
   template <typename T>
   void operator()(const host::nbv::RunField& field, T& member) {
     if (field.per_trial && !per_trial_) return;
-    add(std::string(field.flag), std::string(field.help), field.vocabulary, member);
+    if constexpr (std::is_same_v<T, double>) {
+      // Numbers: above 0, or at least 0 where 0 is a choice.
+      cmd_->add_option(std::string(field.flag), member, std::string(field.help))
+          ->check(field.may_be_zero ? nonNegativeNumber() : positiveNumber())
+          ->capture_default_str();
+    } else {
+      add(std::string(field.flag), std::string(field.help), field.vocabulary, member);
+    }
   }
 
  private:
@@ -49,12 +56,6 @@ class TrialOptionAdder {
   }
   void add(const std::string& flag, const std::string& help, Vocabulary, std::uint64_t& value) {
     cmd_->add_option(flag, value, help)->check(decimalUnsigned())->capture_default_str();
-  }
-  void add(const std::string& flag, const std::string& help, Vocabulary, double& value) {
-    cmd_->add_option(flag, value, help)
-        ->check(finiteNumber())
-        ->check(positiveNumber())
-        ->capture_default_str();
   }
   void add(const std::string& flag, const std::string& help, Vocabulary,
            std::optional<int>& value) {

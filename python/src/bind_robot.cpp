@@ -51,7 +51,8 @@ MoveResult toMoveResult(const py::object& out) {
 /// A Python subclass of fvp.Arm: camera_pose() -> (4, 4), reachable(T) -> bool,
 /// move_to(T) -> MoveResult | MoveStatus | bool, and optionally update_obstacles(map) -> int
 /// and check_goal(T) -> GoalReach | GoalCheck (the loop then checks ranked views with it
-/// before moving, and tries a batch by information per second where travel_s is given).
+/// before moving, and tries a batch by information per second where travel_s is given) and
+/// travel_time_s(T_from, T_to) -> float (a tour orders its clusters by it; NaN: unknown).
 class PyArm : public host::nbv::Arm {
  public:
   Eigen::Isometry3d cameraPose() const override {
@@ -79,6 +80,17 @@ class PyArm : public host::nbv::Arm {
       return {out.cast<host::planner::GoalCheck>()};
     throw std::invalid_argument("fvp.Arm.check_goal: expected a GoalReach or a GoalCheck, got " +
                                 std::string(py::str(py::type::of(out))));
+  }
+  double travelTime_s(const Eigen::Isometry3d& T_world_from_camera,
+                      const Eigen::Isometry3d& T_world_to_camera) const override {
+    py::gil_scoped_acquire gil;
+    const py::function f = py::get_override(static_cast<const Arm*>(this), "travel_time_s");
+    if (!f) return Arm::travelTime_s(T_world_from_camera, T_world_to_camera);
+    const py::object out = f(poseToArray(T_world_from_camera), poseToArray(T_world_to_camera));
+    if (!py::isinstance<py::float_>(out) && !py::isinstance<py::int_>(out))
+      throw std::invalid_argument("fvp.Arm.travel_time_s: expected a number, got " +
+                                  std::string(py::str(py::type::of(out))));
+    return out.cast<double>();
   }
   std::size_t updateObstacles(host::map::MapEngine& map) override {
     py::gil_scoped_acquire gil;
@@ -173,7 +185,9 @@ void bindRobot(py::module_& m) {
       "Subclass it: camera_pose() -> (4, 4); reachable(T) -> bool; move_to(T) -> MoveResult | "
       "MoveStatus | bool; optionally update_obstacles(map) -> int and check_goal(T) -> "
       "GoalReach | GoalCheck (IK and collision only: ranked views it turns down are not moved "
-      "to; a GoalReach's travel_s orders each checked batch by information per second).")
+      "to; a GoalReach's travel_s orders each checked batch by information per second) and "
+      "travel_time_s(T_from, T_to) -> float (a tour visits its clusters in the least time by "
+      "it; NaN or absent: by camera distance).")
       .def(py::init<>())
       .def("camera_pose", [](const host::nbv::Arm& a) { return poseToArray(a.cameraPose()); })
       .def(
@@ -202,6 +216,15 @@ void bindRobot(py::module_& m) {
             return a.checkGoal(pose);
           },
           py::arg("T_world_camera"))
+      .def(
+          "travel_time_s",
+          [](const host::nbv::Arm& a, const py::handle& T_from, const py::handle& T_to) {
+            const Eigen::Isometry3d from = poseFromArray(T_from, "Arm.travel_time_s T_from");
+            const Eigen::Isometry3d to = poseFromArray(T_to, "Arm.travel_time_s T_to");
+            py::gil_scoped_release release;
+            return a.travelTime_s(from, to);
+          },
+          py::arg("T_world_from_camera"), py::arg("T_world_to_camera"))
       .def_property_readonly("checks_goals", &host::nbv::Arm::checksGoals);
 }
 

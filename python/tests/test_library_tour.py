@@ -44,6 +44,9 @@ class DelegatingArm(fvp.Arm):
     def check_goal(self, T_world_camera):
         return self.inner.check_goal(T_world_camera)
 
+    def travel_time_s(self, T_world_from_camera, T_world_to_camera):
+        return self.inner.travel_time_s(T_world_from_camera, T_world_to_camera)
+
 
 class ClusterLog:
     """A tour observer: which clusters started and finished, in order."""

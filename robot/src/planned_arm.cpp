@@ -1,6 +1,7 @@
 #include "fvp/robot/planned_arm.h"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -74,6 +75,18 @@ host::planner::GoalReach PlannedArm::checkGoal(const Eigen::Isometry3d& T_world_
   }
   // The goal moveToPose plans to first; the straight motion to it, the least the move takes.
   return {GoalCheck::kFeasible, arm_.travelTime_s(current, goal)};
+}
+
+double PlannedArm::travelTime_s(const Eigen::Isometry3d& T_world_from_camera,
+                                const Eigen::Isometry3d& T_world_to_camera) const {
+  constexpr double kUnknown = std::numeric_limits<double>::quiet_NaN();
+  const JointVector current = joints();
+  JointVector from = current, to;
+  if (!arm_.T_world_camera(current).isApprox(T_world_from_camera, 1e-9) &&
+      planner_.goalStatus(current, T_world_from_camera, &from) != MotionStatus::kSuccess)
+    return kUnknown;
+  if (planner_.goalStatus(from, T_world_to_camera, &to) != MotionStatus::kSuccess) return kUnknown;
+  return arm_.travelTime_s(from, to);
 }
 
 host::nbv::MoveResult PlannedArm::moveTo(const Eigen::Isometry3d& T_world_camera) {

@@ -23,13 +23,21 @@ FruitletSnapshot fruitlet(double x_m, double size_mm, int well_seen = 4, double 
   return f;
 }
 
-/// views snapshots of two fruitlets whose sizes move by step_mm per view.
-std::vector<SizingSnapshot> history(int views, double step_mm = 0.02) {
+/// A camera 0.3 m from the fruitlets' centroid (0.01, 0, 0.3), azimuth_deg around it.
+Eigen::Vector3d cameraAt(double azimuth_deg) {
+  const double a = azimuth_deg * M_PI / 180.0;
+  return Eigen::Vector3d(0.01, 0.0, 0.3) + 0.3 * Eigen::Vector3d(std::sin(a), -std::cos(a), 0.0);
+}
+
+/// views snapshots of two fruitlets whose sizes move by step_mm per view, taken by a camera
+/// that moves step_deg around them per view.
+std::vector<SizingSnapshot> history(int views, double step_mm = 0.02, double step_deg = 20.0) {
   std::vector<SizingSnapshot> h;
   for (int v = 0; v < views; ++v) {
     SizingSnapshot s;
     s.view = v;
     s.now_s = 5.0 * v;
+    s.camera_position_m = cameraAt(step_deg * v);
     s.fruitlets = {fruitlet(0.0, 8.0 + step_mm * v), fruitlet(0.02, 11.0 - step_mm * v)};
     h.push_back(s);
   }
@@ -45,6 +53,28 @@ TEST(ClusterCompletion, SettledSizesStopOnceEnoughViewsAgree) {
   auto h = history(4);
   h.back().fruitlets[0].center_m.x() += 0.002;
   EXPECT_TRUE(sizesSettled(h, config));
+}
+
+TEST(ClusterCompletion, AgreementAmongViewsFromOneDirectionDoesNotStop) {
+  const ClusterCompletionConfig config;  // 30 degrees
+  // Six views within 10 degrees of each other: what they all miss stays missed.
+  auto h = history(6, 0.0, 2.0);
+  EXPECT_EQ(discoveryWindow(h, config), 0u);
+  EXPECT_FALSE(sizesSettled(h, config));
+  // The window reaches back to the first view that spans 30 degrees with a later one.
+  h.front().camera_position_m = cameraAt(-40.0);
+  EXPECT_EQ(discoveryWindow(h, config), 6u);
+  EXPECT_TRUE(sizesSettled(h, config));
+  // ...and a fruitlet found after that view means the views since found something.
+  h.front().fruitlets.pop_back();
+  EXPECT_FALSE(sizesSettled(h, config));
+  // Off: any stable_views + 1 sizings.
+  ClusterCompletionConfig off;
+  off.min_stable_span_deg = 0.0;
+  EXPECT_EQ(discoveryWindow(h, off), 4u);
+  EXPECT_TRUE(sizesSettled(h, off));
+  // Views spread enough need no more than stable_views + 1.
+  EXPECT_EQ(discoveryWindow(history(6), config), 4u);
 }
 
 TEST(ClusterCompletion, ASizeStillMovingDoesNotStop) {
@@ -86,10 +116,12 @@ TEST(ClusterCompletion, AFruitletFoundLateOrNotYetWellSeenDoesNotStop) {
   auto moved = history(6);
   moved.back().fruitlets[0].center_m.x() += 0.004;
   EXPECT_FALSE(sizesSettled(moved, config));
-  // Once the newcomer is well seen and quiet for three views, the cluster is done.
+  // Once the newcomer is well seen and quiet for three views from around the cluster, the
+  // cluster is done.
   for (int v = 0; v < 4; ++v) {
     SizingSnapshot s = found.back();
     s.view += 1;
+    s.camera_position_m = cameraAt(20.0 * s.view);
     found.push_back(s);
   }
   EXPECT_TRUE(sizesSettled(found, config));
@@ -178,6 +210,9 @@ TEST(ClusterCompletion, BadConfigIsRefusedNamingTheField) {
   c = {};
   c.min_view_span_deg = 200.0;
   refused(c, "min_view_span_deg");
+  c = {};
+  c.min_stable_span_deg = -1.0;
+  refused(c, "min_stable_span_deg");
 }
 
 class CountingClock : public LoopClock {

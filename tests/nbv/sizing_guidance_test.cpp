@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace fvp::host::nbv {
 namespace {
 
@@ -113,6 +115,50 @@ TEST(SizingGuidance, DropsAFruitletAimedAtTwiceInVainAndReturnsToItWhenItGainsAn
   roi.candidates[0].kind = planner::CandidateKind::kRoi;
   guidance.onPlan({.step = &roi});
   EXPECT_EQ(guidance.aimedViews(), 2u);
+}
+
+// Once every size has settled and only a target's evidence holds the stop, each view counts
+// for it, aimed at it or not: the planner preferring other views must not keep the cluster
+// to its cap. While sizes still move, only aimed views count.
+TEST(SizingGuidance, OnceOnlyTheEvidenceHoldsTheStopEveryViewCountsForTheTargets) {
+  const ClusterCompletionConfig config;
+  std::vector<SizingSnapshot> history;
+  RecordingPlanner planner;
+  SizingGuidance guidance(history, config, planner, 0.6);
+  int view = 0;
+  double size_mm = 10.0;
+  const auto sized = [&] {
+    FruitletSnapshot lacking = fruitlet(0.02, 1, 0.0);
+    lacking.size_mm = size_mm;
+    SizingSnapshot s = snapshot(view, {fruitlet(0.0, 4, 60.0), lacking});
+    // Around the cluster, 20 degrees a view: the sizings span directions.
+    const double a = 20.0 * view * M_PI / 180.0;
+    s.camera_position_m =
+        Eigen::Vector3d(0.01, 0.0, 0.3) + 0.3 * Eigen::Vector3d(std::sin(a), -std::cos(a), 0.0);
+    history.push_back(s);
+    guidance.onView({.index = view++});
+  };
+  planner::PlanStep elsewhere = aimedAt(0);
+  elsewhere.candidates[0].kind = planner::CandidateKind::kRoi;
+  // Sizes still moving: views elsewhere do not count.
+  for (int v = 0; v < 5; ++v, size_mm += 0.5) {
+    sized();
+    ASSERT_EQ(planner.targets_.size(), 1u);
+    guidance.onPlan({.step = &elsewhere});
+  }
+  EXPECT_FALSE(guidance.leftOut(Eigen::Vector3d(0.02, 0.0, 0.3)));
+  // Settled over the last 3 + 1 sizings: the next two views count, then it is left out.
+  for (int v = 0; v < 4; ++v) sized();
+  ASSERT_TRUE(sizesSettled(history, config, [](const FruitletSnapshot&) { return true; }));
+  ASSERT_FALSE(sizesSettled(history, config));  // the target's evidence holds the stop
+  guidance.onPlan({.step = &elsewhere});
+  sized();
+  ASSERT_EQ(planner.targets_.size(), 1u);
+  guidance.onPlan({.step = &elsewhere});
+  sized();
+  EXPECT_TRUE(planner.targets_.empty());
+  EXPECT_TRUE(guidance.leftOut(Eigen::Vector3d(0.02, 0.0, 0.3)));
+  EXPECT_EQ(guidance.aimedViews(), 0u);  // none of those views was aimed at it
 }
 
 // An unconfirmed detection (dropped by the hemisphere rule alone) is a target until it has

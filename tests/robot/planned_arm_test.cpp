@@ -238,6 +238,27 @@ TEST(PlannedArm, TheGoalCheckTurnsDownAViewBehindAWallWithoutPlanningAndKeepsOne
   EXPECT_DOUBLE_EQ(robot.executor.trajectories.back().duration_s(), in_front.travel_s);
 }
 
+TEST(PlannedArm, TravelTimeBetweenTwoPosesIsTheCheckedGoalsStraightMotion) {
+  FakeRobot robot(RecordingExecutor::Mode::kMove);
+  const WallScene scene(robot);
+  Eigen::Isometry3d far = robot.arm.cameraPose();
+  far.translation().y() += 3.0;
+  // From where the camera is: the goal check's time.
+  const double here_to_front = robot.arm.travelTime_s(scene.T_start, scene.in_front);
+  EXPECT_DOUBLE_EQ(here_to_front, robot.arm.checkGoal(scene.in_front).travel_s);
+  // Between two other poses: there and back take time, nothing for staying.
+  const double front_to_behind = robot.arm.travelTime_s(scene.in_front, scene.behind);
+  EXPECT_GT(front_to_behind, 0.0);
+  EXPECT_GT(robot.arm.travelTime_s(scene.behind, scene.in_front), 0.0);
+  EXPECT_DOUBLE_EQ(robot.arm.travelTime_s(scene.in_front, scene.in_front), 0.0);
+  // Out of reach at either end, or behind the wall once it is known: unknown.
+  EXPECT_TRUE(std::isnan(robot.arm.travelTime_s(scene.in_front, far)));
+  EXPECT_TRUE(std::isnan(robot.arm.travelTime_s(far, scene.in_front)));
+  ASSERT_EQ(robot.arm.setMap(scene.wall), 0u);
+  EXPECT_TRUE(std::isnan(robot.arm.travelTime_s(scene.in_front, scene.behind)));
+  EXPECT_TRUE(robot.executor.trajectories.empty());  // nothing moved
+}
+
 /// Ranks the views it is given, in that order, in one round.
 class FixedRanking : public host::planner::ViewPlanner {
  public:

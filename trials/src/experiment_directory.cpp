@@ -165,8 +165,9 @@ void visitManifestSettings(Options& settings, Visitor&& visit) {
 /// Settings a manifest may lack: added after format 1 began (absent: off), and in a merged
 /// manifest of format 1 the run's own engine and backend.
 bool mayBeAbsent(std::string_view key, bool merged) {
-  for (const std::string_view k : {"stop", "register_views", "confirm_detections",
-                                   "release_left_out", "arm_config", "size_history"})
+  for (const std::string_view k :
+       {"stop", "register_views", "confirm_detections", "release_left_out", "arm_config",
+        "size_history", "view_overhead_s"})
     if (key == k) return true;
   return merged && (key == "engine" || key == "backend");
 }
@@ -183,9 +184,10 @@ void readChoiceSetting(const std::string& where, const std::string& key, const n
   fieldError(where, key, "one of " + names, v);
 }
 void readSetting(const std::string& where, const std::string& key, const nlohmann::json* v,
-                 double& value) {
-  if (!v || !isFinite(*v) || !(v->get<double>() > 0))
-    fieldError(where, key, "a finite positive number", v);
+                 double& value, bool may_be_zero) {
+  // view_overhead_s 0 is a choice (the planner's order); a budget of 0 is not.
+  if (!v || !isFinite(*v) || !(may_be_zero ? v->get<double>() >= 0 : v->get<double>() > 0))
+    fieldError(where, key, may_be_zero ? "a finite number >= 0" : "a finite positive number", v);
   value = v->get<double>();
 }
 void readSetting(const std::string& where, const std::string& key, const nlohmann::json* v,
@@ -247,7 +249,8 @@ void readManifestSettings(const nlohmann::json& j, const std::string& where, boo
     const nlohmann::json* v = member(j, key.c_str());
     if (!v && mayBeAbsent(key, merged)) {
       if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, std::optional<bool>>)
-        value = false;  // a switch added after format 1: off
+        value = false;                                       // a switch added after format 1: off
+      if constexpr (std::is_same_v<T, double>) value = 0.0;  // view_overhead_s 0: off
       return;
     }
     if (field.vocabulary == host::nbv::FieldVocabulary::kConfigFile) {
@@ -255,7 +258,10 @@ void readManifestSettings(const nlohmann::json& j, const std::string& where, boo
       if constexpr (std::is_same_v<T, std::filesystem::path>) value = m.configs[key].path;
       return;
     }
-    readSetting(where, key, v, value);
+    if constexpr (std::is_same_v<T, double>)
+      readSetting(where, key, v, value, field.may_be_zero);
+    else
+      readSetting(where, key, v, value);
   });
 }
 

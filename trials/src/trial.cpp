@@ -358,6 +358,7 @@ host::nbv::NbvSetupOptions setupOptions(const TrialOptions& o) {
   s.stop.record_size_history = o.record_size_history;
   s.stop.completion.confirm_detections = o.confirm_detections;
   s.stop.completion.release_left_out = o.release_left_out;
+  s.loop.view_overhead_s = o.view_overhead_s;
   return s;
 }
 
@@ -531,6 +532,7 @@ nlohmann::json Trial::Impl::stopJson() const {
           {"same_fruitlet_m", c.same_fruitlet_m},
           {"min_well_seen_images", c.min_well_seen_images},
           {"min_view_span_deg", c.min_view_span_deg},
+          {"min_stable_span_deg", c.min_stable_span_deg},
           {"max_iterations_without_view", c.max_iterations_without_view},
           {"confirm_detections", c.confirm_detections},
           {"release_left_out", c.release_left_out}};

@@ -19,6 +19,8 @@ void ClusterCompletionConfig::validate() const {
     throw std::invalid_argument("cluster completion 'min_well_seen_images': expected at least 1");
   if (!(min_view_span_deg >= 0.0) || !(min_view_span_deg <= 180.0))
     throw std::invalid_argument("cluster completion 'min_view_span_deg': expected 0 to 180");
+  if (!(min_stable_span_deg >= 0.0) || !(min_stable_span_deg <= 180.0))
+    throw std::invalid_argument("cluster completion 'min_stable_span_deg': expected 0 to 180");
   if (max_iterations_without_view < 1)
     throw std::invalid_argument(
         "cluster completion 'max_iterations_without_view': expected at least 1");
@@ -48,6 +50,7 @@ void ClusterCompletion::onView(const ViewEvent& event) {
   snapshot.view = event.index;
   snapshot.now_s = clock_.now_s();
   snapshot.sizing_s = sizing_s;
+  snapshot.camera_position_m = event.T_world_camera.translation();
   if (session_.correctsAnchorOffset()) snapshot.world_shift_m = session_.anchorOffset().shift_m;
   const auto& views = session_.sizingViews();
   // Its images' directions (the well-seen ones, or every sized one of an unconfirmed
@@ -97,19 +100,43 @@ bool lacksEvidence(const FruitletSnapshot& fruitlet, const ClusterCompletionConf
           fruitlet.view_span_deg < config.min_view_span_deg);
 }
 
+std::size_t discoveryWindow(const std::vector<SizingSnapshot>& history,
+                            const ClusterCompletionConfig& config) {
+  const std::size_t least = std::size_t(config.stable_views) + 1;
+  if (history.size() < least || history.back().fruitlets.empty()) return 0;
+  if (config.min_stable_span_deg <= 0.0) return least;
+  Eigen::Vector3d centroid_m = Eigen::Vector3d::Zero();
+  for (const auto& f : history.back().fruitlets) centroid_m += f.center_m;
+  centroid_m /= double(history.back().fruitlets.size());
+  const double min_cos = std::cos(config.min_stable_span_deg * M_PI / 180.0);
+  // Every pair is compared once, when its later (older) snapshot joins the window.
+  std::vector<Eigen::Vector3d> directions;
+  bool spans = false;
+  for (std::size_t n = 1; n <= history.size(); ++n) {
+    const Eigen::Vector3d direction =
+        (history[history.size() - n].camera_position_m - centroid_m).normalized();
+    for (const auto& d : directions) spans = spans || d.dot(direction) <= min_cos;
+    if (spans && n >= least) return n;
+    directions.push_back(direction);
+  }
+  return 0;
+}
+
 bool sizesSettled(const std::vector<SizingSnapshot>& history, const ClusterCompletionConfig& config,
                   const std::function<bool(const FruitletSnapshot&)>& released) {
-  if (history.size() < std::size_t(config.stable_views) + 1) return false;
-  const SizingSnapshot& latest = history.back();
   // A cluster with nothing sized is not done: its fruitlets are still to be found (the
-  // budget ends a cluster that has none).
-  if (latest.fruitlets.empty()) return false;
+  // budget ends a cluster that has none). discoveryWindow is 0 then.
+  const std::size_t window = discoveryWindow(history, config);
+  if (window == 0) return false;
+  const SizingSnapshot& latest = history.back();
   for (const auto& f : latest.fruitlets)
     if (lacksEvidence(f, config) && !(released && released(f))) return false;
-  for (int k = 1; k <= config.stable_views; ++k) {
-    const SizingSnapshot& earlier = history[history.size() - 1 - std::size_t(k)];
+  for (std::size_t k = 1; k < window; ++k) {
+    const SizingSnapshot& earlier = history[history.size() - 1 - k];
     // A fruitlet found or lost: the cluster is still changing.
     if (earlier.fruitlets.size() != latest.fruitlets.size()) return false;
+    // Past the last stable_views + 1 only the count: early centres may sit a few mm off.
+    if (k > std::size_t(config.stable_views)) continue;
     std::vector<bool> taken(earlier.fruitlets.size(), false);  // one-to-one
     for (const auto& f : latest.fruitlets) {
       std::optional<std::size_t> nearest;

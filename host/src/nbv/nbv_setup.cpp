@@ -1,5 +1,6 @@
 #include "fvp/host/nbv/nbv_setup.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -10,6 +11,7 @@
 #include "fvp/host/nbv/approach_sequence.h"
 #include "fvp/host/nbv/loop_observers.h"
 #include "fvp/host/nbv/sizing_guidance.h"
+#include "fvp/host/nbv/tour_order.h"
 #include "fvp/host/planner/planner_registry.h"
 
 namespace fvp::host::nbv {
@@ -31,16 +33,43 @@ class UnchargedClock : public LoopClock {
   const LoopClock& clock_;
 };
 
-/// The target not yet visited whose start view is nearest `here` (the first on a tie).
-std::size_t nearestUnvisited(const std::vector<ClusterTarget>& targets,
-                             const std::vector<bool>& visited, const Eigen::Vector3d& here) {
-  std::size_t k = targets.size();
-  const auto distance = [&](std::size_t i) {
-    return (targets[i].T_world_start_camera.translation() - here).norm();
-  };
+/// The tour's costs between where the arm is (node 0) and the start views of the clusters
+/// left (nodes 1..): the arm's travel times where it gives them; a pair it cannot time (a
+/// start view without collision-free IK, reached through an approach view) is priced at its
+/// camera distance times the median seconds per metre of the pairs it timed; camera distances
+/// alone when it timed none.
+Eigen::MatrixXd tourCosts(const Arm& arm, const std::vector<Eigen::Isometry3d>& poses) {
+  const auto n = Eigen::Index(poses.size());
+  Eigen::MatrixXd seconds = Eigen::MatrixXd::Zero(n, n), metres = Eigen::MatrixXd::Zero(n, n);
+  std::vector<double> seconds_per_metre;
+  for (Eigen::Index a = 0; a < n; ++a)
+    for (Eigen::Index b = 1; b < n; ++b) {  // nothing returns to node 0
+      if (a == b) continue;
+      metres(a, b) =
+          (poses[std::size_t(a)].translation() - poses[std::size_t(b)].translation()).norm();
+      seconds(a, b) = arm.travelTime_s(poses[std::size_t(a)], poses[std::size_t(b)]);
+      if (std::isfinite(seconds(a, b)) && metres(a, b) > 1e-6)
+        seconds_per_metre.push_back(seconds(a, b) / metres(a, b));
+    }
+  if (seconds_per_metre.empty()) return metres;
+  const auto middle = seconds_per_metre.begin() + std::ptrdiff_t(seconds_per_metre.size() / 2);
+  std::nth_element(seconds_per_metre.begin(), middle, seconds_per_metre.end());
+  for (Eigen::Index a = 0; a < n; ++a)
+    for (Eigen::Index b = 0; b < n; ++b)
+      if (!std::isfinite(seconds(a, b))) seconds(a, b) = metres(a, b) * *middle;
+  return seconds;
+}
+
+/// The cluster to visit next: the first of the quickest order through the clusters left, from
+/// where the arm is (tour_order.h). Ordered again after every cluster, from where it ended.
+std::size_t nextOnTour(const Arm& arm, const std::vector<ClusterTarget>& targets,
+                       const std::vector<bool>& visited) {
+  std::vector<std::size_t> left;
+  std::vector<Eigen::Isometry3d> poses = {arm.cameraPose()};
   for (std::size_t i = 0; i < targets.size(); ++i)
-    if (!visited[i] && (k == targets.size() || distance(i) < distance(k))) k = i;
-  return k;
+    if (!visited[i]) left.push_back(i), poses.push_back(targets[i].T_world_start_camera);
+  if (left.size() == 1) return left.front();
+  return left[shortestOpenTour(tourCosts(arm, poses)).front() - 1];
 }
 
 }  // namespace
@@ -80,6 +109,8 @@ void NbvSetupOptions::validate() const {
   perception.validate();
   if (loop.max_consecutive_dropped_frames < 1)
     throw std::invalid_argument("setting 'max_consecutive_dropped_frames': expected at least 1");
+  if (!(loop.view_overhead_s >= 0.0) || !std::isfinite(loop.view_overhead_s))
+    throw std::invalid_argument("setting 'view_overhead_s': expected a finite number >= 0");
 }
 
 NbvSetup::NbvSetup(NbvSetupOptions options) : options_(std::move(options)) {
@@ -184,7 +215,11 @@ TourResult NbvSetup::runTour(const NbvRig& rig, const std::vector<ClusterTarget>
   std::vector<bool> visited(targets.size(), false);
   std::unique_ptr<map::MapEngine> carried_map;
   for (std::size_t step = 0; step < targets.size(); ++step) {
-    const std::size_t k = nearestUnvisited(targets, visited, rig.arm.cameraPose().translation());
+    const auto ordering = Clock::now();
+    const std::size_t k = nextOnTour(rig.arm, targets, visited);
+    // Compute a robot spends too (IK for every pair of start views); none for the last.
+    if (step + 1 < targets.size())
+      rig.clock.chargeCompute(LoopStage::kPlanning, secondsSince(ordering));
     visited[k] = true;
     const ClusterTarget& target = targets[k];
     ClusterVisit visit;

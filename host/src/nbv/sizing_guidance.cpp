@@ -44,11 +44,14 @@ void SizingGuidance::onPlan(const PlanEvent& event) {
     ++aimed_views_;
     aimed_target = chosen.sizing_target;
   }
-  // The view aimed at a target counts for it; every view counts for an unconfirmed one, so
-  // that a cluster waits at most max_aimed_views views on each (the planner may find none of
-  // its candidates worth more than the others').
+  // The view aimed at a target counts for it; every view counts for an unconfirmed one, and
+  // for every target once the sizes have settled and only the targets' evidence holds the
+  // stop: a cluster waits at most max_aimed_views views on each (the planner may find none of
+  // its candidates worth more than the others', and views it prefers then only spend the cap).
+  const bool only_evidence_holds =
+      sizesSettled(history_, config_, [](const FruitletSnapshot&) { return true; });
   for (std::size_t t = 0; t < targets_.size(); ++t) {
-    if (int(t) != aimed_target && !target_unconfirmed_[t]) continue;
+    if (int(t) != aimed_target && !target_unconfirmed_[t] && !only_evidence_holds) continue;
     if (Aim* aim = findAim(targets_[t].center_m))
       ++aim->views;
     else

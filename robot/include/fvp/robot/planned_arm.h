@@ -55,6 +55,10 @@ class PlannedArm : public host::nbv::Arm {
   /// MotionPlanner::goalStatus from the joints now, on the map of the last setMap: IK along
   /// the travel and collision checks (self, static, FCL against the map), no OMPL.
   host::planner::GoalReach checkGoal(const Eigen::Isometry3d& T_world_camera) const override;
+  /// ArmModel::travelTime_s between the goals goalStatus picks: `from`'s from the joints now
+  /// (the joints themselves when the camera is there), `to`'s from `from`'s.
+  double travelTime_s(const Eigen::Isometry3d& T_world_from_camera,
+                      const Eigen::Isometry3d& T_world_to_camera) const override;
   /// setMap with the map's coarse octree.
   std::size_t updateObstacles(host::map::MapEngine& map) override;
 

@@ -15,6 +15,7 @@
 
 #include "fvp/accel/backend_choice.h"
 #include "fvp/host/nbv/stop_rule.h"
+#include "fvp/host/planner/view_overhead.h"
 #include "fvp/robot/sim/sim_clock.h"
 
 namespace fvp::host::nbv {
@@ -62,6 +63,10 @@ struct TrialOptions {
   /// With stop auto: a fruitlet the planner looked for twice in vain no longer holds the stop
   /// (host::nbv::ClusterCompletionConfig::release_left_out).
   bool release_left_out = true;
+  /// Seconds a view costs besides the arm's move: views that pass the goal check are tried
+  /// by information per second (host::nbv::NbvLoopOptions::view_overhead_s); 0: the
+  /// planner's order.
+  double view_overhead_s = host::planner::kDefaultViewOverheadS;
   /// Where result.json, the maps, the TSDF surface, the clusters and report.md go; empty:
   /// nothing is written (the result is only returned).
   std::filesystem::path out_dir;

@@ -46,6 +46,7 @@ void visitTrialFields(Options& o, Visitor&& visit) {
   visit(f::kConfirmDetections, o.confirm_detections);
   visit(f::kReleaseLeftOut, o.release_left_out);
   visit(f::kRegisterViews, o.register_views);
+  visit(f::kViewOverhead, o.view_overhead_s);
   visit(f::kSizeHistory, o.record_size_history);
   visit(t::kClock, o.clock);
 }

@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <cstddef>
+#include <limits>
 #include <string>
 
 #include "fvp/host/planner/goal_check.h"
@@ -56,6 +57,16 @@ class Arm {
   virtual planner::GoalReach checkGoal(const Eigen::Isometry3d& T_world_camera) const {
     (void)T_world_camera;
     return {};
+  }
+  /// The least time the arm takes from one camera pose to another: the straight joint-space
+  /// motion between the configurations it would take there (each the one moveTo would go to,
+  /// `from` reached from where the arm is now), on the map of the last updateObstacles. NaN
+  /// when unknown or when either pose has no collision-free IK. The tour orders clusters by it.
+  virtual double travelTime_s(const Eigen::Isometry3d& T_world_from_camera,
+                              const Eigen::Isometry3d& T_world_to_camera) const {
+    (void)T_world_from_camera;
+    (void)T_world_to_camera;
+    return std::numeric_limits<double>::quiet_NaN();
   }
   /// Called after new views reached the map, before planning, so the arm avoids what the
   /// camera has seen. Returns a count for the log (the simulated arm: voxels it freed where

@@ -46,6 +46,15 @@ struct ClusterCompletionConfig {
   /// d >= 2 cm that is 12 mm, more than a fruitlet's diameter, so no one occluder spoils
   /// both ends of the span.
   double min_view_span_deg = 30.0;
+  /// The views over which no fruitlet was found or lost must come from directions at least
+  /// this far apart, seen from the cluster (the centroid of the latest fruitlets): views close
+  /// together see the same sides, so a fruitlet hidden from one is hidden from all, and their
+  /// agreement says nothing about what is still unseen. The window of stable_views + 1
+  /// sizings grows back until its cameras span this angle. 30 degrees for min_view_span_deg's
+  /// reason: a leaf 2 cm in front of a hidden fruitlet moves 12 mm across the line of sight,
+  /// more than a fruitlet's diameter. Sizes must agree over the last stable_views + 1 only.
+  /// 0: off (the rule before; any stable_views + 1 sizings).
+  double min_stable_span_deg = 30.0;
   /// A cluster is also done when the planner finds no view to move to for this many
   /// iterations in a row ("no_reachable_view"): its threshold decays by threshold_decay
   /// (0.8) in each of max_sampling_rounds (8) rounds, so after 3 iterations it is 0.8^24 =
@@ -77,7 +86,8 @@ struct FruitletSnapshot {
   int well_seen_images = 0;
   double view_span_deg = 0.0;  ///< largest angle between two well-seen views' directions
   sizing::SizeSource size_source = sizing::SizeSource::kWellSeenImages;
-  double size_stderr_mm = -1.0;  ///< the size's standard error; -1 under 2 well-seen images
+  /// The size's standard error (FruitletSupport::size_stderr_mm); -1 under 2 images.
+  double size_stderr_mm = -1.0;
   /// Unit vectors from the fruitlet towards the cameras of its well-seen images.
   std::vector<Eigen::Vector3d> well_seen_directions;
   /// An unconfirmed detection (ClusterCompletionConfig::confirm_detections): well_seen_images,
@@ -90,6 +100,9 @@ struct SizingSnapshot {
   int view = 0;        ///< 0-based index of the view it followed
   double now_s = 0.0;  ///< the loop clock when the view was mapped
   double sizing_s = 0.0;
+  /// Where the camera took the view, in the frame of the session's views (as the fruitlet
+  /// centres' directions are measured).
+  Eigen::Vector3d camera_position_m = Eigen::Vector3d::Zero();
   /// Centres are in the registered maps' frame; this added puts them in the world as the
   /// final sizing reports them (MappingSession::anchorOffset; zero without the correction).
   Eigen::Vector3d world_shift_m = Eigen::Vector3d::Zero();
@@ -147,7 +160,15 @@ class ClusterCompletion : public LoopObserver {
 /// unconfirmed detection needs as many sized images, as far apart).
 bool lacksEvidence(const FruitletSnapshot& fruitlet, const ClusterCompletionConfig& config);
 
-/// Whether the last config.stable_views + 1 snapshots of history agree (the rule of done()).
+/// How many of history's latest snapshots the found-or-lost check spans: at least
+/// config.stable_views + 1, and back until their cameras span config.min_stable_span_deg seen
+/// from the latest fruitlets' centroid; 0 when the whole history does not span it (or is
+/// shorter than stable_views + 1, or has no fruitlet).
+std::size_t discoveryWindow(const std::vector<SizingSnapshot>& history,
+                            const ClusterCompletionConfig& config);
+
+/// Whether the latest snapshots of history agree (the rule of done()): the same fruitlets
+/// over discoveryWindow, sizes within tolerance over the last config.stable_views + 1.
 /// `released` (optional): fruitlets that need not show the evidence.
 bool sizesSettled(const std::vector<SizingSnapshot>& history, const ClusterCompletionConfig& config,
                   const std::function<bool(const FruitletSnapshot&)>& released = {});

@@ -182,11 +182,12 @@ class NbvSetup {
   /// The loop on one cluster from where the arm is, until the stop, then its sizing.
   ClusterRun runCluster(const NbvRig& rig, ClusterWork& work, LoopObserver* observer = nullptr);
 
-  /// The clusters one after another on one clock and one coarse map: the nearest start view
-  /// next; each from its start view or, where the arm cannot stand there, an approach view
-  /// backed off along its axis and then turned about the cluster; a cluster whose views
-  /// show no tag is retried from its next approach view. A cluster the arm cannot reach is
-  /// skipped and counted.
+  /// The clusters one after another on one clock and one coarse map, in the order that
+  /// reaches their start views in the least time (Arm::travelTime_s, tour_order.h; ordered
+  /// again from where each cluster ended, and charged as planning); each from its start view or,
+  /// where the arm cannot stand there, an approach view backed off along its axis and then turned
+  /// about the cluster; a cluster whose views show no tag is retried from its next approach view. A
+  /// cluster the arm cannot reach is skipped and counted.
   TourResult runTour(const NbvRig& rig, const std::vector<ClusterTarget>& targets,
                      TourObserver* observer = nullptr);
 

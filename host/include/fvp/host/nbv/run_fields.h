@@ -35,6 +35,9 @@ struct RunField {
   /// Varies from trial to trial within an experiment (planner, seed): `fvp experiment`
   /// takes lists of them instead, and its manifest records those lists.
   bool per_trial = false;
+  /// A number for which 0 is a choice, not a mistake (view_overhead_s 0: the planner's
+  /// order); other numbers must be above 0.
+  bool may_be_zero = false;
 };
 
 namespace run_fields {
@@ -75,6 +78,14 @@ inline constexpr RunField kRegisterViews{
     "register_views", "--register-views",
     "align each view to the earlier ones before fusing it (a counter-measure to pose errors; a "
     "trial's default: as the world config's run_register_views says, on for the field preset)"};
+inline constexpr RunField kViewOverhead{
+    "view_overhead_s",
+    "--view-overhead-s",
+    "seconds a view costs besides the arm's move (capture and compute): views that pass the goal "
+    "check are tried by information per second of move plus this (0: in the planner's order)",
+    FieldVocabulary::kNone,
+    false,
+    true};
 inline constexpr RunField kMaxDroppedFrames{
     "max_consecutive_dropped_frames", "--max-dropped-frames",
     "frames dropped in a row after which a cluster's loop stops (camera_failed)"};
@@ -129,6 +140,7 @@ void visitSetupFields(Options& o, Visitor&& visit) {
   visit(f::kConfirmDetections, o.stop.completion.confirm_detections);
   visit(f::kReleaseLeftOut, o.stop.completion.release_left_out);
   visit(f::kRegisterViews, o.register_views);
+  visit(f::kViewOverhead, o.loop.view_overhead_s);
   visit(f::kMaxDroppedFrames, o.loop.max_consecutive_dropped_frames);
 }
 

@@ -10,6 +10,8 @@
 #include <limits>
 #include <vector>
 
+#include "fvp/host/planner/view_overhead.h"
+
 namespace fvp::host::planner {
 
 enum class GoalCheck {
@@ -42,11 +44,5 @@ using GoalCheckFn =
 /// iterations of development trees 1-3 before the checks) and still cost far less than a
 /// fixed-clock stage in wall time (0.6 ms a check on 2 cores; docs/results.md).
 inline constexpr std::size_t kDefaultGoalCheckBatch = 16;
-
-/// What a view costs the robot besides its move, for ranking views by time
-/// (planAndMove, view_planner.h): the fixed clock's charges per view (capture 0.2 s, mapping 0.2 s,
-/// TSDF, sizing, planning, motion planning and a batch of goal checks 0.1 s each). A robot
-/// on two cores measured 0.64 s of compute a view plus its capture (issue 41), the same size.
-inline constexpr double kDefaultViewOverheadS = 0.9;
 
 }  // namespace fvp::host::planner

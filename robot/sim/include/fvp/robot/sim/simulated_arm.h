@@ -35,6 +35,10 @@ class SimulatedArm : public host::nbv::Arm {
   host::planner::GoalReach checkGoal(const Eigen::Isometry3d& T_world_camera) const override {
     return arm_.checkGoal(T_world_camera);
   }
+  double travelTime_s(const Eigen::Isometry3d& T_world_from_camera,
+                      const Eigen::Isometry3d& T_world_to_camera) const override {
+    return arm_.travelTime_s(T_world_from_camera, T_world_to_camera);
+  }
   /// The collision checker's map becomes the coarse map, with the voxels the arm occupies
   /// where it stands freed (returns how many).
   std::size_t updateObstacles(host::map::MapEngine& map) override {
