@@ -224,17 +224,12 @@ void aggregate(FruitletEstimate& f, const SizingConfig& config) {
     f.size_ours_mm = median(all);
     f.size_source = SizeSource::kAllImages;
   }
-  // The standard error of the median the size is: of the well-seen images, or of every
-  // image where none is well seen (a sphere-fit size is no median).
   f.support.size_stderr_mm = -1.0;
-  const std::vector<double>* sample = f.size_source == SizeSource::kWellSeenImages ? &good
-                                      : f.size_source == SizeSource::kAllImages    ? &all
-                                                                                   : nullptr;
-  if (sample && sample->size() >= 2) {
+  if (good.size() >= 2) {
     std::vector<double> deviations;
-    for (double v : *sample) deviations.push_back(std::abs(v - f.size_ours_mm));
+    for (double v : good) deviations.push_back(std::abs(v - f.size_ours_mm));
     f.support.size_stderr_mm =
-        1.2533 * 1.4826 * median(deviations) / std::sqrt(double(sample->size()));
+        1.2533 * 1.4826 * median(deviations) / std::sqrt(double(good.size()));
   }
   if (config.estimator == SizingEstimator::kPaper) {
     f.center_m = f.centroid_m;

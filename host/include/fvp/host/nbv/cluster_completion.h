@@ -86,7 +86,7 @@ struct FruitletSnapshot {
   int well_seen_images = 0;
   double view_span_deg = 0.0;  ///< largest angle between two well-seen views' directions
   sizing::SizeSource size_source = sizing::SizeSource::kWellSeenImages;
-  /// The size's standard error (FruitletSupport::size_stderr_mm); -1 under 2 images.
+  /// The size's standard error (FruitletSupport::size_stderr_mm); -1 under 2 well-seen images.
   double size_stderr_mm = -1.0;
   /// Unit vectors from the fruitlet towards the cameras of its well-seen images.
   std::vector<Eigen::Vector3d> well_seen_directions;

@@ -131,9 +131,8 @@ struct DetectionSupport {
   /// The fraction of its sphere required_points stands for: min_support_area_fraction, or
   /// sphere_fit_support_area_fraction when its size came from the sphere fit alone.
   double required_area_fraction = 0.0;
-  /// Ours' confidence: the standard error of the median of its well-seen images' sizes, or of
-  /// every image's where none is well seen (size_source kAllImages) (1.2533 x 1.4826 MAD /
-  /// sqrt(n)); -1 with fewer than two such images or a sphere-fit size.
+  /// Ours' confidence: the standard error of the median of its well-seen images' sizes
+  /// (1.2533 x 1.4826 MAD / sqrt(n)); -1 with fewer than two.
   double size_stderr_mm = -1.0;
   int merged_detections = 0;  ///< detections the overlap rule merged into this one
   /// Whether the views that see its surface call it fruitlet. Over every view and point: a
