@@ -87,10 +87,15 @@ class PyArm : public host::nbv::Arm {
     const py::function f = py::get_override(static_cast<const Arm*>(this), "travel_time_s");
     if (!f) return Arm::travelTime_s(T_world_from_camera, T_world_to_camera);
     const py::object out = f(poseToArray(T_world_from_camera), poseToArray(T_world_to_camera));
-    if (!py::isinstance<py::float_>(out) && !py::isinstance<py::int_>(out))
+    if (py::isinstance<py::bool_>(out) ||
+        (!py::isinstance<py::float_>(out) && !py::isinstance<py::int_>(out)))
       throw std::invalid_argument("fvp.Arm.travel_time_s: expected a number, got " +
                                   std::string(py::str(py::type::of(out))));
-    return out.cast<double>();
+    const double seconds = out.cast<double>();
+    if (seconds < 0.0)  // NaN: unknown, allowed
+      throw std::invalid_argument("fvp.Arm.travel_time_s: expected seconds >= 0 or nan, got " +
+                                  std::to_string(seconds));
+    return seconds;
   }
   std::size_t updateObstacles(host::map::MapEngine& map) override {
     py::gil_scoped_acquire gil;

@@ -85,6 +85,9 @@ def test_the_goal_check_says_how_long_the_move_takes(model, workspace):
     reach = arm.check_goal(goal_pose(model))
     assert isinstance(reach, fvp.GoalReach)
     assert reach.check == fvp.GoalCheck.feasible and reach.travel_s > 0
+    # From where the camera is, the time between two poses is the check's (a tour's cost).
+    assert arm.travel_time_s(arm.camera_pose(), goal_pose(model)) == pytest.approx(
+        reach.travel_s, rel=1e-9)
     # Free space: the move is the straight motion the check timed.
     arm.move_to(goal_pose(model))
     times_s, _ = executor.trajectories[0]

@@ -159,6 +159,18 @@ TEST(SizingGuidance, OnceOnlyTheEvidenceHoldsTheStopEveryViewCountsForTheTargets
   EXPECT_TRUE(planner.targets_.empty());
   EXPECT_TRUE(guidance.leftOut(Eigen::Vector3d(0.02, 0.0, 0.3)));
   EXPECT_EQ(guidance.aimedViews(), 0u);  // none of those views was aimed at it
+  // Without release_left_out a left-out target holds the stop anyway: views elsewhere keep
+  // their old meaning, and the planner keeps aiming at it.
+  ClusterCompletionConfig kept = config;
+  kept.release_left_out = false;
+  std::vector<SizingSnapshot> same = history;
+  SizingGuidance patient(same, kept, planner, 0.6);
+  for (int v = 0; v < 3; ++v) {
+    patient.onView({.index = same.back().view});
+    ASSERT_EQ(planner.targets_.size(), 1u);
+    patient.onPlan({.step = &elsewhere});
+  }
+  EXPECT_FALSE(patient.leftOut(Eigen::Vector3d(0.02, 0.0, 0.3)));
 }
 
 // An unconfirmed detection (dropped by the hemisphere rule alone) is a target until it has

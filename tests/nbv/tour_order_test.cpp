@@ -59,9 +59,9 @@ TEST(TourOrder, BeatsNearestNextWhereGreedIsShortSighted) {
   EXPECT_DOUBLE_EQ(openTourCost(cost, order), 8.0);
 }
 
-TEST(TourOrder, ExactUpToTwelveStopsAndNeverLongerThanNearestNext) {
+TEST(TourOrder, OptimalAgainstBruteForceAndNeverLongerThanNearestNext) {
   for (unsigned seed = 1; seed <= 20; ++seed) {
-    const std::size_t stops = 1 + seed % 7;  // 1..7: brute force is 5040 orders at most
+    const std::size_t stops = 1 + seed % 8;  // 1..8: brute force is 40320 orders at most
     const Eigen::MatrixXd cost = randomCosts(stops, seed);
     const std::vector<std::size_t> order = shortestOpenTour(cost);
     expectEveryStopOnce(order, stops);
@@ -74,6 +74,19 @@ TEST(TourOrder, ExactUpToTwelveStopsAndNeverLongerThanNearestNext) {
     EXPECT_LE(openTourCost(cost, order), openTourCost(cost, nearestNextTour(cost)) + 1e-9)
         << stops << " stops";
   }
+}
+
+TEST(TourOrder, BeyondTheExactLimitTwoOptMendsAGreedyTour) {
+  // 14 stops on a line: six near on the right and one far, seven on the left. Nearest next
+  // runs right to 6, back across to -7.5, then out to 20 (47); left first is 35.
+  std::vector<double> x = {0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 20.0};
+  for (double l = -1.5; l >= -7.5; l -= 1.0) x.push_back(l);
+  const Eigen::MatrixXd cost = onALine(x);
+  ASSERT_GT(std::size_t(cost.rows()) - 1, kExactTourMaxStops);
+  EXPECT_DOUBLE_EQ(openTourCost(cost, nearestNextTour(cost)), 47.0);
+  const std::vector<std::size_t> order = shortestOpenTour(cost);
+  expectEveryStopOnce(order, x.size() - 1);
+  EXPECT_LT(openTourCost(cost, order), 47.0 - 1e-9);
 }
 
 TEST(TourOrder, NoStopsNoOrderAndBadCostsRefused) {

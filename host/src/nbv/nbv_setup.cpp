@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "fvp/accel/backend.h"
@@ -48,7 +49,9 @@ Eigen::MatrixXd tourCosts(const Arm& arm, const std::vector<Eigen::Isometry3d>& 
       metres(a, b) =
           (poses[std::size_t(a)].translation() - poses[std::size_t(b)].translation()).norm();
       seconds(a, b) = arm.travelTime_s(poses[std::size_t(a)], poses[std::size_t(b)]);
-      if (std::isfinite(seconds(a, b)) && metres(a, b) > 1e-6)
+      if (!(seconds(a, b) >= 0.0) || !std::isfinite(seconds(a, b)))  // unknown
+        seconds(a, b) = std::numeric_limits<double>::quiet_NaN();
+      else if (metres(a, b) > 1e-6)
         seconds_per_metre.push_back(seconds(a, b) / metres(a, b));
     }
   if (seconds_per_metre.empty()) return metres;

@@ -48,7 +48,10 @@ void SizingGuidance::onPlan(const PlanEvent& event) {
   // for every target once the sizes have settled and only the targets' evidence holds the
   // stop: a cluster waits at most max_aimed_views views on each (the planner may find none of
   // its candidates worth more than the others', and views it prefers then only spend the cap).
+  // Without release_left_out a target left out still holds the stop: counting views it was
+  // not aimed at would only stop the planner aiming at it.
   const bool only_evidence_holds =
+      config_.release_left_out &&
       sizesSettled(history_, config_, [](const FruitletSnapshot&) { return true; });
   for (std::size_t t = 0; t < targets_.size(); ++t) {
     if (int(t) != aimed_target && !target_unconfirmed_[t] && !only_evidence_holds) continue;

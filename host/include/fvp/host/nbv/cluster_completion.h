@@ -100,8 +100,8 @@ struct SizingSnapshot {
   int view = 0;        ///< 0-based index of the view it followed
   double now_s = 0.0;  ///< the loop clock when the view was mapped
   double sizing_s = 0.0;
-  /// Where the camera took the view, in the frame of the session's views (as the fruitlet
-  /// centres' directions are measured).
+  /// Where the arm put the camera for the view (ViewEvent::T_world_camera; registration may
+  /// move the session's copy by millimetres, nothing at the scale of directions).
   Eigen::Vector3d camera_position_m = Eigen::Vector3d::Zero();
   /// Centres are in the registered maps' frame; this added puts them in the world as the
   /// final sizing reports them (MappingSession::anchorOffset; zero without the correction).
