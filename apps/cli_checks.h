@@ -53,31 +53,27 @@ inline CLI::Validator finiteNumber() {
       "NUMBER", "finiteNumber");
 }
 
-/// A finite number above zero. (CLI::PositiveNumber prints the largest double, 309 digits,
-/// as its bound.)
-inline CLI::Validator positiveNumber() {
+/// A finite number from zero on: above it (zero_allowed false) or at least it. (CLI::
+/// PositiveNumber prints the largest double, 309 digits, as its bound.)
+inline CLI::Validator numberFromZero(bool zero_allowed) {
   return CLI::Validator(
-      [](std::string& text) -> std::string {
+      [zero_allowed](std::string& text) -> std::string {
         std::string copy = text;
         if (std::string error = finiteNumber()(copy); !error.empty()) return error;
-        if (!(std::strtod(text.c_str(), nullptr) > 0.0))
-          return "expected a number above 0, got '" + text + "'";
+        const double v = std::strtod(text.c_str(), nullptr);
+        if (!(zero_allowed ? v >= 0.0 : v > 0.0))
+          return std::string(zero_allowed ? "expected a number of at least 0, got '"
+                                          : "expected a number above 0, got '") +
+                 text + "'";
         return {};
       },
-      "POSITIVE", "positiveNumber");
+      zero_allowed ? "NON_NEGATIVE" : "POSITIVE",
+      zero_allowed ? "nonNegativeNumber" : "positiveNumber");
 }
 
-/// A finite number of at least zero.
-inline CLI::Validator nonNegativeNumber() {
-  return CLI::Validator(
-      [](std::string& text) -> std::string {
-        std::string copy = text;
-        if (std::string error = finiteNumber()(copy); !error.empty()) return error;
-        if (!(std::strtod(text.c_str(), nullptr) >= 0.0))
-          return "expected a number of at least 0, got '" + text + "'";
-        return {};
-      },
-      "NON_NEGATIVE", "nonNegativeNumber");
+/// A finite number above zero.
+inline CLI::Validator positiveNumber() {
+  return numberFromZero(false);
 }
 
 /// A path that is not empty: `--out ""` would write nowhere (the libraries take an empty

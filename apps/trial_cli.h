@@ -31,7 +31,7 @@ class TrialOptionAdder {
     if constexpr (std::is_same_v<T, double>) {
       // Numbers: above 0, or at least 0 where 0 is a choice.
       cmd_->add_option(std::string(field.flag), member, std::string(field.help))
-          ->check(field.may_be_zero ? nonNegativeNumber() : positiveNumber())
+          ->check(numberFromZero(field.may_be_zero))
           ->capture_default_str();
     } else {
       add(std::string(field.flag), std::string(field.help), field.vocabulary, member);
