@@ -121,6 +121,9 @@ TEST(Experiment, PooledMetricsByHand) {
   EXPECT_NE(table.find("| FVP (ours) | 3 | 30.0 | 100.0 | 0.75 |"), std::string::npos);
   EXPECT_GT(fs::file_size(out / "sizes.png"), 5000u);
   EXPECT_EQ(slurp(out / "sizes.png").substr(1, 3), "PNG");
+  // Lines without the clock's stages (as an older build wrote them): no split, no figure.
+  EXPECT_TRUE(s["fvp"]["sim_time_percent"].is_null());
+  EXPECT_FALSE(fs::exists(out / "time_split.png"));
 }
 
 // Trials that kept their sizings: time per cluster, fruitlets per minute, and accuracy
@@ -162,6 +165,59 @@ TEST(Experiment, TimePerClusterAndAccuracyAgainstTimeByHand) {
   EXPECT_DOUBLE_EQ(at(30.0)["mae_mm"].get<double>(), 0.375);
   EXPECT_DOUBLE_EQ(at(40.0)["mae_mm"].get<double>(), 0.75);
   EXPECT_EQ(slurp(out / "accuracy_vs_time.png").substr(1, 3), "PNG");
+}
+
+// Tree trials by hand: the grower's figures (a cluster's median and worst time, views and
+// failed moves per cluster, transit per tree) and where the time went. Seed 10's tree: clusters
+// of 20 and 30 s, 10 views, 1 failed move between views and 2 between clusters, 8 s of its
+// 40 s of motion in transit; seed 11's: 40 and 50 s, 14 views, 3 failed, 12 s transit, every
+// stage twice seed 10's.
+TEST(Experiment, TheGrowersFiguresAndTheTimeSplitByHand) {
+  const fs::path out = freshDir("growers");
+  const TrialRunner tree = [](const TrialOptions& o) {
+    nlohmann::json r = fakeTrial(o);
+    const bool first = o.seed == 10;
+    const double k = first ? 1.0 : 2.0;
+    r["views"] = first ? 10 : 14;
+    r["sim_time_s"] = 60.0 * k;
+    r["clusters"] = {{{"fruitlets", r["fruitlets"]}, {"sim_time_s", first ? 20.0 : 40.0}},
+                     {{"fruitlets", nlohmann::json::array()}, {"sim_time_s", first ? 30.0 : 50.0}}};
+    r["events"] = {{"failed_moves", first ? 1 : 3}};
+    r["tour"] = {{"transit_sim_s", first ? 8.0 : 12.0},
+                 {"transit_motion_status",
+                  first ? nlohmann::json{{"success", 3}, {"no_collision_free_ik", 2}}
+                        : nlohmann::json{{"success", 3}}}};
+    r["sim_time_by_stage_s"] = {{"motion_s", 40.0 * k},    {"capture_s", 4.0 * k},
+                                {"mapping_s", 4.0 * k},    {"tsdf_s", 2.0 * k},
+                                {"sizing_s", 2.0 * k},     {"planning_s", 2.0 * k},
+                                {"goal_check_s", 2.0 * k}, {"motion_planning_s", 2.0 * k}};
+    return r;
+  };
+  runExperiment(options(out, 2), tree, nullptr);
+  const nlohmann::json s = nlohmann::json::parse(slurp(out / "summary.json"));
+  const nlohmann::json& fvp = s["fvp"];
+  EXPECT_EQ(fvp["clusters"].get<double>(), 4.0);
+  EXPECT_DOUBLE_EQ(fvp["median_sim_s_per_cluster"].get<double>(), 35.0);
+  EXPECT_DOUBLE_EQ(fvp["worst_sim_s_per_cluster"].get<double>(), 50.0);
+  EXPECT_DOUBLE_EQ(fvp["views_per_cluster"].get<double>(), 6.0);
+  EXPECT_DOUBLE_EQ(fvp["failed_moves_per_cluster"].get<double>(), 1.5);
+  EXPECT_DOUBLE_EQ(fvp["transit_s_per_tree"].get<double>(), 10.0);
+  // 180 s in all: 120 s of motion of which 20 s transit, 12 s capture, 6 s in no stage.
+  const nlohmann::json& split = fvp["sim_time_percent"];
+  EXPECT_NEAR(split["motion_between_views"].get<double>(), 100.0 * 100 / 180, 1e-9);
+  EXPECT_NEAR(split["transit"].get<double>(), 100.0 * 20 / 180, 1e-9);
+  EXPECT_NEAR(split["capture"].get<double>(), 100.0 * 12 / 180, 1e-9);
+  EXPECT_NEAR(split["other"].get<double>(), 100.0 * 6 / 180, 1e-9);
+  const std::string table = slurp(out / "table1.md");
+  EXPECT_NE(table.find("| FVP (ours) | 4 | 35.0 | 50.0 | 6.0 | 1.50 | 10.0 |"), std::string::npos)
+      << table;
+  EXPECT_NE(table.find("| FVP (ours) | 55.6 | 11.1 | 6.7 | 6.7 | 3.3 |"), std::string::npos)
+      << table;
+  EXPECT_EQ(table.find("paper's sizing estimator | 4 |"), std::string::npos);  // same trials
+  EXPECT_EQ(slurp(out / "time_split.png").substr(1, 3), "PNG");
+  const std::string index = slurp(out / "index.html");
+  EXPECT_NE(index.find("<h2>Where the simulated time went (% of it)</h2>"), std::string::npos);
+  EXPECT_NE(index.find("<img src=\"time_split.png\""), std::string::npos);
 }
 
 TEST(Experiment, ResumeAfterAnInterruptionGivesTheUninterruptedResult) {

@@ -109,6 +109,28 @@ TEST(WorldConfig, ToJsonHasEveryKey) {
   }
 }
 
+// world_field_tree.yaml is the field preset on the tree: every key of world_field.yaml and of
+// world_tree.yaml with the same value, and no key of its own (else the field-tree experiment
+// would drift from the two worlds it claims to combine).
+TEST(WorldConfig, TheFieldTreeIsTheFieldPresetOnTheTree) {
+  const std::filesystem::path dir = std::filesystem::path(FVP_SOURCE_DIR) / "robot/sim/config";
+  const YAML::Node field_tree = YAML::LoadFile((dir / "world_field_tree.yaml").string());
+  std::set<std::string> copied;
+  for (const char* part : {"world_field.yaml", "world_tree.yaml"})
+    for (const auto& entry : YAML::LoadFile((dir / part).string())) {
+      const std::string key = entry.first.as<std::string>();
+      ASSERT_TRUE(field_tree[key]) << key << " of " << part << " is missing";
+      EXPECT_EQ(field_tree[key].as<std::string>(), entry.second.as<std::string>())
+          << key << " differs from " << part;
+      copied.insert(key);
+    }
+  for (const auto& entry : field_tree)
+    EXPECT_TRUE(copied.count(entry.first.as<std::string>())) << entry.first.as<std::string>();
+  const WorldConfig config = WorldConfig::fromYamlFile(dir / "world_field_tree.yaml");
+  EXPECT_EQ(config.cluster_count, 4);
+  EXPECT_EQ(config.run_register_views, 1);
+}
+
 TEST(WorldConfig, ErrorGroupsScaleTheirOwnKeysAndRefuseToLeaveTheirRanges) {
   const WorldConfig field =
       WorldConfig::fromYamlFile(std::string(FVP_SOURCE_DIR) + "/robot/sim/config/world_field.yaml");

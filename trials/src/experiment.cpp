@@ -192,20 +192,95 @@ std::vector<const nlohmann::json*> sizedUnits(const nlohmann::json& trial) {
   return units;
 }
 
+/// A tree trial's moves between clusters that failed (every status but success).
+double failedTransitMoves(const nlohmann::json& trial) {
+  double failed = 0.0;
+  const auto tour = trial.find("tour");
+  if (tour == trial.end() || !tour->is_object()) return 0.0;
+  const auto statuses = tour->find("transit_motion_status");
+  if (statuses == tour->end() || !statuses->is_object()) return 0.0;
+  for (const auto& [status, count] : statuses->items())
+    if (status != "success" && count.is_number()) failed += count.get<double>();
+  return failed;
+}
+
+/// Where the trials' simulated time went, in percent of it: the clock's stages summed
+/// (sim_time_by_stage_s), the arm's motion split into moves between views and a tour's
+/// transit between clusters, and what no stage holds as "other". Null when a trial lacks its
+/// stages (a line of an older build) or no time was charged.
+nlohmann::json timeSplitPercent(const std::vector<const nlohmann::json*>& trials) {
+  std::map<std::string, double> seconds;
+  double sim = 0.0;
+  for (const nlohmann::json* t : trials) {
+    const std::optional<double> sim_s = numberAt(*t, "sim_time_s");
+    const auto stages = t->find("sim_time_by_stage_s");
+    if (!sim_s || stages == t->end() || !stages->is_object()) return nullptr;
+    sim += *sim_s;
+    double transit = numberAt(t->value("tour", nlohmann::json()), "transit_sim_s").value_or(0.0);
+    for (const auto& [stage, value] : stages->items()) {
+      if (!value.is_number()) continue;
+      std::string name = stage.substr(0, stage.size() - (stage.ends_with("_s") ? 2 : 0));
+      double s = value.get<double>();
+      if (name == "motion") {
+        transit = std::min(transit, s);  // a transit's seconds are the arm's motion
+        seconds["transit"] += transit;
+        s -= transit;
+        name = "motion_between_views";
+      }
+      seconds[name] += s;
+    }
+  }
+  if (!(sim > 0.0)) return nullptr;
+  nlohmann::json percent = nlohmann::json::object();
+  double charged = 0.0;
+  for (const auto& [name, s] : seconds) percent[name] = 100.0 * s / sim, charged += s;
+  percent["other"] = std::max(0.0, 100.0 * (sim - charged) / sim);
+  return percent;
+}
+
+/// The grower's figures of some checked trials: a cluster's time (median and worst), views
+/// and failed moves (between views and between clusters) per cluster, a tree's transit, and
+/// where the time went.
+nlohmann::json growersFigures(const std::vector<const nlohmann::json*>& trials) {
+  std::vector<double> sim_per_cluster;
+  double clusters = 0, views = 0, failed = 0, transit = 0, tours = 0;
+  for (const nlohmann::json* t : trials) {
+    const std::vector<const nlohmann::json*> units = sizedUnits(*t);
+    clusters += double(units.size());
+    for (const nlohmann::json* cluster : units)
+      if (const std::optional<double> cluster_s = numberAt(*cluster, "sim_time_s"))
+        sim_per_cluster.push_back(*cluster_s);
+    views += numberAt(*t, "views").value_or(0.0);
+    failed += numberAt(t->value("events", nlohmann::json()), "failed_moves").value_or(0.0) +
+              failedTransitMoves(*t);
+    if (const auto s = numberAt(t->value("tour", nlohmann::json()), "transit_sim_s"))
+      transit += *s, ++tours;
+  }
+  const auto opt = [](bool ok, double v) { return ok ? nlohmann::json(v) : nlohmann::json(); };
+  const bool sized = clusters > 0;
+  return {{"clusters", clusters},
+          {"median_sim_s_per_cluster", opt(!sim_per_cluster.empty(), median(sim_per_cluster))},
+          {"worst_sim_s_per_cluster",
+           opt(!sim_per_cluster.empty(),
+               sim_per_cluster.empty()
+                   ? 0.0
+                   : *std::max_element(sim_per_cluster.begin(), sim_per_cluster.end()))},
+          {"views_per_cluster", opt(sized, sized ? views / clusters : 0.0)},
+          {"failed_moves_per_cluster", opt(sized, sized ? failed / clusters : 0.0)},
+          {"transit_s_per_tree", opt(tours > 0, tours > 0 ? transit / tours : 0.0)},
+          {"sim_time_percent", timeSplitPercent(trials)}};
+}
+
 /// Pools the fruitlets of some checked trials under one estimator's field names.
 nlohmann::json pool(const std::vector<const nlohmann::json*>& trials, const char* fruitlets_key) {
   std::size_t gt = 0, matched = 0;
   std::uint64_t detections = 0;
   double abs_sum = 0, pct_sum = 0, views = 0, wall = 0, sim = 0, matched_in_sim = 0;
-  std::vector<double> sim_per_cluster;
   for (const nlohmann::json* t : trials) {
     views += t->contains("views") ? t->at("views").get<double>() : 0.0;
     const std::optional<double> sim_s = numberAt(*t, "sim_time_s");
     if (sim_s) {
       sim += *sim_s;
-      for (const nlohmann::json* cluster : sizedUnits(*t))
-        if (const std::optional<double> cluster_s = numberAt(*cluster, "sim_time_s"))
-          sim_per_cluster.push_back(*cluster_s);
       for (const auto& f : t->at(fruitlets_key)) matched_in_sim += f.at("matched").get<bool>();
     }
     wall += t->contains("wall_time_s") ? t->at("wall_time_s").get<double>() : 0.0;
@@ -222,20 +297,23 @@ nlohmann::json pool(const std::vector<const nlohmann::json*>& trials, const char
   }
   const auto opt = [](bool ok, double v) { return ok ? nlohmann::json(v) : nlohmann::json(); };
   const std::size_t n = trials.size();
-  return {{"trials", n},
-          {"gt_fruitlets", gt},
-          {"matched", matched},
-          {"match_percent", opt(gt > 0, gt ? 100.0 * double(matched) / double(gt) : 0.0)},
-          {"mae_mm", opt(matched > 0, matched ? abs_sum / double(matched) : 0.0)},
-          {"mape_percent", opt(matched > 0, matched ? pct_sum / double(matched) : 0.0)},
-          {"precision_percent",
-           opt(detections > 0, detections ? 100.0 * double(matched) / double(detections) : 0.0)},
-          {"mean_views", opt(n > 0, n ? views / double(n) : 0.0)},
-          // The time a cluster took (the budget, or less with --stop auto; a tree's clusters
-          // each, the moves between them not included) and what the trials' whole time bought.
-          {"median_sim_s_per_cluster", opt(!sim_per_cluster.empty(), median(sim_per_cluster))},
-          {"matched_per_sim_min", opt(sim > 0, sim > 0 ? 60.0 * matched_in_sim / sim : 0.0)},
-          {"wall_s_per_trial", opt(n > 0, n ? wall / double(n) : 0.0)}};
+  nlohmann::json pooled = {
+      {"trials", n},
+      {"gt_fruitlets", gt},
+      {"matched", matched},
+      {"match_percent", opt(gt > 0, gt ? 100.0 * double(matched) / double(gt) : 0.0)},
+      {"mae_mm", opt(matched > 0, matched ? abs_sum / double(matched) : 0.0)},
+      {"mape_percent", opt(matched > 0, matched ? pct_sum / double(matched) : 0.0)},
+      {"precision_percent",
+       opt(detections > 0, detections ? 100.0 * double(matched) / double(detections) : 0.0)},
+      {"mean_views", opt(n > 0, n ? views / double(n) : 0.0)},
+      // What the trials' whole time bought (a tree's moves between clusters included).
+      {"matched_per_sim_min", opt(sim > 0, sim > 0 ? 60.0 * matched_in_sim / sim : 0.0)},
+      {"wall_s_per_trial", opt(n > 0, n ? wall / double(n) : 0.0)}};
+  // A cluster's time: the budget, or less with --stop auto; a tree's clusters each, the
+  // moves between them not included.
+  pooled.update(growersFigures(trials));
+  return pooled;
 }
 
 /// The gnuplot script of Figure 7: ground truth and each planner's sizes (matched fruitlets;
@@ -288,6 +366,107 @@ std::string sizesFigureScript(const std::vector<nlohmann::json>& trials) {
   for (std::size_t i = 0; i < columns.size(); ++i)
     gp << "$d" << i << " using (" << i + 1 << "):1 lc rgb '" << colours[i % 5] << "', ";
   gp << "$means using 1:2 with points pt 2 ps 2.5 lw 2 lc rgb 'black'\n";
+  return gp.str();
+}
+
+/// The stages of the time split in the order a view spends them, with the words of the
+/// tables and the figure.
+const std::vector<std::pair<std::string, std::string>>& timeSplitStages() {
+  static const std::vector<std::pair<std::string, std::string>> stages = {
+      {"motion_between_views", "motion between views"},
+      {"transit", "transit between clusters"},
+      {"capture", "capture"},
+      {"mapping", "mapping"},
+      {"tsdf", "TSDF"},
+      {"sizing", "sizing"},
+      {"planning", "planning"},
+      {"goal_check", "goal checks"},
+      {"motion_planning", "motion planning"},
+      {"other", "other"}};
+  return stages;
+}
+
+/// Summary rows the grower's tables show: every row but the paper-sizing twins (the same
+/// trials, so the same times).
+std::vector<std::string> timedRows(const nlohmann::json& summary) {
+  std::vector<std::string> rows;
+  for (const auto& [key, row] : summary.items())
+    if (!key.ends_with("-paper-sizing")) rows.push_back(key);
+  return rows;
+}
+
+/// table1.md's second and third tables: the grower's figures and where the time went.
+std::string growersTablesMarkdown(const nlohmann::json& summary,
+                                  const std::map<std::string, std::string>& names) {
+  const auto name = [&](const std::string& key) { return names.count(key) ? names.at(key) : key; };
+  std::ostringstream md;
+  md << "\n## The grower's figures\n\nA cluster's simulated seconds (median and worst; a tree's "
+        "clusters each), its views and failed moves (between views and, on a tree, between "
+        "clusters), a tree's transit between clusters, matched fruitlets per simulated "
+        "minute.\n\n| planner | clusters | s / cluster (median) | s / cluster (worst) | views / "
+        "cluster | failed moves / cluster | transit s / tree | matched / min |\n"
+     << "|---|---|---|---|---|---|---|---|\n";
+  for (const std::string& key : timedRows(summary)) {
+    const nlohmann::json& row = summary[key];
+    md << "| " << name(key) << " | " << fmtOrDash(row["clusters"], 0) << " | "
+       << fmtOrDash(row["median_sim_s_per_cluster"], 1) << " | "
+       << fmtOrDash(row["worst_sim_s_per_cluster"], 1) << " | "
+       << fmtOrDash(row["views_per_cluster"], 1) << " | "
+       << fmtOrDash(row["failed_moves_per_cluster"], 2) << " | "
+       << fmtOrDash(row["transit_s_per_tree"], 1) << " | "
+       << fmtOrDash(row["matched_per_sim_min"], 2) << " |\n";
+  }
+  md << "\n## Where the simulated time went (% of it)\n\n| planner |";
+  for (const auto& [stage, words] : timeSplitStages()) md << " " << words << " |";
+  md << "\n|---|";
+  for (std::size_t i = 0; i < timeSplitStages().size(); ++i) md << "---|";
+  md << "\n";
+  for (const std::string& key : timedRows(summary)) {
+    const nlohmann::json& split = summary[key]["sim_time_percent"];
+    md << "| " << name(key) << " |";
+    for (const auto& [stage, words] : timeSplitStages())
+      md << " " << fmtOrDash(split.is_object() ? split.value(stage, nlohmann::json(0.0)) : split, 1)
+         << " |";
+    md << "\n";
+  }
+  return md.str();
+}
+
+/// The gnuplot script of time_split.png: one stacked bar per row, the time split's stages in
+/// percent of the row's simulated time. Empty when no row has a split.
+std::string timeSplitFigureScript(const nlohmann::json& summary,
+                                  const std::map<std::string, std::string>& names) {
+  std::ostringstream data;
+  std::size_t bars = 0;
+  for (const std::string& key : timedRows(summary)) {
+    const nlohmann::json& split = summary[key]["sim_time_percent"];
+    if (!split.is_object()) continue;
+    // A data column in double quotes (gnuplot splits single-quoted words into columns).
+    std::string label = names.count(key) ? names.at(key) : key;
+    std::erase(label, '"');
+    data << '"' << label << '"';
+    for (const auto& [stage, words] : timeSplitStages()) data << " " << split.value(stage, 0.0);
+    data << "\n";
+    ++bars;
+  }
+  if (bars == 0) return "";
+  // Motion in blues, capture grey, compute in warm colours, planning in greens.
+  static const char* const colours[] = {"#1f77b4", "#aec7e8", "#7f7f7f", "#ff7f0e", "#ffbb78",
+                                        "#d62728", "#2ca02c", "#98df8a", "#17becf", "#e5e5e5"};
+  std::ostringstream gp;
+  gp << "set terminal pngcairo size 900," << 220 + 60 * bars << " font 'DejaVu Sans,12'\n"
+     << "set title 'Where the simulated time went'\n"
+     << "set style data histograms\nset style histogram rowstacked\nset style fill solid "
+        "0.8 border -1\nset boxwidth 0.6\nset key outside right\nset yrange [0:105]\n"
+     << "set grid ytics\nset ylabel '% of the simulated time'\nset xrange [-0.5:" << bars - 0.5
+     << "]\n"
+     << "$split << EOD\n"
+     << data.str() << "EOD\nplot ";
+  for (std::size_t i = 0; i < timeSplitStages().size(); ++i)
+    gp << (i ? ", " : "") << "$split using " << i + 2 << (i ? "" : ":xtic(1)") << " title "
+       << host::gnuplotQuoted(timeSplitStages()[i].second) << " lc rgb '"
+       << colours[i % std::size(colours)] << "'";
+  gp << "\n";
   return gp.str();
 }
 
@@ -386,6 +565,61 @@ std::string accuracyTimeFigureScript(const std::map<std::string, std::vector<Acc
   return gp.str();
 }
 
+/// The tables' words for the summary's rows (others by their keys).
+const std::map<std::string, std::string>& rowNames() {
+  static const std::map<std::string, std::string> names = {
+      {"fvp", "FVP (ours)"},
+      {"rvp", "RVP (ours)"},
+      {"fvp-octomap", "FVP on the octomap engine"},
+      {"fvp-paper-sizing", "FVP, paper's sizing estimator"},
+      {"rvp-paper-sizing", "RVP, paper's sizing estimator"},
+      {"fvp-octomap-paper-sizing", "FVP on octomap, paper's sizing estimator"}};
+  return names;
+}
+
+/// table1.md without its closing line: Table 1, the grower's figures, where the time went.
+std::string table1Markdown(const nlohmann::json& summary) {
+  std::ostringstream md;
+  md << "# Table 1: sizing accuracy (simulated orchard)\n\n"
+     << "Fruitlets pooled over the trials of each row. MP: matched / ground-truth fruitlets "
+        "(centre within 5 mm, one-to-one); MAE and MAPE over matched pairs. s / cluster: "
+        "simulated seconds a cluster took (the budget, or less with --stop auto; each cluster "
+        "of a tree); matched / min: matched fruitlets per simulated minute of the whole run "
+        "(a tree's moves between clusters included).\n\n"
+     << "| planner | trials | views / trial | MP (%) | MAE (mm) | MAPE (%) | precision (%) | "
+        "s / cluster (median) | matched / min |\n"
+     << "|---|---|---|---|---|---|---|---|---|\n"
+     << "| RVP, paper (35 trials) | 35 | - | 82.2 | 1.65 | 14.9 | - | 180 | - |\n"
+     << "| FVP, paper (35 trials) | 35 | - | 90.1 | 1.04 | 9.35 | - | 180 | - |\n";
+  const std::map<std::string, std::string>& names = rowNames();
+  for (const auto& [key, row] : summary.items()) {
+    const auto name = names.count(key) ? names.at(key) : key;
+    md << "| " << name << " | " << row["trials"] << " | " << fmtOrDash(row["mean_views"], 1)
+       << " | " << fmtOrDash(row["match_percent"], 1) << " | " << fmtOrDash(row["mae_mm"], 2)
+       << " | " << fmtOrDash(row["mape_percent"], 2) << " | "
+       << fmtOrDash(row["precision_percent"], 1) << " | "
+       << fmtOrDash(row["median_sim_s_per_cluster"], 1) << " | "
+       << fmtOrDash(row["matched_per_sim_min"], 2) << " |\n";
+  }
+  md << growersTablesMarkdown(summary, names);
+  return md.str();
+}
+
+/// time_split.png where some row has a time split (an extra: a failure is a warning); an
+/// older figure is removed first, so none outlives the tables it would contradict.
+void drawTimeSplitFigure(const fs::path& dir, const nlohmann::json& summary,
+                         const MessageSink& warning) {
+  std::error_code stale;
+  fs::remove(dir / "time_split.png", stale);
+  const std::string script = timeSplitFigureScript(summary, rowNames());
+  if (script.empty()) return;
+  try {
+    host::plotWithGnuplot(script, dir / "time_split.png", "time split figure");
+  } catch (const std::exception& e) {
+    if (warning) warning((dir / "time_split.png").string() + " not drawn: " + oneLine(e.what()));
+  }
+}
+
 }  // namespace
 
 nlohmann::json summarize(const std::vector<nlohmann::json>& trials) {
@@ -409,35 +643,7 @@ bool writeReports(const fs::path& dir, const std::vector<nlohmann::json>& unsort
   const nlohmann::json summary = summarize(trials);
   host::writeFileAtomically(dir / "summary.json", "experiment summary", summary.dump(2) + "\n");
 
-  std::ostringstream md;
-  md << "# Table 1: sizing accuracy (simulated orchard)\n\n"
-     << "Fruitlets pooled over the trials of each row. MP: matched / ground-truth fruitlets "
-        "(centre within 5 mm, one-to-one); MAE and MAPE over matched pairs. s / cluster: "
-        "simulated seconds a cluster took (the budget, or less with --stop auto; each cluster "
-        "of a tree); matched / min: matched fruitlets per simulated minute of the whole run "
-        "(a tree's moves between clusters included).\n\n"
-     << "| planner | trials | views / trial | MP (%) | MAE (mm) | MAPE (%) | precision (%) | "
-        "s / cluster (median) | matched / min |\n"
-     << "|---|---|---|---|---|---|---|---|---|\n"
-     << "| RVP, paper (35 trials) | 35 | - | 82.2 | 1.65 | 14.9 | - | 180 | - |\n"
-     << "| FVP, paper (35 trials) | 35 | - | 90.1 | 1.04 | 9.35 | - | 180 | - |\n";
-  const std::map<std::string, std::string> names = {
-      {"fvp", "FVP (ours)"},
-      {"rvp", "RVP (ours)"},
-      {"fvp-octomap", "FVP on the octomap engine"},
-      {"fvp-paper-sizing", "FVP, paper's sizing estimator"},
-      {"rvp-paper-sizing", "RVP, paper's sizing estimator"},
-      {"fvp-octomap-paper-sizing", "FVP on octomap, paper's sizing estimator"}};
-  for (const auto& [key, row] : summary.items()) {
-    const auto name = names.count(key) ? names.at(key) : key;
-    md << "| " << name << " | " << row["trials"] << " | " << fmtOrDash(row["mean_views"], 1)
-       << " | " << fmtOrDash(row["match_percent"], 1) << " | " << fmtOrDash(row["mae_mm"], 2)
-       << " | " << fmtOrDash(row["mape_percent"], 2) << " | "
-       << fmtOrDash(row["precision_percent"], 1) << " | "
-       << fmtOrDash(row["median_sim_s_per_cluster"], 1) << " | "
-       << fmtOrDash(row["matched_per_sim_min"], 2) << " |\n";
-  }
-  const std::string table = md.str();
+  const std::string table = table1Markdown(summary);
   // The tables first: the figure is an extra that must not cost them.
   host::writeFileAtomically(dir / "table1.md", "Table 1",
                             table + "\nSize distributions: sizes.png.\n");
@@ -473,6 +679,8 @@ bool writeReports(const fs::path& dir, const std::vector<nlohmann::json>& unsort
     }
   }
 
+  drawTimeSplitFigure(dir, summary, warning);
+
   std::string why_not;
   if (trials.empty()) {
     why_not = "no trials";
@@ -499,9 +707,16 @@ namespace {
 
 /// What an experiment directory holds at its top (checked before the first trial).
 const std::vector<std::string>& experimentOutputFiles() {
-  static const std::vector<std::string> files = {
-      "manifest.json", "trials.jsonl",          "summary.json",         "table1.md", "sizes.png",
-      "index.html",    "accuracy_vs_time.json", "accuracy_vs_time.png", "world.yaml"};
+  static const std::vector<std::string> files = {"manifest.json",
+                                                 "trials.jsonl",
+                                                 "summary.json",
+                                                 "table1.md",
+                                                 "sizes.png",
+                                                 "time_split.png",
+                                                 "index.html",
+                                                 "accuracy_vs_time.json",
+                                                 "accuracy_vs_time.png",
+                                                 "world.yaml"};
   return files;
 }
 

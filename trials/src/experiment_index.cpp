@@ -58,6 +58,11 @@ std::string tableHtml(const std::string& markdown) {
   bool in_table = false, header = true;
   for (std::string line; std::getline(lines, line);) {
     if (line.rfind("# ", 0) == 0) continue;  // the page has its own heading
+    if (line.rfind("## ", 0) == 0) {         // a later table's heading
+      if (in_table) html << "</table>\n", in_table = false;
+      html << "<h2>" << escapeHtml(line.substr(3)) << "</h2>\n";
+      continue;
+    }
     if (line.rfind("|", 0) != 0) {
       if (in_table) html << "</table>\n", in_table = false;
       if (!line.empty()) html << "<p>" << escapeHtml(line) << "</p>\n";
@@ -106,7 +111,8 @@ void writeIndexPage(const fs::path& dir, const std::string& table_markdown,
        << tableHtml(table_markdown);
   for (const auto& [file, caption] :
        {std::pair{"sizes.png", "Figure 7: sizes of ground truth and of each planner's estimates"},
-        std::pair{"accuracy_vs_time.png", "Accuracy against the time spent on a cluster"}})
+        std::pair{"accuracy_vs_time.png", "Accuracy against the time spent on a cluster"},
+        std::pair{"time_split.png", "Where the simulated time went"}})
     if (fs::exists(dir / file))
       html << "<h2>" << caption << "</h2>\n<p><img src=\"" << file << "\" alt=\"" << caption
            << "\"></p>\n";

@@ -42,6 +42,7 @@
 #include "fvp/trials/simulated_robot.h"
 #include "fvp/trials/trial_fields.h"
 #include "trial_parts.h"
+#include "trial_report.h"
 #include "trial_viewer.h"
 
 namespace fvp::trials {
@@ -541,6 +542,9 @@ nlohmann::json Trial::Impl::stopJson() const {
 void Trial::Impl::describeRun(nlohmann::json& result, const TrialLog& log,
                               const std::vector<Eigen::Vector3d>& camera_path) const {
   result["clock"] = nlohmann::json::parse(robot->clock().toJson());
+  // The clock's record stays in result.json only; its sums by stage go everywhere the trial
+  // does (an experiment's trials.jsonl, where its time split is pooled).
+  result["sim_time_by_stage_s"] = simulatedSecondsByStage(result["clock"]);
   result["register_views"] = *options.register_views;
   result["view_log"] = log.views();
   result["plan_log"] = log.plans();

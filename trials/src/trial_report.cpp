@@ -224,6 +224,15 @@ bool plotSizeScatter(const nlohmann::json& result, const std::filesystem::path& 
   return true;
 }
 
+std::map<std::string, double> simulatedSecondsByStage(const nlohmann::json& clock) {
+  std::map<std::string, double> charged;
+  for (const auto& it : field(clock, "iterations"))
+    for (const auto& [key, value] : it.items())
+      if (value.is_number() && key != "total_s" && key.ends_with("_s") && !key.ends_with("_wall_s"))
+        charged[key] += value.get<double>();
+  return charged;
+}
+
 ReportFigures writeResultMapAndPath(
     nlohmann::json& result, const World& world, const host::map::MapEngine* map,
     const std::vector<Eigen::Vector3d>& camera_path, const std::vector<PathRegion>& regions,
@@ -299,16 +308,11 @@ void appendSimulatedSummary(std::ostringstream& md, const nlohmann::json& result
 /// iterations also record wall times that the clock does not charge: those are left to
 /// the wall-time section).
 void appendSimulatedBudget(std::ostringstream& md, const nlohmann::json& result) {
-  std::map<std::string, double> charged;
+  std::map<std::string, double> charged = simulatedSecondsByStage(field(result, "clock"));
   double total = 0.0;
   for (const auto& it : field(field(result, "clock"), "iterations"))
-    for (const auto& [key, value] : it.items()) {
-      if (!value.is_number()) continue;
-      if (key == "total_s")
-        total += value.get<double>();
-      else if (key.size() < 7 || key.compare(key.size() - 7, 7, "_wall_s") != 0)
-        charged[key] += value.get<double>();
-    }
+    if (const auto t = it.find("total_s"); t != it.end() && t->is_number())
+      total += t->get<double>();
   md << "\n## Where the simulated budget went\n\nSimulated seconds charged by the clock (`"
      << (field(result, "clock").is_object() ? result["clock"].value("mode", "?") : "?")
      << "` mode), summed over the loop's iterations.\n\n| stage | simulated s |\n|---|---|\n";

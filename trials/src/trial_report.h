@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -53,6 +54,11 @@ void writeTreeOutputs(nlohmann::json& result, const robot::sim::World& world,
                       const std::filesystem::path& out_dir,
                       const std::function<void(const std::string&)>& warn,
                       const ExtraWriter& extra);
+
+/// The simulated seconds a clock's record (result["clock"]) charged, by stage ("capture_s",
+/// "motion_s", ...), summed over its iterations: the wall times the iterations also record
+/// and their "total_s" left out. Empty for a record without iterations.
+std::map<std::string, double> simulatedSecondsByStage(const nlohmann::json& clock);
 
 /// The view's left image as the small PNG of the report (views/NNN.png), encoded: kept in
 /// memory during the loop and written after result.json, so a full disk cannot cost the trial.
