@@ -139,6 +139,28 @@ Trajectory Trajectory::blended(std::vector<JointVector> waypoints, const JointVe
   return traj;
 }
 
+Trajectory Trajectory::blendedWithStops(std::vector<JointVector> waypoints,
+                                        const std::vector<bool>& stops,
+                                        const JointVector& max_velocity,
+                                        const JointVector& max_acceleration) {
+  if (waypoints.empty()) throw std::invalid_argument("Trajectory: no waypoints");
+  if (stops.size() != waypoints.size())
+    throw std::invalid_argument("Trajectory: one stop flag per waypoint expected");
+  Trajectory traj;
+  std::size_t from = 0;
+  for (std::size_t k = 1; k < waypoints.size(); ++k) {
+    if (k + 1 < waypoints.size() && !stops[k]) continue;
+    const Trajectory run = blended({waypoints.begin() + from, waypoints.begin() + k + 1},
+                                   max_velocity, max_acceleration);
+    for (const Piece& p : run.pieces_) traj.addPiece(p.duration_s, p.q0, p.v0, p.a);
+    traj.blended_ = traj.blended_ || run.blended_;
+    traj.max_corner_deviation_ = std::max(traj.max_corner_deviation_, run.max_corner_deviation_);
+    from = k;
+  }
+  traj.waypoints_ = std::move(waypoints);
+  return traj;
+}
+
 const Trajectory::Piece& Trajectory::pieceAt(double t_s, double& tau) const {
   const auto it = std::lower_bound(pieces_.begin(), pieces_.end(), t_s,
                                    [](const Piece& p, double t) { return p.end_s() < t; });

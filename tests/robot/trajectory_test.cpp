@@ -168,4 +168,48 @@ TEST(Trajectory, BlendedOneSegmentIsRestToRestAndACornerIsFaster) {
 }
 
 }  // namespace
+// A rest at a via point: the arm passes it exactly, at rest, and each run between rests is
+// blended as blended() times that run alone; no rests is blended(), every via point a rest
+// is rest to rest. Limits as everywhere.
+TEST(Trajectory, BlendedWithStopsRestsExactlyWhereToldAndBlendsTheRest) {
+  const ArmModel arm{ArmConfig{}};
+  const JointVector& v_max = arm.maxVelocity();
+  const JointVector& a_max = arm.maxAcceleration();
+  std::vector<JointVector> path(5, JointVector::Zero());
+  path[1][1] = 0.5;
+  path[2][1] = 0.5, path[2][2] = 0.5;
+  path[3][2] = 0.5;
+  path[4][2] = 0.5, path[4][3] = -0.6;
+  const std::vector<bool> none(5, false), every(5, true);
+  EXPECT_NEAR(Trajectory::blendedWithStops(path, none, v_max, a_max).duration_s(),
+              Trajectory::blended(path, v_max, a_max).duration_s(), 1e-12);
+  const Trajectory all = Trajectory::blendedWithStops(path, every, v_max, a_max);
+  EXPECT_FALSE(all.isBlended());
+  EXPECT_NEAR(all.duration_s(), Trajectory(path, v_max, a_max).duration_s(), 1e-12);
+
+  std::vector<bool> at_two = none;
+  at_two[2] = true;
+  const Trajectory rests = Trajectory::blendedWithStops(path, at_two, v_max, a_max);
+  EXPECT_TRUE(rests.isBlended());
+  const double first_s =
+      Trajectory::blended({path.begin(), path.begin() + 3}, v_max, a_max).duration_s();
+  const double second_s =
+      Trajectory::blended({path.begin() + 2, path.end()}, v_max, a_max).duration_s();
+  EXPECT_NEAR(rests.duration_s(), first_s + second_s, 1e-12);
+  EXPECT_LT((rests.position(first_s) - path[2]).norm(), 1e-9);  // on the via point,
+  EXPECT_LT(rests.velocity(first_s).norm(), 1e-9);              // at rest
+  // Slower than blending every corner, quicker than resting at every one.
+  EXPECT_GT(rests.duration_s(), Trajectory::blended(path, v_max, a_max).duration_s());
+  EXPECT_LT(rests.duration_s(), all.duration_s());
+  for (int k = 0; k <= 2000; ++k) {
+    const double t = rests.duration_s() * k / 2000;
+    for (int j = 0; j < kArmJoints; ++j) {
+      ASSERT_LE(std::abs(rests.velocity(t)[j]), v_max[j] * (1.0 + 1e-9)) << "t " << t;
+      ASSERT_LE(std::abs(rests.acceleration(t)[j]), a_max[j] * (1.0 + 1e-9)) << "t " << t;
+    }
+  }
+  EXPECT_THROW(Trajectory::blendedWithStops(path, {false, true}, v_max, a_max),
+               std::invalid_argument);
+}
+
 }  // namespace fvp::robot

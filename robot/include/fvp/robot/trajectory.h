@@ -29,6 +29,14 @@ class Trajectory {
   static Trajectory blended(std::vector<JointVector> waypoints, const JointVector& max_velocity,
                             const JointVector& max_acceleration);
 
+  /// Blended through the via points but at rest at those flagged in `stops` (one flag per
+  /// waypoint; the ends rest anyway): each run between rests timed as blended() times it. A
+  /// corner whose blend would collide is passed at rest while the others keep their blends.
+  static Trajectory blendedWithStops(std::vector<JointVector> waypoints,
+                                     const std::vector<bool>& stops,
+                                     const JointVector& max_velocity,
+                                     const JointVector& max_acceleration);
+
   /// The rest-to-rest duration of the straight motion between two configurations (what the
   /// constructor gives for {from, to}), without building it: the time a move costs at least.
   static double restToRestDuration_s(const JointVector& from, const JointVector& to,
