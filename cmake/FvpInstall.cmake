@@ -9,7 +9,7 @@ include(CMakePackageConfigHelpers)
 set(FVP_EXPORTED_LIBRARIES
   fvp_accel
   fvp_host_core fvp_host_perception fvp_host_map fvp_host_tsdf fvp_host_sizing fvp_host_eval
-  fvp_host_session fvp_host_planner fvp_host_nbv fvp_host_report
+  fvp_host_session fvp_host_planner fvp_host_nbv fvp_host_report fvp_host_season
   fvp_robot_sim fvp_sim_pipeline fvp_robot fvp_robot_arm fvp_experiment_directory fvp_trial)
 foreach(lib ${FVP_EXPORTED_LIBRARIES})
   string(REGEX REPLACE "^fvp_" "" name ${lib})

@@ -5,69 +5,22 @@
 #include <limits>
 #include <stdexcept>
 
+#include "fvp/host/core/one_to_one_assignment.h"
+
 namespace fvp::host::eval {
 
 std::vector<int> matchFruitlets(const std::vector<Eigen::Vector3d>& detections_m,
                                 const std::vector<Eigen::Vector3d>& ground_truth_m, double gate_m) {
-  const std::size_t G = ground_truth_m.size(), D = detections_m.size();
-  std::vector<int> match(G, -1);
-  if (G == 0 || D == 0) return match;
-  const auto dist = [&](std::size_t d, std::size_t g) {
-    return (detections_m[d] - ground_truth_m[g]).norm();
-  };
-  if (G > 16) {  // greedy: closest pairs first
-    std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
-    for (std::size_t d = 0; d < D; ++d)
-      for (std::size_t g = 0; g < G; ++g)
-        if (dist(d, g) < gate_m) pairs.emplace_back(dist(d, g), d, g);
-    std::sort(pairs.begin(), pairs.end());
-    std::vector<char> used(D, 0);
-    for (const auto& [e, d, g] : pairs)
-      if (!used[d] && match[g] < 0) used[d] = 1, match[g] = int(d);
-    return match;
-  }
-  // DP over detections with the set of ground-truth fruitlets taken: (matches, -distance).
-  struct Cell {
-    int matches = -1;
-    double distance = 0.0;
-  };
-  const std::size_t S = std::size_t{1} << G;
-  std::vector<std::vector<Cell>> dp(D + 1, std::vector<Cell>(S));
-  std::vector<std::vector<int>> choice(D + 1, std::vector<int>(S, -1));
-  dp[0][0] = {0, 0.0};
-  const auto better = [](const Cell& a, const Cell& b) {
-    return a.matches > b.matches || (a.matches == b.matches && a.distance < b.distance);
-  };
-  for (std::size_t d = 0; d < D; ++d)
-    for (std::size_t s = 0; s < S; ++s) {
-      if (dp[d][s].matches < 0) continue;
-      if (better(dp[d][s], dp[d + 1][s]) || dp[d + 1][s].matches < 0) {
-        dp[d + 1][s] = dp[d][s];
-        choice[d + 1][s] = -1;
-      }
-      for (std::size_t g = 0; g < G; ++g) {
-        if (s & (std::size_t{1} << g)) continue;
-        const double e = dist(d, g);
-        if (!(e < gate_m)) continue;
-        const std::size_t t = s | (std::size_t{1} << g);
-        const Cell c{dp[d][s].matches + 1, dp[d][s].distance + e};
-        if (dp[d + 1][t].matches < 0 || better(c, dp[d + 1][t])) {
-          dp[d + 1][t] = c;
-          choice[d + 1][t] = int(g);
-        }
-      }
-    }
-  std::size_t best = 0;
-  for (std::size_t s = 0; s < S; ++s)
-    if (dp[D][s].matches >= 0 && better(dp[D][s], dp[D][best])) best = s;
-  for (std::size_t d = D, s = best; d > 0; --d) {
-    const int g = choice[d][s];
-    if (g >= 0) {
-      match[g] = int(d - 1);
-      s &= ~(std::size_t{1} << g);
-    }
-  }
-  return match;
+  // Detections are the rows, ground truth the columns (exact up to 16 of them).
+  const std::vector<int> truth_of_detection =
+      assignOneToOne(detections_m.size(), ground_truth_m.size(), [&](std::size_t d, std::size_t g) {
+        const double e = (detections_m[d] - ground_truth_m[g]).norm();
+        return e < gate_m ? e : std::numeric_limits<double>::infinity();
+      });
+  std::vector<int> detection_of_gt(ground_truth_m.size(), -1);
+  for (std::size_t d = 0; d < truth_of_detection.size(); ++d)
+    if (truth_of_detection[d] >= 0) detection_of_gt[std::size_t(truth_of_detection[d])] = int(d);
+  return detection_of_gt;
 }
 
 SizeMetrics sizeMetrics(const std::vector<double>& gt_size_mm,

@@ -1,0 +1,58 @@
+#include "fvp/host/season/growth_rate.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace fvp::host::season {
+namespace {
+
+void checkSize(const SizeOnDay& s, std::size_t index) {
+  const std::string which = "fitGrowthRate: size " + std::to_string(index);
+  if (!std::isfinite(s.day) || !std::isfinite(s.size_mm))
+    throw std::invalid_argument(which + ": day and size_mm must be finite");
+  if (!std::isnan(s.standard_error_mm) && !(s.standard_error_mm > 0.0))
+    throw std::invalid_argument(which + ": standard_error_mm must be > 0 or NaN (unknown)");
+}
+
+}  // namespace
+
+GrowthRate fitGrowthRate(const std::vector<SizeOnDay>& sizes) {
+  GrowthRate rate;
+  rate.sizes = sizes.size();
+  bool weighted = !sizes.empty();
+  for (std::size_t i = 0; i < sizes.size(); ++i) {
+    checkSize(sizes[i], i);
+    weighted = weighted && !std::isnan(sizes[i].standard_error_mm);
+  }
+  const auto weight = [&](const SizeOnDay& s) {
+    return weighted ? 1.0 / (s.standard_error_mm * s.standard_error_mm) : 1.0;
+  };
+  double w_sum = 0.0, day_mean = 0.0, size_mean = 0.0;
+  for (const SizeOnDay& s : sizes) w_sum += weight(s);
+  if (!(w_sum > 0.0)) return rate;
+  for (const SizeOnDay& s : sizes) {
+    day_mean += weight(s) * s.day / w_sum;
+    size_mean += weight(s) * s.size_mm / w_sum;
+  }
+  double s_dd = 0.0, s_ds = 0.0;
+  for (const SizeOnDay& s : sizes) {
+    s_dd += weight(s) * (s.day - day_mean) * (s.day - day_mean);
+    s_ds += weight(s) * (s.day - day_mean) * (s.size_mm - size_mean);
+  }
+  if (!(s_dd > 0.0)) return rate;  // every size on one day: no span to grow over
+  rate.mm_per_day = s_ds / s_dd;
+  if (weighted) {
+    rate.standard_error_mm_per_day = std::sqrt(1.0 / s_dd);
+  } else if (sizes.size() >= 3) {
+    double residuals = 0.0;
+    for (const SizeOnDay& s : sizes) {
+      const double r = s.size_mm - (size_mean + rate.mm_per_day * (s.day - day_mean));
+      residuals += r * r;
+    }
+    rate.standard_error_mm_per_day = std::sqrt(residuals / double(sizes.size() - 2) / s_dd);
+  }
+  return rate;
+}
+
+}  // namespace fvp::host::season
