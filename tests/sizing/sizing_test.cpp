@@ -11,6 +11,7 @@
 #include "backend_test_support.h"
 #include "fvp/host/core/look_at.h"
 #include "fvp/host/eval/fruitlet_matching.h"
+#include "fvp/host/eval/sizing_score.h"
 #include "fvp/host/sizing/fruitlet_sizer.h"
 #include "fvp/host/sizing/point_filters.h"
 #include "fvp/host/tsdf/tsdf_volume.h"
@@ -125,6 +126,27 @@ TEST(Matching, MetricsByHand) {
   const auto none = eval::sizeMetrics({10.0}, {}, {-1}, 0);
   EXPECT_FALSE(none.mae_mm.has_value());
   EXPECT_FALSE(none.precision_percent.has_value());
+}
+
+// Detections in the tag's frame: a tag turned 90 degrees about z, 1 m along x.
+TEST(Matching, TagFrameCentresByHand) {
+  nlohmann::json details = {{"sized_fruitlets", {{{"center_m", {1.0, 0.02, 0.5}}}}}};
+  const nlohmann::json untouched = details;
+  eval::addTagFrame(details, std::nullopt);
+  EXPECT_EQ(details, untouched);
+  Eigen::Isometry3d T_world_tag = Eigen::Isometry3d::Identity();
+  T_world_tag.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T_world_tag.translation() = Eigen::Vector3d(1.0, 0.0, 0.0);
+  eval::addTagFrame(details, T_world_tag);
+  // World +y is the tag's +x: the fruitlet 2 cm along world y is 2 cm along the tag's x.
+  const auto& c = details["sized_fruitlets"][0]["center_tag_m"];
+  EXPECT_NEAR(c[0].get<double>(), 0.02, 1e-12);
+  EXPECT_NEAR(c[1].get<double>(), 0.0, 1e-12);
+  EXPECT_NEAR(c[2].get<double>(), 0.5, 1e-12);
+  const auto& q = details["T_world_tag"]["quaternion_wxyz"];
+  EXPECT_NEAR(q[0].get<double>(), std::sqrt(0.5), 1e-12);
+  EXPECT_NEAR(q[3].get<double>(), std::sqrt(0.5), 1e-12);
+  EXPECT_EQ(details["T_world_tag"]["translation_m"], nlohmann::json({1.0, 0.0, 0.0}));
 }
 
 TEST(SphereFit, RecoversCentreAndRadiusFromAHemisphere) {

@@ -127,7 +127,8 @@ nlohmann::json TrialParts::score(host::sizing::SizingResult sizing,
   const std::vector<host::eval::GroundTruthFruitlet> truth = groundTruthOf(world, fruitlet_indices);
   nlohmann::json out = host::eval::scoreBothEstimators(sizing_, truth, estimator);
   // The details object must outlive the loop (items() of a temporary would dangle).
-  const nlohmann::json details = host::eval::sizingDetails(sizing_);
+  nlohmann::json details = host::eval::sizingDetails(sizing_);
+  host::eval::addTagFrame(details, session().T_world_tag());
   for (const auto& [key, value] : details.items()) out[key] = value;
   // No TSDF when no view ever saw the tag (nothing was sized then).
   const host::tsdf::TsdfVolume* tsdf = session().tsdf();

@@ -88,7 +88,8 @@ nlohmann::json sizeCaptureSet(const std::filesystem::path& captures_dir,
                : std::next(it);
   }
   // The details object must outlive the loop (items() of a temporary would dangle).
-  const nlohmann::json details = eval::sizingDetails(sized);
+  nlohmann::json details = eval::sizingDetails(sized);
+  eval::addTagFrame(details, session.T_world_tag());
   for (const auto& [key, value] : details.items()) out[key] = value;
   out["captures"] = set.captures;
   out["cluster_region_found"] = session.region().has_value();

@@ -4,7 +4,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,5 +39,11 @@ nlohmann::json scoreBothEstimators(const sizing::SizingResult& sizing,
 /// Every detection with both estimators' sizes and every per-image measurement, and the
 /// chain's counts and expected events: "sized_fruitlets" and "sizing_stats".
 nlohmann::json sizingDetails(const sizing::SizingResult& sizing);
+
+/// Adds to sizingDetails' output the cluster tag's pose, "T_world_tag": {"translation_m",
+/// "quaternion_wxyz"}, and each sized fruitlet's centre in the tag's frame, "center_tag_m":
+/// the frame in which a later visit finds the same fruitlets (docs/season.md). Nothing is
+/// added without a tag pose.
+void addTagFrame(nlohmann::json& details, const std::optional<Eigen::Isometry3d>& T_world_tag);
 
 }  // namespace fvp::host::eval
