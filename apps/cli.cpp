@@ -35,6 +35,7 @@ int runFvp(int argc, const char* const* argv, CliMode mode) {
   addRunCommand(app);
   addPlanCommand(app);
   addSizeCommand(app);
+  addSeasonCommand(app);
   addExperimentCommands(app);
   if (mode == CliMode::kParseOnly)
     for (CLI::App* sub : app.get_subcommands({})) sub->callback([] {});

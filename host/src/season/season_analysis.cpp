@@ -1,0 +1,136 @@
+#include "fvp/host/season/season_analysis.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <stdexcept>
+#include <string>
+
+namespace fvp::host::season {
+
+void SeasonConfig::validate() const {
+  association.validate();
+  fate.validate();
+}
+
+namespace {
+
+/// Follows one cluster's fruitlets over the visits: each visit that saw the tag is associated
+/// with the last size of every track so far (tracks missed once stay, to be found again); the
+/// unpaired fruitlets start tracks; a track not found on the cluster's latest visit is gone.
+void followCluster(int tag_id, const std::vector<SeasonVisit>& visits,
+                   const AssociationConfig& config, SeasonAnalysis& out) {
+  ClusterSeason cluster;
+  cluster.tag_id = tag_id;
+  for (std::size_t v = 0; v < visits.size(); ++v)
+    for (const VisitCluster& c : visits[v].clusters) {
+      if (c.tag_id != tag_id) continue;
+      if (!c.tag_seen) {
+        ++cluster.visits_without_tag;
+        continue;
+      }
+      ++cluster.visits_with_tag;
+      std::vector<VisitFruitlet> earlier, later;
+      double oldest_day = visits[v].day;
+      for (const std::size_t t : cluster.tracks) {
+        earlier.push_back(out.tracks[t].sizes.back().sized.at);
+        oldest_day = std::min(oldest_day, out.tracks[t].sizes.back().day);
+      }
+      for (const SizedFruitlet& f : c.fruitlets) later.push_back(f.at);
+      // The widest growth gate the tracks need: since the oldest last size.
+      const Association a = associateFruitlets(earlier, later, visits[v].day - oldest_day, config);
+      const std::vector<std::size_t> before = cluster.tracks;
+      for (std::size_t e = 0; e < before.size(); ++e) {
+        FruitletTrack& track = out.tracks[before[e]];
+        const int l = a.later_of_earlier[e];
+        track.gone = l < 0;
+        if (l >= 0)
+          track.sizes.push_back({v, visits[v].day, c.fruitlets[std::size_t(l)], a.confidence[e]});
+      }
+      for (std::size_t l = 0; l < later.size(); ++l) {
+        if (a.earlier_of_later[l] >= 0) continue;
+        FruitletTrack track;
+        track.tag_id = tag_id;
+        track.sizes.push_back({v, visits[v].day, c.fruitlets[l]});
+        cluster.tracks.push_back(out.tracks.size());
+        out.tracks.push_back(std::move(track));
+      }
+    }
+  out.clusters.push_back(std::move(cluster));
+}
+
+/// The expected share set among the tracks with a fate or gone (gone: dropped).
+FruitSet fruitSetOf(const std::vector<FruitletTrack>& tracks,
+                    const std::vector<std::size_t>& indices) {
+  FruitSet set;
+  double expected = 0.0, variance = 0.0;
+  for (const std::size_t i : indices) {
+    const FruitletTrack& t = tracks[i];
+    if (t.gone) {
+      ++set.gone;
+      continue;
+    }
+    if (t.fate.fate == Fate::kUnknown) {
+      ++set.unknown;
+      continue;
+    }
+    ++(t.fate.fate == Fate::kPersists ? set.persisting : set.abscising);
+    expected += t.fate.persist_probability;
+    variance += t.fate.persist_probability * (1.0 - t.fate.persist_probability);
+  }
+  const std::size_t counted = set.persisting + set.abscising + set.gone;
+  if (counted > 0) {
+    set.percent = 100.0 * expected / double(counted);
+    set.standard_error_percent = 100.0 * std::sqrt(variance) / double(counted);
+  }
+  return set;
+}
+
+/// Every track's rate, and every fate against the whole sample's reference (gone tracks
+/// neither set the reference nor get a fate).
+void predictFates(SeasonAnalysis& out, const FateConfig& config) {
+  std::vector<GrowthRate> rates;
+  for (FruitletTrack& t : out.tracks) {
+    std::vector<SizeOnDay> sizes;
+    for (const TrackedSize& s : t.sizes)
+      sizes.push_back({s.day, s.sized.at.size_mm, s.sized.standard_error_mm});
+    t.rate = fitGrowthRate(sizes);
+    rates.push_back(t.gone ? GrowthRate{} : t.rate);
+  }
+  const FruitSetPrediction prediction = predictFruitSet(rates, config);
+  out.reference_mm_per_day = prediction.reference_mm_per_day;
+  out.threshold_mm_per_day = prediction.threshold_mm_per_day;
+  std::vector<std::size_t> all;
+  for (std::size_t i = 0; i < out.tracks.size(); ++i) {
+    out.tracks[i].fate = prediction.fates[i];
+    all.push_back(i);
+  }
+  out.fruit_set = fruitSetOf(out.tracks, all);
+  for (ClusterSeason& c : out.clusters) c.fruit_set = fruitSetOf(out.tracks, c.tracks);
+}
+
+}  // namespace
+
+SeasonAnalysis analyzeSeason(std::vector<SeasonVisit> visits, const SeasonConfig& config) {
+  config.validate();
+  std::stable_sort(visits.begin(), visits.end(),
+                   [](const SeasonVisit& a, const SeasonVisit& b) { return a.day < b.day; });
+  SeasonAnalysis out;
+  std::set<int> tags;
+  for (std::size_t v = 0; v < visits.size(); ++v) {
+    if (!std::isfinite(visits[v].day))
+      throw std::invalid_argument("analyzeSeason: " + visits[v].source + ": day is not finite");
+    if (v > 0 && visits[v].day == visits[v - 1].day)
+      throw std::invalid_argument("analyzeSeason: two visits on day " +
+                                  std::to_string(visits[v].day) + ": " + visits[v - 1].source +
+                                  " and " + visits[v].source);
+    out.days.push_back(visits[v].day);
+    out.sources.push_back(visits[v].source);
+    for (const VisitCluster& c : visits[v].clusters) tags.insert(c.tag_id);
+  }
+  for (const int tag : tags) followCluster(tag, visits, config.association, out);
+  predictFates(out, config.fate);
+  return out;
+}
+
+}  // namespace fvp::host::season

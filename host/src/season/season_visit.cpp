@@ -1,0 +1,127 @@
+#include "fvp/host/season/season_visit.h"
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+
+namespace fvp::host::season {
+namespace {
+
+using nlohmann::json;
+
+[[noreturn]] void fail(const std::string& source, const std::string& field,
+                       const std::string& expected) {
+  throw std::runtime_error(source + ": " + field + ": expected " + expected);
+}
+
+double finiteNumber(const json& j, const std::string& source, const std::string& field) {
+  if (!j.is_number() || !std::isfinite(j.get<double>())) fail(source, field, "a finite number");
+  return j.get<double>();
+}
+
+Eigen::Vector3d vector3(const json& j, const std::string& source, const std::string& field) {
+  if (!j.is_array() || j.size() != 3) fail(source, field, "an array of 3 numbers");
+  return {finiteNumber(j[0], source, field + "[0]"), finiteNumber(j[1], source, field + "[1]"),
+          finiteNumber(j[2], source, field + "[2]")};
+}
+
+SizedFruitlet sizedFruitlet(const json& f, const std::string& source, const std::string& field) {
+  if (!f.is_object()) fail(source, field, "an object");
+  SizedFruitlet out;
+  const auto center = f.find("center_tag_m");
+  if (center == f.end()) fail(source, field + ".center_tag_m", "the centre in the tag's frame");
+  out.at.center_tag_m = vector3(*center, source, field + ".center_tag_m");
+  const auto size = f.find("size_mm");
+  if (size == f.end()) fail(source, field + ".size_mm", "a size in mm");
+  out.at.size_mm = finiteNumber(*size, source, field + ".size_mm");
+  if (!(out.at.size_mm > 0.0)) fail(source, field + ".size_mm", "a size > 0");
+  const auto support = f.find("support");
+  if (support != f.end() && support->is_object()) {
+    const auto se = support->find("size_stderr_mm");
+    if (se != support->end() && !se->is_null()) {
+      const double v = finiteNumber(*se, source, field + ".support.size_stderr_mm");
+      if (v > 0.0) out.standard_error_mm = v;  // 0: one image, no spread measured
+    }
+  }
+  return out;
+}
+
+/// A cluster's sizing: "sized_fruitlets" with the tag frame ("T_world_tag" present), or no
+/// tag seen (no "T_world_tag": nothing to place).
+VisitCluster clusterOf(const json& sizing, int tag_id, const std::string& source,
+                       const std::string& field) {
+  VisitCluster cluster;
+  cluster.tag_id = tag_id;
+  cluster.tag_seen = sizing.contains("T_world_tag");
+  if (!cluster.tag_seen) return cluster;
+  const auto fruitlets = sizing.find("sized_fruitlets");
+  if (fruitlets == sizing.end() || !fruitlets->is_array())
+    fail(source, field + "sized_fruitlets", "an array of sized fruitlets");
+  for (std::size_t i = 0; i < fruitlets->size(); ++i)
+    cluster.fruitlets.push_back(sizedFruitlet(
+        (*fruitlets)[i], source, field + "sized_fruitlets[" + std::to_string(i) + "]"));
+  return cluster;
+}
+
+int tagIdOf(const json& object, const std::string& source, const std::string& field) {
+  const auto id = object.find("tag_id");
+  if (id == object.end()) return 0;
+  if (!id->is_number_integer() || id->get<long long>() < 0 || id->get<long long>() > 1 << 20)
+    fail(source, field + "tag_id", "a tag id (an integer >= 0)");
+  return id->get<int>();
+}
+
+}  // namespace
+
+SeasonVisit parseSeasonVisit(const std::string& json_text, const std::string& source, double day) {
+  if (!std::isfinite(day)) fail(source, "day", "a finite number of days");
+  json root;
+  try {
+    root = json::parse(json_text);
+  } catch (const json::exception& e) {
+    throw std::runtime_error(source + ": not JSON: " + e.what());
+  }
+  if (!root.is_object())
+    fail(source, "the document", "an object (a result.json or fruitlets.json)");
+  SeasonVisit visit;
+  visit.day = day;
+  visit.source = source;
+  const auto clusters = root.find("clusters");
+  if (clusters == root.end()) {
+    visit.clusters.push_back(clusterOf(root, tagIdOf(root, source, ""), source, ""));
+    return visit;
+  }
+  if (!clusters->is_array()) fail(source, "clusters", "an array (a tree's clusters)");
+  for (std::size_t i = 0; i < clusters->size(); ++i) {
+    const std::string field = "clusters[" + std::to_string(i) + "].";
+    const json& c = (*clusters)[i];
+    if (!c.is_object()) fail(source, field, "an object");
+    if (!c.contains("sized_fruitlets") && !c.contains("T_world_tag")) continue;  // not run
+    visit.clusters.push_back(clusterOf(c, tagIdOf(c, source, field), source, field));
+  }
+  return visit;
+}
+
+SeasonVisit readSeasonVisit(const std::filesystem::path& path, double day) {
+  std::filesystem::path file = path;
+  if (!std::filesystem::exists(path))
+    throw std::runtime_error(path.string() +
+                             ": no such file or directory (expected a result.json, a "
+                             "fruitlets.json or a directory holding one)");
+  if (std::filesystem::is_directory(path)) {
+    file = path / "result.json";
+    if (!std::filesystem::exists(file)) file = path / "fruitlets.json";
+    if (!std::filesystem::exists(file))
+      throw std::runtime_error(path.string() +
+                               ": expected a result.json or fruitlets.json in the directory");
+  }
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw std::runtime_error(file.string() + ": cannot be read");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parseSeasonVisit(text.str(), file.string(), day);
+}
+
+}  // namespace fvp::host::season

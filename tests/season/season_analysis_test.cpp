@@ -1,0 +1,117 @@
+// A season from visits as results hold them: the visit reader, the tracks across visits,
+// fates and fruit set by hand (tests/season/data: a tree of two clusters on days 0 and 4).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "fvp/host/season/season_analysis.h"
+
+namespace fvp::host::season {
+namespace {
+
+const std::string kData = std::string(FVP_SOURCE_DIR) + "/tests/season/data/";
+
+std::string errorOf(const std::string& text) {
+  try {
+    parseSeasonVisit(text, "visit.json", 0.0);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(SeasonVisit, ReadsATreesClustersInTheTagsFrame) {
+  const SeasonVisit v = readSeasonVisit(kData + "tree_day0.json", 0.0);
+  ASSERT_EQ(v.clusters.size(), 2u);
+  EXPECT_EQ(v.clusters[0].tag_id, 3);
+  EXPECT_EQ(v.clusters[1].tag_id, 5);
+  ASSERT_EQ(v.clusters[0].fruitlets.size(), 3u);
+  EXPECT_NEAR(v.clusters[0].fruitlets[1].at.center_tag_m.x(), 0.012, 1e-12);
+  EXPECT_DOUBLE_EQ(v.clusters[0].fruitlets[2].standard_error_mm, 0.25);
+  EXPECT_TRUE(std::isnan(v.clusters[1].fruitlets[1].standard_error_mm));  // null: unknown
+}
+
+TEST(SeasonVisit, OneClusterAndAClusterWithoutItsTag) {
+  const SeasonVisit one = parseSeasonVisit(
+      R"({"T_world_tag": {}, "sized_fruitlets": [{"center_tag_m": [0, 0, 0.05], "size_mm": 7}]})",
+      "result.json", 2.0);
+  ASSERT_EQ(one.clusters.size(), 1u);
+  EXPECT_EQ(one.clusters[0].tag_id, 0);
+  EXPECT_EQ(one.clusters[0].fruitlets.size(), 1u);
+  const SeasonVisit unseen = parseSeasonVisit(
+      R"({"clusters": [{"tag_id": 2, "sized_fruitlets": []}, {"tag_id": 4}]})", "r.json", 0.0);
+  ASSERT_EQ(unseen.clusters.size(), 1u);  // the second was never run
+  EXPECT_FALSE(unseen.clusters[0].tag_seen);
+}
+
+TEST(SeasonVisit, BadVisitsNameTheFileAndTheField) {
+  EXPECT_EQ(errorOf("[1]"),
+            "visit.json: the document: expected an object (a result.json or fruitlets.json)");
+  EXPECT_NE(errorOf("{").find("visit.json: not JSON"), std::string::npos);
+  EXPECT_EQ(errorOf(R"({"T_world_tag": {}, "sized_fruitlets": [{"size_mm": 7}]})"),
+            "visit.json: sized_fruitlets[0].center_tag_m: expected the centre in the tag's frame");
+  EXPECT_EQ(
+      errorOf(
+          R"({"T_world_tag": {}, "sized_fruitlets": [{"center_tag_m": [0, 0], "size_mm": 7}]})"),
+      "visit.json: sized_fruitlets[0].center_tag_m: expected an array of 3 numbers");
+  EXPECT_EQ(
+      errorOf(
+          R"({"T_world_tag": {}, "sized_fruitlets": [{"center_tag_m": [0, 0, 0], "size_mm": -1}]})"),
+      "visit.json: sized_fruitlets[0].size_mm: expected a size > 0");
+  EXPECT_EQ(errorOf(R"({"clusters": [{"tag_id": -3, "T_world_tag": {}, "sized_fruitlets": []}]})"),
+            "visit.json: clusters[0].tag_id: expected a tag id (an integer >= 0)");
+  EXPECT_EQ(errorOf(R"({"clusters": 3})"),
+            "visit.json: clusters: expected an array (a tree's clusters)");
+  EXPECT_THROW(readSeasonVisit(kData + "no_such_visit.json", 0.0), std::runtime_error);
+}
+
+// Tag 3: fruitlets grew 3.6 and 3.2 mm and one 0.4 mm in 4 days; tag 5: one grew 3.0 mm, one
+// fell off. Reference: the fastest fifth of 4 rates, the fastest alone, 0.9 mm/day.
+TEST(SeasonAnalysis, TwoVisitsOfATreeByHand) {
+  const SeasonAnalysis s = analyzeSeason({readSeasonVisit(kData + "tree_day4.json", 4.0),
+                                          readSeasonVisit(kData + "tree_day0.json", 0.0)});
+  EXPECT_EQ(s.days, (std::vector<double>{0.0, 4.0}));  // in day order
+  ASSERT_EQ(s.clusters.size(), 2u);
+  ASSERT_EQ(s.tracks.size(), 5u);
+  EXPECT_NEAR(s.reference_mm_per_day, 0.9, 1e-12);
+  EXPECT_NEAR(s.threshold_mm_per_day, 0.45, 1e-12);
+  const auto rate = [&](std::size_t t) { return s.tracks[t].rate.mm_per_day; };
+  EXPECT_NEAR(rate(0), 0.9, 1e-12);
+  EXPECT_NEAR(rate(1), 0.8, 1e-12);
+  EXPECT_NEAR(rate(2), 0.1, 1e-12);
+  EXPECT_NEAR(s.tracks[2].rate.standard_error_mm_per_day, std::sqrt(0.0625 + 0.04) / 4, 1e-12);
+  EXPECT_EQ(s.tracks[0].fate.fate, Fate::kPersists);
+  EXPECT_EQ(s.tracks[2].fate.fate, Fate::kAbscises);
+  EXPECT_NEAR(rate(3), 0.75, 1e-12);
+  EXPECT_TRUE(s.tracks[4].gone);
+  EXPECT_GT(s.tracks[0].sizes[1].association_confidence, 0.99);
+  EXPECT_EQ(s.clusters[0].fruit_set.persisting, 2u);
+  EXPECT_EQ(s.clusters[0].fruit_set.abscising, 1u);
+  EXPECT_NEAR(s.clusters[0].fruit_set.percent, 100.0 * 2 / 3, 0.01);
+  EXPECT_EQ(s.clusters[1].fruit_set.gone, 1u);
+  EXPECT_NEAR(s.clusters[1].fruit_set.percent, 50.0, 0.01);
+  EXPECT_NEAR(s.fruit_set.percent, 60.0, 0.01);
+  const nlohmann::json j = seasonJson(s, {});
+  EXPECT_EQ(j["format"], 1);
+  EXPECT_EQ(j["clusters"][1]["fruitlets"][1]["fate"], "gone");
+  EXPECT_EQ(j["clusters"][0]["fruitlets"][2]["fate"], "abscises");
+  EXPECT_EQ(j["clusters"][0]["fruitlets"][0]["sizes"].size(), 2u);
+  EXPECT_TRUE(j["clusters"][0]["fruitlets"][0]["sizes"][0]["association_confidence"].is_null());
+}
+
+TEST(SeasonAnalysis, AVisitWithoutTheTagLeavesTheFruitletsAndTwoOnOneDayAreRefused) {
+  const SeasonVisit day0 = readSeasonVisit(kData + "tree_day0.json", 0.0);
+  SeasonVisit blind = readSeasonVisit(kData + "tree_day4.json", 4.0);
+  blind.clusters[1].tag_seen = false;
+  blind.clusters[1].fruitlets.clear();
+  const SeasonAnalysis s = analyzeSeason({day0, blind});
+  EXPECT_EQ(s.clusters[1].visits_without_tag, 1u);
+  EXPECT_FALSE(s.tracks[3].gone);  // not looked at: not gone, and no rate (unknown)
+  EXPECT_EQ(s.tracks[3].fate.fate, Fate::kUnknown);
+  EXPECT_THROW(analyzeSeason({day0, day0}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace fvp::host::season
