@@ -1,11 +1,12 @@
 // Perception and sizing from Python: the perception configuration (tag, Cluster Region, HSV
-// thresholds) and `fvp size` over a capture set.
+// thresholds), `fvp size` over a capture set, and `fvp season` over visits' results.
 #include <pybind11/stl.h>
 
 #include "bindings.h"
 #include "conversions.h"
 #include "fvp/host/perception/perception_pipeline.h"
 #include "fvp/host/report/capture_set_report.h"
+#include "fvp/host/season/season_analysis.h"
 
 namespace fvp::python {
 
@@ -40,6 +41,20 @@ void bindPerceptionSizing(py::module_& m) {
       py::arg("estimator") = "ours", py::arg("engine") = "grid", py::arg("backend") = "auto",
       "`fvp size` as a function: sizes a capture set (docs/capture-format.md) and returns "
       "fruitlets.json's object (written to out_dir when given).");
+
+  m.def(
+      "season",
+      [](const std::vector<std::pair<double, std::string>>& visits) {
+        std::vector<host::season::SeasonVisit> read;
+        for (const auto& [day, path] : visits)
+          read.push_back(host::season::readSeasonVisit(path, day));
+        const host::season::SeasonConfig config;
+        return jsonToPython(
+            host::season::seasonJson(host::season::analyzeSeason(read, config), config));
+      },
+      py::arg("visits"),
+      "`fvp season` as a function: visits as (day, path) pairs, each path a result.json, a "
+      "fruitlets.json or a directory holding one; returns season.json's object (docs/season.md).");
 }
 
 }  // namespace fvp::python

@@ -64,7 +64,7 @@ py::dict nbvResultToDict(const host::nbv::NbvResult& r);
 
 // The module's areas, one file each (bind_*.cpp), called in this order by PYBIND11_MODULE.
 void bindCore(py::module_& m);  ///< planners(), backends(), StereoIntrinsics, StereoFrame
-void bindPerceptionSizing(py::module_& m);  ///< PerceptionConfig, size_captures
+void bindPerceptionSizing(py::module_& m);  ///< PerceptionConfig, size_captures, season
 void bindSession(py::module_& m);           ///< MapEngine, MappingSession
 void bindPlanners(py::module_& m);          ///< Planner, info_gain
 void bindRobot(py::module_& m);             ///< Camera, Arm, CaptureResult, MoveResult

@@ -1,0 +1,29 @@
+"""fvp.season: visits' results (day, path) to growth rates, fates and fruit set, the same
+object `fvp season` writes as season.json (docs/season.md)."""
+import json
+import os
+import subprocess
+
+import pytest
+
+import fvp
+
+DATA = os.path.join(os.environ.get("FVP_SOURCE_DIR", "."), "tests/season/data")
+
+
+def test_two_visits_of_a_tree_match_the_command(fvp_exe, tmp_path):
+    visits = [(4.0, os.path.join(DATA, "tree_day4.json")), (0.0, os.path.join(DATA, "tree_day0.json"))]
+    season = fvp.season(visits)
+    assert [v["day"] for v in season["visits"]] == [0.0, 4.0]
+    assert season["fruit_set"]["percent"] == pytest.approx(60.0, abs=0.01)
+    fates = [f["fate"] for c in season["clusters"] for f in c["fruitlets"]]
+    assert fates == ["persists", "persists", "abscises", "persists", "gone"]
+    subprocess.run([fvp_exe, "season", "--visit", f"4={visits[0][1]}", "--visit",
+                    f"0={visits[1][1]}", "--out", str(tmp_path)], check=True,
+                   stdout=subprocess.DEVNULL)
+    assert json.loads((tmp_path / "season.json").read_text()) == season
+
+
+def test_a_missing_visit_is_an_error_naming_it():
+    with pytest.raises(RuntimeError, match="no_such_visit.json: no such file or directory"):
+        fvp.season([(0.0, os.path.join(DATA, "tree_day0.json")), (4.0, "/nonexistent/no_such_visit.json")])
