@@ -2,6 +2,7 @@
 // trampolines call their Python methods); what a capture and a move return.
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 
@@ -42,7 +43,7 @@ MoveResult toMoveResult(const py::object& out) {
   if (py::isinstance<MoveResult>(out)) return out.cast<MoveResult>();
   if (py::isinstance<MoveStatus>(out)) return {out.cast<MoveStatus>(), 0.0};
   if (py::isinstance<py::bool_>(out))
-    return {out.cast<bool>() ? MoveStatus::kSuccess : MoveStatus::kExecutionFailed, 0.0};
+    return {out.cast<bool>() ? MoveStatus::kSuccess : MoveStatus::kExecutionFailed, 0.0, 0.0};
   throw std::invalid_argument(
       "fvp.Arm.move_to: expected a MoveResult, a MoveStatus or a bool, got " +
       std::string(py::str(py::type::of(out))));
@@ -113,6 +114,29 @@ class PyArm : public host::nbv::Arm {
   }
 };
 
+/// fvp.MoveStatus and fvp.MoveResult: how a move ended.
+void bindMoveResult(py::module_& m) {
+  py::enum_<MoveStatus> status(m, "MoveStatus");
+  for (const MoveStatus s :
+       {MoveStatus::kSuccess, MoveStatus::kNoIk, MoveStatus::kNoCollisionFreeIk,
+        MoveStatus::kStartInvalid, MoveStatus::kNoPath, MoveStatus::kTimeout, MoveStatus::kRefused,
+        MoveStatus::kExecutionFailed})
+    status.value(host::nbv::toString(s), s);
+  py::class_<MoveResult>(m, "MoveResult",
+                         "How a move ended, the planning time it took and the arm's time in "
+                         "motion.")
+      .def(py::init([](MoveStatus s, double planning_wall_s, double motion_s) {
+             if (!(motion_s >= 0.0) || !std::isfinite(motion_s))
+               throw py::value_error("fvp.MoveResult: motion_s: expected seconds >= 0");
+             return MoveResult{s, planning_wall_s, motion_s};
+           }),
+           py::arg("status"), py::arg("planning_wall_s") = 0.0, py::arg("motion_s") = 0.0)
+      .def_readonly("status", &MoveResult::status)
+      .def_readonly("planning_wall_s", &MoveResult::planning_wall_s)
+      .def_readonly("motion_s", &MoveResult::motion_s)
+      .def_property_readonly("ok", &MoveResult::ok);
+}
+
 }  // namespace
 
 void bindRobot(py::module_& m) {
@@ -135,20 +159,7 @@ void bindRobot(py::module_& m) {
       .def_readonly("detail", &CaptureResult::detail)
       .def_property_readonly("ok", &CaptureResult::ok);
 
-  py::enum_<MoveStatus> status(m, "MoveStatus");
-  for (const MoveStatus s :
-       {MoveStatus::kSuccess, MoveStatus::kNoIk, MoveStatus::kNoCollisionFreeIk,
-        MoveStatus::kStartInvalid, MoveStatus::kNoPath, MoveStatus::kTimeout, MoveStatus::kRefused,
-        MoveStatus::kExecutionFailed})
-    status.value(host::nbv::toString(s), s);
-  py::class_<MoveResult>(m, "MoveResult", "How a move ended, and the planning time it took.")
-      .def(py::init([](MoveStatus s, double planning_wall_s) {
-             return MoveResult{s, planning_wall_s};
-           }),
-           py::arg("status"), py::arg("planning_wall_s") = 0.0)
-      .def_readonly("status", &MoveResult::status)
-      .def_readonly("planning_wall_s", &MoveResult::planning_wall_s)
-      .def_property_readonly("ok", &MoveResult::ok);
+  bindMoveResult(m);
 
   py::class_<host::nbv::Camera, PyCamera>(
       m, "Camera",

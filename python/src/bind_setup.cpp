@@ -186,13 +186,15 @@ void bindSetup(py::module_& m) {
             py::dict d;
             d["visits"] = visits;
             d["transit_s"] = tour.transit_s;
+            d["transit_motion_s"] = tour.transit_motion_s;
             d["transit_motion"] = tour.transit_motion;
             return d;
           },
           py::kw_only(), py::arg("camera"), py::arg("arm"), py::arg("targets"),
           py::arg("clock") = nullptr, py::arg("observer") = py::none(),
           "The clusters one after another (nearest start view next, approach views, skips "
-          "counted); returns visits (in visit order), transit_s, transit_motion.");
+          "counted); returns visits (in visit order), transit_s (of it transit_motion_s in "
+          "motion), transit_motion.");
 }
 
 }  // namespace fvp::python

@@ -1,6 +1,7 @@
 // The gated one-to-one assignment against brute force over every assignment.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -78,6 +79,16 @@ TEST(OneToOneAssignment, MorePairsBeatLessCostAndBeyondSixteenColumnsIsGreedy) {
   // Beyond the exact limit: closest first, so row 0 keeps column 0 and row 1 goes unpaired.
   const auto wide = [&](std::size_t r, std::size_t c) { return c < 2 ? table[r][c] : inf; };
   EXPECT_EQ(assignOneToOne(2, kExactAssignmentMaxColumns + 1, wide), (std::vector<int>{0, -1}));
+  // Too many rows for the exact search's memory: greedy, still one to one.
+  const auto many = [](std::size_t r, std::size_t c) { return double((r * 7 + c * 3) % 11); };
+  const std::vector<int> big = assignOneToOne(100, kExactAssignmentMaxColumns, many);
+  std::vector<int> seen(kExactAssignmentMaxColumns, 0);
+  for (const int c : big) {
+    if (c >= 0) {
+      EXPECT_EQ(seen[std::size_t(c)]++, 0);
+    }
+  }
+  EXPECT_EQ(std::count(big.begin(), big.end(), -1), 100 - int(kExactAssignmentMaxColumns));
   EXPECT_TRUE(assignOneToOne(0, 3, cost).empty());
   EXPECT_EQ(assignOneToOne(2, 0, cost), (std::vector<int>{-1, -1}));
 }

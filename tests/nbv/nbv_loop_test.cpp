@@ -72,9 +72,9 @@ class FakeArm : public Arm {
   bool reachable(const Eigen::Isometry3d&) const override { return true; }
   MoveResult moveTo(const Eigen::Isometry3d& T) override {
     ++moves;
-    if (refuse_every && moves % refuse_every == 0) return {MoveStatus::kRefused, 0.0};
+    if (refuse_every && moves % refuse_every == 0) return {MoveStatus::kRefused, 0.0, 0.0};
     pose_ = T;
-    return {MoveStatus::kSuccess, 0.0};
+    return {MoveStatus::kSuccess, 0.0, 0.0};
   }
   std::size_t updateObstacles(map::MapEngine&) override { return ++obstacle_updates; }
   bool checksGoals() const override { return checks_goals; }

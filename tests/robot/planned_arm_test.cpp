@@ -111,6 +111,7 @@ TEST(PlannedArm, AReachablePoseMovesAlongATrajectoryFromTheCurrentJointsToTheGoa
   EXPECT_EQ(trajectory.waypoints().front(), start);
   EXPECT_EQ(trajectory.position(0.0), start);
   EXPECT_GT(trajectory.duration_s(), 0.0);
+  EXPECT_EQ(moved.motion_s, trajectory.duration_s());  // the arm's time in motion
   const Eigen::Isometry3d T_end = robot.model.T_world_camera(trajectory.waypoints().back());
   EXPECT_LT((T_end.translation() - goal.translation()).norm(), 1e-6);
   EXPECT_LT(rotationError_rad(T_end, goal), 1e-6);
@@ -132,6 +133,7 @@ TEST(PlannedArm, ARefusedTrajectoryIsRefusedAndTheArmStaysWhereItWas) {
   EXPECT_TRUE(robot.arm.cameraPose().isApprox(T_before, 0.0));
   EXPECT_EQ(move.result().status, MoveStatus::kRefused);
   EXPECT_EQ(move.result().planning_wall_s, move.plan.planning_wall_s);
+  EXPECT_EQ(move.result().motion_s, 0.0);  // refused: the arm did not move
 }
 
 TEST(PlannedArm, AnExecutionThatStopsShortFails) {

@@ -82,6 +82,16 @@ TEST(FruitletAssociation, AMergedOutlineTakesOneIdentityWithLowConfidence) {
   EXPECT_LT(a.confidence[1], 0.7);
 }
 
+// Each earlier fruitlet's growth gate counts from its own last size: 5 mm of growth is
+// possible in 7 days, not in 1.
+TEST(FruitletAssociation, EachFruitletsGrowthGateIsItsOwn) {
+  const std::vector<VisitFruitlet> earlier = {{{0, 0, 0.05}, 7.0}, {{0.004, 0, 0.05}, 7.0}};
+  const std::vector<VisitFruitlet> later = {{{0.001, 0, 0.05}, 12.0}};
+  const Association a = associateFruitlets(earlier, later, std::vector<double>{1.0, 7.0});
+  EXPECT_EQ(a.earlier_of_later[0], 1);  // the farther one, seen 7 days ago
+  EXPECT_THROW(associateFruitlets(earlier, later, std::vector<double>{1.0}), std::invalid_argument);
+}
+
 TEST(FruitletAssociation, BadSettingsAreRefused) {
   AssociationConfig bad;
   bad.center_sigma_m = 0.0;

@@ -48,6 +48,8 @@ TEST(GrowthRate, NoSpanNoRateAndBadInputIsRefused) {
   EXPECT_THROW(fitGrowthRate({{INFINITY, 6.0}, {1.0, 7.0}}), std::invalid_argument);
   EXPECT_THROW(fitGrowthRate({{0.0, 6.0, 0.0}, {1.0, 7.0, 0.2}}), std::invalid_argument);
   EXPECT_THROW(fitGrowthRate({{0.0, 6.0, -0.1}, {1.0, 7.0, 0.2}}), std::invalid_argument);
+  // A standard error so small its weight would overflow.
+  EXPECT_THROW(fitGrowthRate({{0.0, 6.0, 1e-200}, {1.0, 7.0, 0.2}}), std::invalid_argument);
 }
 
 // The stated standard error covers the true rate as often as it says: 95 % intervals over

@@ -65,6 +65,22 @@ TEST(SeasonVisit, BadVisitsNameTheFileAndTheField) {
   EXPECT_EQ(errorOf(R"({"clusters": 3})"),
             "visit.json: clusters: expected an array (a tree's clusters)");
   EXPECT_THROW(readSeasonVisit(kData + "no_such_visit.json", 0.0), std::runtime_error);
+  EXPECT_EQ(
+      errorOf(R"({"clusters": [{"tag_id": 1, "T_world_tag": {}, "sized_fruitlets": []},
+                                     {"tag_id": 1, "T_world_tag": {}, "sized_fruitlets": []}]})"),
+      "visit.json: clusters[1].tag_id: expected a tag of its own (clusters[0] has tag 1 too)");
+  EXPECT_EQ(errorOf(R"({"T_world_tag": {}, "sized_fruitlets": [{"center_tag_m": [0, 0, 0],
+                        "size_mm": 7, "support": {"size_stderr_mm": -0.2}}]})"),
+            "visit.json: sized_fruitlets[0].support.size_stderr_mm: expected -1 or 0 (unknown) "
+            "or a standard error of at least 1e-6 mm");
+  EXPECT_EQ(errorOf(R"({"T_world_tag": {}, "sized_fruitlets": [{"center_tag_m": [0, 0, 0],
+                        "size_mm": 7, "support": 3}]})"),
+            "visit.json: sized_fruitlets[0].support: expected an object");
+  std::string crowded = R"({"T_world_tag": {}, "sized_fruitlets": [)";
+  for (int i = 0; i < 65; ++i)
+    crowded += std::string(i ? "," : "") + R"({"center_tag_m": [0, 0, 0], "size_mm": 7})";
+  EXPECT_EQ(errorOf(crowded + "]}"),
+            "visit.json: sized_fruitlets: expected at most 64 fruitlets in a cluster");
 }
 
 // Tag 3: fruitlets grew 3.6 and 3.2 mm and one 0.4 mm in 4 days; tag 5: one grew 3.0 mm, one

@@ -58,7 +58,7 @@ class ArmWithABlockedRegion : public host::nbv::Arm {
     return !blocked_(T) && arm_.reachable(T);
   }
   host::nbv::MoveResult moveTo(const Eigen::Isometry3d& T) override {
-    if (blocked_(T)) return {host::nbv::MoveStatus::kNoIk, 0.0};
+    if (blocked_(T)) return {host::nbv::MoveStatus::kNoIk, 0.0, 0.0};
     return arm_.moveTo(T);
   }
   std::size_t updateObstacles(host::map::MapEngine& map) override {

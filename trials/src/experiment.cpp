@@ -216,7 +216,11 @@ nlohmann::json timeSplitPercent(const std::vector<const nlohmann::json*>& trials
     const auto stages = t->find("sim_time_by_stage_s");
     if (!sim_s || stages == t->end() || !stages->is_object()) return nullptr;
     sim += *sim_s;
-    double transit = numberAt(t->value("tour", nlohmann::json()), "transit_sim_s").value_or(0.0);
+    // The transit's motion (its planning stays in the planning stages); a line of an older
+    // build has only the whole transit time, its moves' planning included.
+    const nlohmann::json tour = t->value("tour", nlohmann::json());
+    double transit = numberAt(tour, "transit_motion_sim_s")
+                         .value_or(numberAt(tour, "transit_sim_s").value_or(0.0));
     for (const auto& [stage, value] : stages->items()) {
       if (!value.is_number()) continue;
       std::string name = stage.substr(0, stage.size() - (stage.ends_with("_s") ? 2 : 0));

@@ -291,7 +291,7 @@ struct TourRecord {
   nlohmann::json cluster_write_failures = nlohmann::json::object();  // as extraWriter records
   std::uint64_t detections = 0;
   int views = 0;
-  double transit_s = 0.0;
+  double transit_s = 0.0, transit_motion_s = 0.0;
   nlohmann::json planner_config, trial_config;
   std::string scene_error;  // why the scene could not be built (no viewer then)
   nlohmann::json overlays = nlohmann::json::array();
@@ -674,6 +674,7 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
       setup->runTour({loop_camera, loop_arm, loop_clock}, robot->clusterTargets(), &recorder);
   for (const auto& visit : done.visits) tour.order.push_back(visit.index);
   tour.transit_s = done.transit_s;
+  tour.transit_motion_s = done.transit_motion_s;
   for (const auto& [status, count] : done.transit_motion) tour.transit_motion[status] = count;
 
   nlohmann::json result = treeResult(tour, scene);
@@ -836,6 +837,7 @@ nlohmann::json Trial::Impl::treeResult(TourRecord& tour, host::report::ViewerSce
   result["tour"] = {{"order", tour.order},
                     {"cluster_status", tour.cluster_status},
                     {"transit_sim_s", tour.transit_s},
+                    {"transit_motion_sim_s", tour.transit_motion_s},
                     {"transit_motion_status", tour.transit_motion}};
   result["events"] = tour.events.empty() ? eventsJson({}) : tour.events;
   tour.wall["rendering"] = camera->totalRenderSeconds();

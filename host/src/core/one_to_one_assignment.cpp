@@ -28,7 +28,8 @@ std::vector<int> assignOneToOne(std::size_t rows, std::size_t columns,
                                 const std::function<double(std::size_t, std::size_t)>& cost) {
   std::vector<int> column_of_row(rows, -1);
   if (rows == 0 || columns == 0) return column_of_row;
-  if (columns > kExactAssignmentMaxColumns) return greedyAssignment(rows, columns, cost);
+  if (columns > kExactAssignmentMaxColumns || (rows + 1) > kExactAssignmentMaxCells >> columns)
+    return greedyAssignment(rows, columns, cost);
   // Over the rows in order, with the set of columns taken: (pairs, summed cost).
   struct Cell {
     int pairs = -1;  // -1: not reachable

@@ -52,6 +52,7 @@ bool ApproachSequence::moveToNext(Arm& arm, const LoopClock& clock, ClusterVisit
     const double before_s = clock.now_s();
     const MoveResult move = arm.moveTo(T);
     tour.transit_s += clock.now_s() - before_s;
+    tour.transit_motion_s += move.motion_s;
     move_status_ = toString(move.status);
     ++tour.transit_motion[move_status_];
     if (move.ok()) {

@@ -24,16 +24,28 @@ void AssociationConfig::validate() const {
 Association associateFruitlets(const std::vector<VisitFruitlet>& earlier,
                                const std::vector<VisitFruitlet>& later, double days_between,
                                const AssociationConfig& config) {
-  config.validate();
   if (!(days_between >= 0.0) || !std::isfinite(days_between))
-    throw std::invalid_argument("associateFruitlets: days_between must be >= 0");
-  const double max_growth_mm = config.max_growth_mm_per_day * days_between;
+    throw std::invalid_argument("associateFruitlets: days between visits must be >= 0");
+  return associateFruitlets(earlier, later, std::vector<double>(earlier.size(), days_between),
+                            config);
+}
+
+Association associateFruitlets(const std::vector<VisitFruitlet>& earlier,
+                               const std::vector<VisitFruitlet>& later,
+                               const std::vector<double>& days_since,
+                               const AssociationConfig& config) {
+  config.validate();
+  if (days_since.size() != earlier.size())
+    throw std::invalid_argument("associateFruitlets: one days_since per earlier fruitlet expected");
+  for (const double days : days_since)
+    if (!(days >= 0.0) || !std::isfinite(days))
+      throw std::invalid_argument("associateFruitlets: days between visits must be >= 0");
   // The squared shift in units of its spread; +inf where a gate refuses the pair.
   const auto cost = [&](std::size_t e, std::size_t l) {
     const double shift_m = (later[l].center_tag_m - earlier[e].center_tag_m).norm();
     const double growth_mm = later[l].size_mm - earlier[e].size_mm;
     if (!(shift_m <= config.max_center_shift_m) || !(growth_mm >= -config.max_shrink_mm) ||
-        !(growth_mm <= max_growth_mm))
+        !(growth_mm <= config.max_growth_mm_per_day * days_since[e]))
       return std::numeric_limits<double>::infinity();
     const double z = shift_m / config.center_sigma_m;
     return z * z;

@@ -11,8 +11,10 @@ void checkSize(const SizeOnDay& s, std::size_t index) {
   const std::string which = "fitGrowthRate: size " + std::to_string(index);
   if (!std::isfinite(s.day) || !std::isfinite(s.size_mm))
     throw std::invalid_argument(which + ": day and size_mm must be finite");
-  if (!std::isnan(s.standard_error_mm) && !(s.standard_error_mm > 0.0))
-    throw std::invalid_argument(which + ": standard_error_mm must be > 0 or NaN (unknown)");
+  if (!std::isnan(s.standard_error_mm) &&
+      !(s.standard_error_mm >= kMinStandardErrorMm && std::isfinite(s.standard_error_mm)))
+    throw std::invalid_argument(which +
+                                ": standard_error_mm must be at least 1e-6 or NaN (unknown)");
 }
 
 }  // namespace

@@ -31,14 +31,13 @@ void followCluster(int tag_id, const std::vector<SeasonVisit>& visits,
       }
       ++cluster.visits_with_tag;
       std::vector<VisitFruitlet> earlier, later;
-      double oldest_day = visits[v].day;
+      std::vector<double> days_since;  // each track's growth gate: since its own last size
       for (const std::size_t t : cluster.tracks) {
         earlier.push_back(out.tracks[t].sizes.back().sized.at);
-        oldest_day = std::min(oldest_day, out.tracks[t].sizes.back().day);
+        days_since.push_back(visits[v].day - out.tracks[t].sizes.back().day);
       }
       for (const SizedFruitlet& f : c.fruitlets) later.push_back(f.at);
-      // The widest growth gate the tracks need: since the oldest last size.
-      const Association a = associateFruitlets(earlier, later, visits[v].day - oldest_day, config);
+      const Association a = associateFruitlets(earlier, later, days_since, config);
       const std::vector<std::size_t> before = cluster.tracks;
       for (std::size_t e = 0; e < before.size(); ++e) {
         FruitletTrack& track = out.tracks[before[e]];
@@ -113,13 +112,14 @@ void predictFates(SeasonAnalysis& out, const FateConfig& config) {
 
 SeasonAnalysis analyzeSeason(std::vector<SeasonVisit> visits, const SeasonConfig& config) {
   config.validate();
+  for (const SeasonVisit& visit : visits)  // before sorting: NaN has no order
+    if (!std::isfinite(visit.day))
+      throw std::invalid_argument("analyzeSeason: " + visit.source + ": day is not finite");
   std::stable_sort(visits.begin(), visits.end(),
                    [](const SeasonVisit& a, const SeasonVisit& b) { return a.day < b.day; });
   SeasonAnalysis out;
   std::set<int> tags;
   for (std::size_t v = 0; v < visits.size(); ++v) {
-    if (!std::isfinite(visits[v].day))
-      throw std::invalid_argument("analyzeSeason: " + visits[v].source + ": day is not finite");
     if (v > 0 && visits[v].day == visits[v - 1].day)
       throw std::invalid_argument("analyzeSeason: two visits on day " +
                                   std::to_string(visits[v].day) + ": " + visits[v - 1].source +

@@ -2,14 +2,21 @@
 
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
+
+#include "fvp/host/season/growth_rate.h"
 
 namespace fvp::host::season {
 namespace {
 
 using nlohmann::json;
+
+/// More than a cluster holds by far (3-8 fruitlets): a file with more is not a cluster's
+/// sizing, and the association's exact search grows with it.
+constexpr std::size_t kMaxFruitletsPerCluster = 64;
 
 [[noreturn]] void fail(const std::string& source, const std::string& field,
                        const std::string& expected) {
@@ -38,13 +45,16 @@ SizedFruitlet sizedFruitlet(const json& f, const std::string& source, const std:
   out.at.size_mm = finiteNumber(*size, source, field + ".size_mm");
   if (!(out.at.size_mm > 0.0)) fail(source, field + ".size_mm", "a size > 0");
   const auto support = f.find("support");
-  if (support != f.end() && support->is_object()) {
-    const auto se = support->find("size_stderr_mm");
-    if (se != support->end() && !se->is_null()) {
-      const double v = finiteNumber(*se, source, field + ".support.size_stderr_mm");
-      if (v > 0.0) out.standard_error_mm = v;  // 0: one image, no spread measured
-    }
-  }
+  if (support == f.end()) return out;
+  if (!support->is_object()) fail(source, field + ".support", "an object");
+  const auto se = support->find("size_stderr_mm");
+  if (se == support->end() || se->is_null()) return out;
+  const double v = finiteNumber(*se, source, field + ".support.size_stderr_mm");
+  // -1: fewer than two well-seen images (the sizer's "unknown"); 0: no spread measured.
+  if (v != -1.0 && v != 0.0 && !(v >= kMinStandardErrorMm))
+    fail(source, field + ".support.size_stderr_mm",
+         "-1 or 0 (unknown) or a standard error of at least 1e-6 mm");
+  if (v > 0.0) out.standard_error_mm = v;
   return out;
 }
 
@@ -59,6 +69,9 @@ VisitCluster clusterOf(const json& sizing, int tag_id, const std::string& source
   const auto fruitlets = sizing.find("sized_fruitlets");
   if (fruitlets == sizing.end() || !fruitlets->is_array())
     fail(source, field + "sized_fruitlets", "an array of sized fruitlets");
+  if (fruitlets->size() > kMaxFruitletsPerCluster)
+    fail(source, field + "sized_fruitlets",
+         "at most " + std::to_string(kMaxFruitletsPerCluster) + " fruitlets in a cluster");
   for (std::size_t i = 0; i < fruitlets->size(); ++i)
     cluster.fruitlets.push_back(sizedFruitlet(
         (*fruitlets)[i], source, field + "sized_fruitlets[" + std::to_string(i) + "]"));
@@ -94,12 +107,18 @@ SeasonVisit parseSeasonVisit(const std::string& json_text, const std::string& so
     return visit;
   }
   if (!clusters->is_array()) fail(source, "clusters", "an array (a tree's clusters)");
+  std::map<int, std::size_t> index_of_tag;
   for (std::size_t i = 0; i < clusters->size(); ++i) {
     const std::string field = "clusters[" + std::to_string(i) + "].";
     const json& c = (*clusters)[i];
     if (!c.is_object()) fail(source, field, "an object");
     if (!c.contains("sized_fruitlets") && !c.contains("T_world_tag")) continue;  // not run
-    visit.clusters.push_back(clusterOf(c, tagIdOf(c, source, field), source, field));
+    const int tag = tagIdOf(c, source, field);
+    if (const auto [it, added] = index_of_tag.emplace(tag, i); !added)
+      fail(source, field + "tag_id",
+           "a tag of its own (clusters[" + std::to_string(it->second) + "] has tag " +
+               std::to_string(tag) + " too)");
+    visit.clusters.push_back(clusterOf(c, tag, source, field));
   }
   return visit;
 }

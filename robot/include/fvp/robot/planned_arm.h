@@ -30,7 +30,10 @@ struct PlannedMove {
   host::nbv::MoveStatus status = host::nbv::MoveStatus::kNoPath;
   MotionPlan plan;
   ExecutionResult execution;  ///< kFailed with no detail when nothing was executed
-  host::nbv::MoveResult result() const { return {status, plan.planning_wall_s}; }
+  host::nbv::MoveResult result() const {
+    const bool moved = status == host::nbv::MoveStatus::kSuccess;
+    return {status, plan.planning_wall_s, moved ? plan.trajectory.duration_s() : 0.0};
+  }
 };
 
 /// How far (per joint, rad or m for the slider) the joints may be from the trajectory's

@@ -14,8 +14,8 @@ namespace fvp::host::eval {
 inline constexpr double kDefaultMatchGateM = 0.005;
 
 /// detection_of_gt[g]: index of the detection matched to ground-truth fruitlet g, or -1.
-/// Exact for up to 16 ground-truth fruitlets (a clusters holds 3-6); greedy by distance
-/// beyond that.
+/// Exact for up to 16 ground-truth fruitlets (a cluster holds 3-6) and 63 detections with
+/// 16 of them (assignOneToOne's bounds); greedy by distance beyond that.
 std::vector<int> matchFruitlets(const std::vector<Eigen::Vector3d>& detections_m,
                                 const std::vector<Eigen::Vector3d>& ground_truth_m,
                                 double gate_m = kDefaultMatchGateM);

@@ -32,6 +32,9 @@ const char* toString(MoveStatus status);
 struct MoveResult {
   MoveStatus status = MoveStatus::kNoPath;
   double planning_wall_s = 0.0;  ///< wall time spent planning the motion (for reports)
+  /// The arm's time in motion: the executed trajectory's duration (0 when it did not move,
+  /// or for an arm that does not say).
+  double motion_s = 0.0;
   bool ok() const { return status == MoveStatus::kSuccess; }
 };
 

@@ -150,8 +150,10 @@ class TourObserver : public LoopObserver {
 };
 
 struct TourResult {
-  std::vector<ClusterVisit> visits;                   ///< in visit order
-  double transit_s = 0.0;                             ///< the clock spent moving between clusters
+  std::vector<ClusterVisit> visits;  ///< in visit order
+  double transit_s = 0.0;            ///< the clock spent moving between clusters
+  /// Of transit_s, the arm's motion (MoveResult::motion_s); the rest is the moves' planning.
+  double transit_motion_s = 0.0;
   std::map<std::string, std::size_t> transit_motion;  ///< MoveStatus name -> count
   /// The map the last sized cluster handed on (its coarse map covers the whole tour).
   std::unique_ptr<map::MapEngine> map;

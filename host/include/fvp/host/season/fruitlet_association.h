@@ -40,8 +40,15 @@ struct Association {
 
 /// The one-to-one assignment with the most pairs within the gates (the centre within
 /// max_center_shift_m, the size change within [-max_shrink_mm, max_growth_mm_per_day * days]),
-/// and among those the least summed squared shift: exact for up to 16 later fruitlets.
-/// days_between must be >= 0.
+/// and among those the least summed squared shift (assignOneToOne: exact for up to 16 later
+/// fruitlets). days_since[e]: the days from earlier fruitlet e's size to the later visit, each
+/// >= 0 (fruitlets last seen on different visits each get their own growth gate).
+Association associateFruitlets(const std::vector<VisitFruitlet>& earlier,
+                               const std::vector<VisitFruitlet>& later,
+                               const std::vector<double>& days_since,
+                               const AssociationConfig& config = {});
+
+/// The same with every earlier fruitlet sized days_between before the later visit.
 Association associateFruitlets(const std::vector<VisitFruitlet>& earlier,
                                const std::vector<VisitFruitlet>& later, double days_between,
                                const AssociationConfig& config = {});

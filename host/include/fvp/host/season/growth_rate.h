@@ -23,11 +23,15 @@ struct GrowthRate {
   std::size_t sizes = 0;  ///< the sizes the rate rests on
 };
 
+/// The smallest standard error a size may state (a micrometre): below it the weights of the
+/// fit overflow.
+inline constexpr double kMinStandardErrorMm = 1e-6;
+
 /// The least-squares slope of size against day: weighted by 1 / standard error^2 when every
 /// size has one (the slope's standard error then follows from them), else unweighted (its
 /// standard error from the residuals, with three or more sizes). A fruitlet sized on one day
-/// only has no rate (NaN), an expected outcome; a non-finite day or size, or a negative or
-/// zero standard error, is std::invalid_argument.
+/// only has no rate (NaN), an expected outcome; a non-finite day or size, or a standard error
+/// below kMinStandardErrorMm, is std::invalid_argument.
 GrowthRate fitGrowthRate(const std::vector<SizeOnDay>& sizes);
 
 }  // namespace fvp::host::season
