@@ -36,6 +36,7 @@ int runFvp(int argc, const char* const* argv, CliMode mode) {
   addPlanCommand(app);
   addSizeCommand(app);
   addSeasonCommand(app);
+  addSeasonsCommand(app);
   addExperimentCommands(app);
   if (mode == CliMode::kParseOnly)
     for (CLI::App* sub : app.get_subcommands({})) sub->callback([] {});

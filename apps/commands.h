@@ -27,6 +27,7 @@ void addRunCommand(CLI::App& app);
 void addPlanCommand(CLI::App& app);
 void addSizeCommand(CLI::App& app);
 void addSeasonCommand(CLI::App& app);
+void addSeasonsCommand(CLI::App& app);
 void addExperimentCommands(CLI::App& app);
 
 /// Keeps p alive until the running runFvp returns (no-op outside runFvp).

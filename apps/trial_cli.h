@@ -63,6 +63,12 @@ class TrialOptionAdder {
             flag, [&value](int n) { value = n > 0 ? std::optional<int>(n) : std::nullopt; }, help)
         ->check(decimalUnsigned());
   }
+  void add(const std::string& flag, const std::string& help, Vocabulary,
+           std::optional<double>& value) {
+    cmd_->add_option_function<double>(
+            flag, [&value](double x) { value = x; }, help)
+        ->check(numberFromZero(true));
+  }
   void add(const std::string& flag, const std::string& help, Vocabulary, bool& value) {
     cmd_->add_flag(flag + ",!--no-" + flag.substr(2), value,
                    help + " (default: " + (value ? "on" : "off") + ")");

@@ -52,16 +52,19 @@ void bindSim(py::module_& m) {
       "The simulator as a robot: a world from a seed, its stereo camera, the UR5 on its slider "
       "and the simulated clock, for the library's fvp.NbvSetup (as a real robot's would be).")
       .def(py::init([](std::uint64_t seed, const std::string& world_config,
-                       const std::string& arm_config, const std::string& clock) {
+                       const std::string& arm_config, const std::string& clock,
+                       std::optional<double> season_day) {
              trials::SimulatedRobotOptions o;
              o.seed = seed;
              o.world_config = world_config;
+             o.season_day = season_day;
              o.arm_config = arm_config;
              o.clock = robot::sim::SimClock::modeFromString(clock);
              return std::make_unique<trials::SimulatedRobot>(o);
            }),
            py::kw_only(), py::arg("seed") = 1, py::arg("world_config") = "",
-           py::arg("arm_config") = "", py::arg("clock") = "wall")
+           py::arg("arm_config") = "", py::arg("clock") = "wall",
+           py::arg("season_day") = py::none())
       .def_property_readonly(
           "camera", [](trials::SimulatedRobot& r) -> host::nbv::Camera& { return r.camera(); },
           py::return_value_policy::reference_internal, "The simulated camera (fvp.Camera).")

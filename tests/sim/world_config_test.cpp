@@ -131,6 +131,26 @@ TEST(WorldConfig, TheFieldTreeIsTheFieldPresetOnTheTree) {
   EXPECT_EQ(config.run_register_views, 1);
 }
 
+TEST(WorldConfig, TheSeasonTreeIsTheFieldTreeWithFruitletsNearSixMillimetres) {
+  const std::filesystem::path dir = std::filesystem::path(FVP_SOURCE_DIR) / "robot/sim/config";
+  const YAML::Node season = YAML::LoadFile((dir / "world_season.yaml").string());
+  std::set<std::string> keys;
+  for (const auto& entry : YAML::LoadFile((dir / "world_field_tree.yaml").string())) {
+    const std::string key = entry.first.as<std::string>();
+    ASSERT_TRUE(season[key]) << key << " of world_field_tree.yaml is missing";
+    EXPECT_EQ(season[key].as<std::string>(), entry.second.as<std::string>()) << key;
+    keys.insert(key);
+  }
+  for (const auto& entry : season) {
+    const std::string key = entry.first.as<std::string>();
+    EXPECT_TRUE(keys.count(key) || key == "min_radius_m" || key == "max_radius_m") << key;
+  }
+  const WorldConfig config = WorldConfig::fromYamlFile(dir / "world_season.yaml");
+  EXPECT_EQ(config.min_radius_m, 0.003);  // 6 mm across
+  EXPECT_EQ(config.max_radius_m, 0.005);
+  EXPECT_EQ(config.season_day, 0.0);
+}
+
 TEST(WorldConfig, ErrorGroupsScaleTheirOwnKeysAndRefuseToLeaveTheirRanges) {
   const WorldConfig field =
       WorldConfig::fromYamlFile(std::string(FVP_SOURCE_DIR) + "/robot/sim/config/world_field.yaml");

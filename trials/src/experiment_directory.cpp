@@ -167,7 +167,7 @@ void visitManifestSettings(Options& settings, Visitor&& visit) {
 bool mayBeAbsent(std::string_view key, bool merged) {
   for (const std::string_view k :
        {"stop", "register_views", "confirm_detections", "release_left_out", "arm_config",
-        "size_history", "view_overhead_s"})
+        "size_history", "view_overhead_s", "season_day"})
     if (key == k) return true;
   return merged && (key == "engine" || key == "backend");
 }
@@ -202,6 +202,14 @@ void readSetting(const std::string& where, const std::string& key, const nlohman
                  bool& value) {
   if (!v || !v->is_boolean()) fieldError(where, key, "true or false", v);
   value = v->get<bool>();
+}
+void readSetting(const std::string& where, const std::string& key, const nlohmann::json* v,
+                 std::optional<double>& value) {
+  // null: the world config's (season_day).
+  if (v && v->is_null()) return void(value.reset());
+  double x = 0.0;
+  readSetting(where, key, v, x, true);
+  value = x;
 }
 void readSetting(const std::string& where, const std::string& key, const nlohmann::json* v,
                  std::optional<bool>& value) {
@@ -283,7 +291,7 @@ std::vector<SettingValue> settingValues(const ExperimentManifest& m) {
     }
     const nlohmann::json j = settingJson(value);
     std::string shown = j.is_string() ? j.get<std::string>() : j.dump();
-    if (j.is_null()) shown = "none (no limit)";
+    if (j.is_null()) shown = key == "season_day" ? "(the world config's)" : "none (no limit)";
     if (key == "engine" && shown.empty()) shown = "(each planner's own)";
     out.push_back({key, j, std::move(shown)});
   });

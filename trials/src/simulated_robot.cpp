@@ -6,6 +6,7 @@
 
 #include "fvp/robot/arm_model.h"
 #include "fvp/robot/sim/pose_error_model.h"
+#include "fvp/robot/sim/season_growth.h"
 #include "fvp/robot/sim/segmentation_model.h"
 #include "fvp/robot/sim/sim_clock.h"
 #include "fvp/robot/sim/simulated_arm.h"
@@ -44,16 +45,25 @@ std::vector<host::nbv::ClusterTarget> targetsOf(const World& world) {
   return targets;
 }
 
+WorldConfig worldConfigOf(const SimulatedRobotOptions& o) {
+  WorldConfig config =
+      o.world_config.empty() ? WorldConfig{} : WorldConfig::fromYamlFile(o.world_config);
+  if (o.season_day) {
+    config.season_day = *o.season_day;
+    config.validate("the visit's season_day (--season-day)");
+  }
+  return config;
+}
+
 }  // namespace
 
 struct SimulatedRobot::Impl {
   explicit Impl(const SimulatedRobotOptions& o)
-      : world(World::generate(
-            o.world_config.empty() ? WorldConfig{} : WorldConfig::fromYamlFile(o.world_config),
-            o.seed)),
+      : world(World::generate(worldConfigOf(o), o.seed)),
+        visit_seed(visitSeed(o.seed, world.config().season_day)),
         targets(targetsOf(world)) {
-    RenderConfig render_config = renderConfigFor(world.config(), {}, o.seed);
-    render_config.noise_seed = o.seed;
+    RenderConfig render_config = renderConfigFor(world.config(), {}, visit_seed);
+    render_config.noise_seed = visit_seed;
     renderer = std::make_unique<StereoRenderer>(world, render_config);
     if (!o.arm_config.empty()) arm_config = ArmConfig::fromYamlFile(o.arm_config);
     if (arm_config.workspace_cache_dir.empty()) arm_config.workspace_cache_dir = defaultCacheDir();
@@ -70,10 +80,10 @@ struct SimulatedRobot::Impl {
                                ": the start view is out of the arm's reach");
     sim_arm = std::make_unique<SimulatedArm>(*arm, *workspace, *clock, *start);
     // A fixed clock is for runs that repeat: then the moves must repeat too.
-    if (clock->mode() == SimClock::Mode::kFixed) sim_arm->setReproducibleMotionPlanning(o.seed);
-    pose_errors = std::make_unique<PoseErrorModel>(world.config(), o.seed);
-    wind = std::make_unique<WindModel>(world, o.seed);
-    segmentation = std::make_unique<SegmentationModel>(world.config(), o.seed);
+    if (clock->mode() == SimClock::Mode::kFixed) sim_arm->setReproducibleMotionPlanning(visit_seed);
+    pose_errors = std::make_unique<PoseErrorModel>(world.config(), visit_seed);
+    wind = std::make_unique<WindModel>(world, visit_seed);
+    segmentation = std::make_unique<SegmentationModel>(world.config(), visit_seed);
     camera = std::make_unique<SimulatedCamera>(
         *renderer, *clock,
         SimulatedErrors{pose_errors->enabled() ? pose_errors.get() : nullptr,
@@ -82,6 +92,7 @@ struct SimulatedRobot::Impl {
   }
 
   World world;
+  std::uint64_t visit_seed;
   std::vector<host::nbv::ClusterTarget> targets;
   std::unique_ptr<StereoRenderer> renderer;
   ArmConfig arm_config;

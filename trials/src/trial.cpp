@@ -393,6 +393,7 @@ struct Trial::Impl {
     SimulatedRobotOptions sim;
     sim.seed = options.seed;
     sim.world_config = options.world_config;
+    sim.season_day = options.season_day;
     sim.arm_config = options.arm_config;
     sim.clock = options.clock;
     sim.on_warning = [this](const std::string& text) { warn(text); };

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -44,13 +45,15 @@ void followCluster(int tag_id, const std::vector<SeasonVisit>& visits,
         const int l = a.later_of_earlier[e];
         track.gone = l < 0;
         if (l >= 0)
-          track.sizes.push_back({v, visits[v].day, c.fruitlets[std::size_t(l)], a.confidence[e]});
+          track.sizes.push_back(
+              {v, visits[v].day, c.fruitlets[std::size_t(l)], a.confidence[e], std::size_t(l)});
       }
       for (std::size_t l = 0; l < later.size(); ++l) {
         if (a.earlier_of_later[l] >= 0) continue;
         FruitletTrack track;
         track.tag_id = tag_id;
-        track.sizes.push_back({v, visits[v].day, c.fruitlets[l]});
+        track.sizes.push_back(
+            {v, visits[v].day, c.fruitlets[l], std::numeric_limits<double>::quiet_NaN(), l});
         cluster.tracks.push_back(out.tracks.size());
         out.tracks.push_back(std::move(track));
       }

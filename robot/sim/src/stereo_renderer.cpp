@@ -337,7 +337,9 @@ Eigen::Vector3d StereoRenderer::Impl::albedo(const Primitive& prim,
   switch (prim.kind) {
     case PrimitiveKind::kEllipsoid: {
       // Speckle in value only: hue and saturation stay the palette's.
-      const std::uint64_t seed = detail::hashCombine(kFruitSeed, prim.source_index);
+      // By identity: a fruitlet keeps its speckle when a neighbour falls off (A season).
+      const std::uint64_t seed =
+          detail::hashCombine(kFruitSeed, world.fruitlets()[prim.source_index].identity);
       const double fine = detail::fractalNoise(p / kFruitSpeckleM, seed, 2);
       const double coarse = detail::valueNoise(p / (4.0 * kFruitSpeckleM), seed + 1);
       const double value = 0.6 + 0.45 * (0.65 * fine + 0.35 * coarse);

@@ -151,6 +151,30 @@ nlohmann::ordered_json toJson(const Eigen::Matrix3d& m) {
   return rows;
 }
 
+nlohmann::ordered_json finiteOrNull(double v) {
+  return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr);
+}
+
+// The season's truth: each fruitlet's curve by identity, its size and whether it is on the
+// tree on `day`.
+nlohmann::ordered_json seasonJson(const SeasonGrowth& season, double day) {
+  nlohmann::ordered_json fruitlets = nlohmann::ordered_json::array();
+  for (const GrowthCurve& c : season.fruitlets) {
+    fruitlets.push_back({{"identity", c.identity},
+                         {"cluster", c.cluster},
+                         {"king", c.king},
+                         {"abscises", c.abscises},
+                         {"rate_mm_per_day", c.rate_mm_per_day},
+                         {"stops_growing_day", finiteOrNull(c.stops_growing_day)},
+                         {"falls_off_day", finiteOrNull(c.falls_off_day)},
+                         {"grown_mm", c.grownMm(day)},
+                         {"on_tree", c.onTree(day)}});
+  }
+  return {{"day", day},
+          {"fastest_growth_mm_per_day", season.fastest_mm_per_day},
+          {"fruitlets", fruitlets}};
+}
+
 // World::generate's pieces. The order of the draws is the world: a seed gives the same world
 // only while every piece draws from the sampler in the same order.
 
@@ -244,6 +268,7 @@ std::vector<Fruitlet> drawClusterFruitlets(const WorldConfig& config, const Bran
     for (int i = 0; i < count; ++i) {
       Fruitlet f;
       f.index = first_index + i;
+      f.identity = f.index;
       f.radius_m = rng.uniform(config.min_radius_m, config.max_radius_m);
       f.elongation = rng.uniform(config.min_elongation, config.max_elongation);
       f.R_world_fruitlet = rng.rotation();
@@ -471,7 +496,175 @@ void paintGreenFruitlets(const WorldConfig& config, std::uint64_t seed,
   }
 }
 
+// A season's pieces (World::grownTo; docs/simulation.md "A season").
+
+// Fruitlets that grew into each other beyond kMaxPressM (bounding spheres) push each other
+// apart, horizontally (they hang on their stems), half the excess each.
+void pressApart(std::vector<Fruitlet>& fruitlets) {
+  constexpr int kRelaxations = 50;
+  for (int round = 0; round < kRelaxations; ++round) {
+    bool moved = false;
+    for (std::size_t i = 0; i < fruitlets.size(); ++i) {
+      for (std::size_t j = i + 1; j < fruitlets.size(); ++j) {
+        Eigen::Vector3d apart = fruitlets[j].center_m - fruitlets[i].center_m;
+        const double excess = fruitlets[i].boundingRadius_m() + fruitlets[j].boundingRadius_m() -
+                              kMaxPressM - apart.norm();
+        if (excess <= 1e-9) continue;
+        apart.z() = 0.0;
+        // Stacked exactly above each other: apart along x (never happens with drawn centres).
+        const Eigen::Vector3d dir =
+            apart.norm() > 1e-12 ? Eigen::Vector3d(apart.normalized()) : Eigen::Vector3d::UnitX();
+        fruitlets[i].center_m -= 0.5 * excess * dir;
+        fruitlets[j].center_m += 0.5 * excess * dir;
+        moved = true;
+      }
+    }
+    if (!moved) break;
+  }
+}
+
+// The nearest point of a tag's plate to p.
+Eigen::Vector3d nearestPlatePoint(const Eigen::Vector3d& p_world, const AprilTagPlacement& tag) {
+  Eigen::Vector3d q = tag.T_world_tag.inverse() * p_world;
+  const double h = 0.5 * tag.plate_size_m;
+  q = Eigen::Vector3d(std::clamp(q.x(), -h, h), std::clamp(q.y(), -h, h), 0.0);
+  return tag.T_world_tag * q;
+}
+
+// Pushes a fruitlet straight away from `nearest` until it clears it by `clearance_m`.
+void pushClear(Fruitlet& f, const Eigen::Vector3d& nearest, double clearance_m) {
+  const Eigen::Vector3d away = f.center_m - nearest;
+  const double d = away.norm();
+  if (d >= clearance_m) return;
+  f.center_m += (clearance_m - d) * (d > 1e-12 ? Eigen::Vector3d(away / d)
+                                               : Eigen::Vector3d(-Eigen::Vector3d::UnitZ()));
+}
+
+// Grown fruitlets pressed apart, then pushed off every tag plate and branch (min_gap_m, as
+// on day 0); a few rounds, since a push may press a neighbour again.
+void settleFruitlets(std::vector<Fruitlet>& fruitlets, const std::vector<FruitletCluster>& clusters,
+                     const std::vector<BranchSegment>& branches, double gap_m) {
+  constexpr int kRounds = 5;
+  for (int round = 0; round < kRounds; ++round) {
+    pressApart(fruitlets);
+    for (Fruitlet& f : fruitlets) {
+      const double reach = f.boundingRadius_m() + gap_m;
+      for (const FruitletCluster& c : clusters)
+        pushClear(f, nearestPlatePoint(f.center_m, c.tag), reach);
+      for (const BranchSegment& b : branches) {
+        const Eigen::Vector3d axis = b.end_m - b.start_m;
+        const double t =
+            std::clamp((f.center_m - b.start_m).dot(axis) / axis.squaredNorm(), 0.0, 1.0);
+        pushClear(f, b.start_m + t * axis, reach + b.radius_m);
+      }
+    }
+  }
+}
+
+// A leaf grown by `scale` about its stalk and turned by angle_rad about axis there.
+Leaf grownLeaf(const Leaf& leaf, double scale, const Eigen::Vector3d& axis, double angle_rad) {
+  const Eigen::Vector3d stalk = leaf.attachment_m();
+  Leaf grown = leaf;
+  grown.half_length_m *= scale;
+  grown.half_width_m *= scale;
+  grown.curl_per_m /= scale;  // the same shape, larger: z = c x^2 scales with 1/size
+  grown.T_world_leaf.linear() =
+      Eigen::AngleAxisd(angle_rad, axis).toRotationMatrix() * leaf.T_world_leaf.linear();
+  // The stalk stays where it was.
+  grown.T_world_leaf.translation() += stalk - grown.attachment_m();
+  return grown;
+}
+
+bool leafClearOf(const Leaf& leaf, const std::vector<Fruitlet>& fruitlets, double gap_m,
+                 const Fruitlet** blocking) {
+  for (const Fruitlet& f : fruitlets) {
+    if (leaf.distanceLowerBound_m(f.center_m) < f.boundingRadius_m() + gap_m) {
+      *blocking = &f;
+      return false;
+    }
+  }
+  return true;
+}
+
+// Where a leaf may be on a later day: clear of the fruitlets, hiding no tag from its start
+// view, clear of every start camera (the day-0 rules).
+bool leafFits(const Leaf& leaf, const std::vector<Fruitlet>& fruitlets,
+              const std::vector<FruitletCluster>& clusters, double gap_m) {
+  const Fruitlet* blocking = nullptr;
+  if (!leafClearOf(leaf, fruitlets, gap_m, &blocking)) return false;
+  for (const FruitletCluster& c : clusters) {
+    const Eigen::Vector3d camera_m = c.T_world_start_camera.translation();
+    if (leafHidesTag(leaf, c.tag, camera_m) || (leaf.T_world_leaf.translation() - camera_m).norm() <
+                                                   kLeafCameraClearanceM + leaf.half_length_m)
+      return false;
+  }
+  return true;
+}
+
+// A leaf on `day`: grown and turned about its stalk where that fits, else grown only, else
+// as on day 0; a day-0 leaf the fruitlets grew into is pushed off them a millimetre at a time
+// (its stalk moves with it: the one case a leaf leaves its place).
+Leaf seasonLeaf(const Leaf& day0, const LeafGrowth& growth, double day,
+                const std::vector<Fruitlet>& fruitlets,
+                const std::vector<FruitletCluster>& clusters, double gap_m) {
+  const double scale = 1.0 + kLeafGrowthPerDay * day;
+  for (const Leaf& leaf :
+       {grownLeaf(day0, scale, growth.turn_axis, growth.turn_deg_per_day * day * kDegToRad),
+        grownLeaf(day0, scale, growth.turn_axis, 0.0)})
+    if (leafFits(leaf, fruitlets, clusters, gap_m)) return leaf;
+  Leaf leaf = day0;
+  constexpr int kPushSteps = 40;
+  constexpr double kPushStepM = 0.001;
+  const Fruitlet* blocking = nullptr;
+  for (int step = 0; step < kPushSteps && !leafClearOf(leaf, fruitlets, gap_m, &blocking); ++step) {
+    const Eigen::Vector3d away = leaf.T_world_leaf.translation() - blocking->center_m;
+    leaf.T_world_leaf.translation() +=
+        kPushStepM *
+        (away.norm() > 1e-12 ? Eigen::Vector3d(away.normalized()) : Eigen::Vector3d::UnitZ());
+  }
+  return leaf;
+}
+
 }  // namespace
+
+World World::grownTo(double day) const {
+  World grown = *this;
+  grown.config_.season_day = day;
+  std::vector<int> cluster_of_identity(fruitlets_.size(), 0);
+  for (const FruitletCluster& c : clusters_)
+    for (int i : c.fruitlet_indices) cluster_of_identity[i] = c.index;
+  grown.fruitlets_.clear();
+  std::vector<int> cluster_of;
+  for (const Fruitlet& f : fruitlets_) {
+    const GrowthCurve& curve = season_.fruitlets.at(f.identity);
+    if (!curve.onTree(day)) continue;
+    Fruitlet g = f;
+    const double grown_mm = curve.grownMm(day);
+    g.radius_m += 0.0005 * grown_mm;
+    g.center_m.z() -= kStemDroopMPerMm * grown_mm;
+    g.index = static_cast<int>(grown.fruitlets_.size());
+    grown.fruitlets_.push_back(g);
+    cluster_of.push_back(cluster_of_identity[f.identity]);
+  }
+  settleFruitlets(grown.fruitlets_, clusters_, branches_, config_.min_gap_m);
+  for (FruitletCluster& c : grown.clusters_) {
+    c.fruitlet_indices.clear();
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (std::size_t i = 0; i < grown.fruitlets_.size(); ++i) {
+      if (cluster_of[i] != c.index) continue;
+      c.fruitlet_indices.push_back(static_cast<int>(i));
+      sum += grown.fruitlets_[i].center_m;
+    }
+    // The start view stays where the robot would go: the cluster has not moved.
+    if (!c.fruitlet_indices.empty()) c.center_m = sum / double(c.fruitlet_indices.size());
+  }
+  for (std::size_t l = 0; l < leaves_.size(); ++l)
+    grown.leaves_[l] = seasonLeaf(leaves_[l], season_.leaves.at(l), day, grown.fruitlets_,
+                                  clusters_, config_.min_gap_m);
+  return grown;
+}
+
+namespace {}  // namespace
 
 double Leaf::distanceLowerBound_m(const Eigen::Vector3d& p_world_m) const {
   const Eigen::Vector3d q = T_world_leaf.inverse() * p_world_m;
@@ -524,6 +717,7 @@ World World::fromParts(std::vector<Fruitlet> fruitlets, std::vector<Leaf> leaves
       throw std::invalid_argument("World::fromParts: fruitlet indices must be 0..n-1 in order");
     }
   }
+  for (Fruitlet& f : fruitlets) f.identity = f.index;
   for (std::size_t i = 0; i < leaves.size(); ++i) {
     if (leaves[i].index != static_cast<int>(i)) {
       throw std::invalid_argument("World::fromParts: leaf indices must be 0..n-1 in order");
@@ -576,7 +770,8 @@ World World::generate(const WorldConfig& config, std::uint64_t seed) {
   world.leaves_ = std::move(tree.leaves);
   world.branches_ = std::move(tree.branches);
   world.has_tag_ = true;
-  return world;
+  world.season_ = drawSeasonGrowth(world, seed);
+  return config.season_day > 0.0 ? world.grownTo(config.season_day) : world;
 }
 
 std::string World::groundTruthJson() const {
@@ -587,6 +782,7 @@ std::string World::groundTruthJson() const {
   json["fruitlets"] = nlohmann::ordered_json::array();
   for (const Fruitlet& f : fruitlets_) {
     json["fruitlets"].push_back({{"index", f.index},
+                                 {"identity", f.identity},
                                  {"object_id", kFirstFruitletId + f.index},
                                  {"center_m", toJson(f.center_m)},
                                  {"gt_size_mm", f.gtSizeMm()},
@@ -628,6 +824,7 @@ std::string World::groundTruthJson() const {
                               {"half_width_m", l.half_width_m},
                               {"curl_per_m", l.curl_per_m}});
   }
+  json["season"] = seasonJson(season_, config_.season_day);
   return json.dump(2);
 }
 

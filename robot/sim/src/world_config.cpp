@@ -85,6 +85,11 @@ const std::vector<KeySpec>& keySpecs() {
       {"segmentation_false_blobs", &WorldConfig::segmentation_false_blobs, 0.0, 20.0},
       // Ten times the flash saturates every lit surface: no camera would be exposed so.
       {"sun_strength", &WorldConfig::sun_strength, 0.0, 10.0},
+      {"season_day", &WorldConfig::season_day, 0.0, kMaxSeasonDay},
+      {"min_fastest_growth_mm_per_day", &WorldConfig::min_fastest_growth_mm_per_day, 0.0, 3.0},
+      {"max_fastest_growth_mm_per_day", &WorldConfig::max_fastest_growth_mm_per_day, 0.0, 3.0,
+       "min_fastest_growth_mm_per_day"},
+      {"abscission_probability", &WorldConfig::abscission_probability, 0.0, 1.0},
       {"run_register_views", &WorldConfig::run_register_views, 0, 1},
   };
   return specs;

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,7 +30,11 @@ namespace fvp::trials {
 struct SimulatedRobotOptions {
   std::uint64_t seed = 1;              ///< the world, its noise and its errors
   std::filesystem::path world_config;  ///< empty: robot/sim/config/world_default.yaml's values
-  std::filesystem::path arm_config;    ///< empty: the built-in arm
+  /// The season's day to visit (docs/simulation.md "A season"): overrides the world config's
+  /// season_day. The world is the seed's, grown; what a visit draws anew (noise, wind, light,
+  /// pose and segmentation errors, motion planning) comes from robot::sim::visitSeed.
+  std::optional<double> season_day;
+  std::filesystem::path arm_config;  ///< empty: the built-in arm
   /// "wall": compute charged as measured; "fixed": as constants, and motion planning
   /// reproducible (the same run on any machine).
   robot::sim::SimClock::Mode clock = robot::sim::SimClock::Mode::kWall;

@@ -36,7 +36,10 @@ struct TrialProgress {
 struct TrialOptions {
   std::string planner = "fvp";  ///< "fvp" or "rvp"
   std::uint64_t seed = 1;
-  std::filesystem::path world_config;    ///< empty: robot/sim/config/world_default.yaml
+  std::filesystem::path world_config;  ///< empty: robot/sim/config/world_default.yaml
+  /// The season's day to visit (docs/simulation.md "A season"); none: the world config's
+  /// season_day.
+  std::optional<double> season_day;
   std::filesystem::path planner_config;  ///< empty: the planner's default config
   std::filesystem::path arm_config;  ///< empty: the built-in arm (robot/config/arm_default.yaml)
   double budget_s = 180.0;           ///< simulated seconds (paper: 180)

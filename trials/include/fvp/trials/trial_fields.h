@@ -18,6 +18,14 @@ using host::nbv::RunField;
 inline constexpr RunField kWorldConfig{
     "world_config", "--world", "world config YAML (default: robot/sim/config/world_default.yaml)",
     FieldVocabulary::kConfigFile};
+inline constexpr RunField kSeasonDay{
+    "season_day",
+    "--season-day",
+    "the season's day to visit: the world grown that many days after the first visit "
+    "(docs/simulation.md \"A season\"; default: the world config's season_day)",
+    FieldVocabulary::kNone,
+    false,
+    true};
 inline constexpr RunField kArmConfig{
     "arm_config", "--arm", "arm config YAML (default: built-in, robot/config/arm_default.yaml)",
     FieldVocabulary::kConfigFile};
@@ -36,6 +44,7 @@ void visitTrialFields(Options& o, Visitor&& visit) {
   visit(f::kPlanner, o.planner);
   visit(f::kSeed, o.seed);
   visit(t::kWorldConfig, o.world_config);
+  visit(t::kSeasonDay, o.season_day);
   visit(f::kPlannerConfig, o.planner_config);
   visit(t::kArmConfig, o.arm_config);
   visit(f::kBudget, o.budget_s);

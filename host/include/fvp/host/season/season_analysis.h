@@ -28,6 +28,8 @@ struct TrackedSize {
   SizedFruitlet sized;
   /// The association's confidence in linking it to the track's earlier size; NaN first.
   double association_confidence = std::numeric_limits<double>::quiet_NaN();
+  /// Its place among that visit's cluster's fruitlets (a result's sized_fruitlets order).
+  std::size_t index_in_visit = 0;
 };
 
 /// One fruitlet over the season: its sizes, its growth rate and its predicted fate.

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "fvp/robot/sim/object_ids.h"
+#include "fvp/robot/sim/season_growth.h"
 #include "fvp/robot/sim/world_config.h"
 
 namespace fvp::robot::sim {
@@ -24,6 +25,9 @@ namespace fvp::robot::sim {
 /// An ellipsoid fruitlet with semi-axes (r, r, e*r) along the columns of R_world_fruitlet.
 struct Fruitlet {
   int index = 0;  ///< 0-based; object id is kFirstFruitletId + index
+  /// Its index on the season's day 0 (World::generate; the same as index on day 0 and in
+  /// fromParts worlds): how a fruitlet is known across a season's visits.
+  int identity = 0;
   Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
   Eigen::Matrix3d R_world_fruitlet = Eigen::Matrix3d::Identity();
   double radius_m = 0.0;                          ///< r: equatorial semi-axis
@@ -124,10 +128,20 @@ class World {
   /// pose). Throws std::invalid_argument if the counts or indices differ.
   World withMovedParts(std::vector<Fruitlet> fruitlets, std::vector<Leaf> leaves) const;
 
-  /// Ground truth as JSON text (seed, config, fruitlets with centre / size, tag pose).
+  /// The season this world grows through (season_growth.h): its fruitlets' growth curves
+  /// by identity, its leaves' growth. Empty for a fromParts world.
+  const SeasonGrowth& seasonGrowth() const { return season_; }
+
+  /// Ground truth as JSON text (seed, config, fruitlets with centre / size, tag pose; the
+  /// season's growth curves in "season").
   std::string groundTruthJson() const;
 
  private:
+  /// This day-0 world as it has grown by `day` (docs/simulation.md "A season"): fallen
+  /// fruitlets removed and the rest renumbered (identity kept), grown, drooped and pressed
+  /// apart; leaves grown, turned and pushed off the fruitlets; tags and branches unchanged.
+  World grownTo(double day) const;
+
   WorldConfig config_;
   std::uint64_t seed_ = 0;
   std::vector<Fruitlet> fruitlets_;
@@ -135,6 +149,7 @@ class World {
   std::vector<BranchSegment> branches_;
   std::vector<FruitletCluster> clusters_{1};
   bool has_tag_ = false;
+  SeasonGrowth season_;
 };
 
 }  // namespace fvp::robot::sim

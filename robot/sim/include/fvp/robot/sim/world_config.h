@@ -11,6 +11,10 @@
 
 namespace fvp::robot::sim {
 
+/// The last day a season may be visited (season_day's range): by then the fruitlets are
+/// apples and the thinning decision long made.
+inline constexpr double kMaxSeasonDay = 60.0;
+
 struct WorldConfig {
   // Cluster
   int min_fruitlets = 3;
@@ -99,6 +103,17 @@ struct WorldConfig {
   /// flash's at its full-scale distance (0: the flash alone); its direction is drawn per
   /// trial, and the sky adds kSkyToSunRatio of it as diffuse light.
   double sun_strength = 0.0;
+  // A season (docs/simulation.md "A season"): the world as it has grown season_day days after
+  // the first visit; 0 is the world as generated. The growth draws come from a stream of
+  // their own, so the day-0 world is the same for any season keys.
+  double season_day = 0.0;
+  /// The diameter growth rate of the season's fastest-growing fruitlets, drawn per world
+  /// (every cluster of a tree shares the weather): about 1 mm a day in a warm week, 0.4 in a
+  /// cold one.
+  double min_fastest_growth_mm_per_day = 0.4;
+  double max_fastest_growth_mm_per_day = 1.0;
+  /// The chance that a fruitlet other than its cluster's king (its largest) is bound to drop.
+  double abscission_probability = 0.6;
   /// How the world is meant to be run, not how it is built: 1 = with view registration
   /// (`fvp run --register-views`), what a preset with pose errors needs; a run that says
   /// --register-views or --no-register-views decides itself.

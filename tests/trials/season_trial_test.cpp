@@ -1,0 +1,101 @@
+// A simulated season (trials/season_trial.h): visits of one tree on two days, each a trial of
+// the grown world; with a fixed clock the season repeats exactly; the season experiment keeps
+// finished seasons only on --resume and only with the same settings and days. One view a
+// cluster keeps it short.
+#include "fvp/trials/season_trial.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+namespace fvp::trials {
+namespace {
+
+class SeasonTrial : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("fvp_season_trial_test_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+    std::ofstream(dir_ / "tree.yaml") << "cluster_count: 2\nleaf_count: 10\nmin_radius_m: 0.003\n"
+                                         "max_radius_m: 0.005\n";
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  SeasonExperimentOptions options(const std::string& out) const {
+    SeasonExperimentOptions o;
+    o.season.visit.world_config = dir_ / "tree.yaml";
+    o.season.visit.backend = accel::BackendChoice::kCpu;
+    o.season.visit.clock = robot::sim::SimClock::Mode::kFixed;
+    o.season.visit.max_views = 1;
+    o.season.days = {0.0, 5.0};
+    o.seasons = 1;
+    o.first_seed = 3;
+    o.out_dir = dir_ / out;
+    return o;
+  }
+
+  static nlohmann::json withoutWallTime(nlohmann::json line) {
+    for (auto& v : line["visits"]) v.erase("wall_time_s");
+    return line;
+  }
+
+  std::filesystem::path dir_;
+};
+
+TEST_F(SeasonTrial, RepeatsExactlyAndResumesOnlyWhatItWouldRun) {
+  const SeasonExperimentOptions first = options("a");
+  const nlohmann::json summary = runSeasonExperiment(first);
+  EXPECT_EQ(summary["seasons"], 1);
+  const std::filesystem::path season = first.out_dir / "season-3";
+  for (const char* file : {"day-0/result.json", "day-5/result.json", "season.json",
+                           "season_score.json", "../summary.json", "../table.md"})
+    EXPECT_TRUE(std::filesystem::exists(season / file)) << file;
+  const std::vector<nlohmann::json> lines = readSeasons(first.out_dir);
+  ASSERT_EQ(lines.size(), 1u);
+  const nlohmann::json& line = lines.front();
+  ASSERT_EQ(line["visits"].size(), 2u);
+  EXPECT_EQ(line["visits"][1]["day"], 5.0);
+  // The later visit saw the grown tree: its truth is of day 5.
+  std::ifstream day5(season / "day-5/result.json");
+  EXPECT_EQ(nlohmann::json::parse(day5)["settings"]["season_day"], 5.0);
+  EXPECT_GT(line["score"]["fruitlets"].get<int>(), 0);
+
+  // The same season again, elsewhere: the same line, wall times aside.
+  SeasonTrialOptions again = first.season;
+  again.visit.seed = 3;
+  again.out_dir = dir_ / "b";
+  EXPECT_EQ(withoutWallTime(runSeasonTrial(again)), withoutWallTime(line));
+
+  // Finished seasons: kept on --resume, an error without it or with other days.
+  EXPECT_THROW(runSeasonExperiment(first), std::runtime_error);
+  SeasonExperimentOptions resume = first;
+  resume.resume = true;
+  EXPECT_EQ(runSeasonExperiment(resume)["seasons"], 1);
+  resume.season.days = {0.0, 6.0};
+  try {
+    runSeasonExperiment(resume);
+    FAIL() << "resumed a season of other days";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("days"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SeasonDays, AreCheckedNamingTheDay) {
+  EXPECT_THROW(checkSeasonDays({0.0}), std::invalid_argument);
+  EXPECT_THROW(checkSeasonDays({0.0, 4.0, 4.0}), std::invalid_argument);
+  EXPECT_THROW(checkSeasonDays({0.0, 61.0}), std::invalid_argument);
+  EXPECT_THROW(checkSeasonDays({-1.0, 4.0}), std::invalid_argument);
+  EXPECT_NO_THROW(checkSeasonDays({0.0, 3.5, 7.0}));
+  try {
+    checkSeasonDays({0.0, 7.0, 4.0});
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("4"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace fvp::trials
