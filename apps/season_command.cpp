@@ -15,6 +15,9 @@
 #include "fvp/host/core/number_text.h"
 #include "fvp/host/core/output_directory.h"
 #include "fvp/host/season/season_analysis.h"
+#ifndef FVP_CLI_PARSE_ONLY
+#include "fvp/host/report/season_report.h"
+#endif
 
 namespace fvp::apps {
 namespace {
@@ -88,8 +91,12 @@ void addSeasonCommand(CLI::App& app) {
     const host::OutputDirectoryLock lock(opt->out, "--out");
     host::writeFileAtomically(std::filesystem::path(opt->out) / "season.json", "season",
                               host::season::seasonJson(season, config).dump(2) + "\n");
+    const bool drawn = host::report::writeSeasonReport(
+        season, opt->out,
+        [](const std::string& line) { std::cerr << "fvp: warning: " << line << "\n"; });
     printSeason(season);
-    std::cout << "wrote " << opt->out << "/season.json\n";
+    std::cout << "wrote " << opt->out << "/{season.json, season.md" << (drawn ? ", season.png" : "")
+              << "}\n";
   });
 }
 

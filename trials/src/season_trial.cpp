@@ -9,6 +9,7 @@
 
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/host/core/output_directory.h"
+#include "fvp/host/report/season_report.h"
 #include "fvp/host/season/season_visit.h"
 #include "fvp/robot/sim/world.h"
 #include "fvp/robot/sim/world_config.h"
@@ -122,6 +123,7 @@ nlohmann::json runSeasonTrial(const SeasonTrialOptions& o) {
   if (!o.out_dir.empty()) {
     host::writeFileAtomically(o.out_dir / "season.json", "season",
                               host::season::seasonJson(analysis, o.season).dump(2) + "\n");
+    host::report::writeSeasonReport(analysis, o.out_dir, o.progress);
     host::writeFileAtomically(o.out_dir / "season_score.json", "season score", line.dump(2) + "\n");
   }
   return line;
