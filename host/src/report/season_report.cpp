@@ -86,7 +86,8 @@ std::string seasonFigureScript(const season::SeasonAnalysis& s) {
   std::ostringstream gp;
   gp << "set terminal pngcairo size " << 520 * columns << ","
      << 360 * std::max<std::size_t>(rows, 1) << " font 'DejaVu Sans,10'\nset multiplot layout "
-     << std::max<std::size_t>(rows, 1) << "," << columns
+     << std::max<std::size_t>(rows, 1) << "," << columns << " title "
+     << gnuplotQuoted("size against day: green persists / red abscises / grey gone / black unknown")
      << "\nset xlabel 'day'\nset ylabel 'size (mm)'\nset grid\nunset key\n";
   for (std::size_t p = 0; p < panels; ++p) {
     const season::ClusterSeason& c = s.clusters[p];
