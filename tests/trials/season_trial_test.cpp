@@ -63,6 +63,14 @@ TEST_F(SeasonTrial, RepeatsExactlyAndResumesOnlyWhatItWouldRun) {
   std::ifstream day5(season / "day-5/result.json");
   EXPECT_EQ(nlohmann::json::parse(day5)["settings"]["season_day"], 5.0);
   EXPECT_GT(line["score"]["fruitlets"].get<int>(), 0);
+  // Every visit placed its clusters in their tags' frames (the start view sees each tag).
+  std::ifstream season_json(season / "season.json");
+  const nlohmann::json analysis = nlohmann::json::parse(season_json);
+  ASSERT_EQ(analysis["clusters"].size(), 2u);
+  for (const auto& c : analysis["clusters"]) {
+    EXPECT_EQ(c["visits_with_tag"], 2) << c.dump();
+    EXPECT_FALSE(c["fruitlets"].empty()) << c.dump();
+  }
 
   // The same season again, elsewhere: the same line, wall times aside.
   SeasonTrialOptions again = first.season;

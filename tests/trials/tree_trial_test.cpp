@@ -133,6 +133,9 @@ TEST_F(TreeTrial, VisitsEveryClusterOnceAndSkipsOneItCannotReach) {
     EXPECT_EQ(c["fruitlets"].size(),
               world.clusters()[c["index"].get<std::size_t>()].fruitlet_indices.size());
     EXPECT_TRUE(std::filesystem::exists(o.out_dir / ("cluster_" + c["index"].dump()) / "mesh.ply"));
+    // The tag's frame, in which a later visit finds the same fruitlets (docs/season.md).
+    EXPECT_TRUE(c.contains("T_world_tag")) << "cluster " << c["index"];
+    for (const auto& f : c["sized_fruitlets"]) EXPECT_TRUE(f.contains("center_tag_m"));
   }
   EXPECT_EQ(r["views"], views);
   // Every fruitlet of the tree is scored once, the blocked cluster's as missed.

@@ -733,7 +733,7 @@ void Trial::Impl::recordCluster(const host::nbv::ClusterVisit& visit, TrialParts
       entry[key] = std::move(tagged);
     } else if (key == "detections" || key.rfind("metrics", 0) == 0 || key == "sizing_estimator" ||
                key == "unsupported_detections" || key == "sized_fruitlets" ||
-               key == "sizing_stats") {
+               key == "sizing_stats" || key == "T_world_tag") {
       entry[key] = value;
     }
   }
