@@ -141,6 +141,20 @@ TEST(SeasonScore, AFruitletMissedOnTheLastVisitIsWronglyGone) {
   }
 }
 
+TEST(SeasonScore, ASpuriousDetectionsLinkIsCountedApart) {
+  Season season(1, {0.0, 4.0});
+  // A false blob on a leaf, sized on both days at one place in tag 0's frame, matched to no
+  // fruitlet: the analysis links it, and the score keeps that link out of the association's.
+  for (auto& result : season.results)
+    result["clusters"][0]["sized_fruitlets"].push_back({{"center_tag_m", {0.0, 0.05, 0.01}},
+                                                        {"size_mm", 7.0},
+                                                        {"support", {{"size_stderr_mm", 0.05}}}});
+  const nlohmann::json s = season.score();
+  EXPECT_EQ(s["association"]["links_with_spurious"], 1);
+  EXPECT_EQ(s["association"]["links_correct"], s["association"]["links_made"]);
+  EXPECT_EQ(s["association"]["truth_links_found"], s["association"]["truth_links"]);
+}
+
 TEST(SeasonScore, AWorldOfAnotherDayIsRefused) {
   Season season(1, {0.0, 4.0});
   season.worlds[1] = World::generate(seasonTree(5.0), 1);

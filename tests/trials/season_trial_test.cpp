@@ -78,6 +78,14 @@ TEST_F(SeasonTrial, RepeatsExactlyAndResumesOnlyWhatItWouldRun) {
   again.out_dir = dir_ / "b";
   EXPECT_EQ(withoutWallTime(runSeasonTrial(again)), withoutWallTime(line));
 
+  // A season cut short keeps its finished visits on resume: rescored from them, the same.
+  std::filesystem::remove(season / "season_score.json");
+  std::filesystem::remove(season / "day-5" / "result.json");
+  SeasonExperimentOptions cut = first;
+  cut.resume = true;
+  runSeasonExperiment(cut);
+  EXPECT_EQ(withoutWallTime(readSeasons(first.out_dir).front()), withoutWallTime(line));
+
   // Finished seasons: kept on --resume, an error without it or with other days.
   EXPECT_THROW(runSeasonExperiment(first), std::runtime_error);
   SeasonExperimentOptions resume = first;

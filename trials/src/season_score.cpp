@@ -98,15 +98,20 @@ nlohmann::json numberOrNull(double v) {
 }
 
 /// Links the tracks made (one size to the next) against the truth's (a fruitlet's consecutive
-/// sightings).
+/// sightings). A link with a spurious end (a detection of no fruitlet) is a detection's error,
+/// not the association's: counted apart, outside correct_percent.
 nlohmann::json associationScore(const Scoring& s) {
-  std::size_t made = 0, correct = 0, truth_links = 0, found = 0;
+  std::size_t made = 0, correct = 0, with_spurious = 0, truth_links = 0, found = 0;
   std::set<std::tuple<int, std::size_t, std::size_t>> correct_links;
   for (const FruitletTrack& t : s.analysis.tracks)
     for (std::size_t k = 1; k < t.sizes.size(); ++k) {
-      ++made;
       const int a = s.identityOf(t, t.sizes[k - 1]), b = s.identityOf(t, t.sizes[k]);
-      if (a < 0 || a != b) continue;
+      if (a < 0 || b < 0) {
+        ++with_spurious;
+        continue;
+      }
+      ++made;
+      if (a != b) continue;
       ++correct;
       correct_links.insert({a, t.sizes[k - 1].visit, t.sizes[k].visit});
     }
@@ -120,6 +125,7 @@ nlohmann::json associationScore(const Scoring& s) {
     }
   return {{"links_made", made},
           {"links_correct", correct},
+          {"links_with_spurious", with_spurious},
           {"truth_links", truth_links},
           {"truth_links_found", found},
           {"correct_percent", numberOrNull(percent(correct, made))},

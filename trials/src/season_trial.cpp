@@ -4,6 +4,7 @@
 #include <fstream>
 #include <iomanip>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -45,6 +46,23 @@ nlohmann::json visitFigures(double day, const nlohmann::json& result) {
 }
 
 }  // namespace
+
+/// A visit's result.json already in its directory (a season cut short), when it is this
+/// visit's: the same settings, seed and day; another is an error naming the file.
+std::optional<nlohmann::json> finishedVisit(const TrialOptions& visit) {
+  const fs::path file = visit.out_dir / "result.json";
+  if (visit.out_dir.empty() || !fs::exists(file)) return std::nullopt;
+  std::ifstream in(file);
+  const nlohmann::json result = nlohmann::json::parse(in, nullptr, false);
+  TrialOptions resolved = visit;
+  resolved.register_views = registerViewsOf(visit);
+  if (result.is_discarded() || !result.is_object() ||
+      result.value("settings", nlohmann::json()) != nlohmann::json(trialSettingsJson(resolved)))
+    throw std::runtime_error(file.string() +
+                             ": not this visit's result (another seed, day or settings); "
+                             "another --out");
+  return result;
+}
 
 void checkSeasonDays(const std::vector<double>& days) {
   if (days.size() < 2)
@@ -97,7 +115,8 @@ nlohmann::json runSeasonTrial(const SeasonTrialOptions& o) {
     TrialOptions visit = o.visit;
     visit.season_day = day;
     if (!o.out_dir.empty()) visit.out_dir = o.out_dir / ("day-" + dayText(day));
-    results.push_back(runTrial(visit));
+    results.push_back(o.reuse_visits ? finishedVisit(visit).value_or(runTrial(visit))
+                                     : runTrial(visit));
     config.season_day = day;
     worlds.push_back(robot::sim::World::generate(config, o.visit.seed));
     const std::string source = visit.out_dir.empty() ? "visit of day " + dayText(day)
@@ -204,6 +223,7 @@ nlohmann::json summarizeSeasons(const std::vector<nlohmann::json>& seasons) {
   return {{"seasons", seasons.size()},
           {"association_correct_percent",
            ratio(p.at("association.links_correct"), p.at("association.links_made"))},
+          {"association_links_with_spurious", p.at("association.links_with_spurious")},
           {"association_found_percent",
            ratio(p.at("association.truth_links_found"), p.at("association.truth_links"))},
           {"gone_reported_percent", ratio(p.at("gone.reported_gone"), p.at("gone.fallen_sized"))},
@@ -271,6 +291,7 @@ nlohmann::json runSeasonExperiment(const SeasonExperimentOptions& o) {
   const nlohmann::json settings = seasonSettings(o.season);
   for (int k = o.shard_index; k < o.seasons; k += o.shard_count) {
     SeasonTrialOptions season = o.season;
+    season.reuse_visits = o.resume;
     season.visit.seed = o.first_seed + std::uint64_t(k);
     season.out_dir = o.out_dir / ("season-" + std::to_string(season.visit.seed));
     const fs::path done = season.out_dir / "season_score.json";

@@ -28,6 +28,10 @@ struct SeasonTrialOptions {
   /// writes it) and DIR/season_score.json; empty: nothing written.
   std::filesystem::path out_dir;
   std::function<void(const std::string&)> progress;  ///< a line per visit
+  /// Keep a visit whose result.json is already in its directory (the same settings, seed and
+  /// day; another is an error) instead of running it again: a season cut short resumes, and
+  /// a finished one is rescored after its season_score.json is removed.
+  bool reuse_visits = false;
 };
 
 /// The days' check: two or more, finite, increasing, within season_day's range. Throws
@@ -53,7 +57,8 @@ struct SeasonExperimentOptions {
 /// writes summary.json and table.md over every finished season in out_dir (so shards run into
 /// one directory make one report). A season already finished there is skipped with resume
 /// when its settings and days are these (else an error naming the first that differs), and
-/// is an error without. Returns the summary.
+/// is an error without; with resume, an unfinished season keeps its finished visits
+/// (SeasonTrialOptions::reuse_visits). Returns the summary.
 nlohmann::json runSeasonExperiment(const SeasonExperimentOptions& options);
 
 /// The finished seasons' lines in a directory (season-*/season_score.json), by seed.
