@@ -27,3 +27,18 @@ def test_two_visits_of_a_tree_match_the_command(fvp_exe, tmp_path):
 def test_a_missing_visit_is_an_error_naming_it():
     with pytest.raises(RuntimeError, match="no_such_visit.json: no such file or directory"):
         fvp.season([(0.0, os.path.join(DATA, "tree_day0.json")), (4.0, "/nonexistent/no_such_visit.json")])
+
+
+def test_the_simulated_robot_visits_the_tree_on_a_later_day():
+    """fvp.sim.Robot(season_day=D): the same tree grown D days (docs/simulation.md "A season"):
+    its clusters' start views stay, their fruitlets' centroids move (grown, drooped, some
+    fallen); a day past the season's range is refused naming the key."""
+    tree = os.path.join(os.environ.get("FVP_SOURCE_DIR", "."), "robot/sim/config/world_season.yaml")
+    day0 = fvp.sim.Robot(seed=3, world_config=tree, season_day=0.0)
+    day7 = fvp.sim.Robot(seed=3, world_config=tree, season_day=7.0)
+    assert len(day0.targets) == len(day7.targets) == 4
+    for a, b in zip(day0.targets, day7.targets):
+        assert (a.T_world_start_camera == b.T_world_start_camera).all()
+        assert not (a.center_m == b.center_m).all()
+    with pytest.raises(ValueError, match="season_day"):
+        fvp.sim.Robot(seed=3, world_config=tree, season_day=99.0)
