@@ -129,5 +129,40 @@ TEST(SeasonAnalysis, AVisitWithoutTheTagLeavesTheFruitletsAndTwoOnOneDayAreRefus
   EXPECT_THROW(analyzeSeason({day0, day0}), std::invalid_argument);
 }
 
+TEST(SeasonAnalysis, OneSightingBetweenTheFirstAndLastVisitIsUnconfirmedNotGone) {
+  // Fruitlet A on every visit; B only on day 4 (a false blob, most likely: no fruitlet appears
+  // after bloom); C only on day 0 (fell off, or hidden since: gone).
+  const auto visit = [](double day, const std::string& fruitlets) {
+    return parseSeasonVisit(R"({"T_world_tag": {}, "sized_fruitlets": [)" + fruitlets + "]}",
+                            "day" + std::to_string(int(day)), day);
+  };
+  const std::string a0 = R"({"center_tag_m": [0, 0, 0.05], "size_mm": 7})";
+  const std::string c0 = R"({"center_tag_m": [-0.02, 0, 0.05], "size_mm": 6})";
+  const SeasonAnalysis s = analyzeSeason(
+      {visit(0, a0 + "," + c0),
+       visit(
+           4,
+           R"({"center_tag_m": [0, 0, 0.05], "size_mm": 9}, {"center_tag_m": [0.02, 0, 0.05], "size_mm": 7})"),
+       visit(7, R"({"center_tag_m": [0, 0, 0.05], "size_mm": 11})")});
+  ASSERT_EQ(s.tracks.size(), 3u);
+  int unconfirmed = 0, gone = 0;
+  for (const FruitletTrack& t : s.tracks) {
+    unconfirmed += t.unconfirmed;
+    gone += t.gone;
+    if (t.unconfirmed) {
+      EXPECT_EQ(t.sizes.front().day, 4.0);
+    }
+    if (t.gone) {
+      EXPECT_EQ(t.sizes.front().day, 0.0);
+    }
+  }
+  EXPECT_EQ(unconfirmed, 1);
+  EXPECT_EQ(gone, 1);
+  EXPECT_EQ(s.fruit_set.unconfirmed, 1u);
+  EXPECT_EQ(s.fruit_set.gone, 1u);
+  EXPECT_EQ(s.fruit_set.persisting, 1u);
+  EXPECT_NEAR(s.fruit_set.percent, 50.0, 1e-6);  // A stays, C dropped; B not counted
+}
+
 }  // namespace
 }  // namespace fvp::host::season

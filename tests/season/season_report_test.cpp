@@ -30,7 +30,8 @@ TEST(SeasonReport, EveryClusterAndFruitletWithItsFate) {
     rows += c.tracks.size();
   }
   std::size_t fates = 0;
-  for (const char* word : {"| persists |", "| abscises |", "| gone |", "| unknown |"})
+  for (const char* word :
+       {"| persists |", "| abscises |", "| gone |", "| unknown |", "| unconfirmed |"})
     for (std::size_t at = md.find(word); at != std::string::npos; at = md.find(word, at + 1))
       ++fates;
   EXPECT_EQ(fates, rows);

@@ -221,6 +221,7 @@ struct Confusion {
 };
 
 std::optional<bool> dropsOf(const FruitletTrack& t) {
+  if (t.unconfirmed) return std::nullopt;
   if (t.gone) return true;
   if (t.fate.fate == Fate::kUnknown) return std::nullopt;
   return t.fate.fate == Fate::kAbscises;

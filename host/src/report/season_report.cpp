@@ -15,6 +15,7 @@ using season::FruitletTrack;
 
 /// What a track's fate reads as in the report: gone first (its fate is known).
 const char* fateWord(const FruitletTrack& t) {
+  if (t.unconfirmed) return "unconfirmed";
   return t.gone ? "gone" : season::toString(t.fate.fate);
 }
 

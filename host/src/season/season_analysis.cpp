@@ -16,6 +16,24 @@ void SeasonConfig::validate() const {
 
 namespace {
 
+/// Tracks sized on one visit between the cluster's first and last that saw its tag: a
+/// fruitlet that appeared after the first visit and was gone by the last.
+void markUnconfirmed(const ClusterSeason& cluster, const std::vector<SeasonVisit>& visits,
+                     std::vector<FruitletTrack>& tracks) {
+  std::vector<std::size_t> seen;  // the visits that saw the cluster's tag
+  for (std::size_t v = 0; v < visits.size(); ++v)
+    for (const VisitCluster& c : visits[v].clusters)
+      if (c.tag_id == cluster.tag_id && c.tag_seen) seen.push_back(v);
+  for (const std::size_t t : cluster.tracks) {
+    FruitletTrack& track = tracks[t];
+    const std::size_t v = track.sizes.front().visit;
+    if (track.sizes.size() == 1 && !seen.empty() && v != seen.front() && v != seen.back()) {
+      track.unconfirmed = true;
+      track.gone = false;
+    }
+  }
+}
+
 /// Follows one cluster's fruitlets over the visits: each visit that saw the tag is associated
 /// with the last size of every track so far (tracks missed once stay, to be found again); the
 /// unpaired fruitlets start tracks; a track not found on the cluster's latest visit is gone.
@@ -58,6 +76,7 @@ void followCluster(int tag_id, const std::vector<SeasonVisit>& visits,
         out.tracks.push_back(std::move(track));
       }
     }
+  markUnconfirmed(cluster, visits, out.tracks);
   out.clusters.push_back(std::move(cluster));
 }
 
@@ -68,6 +87,10 @@ FruitSet fruitSetOf(const std::vector<FruitletTrack>& tracks,
   double expected = 0.0, variance = 0.0;
   for (const std::size_t i : indices) {
     const FruitletTrack& t = tracks[i];
+    if (t.unconfirmed) {
+      ++set.unconfirmed;
+      continue;
+    }
     if (t.gone) {
       ++set.gone;
       continue;

@@ -19,7 +19,8 @@ json fruitSetJson(const FruitSet& s) {
           {"persisting", s.persisting},
           {"abscising", s.abscising},
           {"gone", s.gone},
-          {"unknown", s.unknown}};
+          {"unknown", s.unknown},
+          {"unconfirmed", s.unconfirmed}};
 }
 
 json trackJson(const FruitletTrack& t, std::size_t id) {
@@ -38,7 +39,10 @@ json trackJson(const FruitletTrack& t, std::size_t id) {
           {"growth_rate_mm_per_day", numberOrNull(t.rate.mm_per_day)},
           {"growth_rate_standard_error_mm_per_day", numberOrNull(t.rate.standard_error_mm_per_day)},
           {"gone", t.gone},
-          {"fate", t.gone ? "gone" : toString(t.fate.fate)},
+          {"unconfirmed", t.unconfirmed},
+          {"fate", t.unconfirmed ? "unconfirmed"
+                   : t.gone      ? "gone"
+                                 : toString(t.fate.fate)},
           {"persist_probability", t.gone ? json(0.0) : numberOrNull(t.fate.persist_probability)}};
 }
 

@@ -39,6 +39,10 @@ struct FruitletTrack {
   /// Not found on the cluster's last visit that saw its tag: fell off (or hidden); counted
   /// as not set.
   bool gone = false;
+  /// Sized on one visit only, neither the cluster's first nor its last that saw its tag: no
+  /// fruitlet appears after bloom, so most likely a false detection. Neither gone nor counted
+  /// in the fruit set.
+  bool unconfirmed = false;
   GrowthRate rate;
   FatePrediction fate;  ///< kUnknown for a gone fruitlet (its fate is known: it is off)
 };
@@ -48,7 +52,7 @@ struct FruitletTrack {
 struct FruitSet {
   double percent = std::numeric_limits<double>::quiet_NaN();
   double standard_error_percent = std::numeric_limits<double>::quiet_NaN();
-  std::size_t persisting = 0, abscising = 0, gone = 0, unknown = 0;
+  std::size_t persisting = 0, abscising = 0, gone = 0, unknown = 0, unconfirmed = 0;
 };
 
 struct ClusterSeason {
