@@ -85,6 +85,13 @@ TEST_F(SeasonTrial, RepeatsExactlyAndResumesOnlyWhatItWouldRun) {
   cut.resume = true;
   runSeasonExperiment(cut);
   EXPECT_EQ(withoutWallTime(readSeasons(first.out_dir).front()), withoutWallTime(line));
+  // Kept, not run again: a mark put in day 0's result comes back in the season's line.
+  std::filesystem::remove(season / "season_score.json");
+  nlohmann::json day0 = nlohmann::json::parse(std::ifstream(season / "day-0/result.json"));
+  day0["views"] = 999;
+  std::ofstream(season / "day-0/result.json") << day0.dump();
+  runSeasonExperiment(cut);
+  EXPECT_EQ(readSeasons(first.out_dir).front()["visits"][0]["views"], 999);
 
   // Finished seasons: kept on --resume, an error without it or with other days.
   EXPECT_THROW(runSeasonExperiment(first), std::runtime_error);

@@ -115,8 +115,8 @@ nlohmann::json runSeasonTrial(const SeasonTrialOptions& o) {
     TrialOptions visit = o.visit;
     visit.season_day = day;
     if (!o.out_dir.empty()) visit.out_dir = o.out_dir / ("day-" + dayText(day));
-    results.push_back(o.reuse_visits ? finishedVisit(visit).value_or(runTrial(visit))
-                                     : runTrial(visit));
+    std::optional<nlohmann::json> kept = o.reuse_visits ? finishedVisit(visit) : std::nullopt;
+    results.push_back(kept ? std::move(*kept) : runTrial(visit));
     config.season_day = day;
     worlds.push_back(robot::sim::World::generate(config, o.visit.seed));
     const std::string source = visit.out_dir.empty() ? "visit of day " + dayText(day)
