@@ -21,31 +21,33 @@
 namespace fvp::apps {
 namespace {
 
-/// "0,4,7": decimal days, comma-separated (their order and range: trials::checkSeasonDays).
+/// "0,4,7": the day texts between the commas.
+std::vector<std::string> dayTexts(const std::string& text) {
+  std::vector<std::string> days;
+  for (std::size_t from = 0;;) {
+    const std::size_t comma = text.find(',', from);
+    days.push_back(text.substr(from, comma - from));
+    if (comma == std::string::npos) return days;
+    from = comma + 1;
+  }
+}
+
+/// Decimal days, comma-separated (their order and range: trials::checkSeasonDays).
 CLI::Validator dayListText() {
   return CLI::Validator(
       [](std::string& text) -> std::string {
-        std::size_t from = 0;
-        for (;;) {
-          const std::size_t comma = text.find(',', from);
-          const std::string day = text.substr(from, comma - from);
+        for (const std::string& day : dayTexts(text))
           if (!host::isDecimalNumberText(day, false))
             return "expected decimal days separated by commas (e.g. 0,4,7), got '" + day + "'";
-          if (comma == std::string::npos) return {};
-          from = comma + 1;
-        }
+        return {};
       },
       "DAY,DAY,...", "dayList");
 }
 
 [[maybe_unused]] std::vector<double> parseDays(const std::string& text) {
   std::vector<double> days;
-  for (std::size_t from = 0;;) {
-    const std::size_t comma = text.find(',', from);
-    days.push_back(std::strtod(text.substr(from, comma - from).c_str(), nullptr));
-    if (comma == std::string::npos) return days;
-    from = comma + 1;
-  }
+  for (const std::string& day : dayTexts(text)) days.push_back(std::strtod(day.c_str(), nullptr));
+  return days;
 }
 
 struct SeasonsCommandOptions {

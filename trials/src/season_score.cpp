@@ -214,9 +214,9 @@ struct Confusion {
       ++(truth_drops ? fn : tn);
   }
   nlohmann::json json() const {
-    const double f1 = 2 * tp + fp + fn > 0 ? 2.0 * double(tp) / double(2 * tp + fp + fn) : 1.0;
-    return {{"true_drops", tp}, {"false_drops", fp},      {"missed_drops", fn},
-            {"true_stays", tn}, {"undecided", undecided}, {"f1_drops", f1}};
+    return {{"true_drops", tp},       {"false_drops", fp},
+            {"missed_drops", fn},     {"true_stays", tn},
+            {"undecided", undecided}, {"f1_drops", dropsF1(double(tp), double(fp), double(fn))}};
   }
 };
 
@@ -277,6 +277,11 @@ CaliperOutcome caliperBaseline(const Scoring& s, const std::vector<int>& identit
 }
 
 }  // namespace
+
+double dropsF1(double true_drops, double false_drops, double missed_drops) {
+  const double denominator = 2.0 * true_drops + false_drops + missed_drops;
+  return denominator > 0 ? 2.0 * true_drops / denominator : 1.0;
+}
 
 nlohmann::json scoreSeason(const SeasonScoreInput& in) {
   if (!in.analysis || in.visit_results.size() != in.analysis->days.size() ||

@@ -45,8 +45,6 @@ nlohmann::json visitFigures(double day, const nlohmann::json& result) {
           {"wall_time_s", result.value("wall_time_s", 0.0)}};
 }
 
-}  // namespace
-
 /// A visit's result.json already in its directory (a season cut short), when it is this
 /// visit's: the same settings, seed and day; another is an error naming the file.
 std::optional<nlohmann::json> finishedVisit(const TrialOptions& visit) {
@@ -63,6 +61,8 @@ std::optional<nlohmann::json> finishedVisit(const TrialOptions& visit) {
                              "another --out");
   return result;
 }
+
+}  // namespace
 
 void checkSeasonDays(const std::vector<double>& days) {
   if (days.size() < 2)
@@ -169,10 +169,6 @@ nlohmann::json ratio(double part, double whole, double scale = 100.0) {
   return whole > 0 ? nlohmann::json(scale * part / whole) : nlohmann::json(nullptr);
 }
 
-double f1(double tp, double fp, double fn) {
-  return 2 * tp + fp + fn > 0 ? 2.0 * tp / (2 * tp + fp + fn) : 1.0;
-}
-
 }  // namespace
 
 nlohmann::json summarizeSeasons(const std::vector<nlohmann::json>& seasons) {
@@ -218,7 +214,8 @@ nlohmann::json summarizeSeasons(const std::vector<nlohmann::json>& seasons) {
                       {"precision_percent", ratio(matched, detections)}});
   }
   const auto rf1 = [&](const std::string& who) {
-    return f1(p.at(who + ".true_drops"), p.at(who + ".false_drops"), p.at(who + ".missed_drops"));
+    return dropsF1(p.at(who + ".true_drops"), p.at(who + ".false_drops"),
+                   p.at(who + ".missed_drops"));
   };
   return {{"seasons", seasons.size()},
           {"association_correct_percent",

@@ -3,35 +3,16 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
-#include <numbers>
-#include <random>
 
 #include "fvp/robot/sim/world.h"
 #include "procedural_texture.h"
+#include "sampler.h"
 
 namespace fvp::robot::sim {
 namespace {
 
 // "sesn" in ASCII: the season's stream, apart from the generator's.
 constexpr std::uint64_t kSeasonStream = 0x7365736e;
-
-// Uniform variates from raw mt19937_64 output (the generator's rule: std's distributions are
-// implementation-defined).
-class SeasonSampler {
- public:
-  explicit SeasonSampler(std::uint64_t seed) : engine_(detail::hashCombine(seed, kSeasonStream)) {}
-  double uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }
-  double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
-  Eigen::Vector3d unitVector() {
-    const double z = uniform(-1.0, 1.0);
-    const double phi = uniform(0.0, 2.0 * std::numbers::pi);
-    const double s = std::sqrt(std::max(0.0, 1.0 - z * z));
-    return {s * std::cos(phi), s * std::sin(phi), z};
-  }
-
- private:
-  std::mt19937_64 engine_;
-};
 
 }  // namespace
 
@@ -41,7 +22,8 @@ double GrowthCurve::grownMm(double day) const {
 
 SeasonGrowth drawSeasonGrowth(const World& day0, std::uint64_t seed) {
   const WorldConfig& config = day0.config();
-  SeasonSampler rng(seed);
+  // The generator's sampler on the season's own stream.
+  detail::Sampler rng(detail::hashCombine(seed, kSeasonStream));
   SeasonGrowth season;
   season.fastest_mm_per_day =
       rng.uniform(config.min_fastest_growth_mm_per_day, config.max_fastest_growth_mm_per_day);

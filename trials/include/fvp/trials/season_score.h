@@ -30,6 +30,10 @@ struct SeasonScoreInput {
   host::season::FateConfig fate;  ///< the rule the calipers' readings are judged by
 };
 
+/// F1 of "drops" from its confusion counts (1 when there is nothing to find and nothing
+/// found): one season's and the pooled seasons'.
+double dropsF1(double true_drops, double false_drops, double missed_drops);
+
 /// The score object (docs/season.md "season_score.json"): association (links made, correct,
 /// truth links), gone (fallen fruitlets reported gone, tracks wrongly gone), growth (rate MAE
 /// against the truth's rate over the same days, and how often the stated uncertainty covers
