@@ -10,6 +10,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "fvp/host/core/segment_distance.h"
 #include "fvp/robot/sim/world.h"
 
 namespace fvp::robot::sim {
@@ -147,13 +148,9 @@ TEST(SeasonGrowth, GrownFruitletsKeepOffPlatesBranchesAndEachOther) {
                                   std::max(std::abs(q.y()) - h, 0.0), q.z());
         EXPECT_GE(off.norm(), reach) << "seed " << seed << ": a fruitlet in tag " << c.tag.tag_id;
       }
-      for (const BranchSegment& b : world.branches()) {
-        const Eigen::Vector3d axis = b.end_m - b.start_m;
-        const double t =
-            std::clamp((f.center_m - b.start_m).dot(axis) / axis.squaredNorm(), 0.0, 1.0);
-        EXPECT_GE((f.center_m - b.start_m - t * axis).norm(), reach + b.radius_m)
+      for (const BranchSegment& b : world.branches())
+        EXPECT_GE(host::pointSegmentDistance(f.center_m, b.start_m, b.end_m), reach + b.radius_m)
             << "seed " << seed << ": a fruitlet in a branch";
-      }
       for (const Fruitlet& g : world.fruitlets())
         if (g.index > f.index)
           EXPECT_GE((f.center_m - g.center_m).norm() + kMaxPressM + 1e-6,

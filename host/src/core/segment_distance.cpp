@@ -4,12 +4,17 @@
 
 namespace fvp::host {
 
-double pointSegmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
-                            const Eigen::Vector3d& b) {
+Eigen::Vector3d closestPointOnSegment(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                      const Eigen::Vector3d& b) {
   const Eigen::Vector3d ab = b - a;
   const double len2 = ab.squaredNorm();
   const double t = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return (a + t * ab - p).norm();
+  return a + t * ab;
+}
+
+double pointSegmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                            const Eigen::Vector3d& b) {
+  return (closestPointOnSegment(p, a, b) - p).norm();
 }
 
 double segmentSegmentDistance(const Eigen::Vector3d& p1, const Eigen::Vector3d& q1,

@@ -523,12 +523,9 @@ void settleFruitlets(std::vector<Fruitlet>& fruitlets, const std::vector<Fruitle
       const double reach = f.boundingRadius_m() + gap_m;
       for (const FruitletCluster& c : clusters)
         pushClear(f, nearestPlatePoint(f.center_m, c.tag), reach);
-      for (const BranchSegment& b : branches) {
-        const Eigen::Vector3d axis = b.end_m - b.start_m;
-        const double t =
-            std::clamp((f.center_m - b.start_m).dot(axis) / axis.squaredNorm(), 0.0, 1.0);
-        pushClear(f, b.start_m + t * axis, reach + b.radius_m);
-      }
+      for (const BranchSegment& b : branches)
+        pushClear(f, host::closestPointOnSegment(f.center_m, b.start_m, b.end_m),
+                  reach + b.radius_m);
     }
   }
 }
@@ -602,9 +599,6 @@ Leaf seasonLeaf(const Leaf& day0, const LeafGrowth& growth, double day,
 World World::grownTo(double day) const {
   World grown = *this;
   grown.config_.season_day = day;
-  std::vector<int> cluster_of_identity(fruitlets_.size(), 0);
-  for (const FruitletCluster& c : clusters_)
-    for (int i : c.fruitlet_indices) cluster_of_identity[i] = c.index;
   grown.fruitlets_.clear();
   std::vector<int> cluster_of;
   for (const Fruitlet& f : fruitlets_) {
@@ -616,7 +610,7 @@ World World::grownTo(double day) const {
     g.center_m.z() -= kStemDroopMPerMm * grown_mm;
     g.index = static_cast<int>(grown.fruitlets_.size());
     grown.fruitlets_.push_back(g);
-    cluster_of.push_back(cluster_of_identity[f.identity]);
+    cluster_of.push_back(curve.cluster);
   }
   settleFruitlets(grown.fruitlets_, clusters_, branches_, config_.min_gap_m);
   for (FruitletCluster& c : grown.clusters_) {
@@ -635,8 +629,6 @@ World World::grownTo(double day) const {
                                   clusters_, config_.min_gap_m);
   return grown;
 }
-
-namespace {}  // namespace
 
 double Leaf::distanceLowerBound_m(const Eigen::Vector3d& p_world_m) const {
   const Eigen::Vector3d q = T_world_leaf.inverse() * p_world_m;

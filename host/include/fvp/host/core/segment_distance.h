@@ -7,6 +7,10 @@
 namespace fvp::host {
 
 /// Shortest distance from p to the segment [a, b].
+/// The point of segment [a, b] nearest to p (a for a zero-length segment).
+Eigen::Vector3d closestPointOnSegment(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                      const Eigen::Vector3d& b);
+
 double pointSegmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
                             const Eigen::Vector3d& b);
 
