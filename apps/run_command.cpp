@@ -23,6 +23,10 @@ void addRunCommand(CLI::App& app) {
                                  "Run one simulated trial; write result.json, report.md and "
                                  "viewer.html (the trial in 3-D) to --out");
   addTrialOptions(cmd, opt->trial, /*with_per_trial=*/true);
+  cmd->add_option("--remember", opt->trial.remembered_visit,
+                  "an earlier visit of the same tree (its result.json or --out directory): "
+                  "each cluster starts from what it learned (docs/season.md)")
+      ->check(nonEmptyPath());
   cmd->add_option("--out", opt->out, "output directory")->required()->check(nonEmptyPath());
   FVP_ON_RUN(cmd, [opt] {
     trials::TrialOptions trial = opt->trial;

@@ -1,11 +1,13 @@
-// parseSeasonVisit (host/src/season/season_visit.cpp) on the input as a visit's result.json or
-// fruitlets.json text. What it accepts must be usable by the season's association and growth
-// rates: finite centres, finite positive sizes, standard errors positive or unknown.
+// parseSeasonVisit (host/src/season/season_visit.cpp) and parseVisitMemory
+// (remembered_visit.cpp) on the input as a visit's result.json or fruitlets.json text. What they
+// accept must be usable by the season's association and growth rates and by a later visit:
+// finite centres, finite positive sizes, standard errors positive or unknown, rigid poses.
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
 #include "fuzz_support.h"
+#include "fvp/host/season/remembered_visit.h"
 #include "fvp/host/season/season_visit.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -24,6 +26,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
           std::abort();
         }
       }
+    for (const auto& [tag, memory] : fvp::host::season::parseVisitMemory(text, "visit.json"))
+      for (const auto& T : memory.T_tag_camera)
+        if (!T.matrix().allFinite() || !(T.linear().transpose() * T.linear()).isIdentity(1e-6) ||
+            tag < 0) {
+          std::fprintf(stderr, "fvp fuzz: remembered a view that is not a pose in tag %d\n", tag);
+          std::abort();
+        }
   } catch (const nlohmann::json::exception& e) {
     fz::reportEscapedException("nlohmann_json", e);
   } catch (const std::exception&) {

@@ -22,6 +22,7 @@ trials::TrialOptions trialOptions(const py::kwargs& kw, const char* owner) {
   RunKeywords keywords(kw, owner);
   trials::visitTrialFields(o, keywords);
   keywords.take("out_dir", o.out_dir);
+  keywords.take("remembered_visit", o.remembered_visit);
   keywords.finish();
   // Warnings stay in result["warnings"]; Python callers read them there.
   return o;
@@ -39,7 +40,9 @@ std::string trialKeywordDoc() {
                return settingJson(value);
              }) +
          "  out_dir (default: \"\"): where result.json and the trial's files go (empty: "
-         "nothing is written)\n";
+         "nothing is written)\n"
+         "  remembered_visit (default: \"\"): an earlier visit of the same tree (its result.json "
+         "or directory): each cluster starts from what it learned (docs/season.md)\n";
 }
 
 }  // namespace

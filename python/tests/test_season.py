@@ -42,3 +42,18 @@ def test_the_simulated_robot_visits_the_tree_on_a_later_day():
         assert not (a.center_m == b.center_m).all()
     with pytest.raises(ValueError, match="season_day"):
         fvp.sim.Robot(seed=3, world_config=tree, season_day=99.0)
+
+
+def test_a_later_visit_remembers_the_earlier_one(tmp_path):
+    """fvp.sim.Trial(remembered_visit=...): each cluster of the later visit starts from what the
+    earlier visit learned of it (docs/season.md "Visits remembered"); one that is not there is
+    an error naming it."""
+    tree = os.path.join(os.environ.get("FVP_SOURCE_DIR", "."), "robot/sim/config/world_season.yaml")
+    common = dict(seed=3, world_config=tree, clock="fixed", backend="cpu", max_views=1)
+    fvp.sim.Trial(season_day=0.0, out_dir=str(tmp_path / "day-0"), **common).run()
+    later = fvp.sim.Trial(season_day=4.0, remembered_visit=str(tmp_path / "day-0"), **common).run()
+    assert later["remembered_visit"] == str(tmp_path / "day-0")
+    remembered = [c["memory"] for c in later["clusters"] if "memory" in c]
+    assert remembered and all(m["fruitlets"] > 0 for m in remembered)
+    with pytest.raises(RuntimeError, match="no_such_visit: no such file or directory"):
+        fvp.sim.Trial(season_day=4.0, remembered_visit="/nonexistent/no_such_visit", **common)

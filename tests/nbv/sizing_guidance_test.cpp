@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
 
 namespace fvp::host::nbv {
 namespace {
@@ -219,6 +220,80 @@ TEST(SizingGuidance, AnUnconfirmedDetectionHoldsTheClusterForAtMostTwoViews) {
   other.onView({.index = 0});
   EXPECT_TRUE(planner.targets_.empty());
   EXPECT_FALSE(other.waitingOnUnconfirmed());
+}
+
+TEST(SizingGuidance, ARememberedFruitletNotFoundIsSoughtThenGone) {
+  const ClusterCompletionConfig config;
+  std::vector<SizingSnapshot> history;
+  RecordingPlanner planner;
+  SizingGuidance guidance(history, config, planner, 0.6);
+  std::optional<Eigen::Isometry3d> T_world_tag;
+  // The earlier visit's two fruitlets; the tag stands 1 m along x in this visit's world.
+  guidance.expect(
+      {{Eigen::Vector3d(-1.0, 0.0, 0.3), 8.0}, {Eigen::Vector3d(-0.98, 0.0, 0.3), 6.0}},
+      [&]() -> const std::optional<Eigen::Isometry3d>& { return T_world_tag; }, 0.008);
+  int view = 0;
+  const auto sized = [&](std::vector<FruitletSnapshot> fruitlets) {
+    history.push_back(snapshot(view, std::move(fruitlets)));
+    guidance.onView({.index = view++});
+  };
+  sized({fruitlet(0.0, 4, 60.0)});
+  EXPECT_TRUE(planner.targets_.empty()) << "no tag seen yet: nothing to expect";
+  EXPECT_FALSE(guidance.waitingOnExpected());
+  T_world_tag = Eigen::Isometry3d(Eigen::Translation3d(1.0, 0.0, 0.0));
+  sized({fruitlet(0.0, 4, 60.0)});
+  ASSERT_EQ(planner.targets_.size(), 1u);
+  EXPECT_NEAR(planner.targets_[0].center_m.x(), 0.02, 1e-12);
+  EXPECT_DOUBLE_EQ(planner.targets_[0].radius_m, 0.003);
+  EXPECT_TRUE(planner.targets_[0].seen_from.empty()) << "any direction may show it";
+  EXPECT_TRUE(guidance.waitingOnExpected());
+  EXPECT_EQ(guidance.expectedFound(), 1u);
+  // Remembered views do not count: they showed the cluster as it was.
+  planner::PlanStep remembered = aimedAt(-1);
+  remembered.candidates[0].kind = planner::CandidateKind::kRemembered;
+  for (int k = 0; k < 3; ++k) {
+    guidance.onPlan({.step = &remembered});
+    sized({fruitlet(0.0, 4, 60.0)});
+  }
+  EXPECT_TRUE(guidance.waitingOnExpected());
+  // Two views of the planner's own, and it is still not there: gone.
+  planner::PlanStep elsewhere = aimedAt(-1);
+  elsewhere.candidates[0].kind = planner::CandidateKind::kRoi;
+  guidance.onPlan({.step = &elsewhere});
+  sized({fruitlet(0.0, 4, 60.0)});
+  EXPECT_TRUE(guidance.waitingOnExpected());
+  guidance.onPlan({.step = &elsewhere});
+  sized({fruitlet(0.0, 4, 60.0)});
+  EXPECT_FALSE(guidance.waitingOnExpected());
+  EXPECT_TRUE(planner.targets_.empty());
+  EXPECT_EQ(guidance.expectedGone(), 1u);
+  EXPECT_EQ(guidance.expectedFound(), 1u);
+  // Found after all, 5 mm from where it was (a drooping stem): no longer gone.
+  sized({fruitlet(0.0, 4, 60.0), fruitlet(0.025, 4, 60.0)});
+  EXPECT_EQ(guidance.expectedFound(), 2u);
+  EXPECT_EQ(guidance.expectedGone(), 0u);
+}
+
+TEST(SizingGuidance, OneFruitletIsNotTwoRememberedOnes) {
+  const ClusterCompletionConfig config;
+  std::vector<SizingSnapshot> history;
+  RecordingPlanner planner;
+  SizingGuidance guidance(history, config, planner, 0.6);
+  const std::optional<Eigen::Isometry3d> T_world_tag = Eigen::Isometry3d::Identity();
+  guidance.expect(
+      {{Eigen::Vector3d(0.0, 0.0, 0.3), 8.0}, {Eigen::Vector3d(0.006, 0.0, 0.3), 8.0}},
+      [&]() -> const std::optional<Eigen::Isometry3d>& { return T_world_tag; }, 0.008);
+  // One fruitlet within the gate of both: it is the nearer one's; the other is sought.
+  history.push_back(snapshot(0, {fruitlet(0.005, 4, 60.0)}));
+  guidance.onView({.index = 0});
+  EXPECT_EQ(guidance.expectedFound(), 1u);
+  ASSERT_EQ(planner.targets_.size(), 1u);
+  EXPECT_NEAR(planner.targets_[0].center_m.x(), 0.0, 1e-12);
+  EXPECT_THROW(guidance.expect({}, {}, 0.008), std::invalid_argument);
+  EXPECT_THROW(
+      guidance.expect(
+          {}, [&]() -> const std::optional<Eigen::Isometry3d>& { return T_world_tag; }, 0.0),
+      std::invalid_argument);
 }
 
 TEST(SizingGuidance, RejectsBadSettings) {

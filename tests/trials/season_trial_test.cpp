@@ -1,7 +1,7 @@
 // A simulated season (trials/season_trial.h): visits of one tree on two days, each a trial of
 // the grown world; with a fixed clock the season repeats exactly; the season experiment keeps
-// finished seasons only on --resume and only with the same settings and days. One view a
-// cluster keeps it short.
+// finished seasons only on --resume and only with the same settings and days; a later visit
+// starts from the one before it. One view a cluster keeps it short.
 #include "fvp/trials/season_trial.h"
 
 #include <gtest/gtest.h>
@@ -61,7 +61,16 @@ TEST_F(SeasonTrial, RepeatsExactlyAndResumesOnlyWhatItWouldRun) {
   EXPECT_EQ(line["visits"][1]["day"], 5.0);
   // The later visit saw the grown tree: its truth is of day 5.
   std::ifstream day5(season / "day-5/result.json");
-  EXPECT_EQ(nlohmann::json::parse(day5)["settings"]["season_day"], 5.0);
+  const nlohmann::json day5_result = nlohmann::json::parse(day5);
+  EXPECT_EQ(day5_result["settings"]["season_day"], 5.0);
+  // ...and started from the visit before it: each cluster remembered its fruitlets and views.
+  EXPECT_EQ(day5_result["remembered_visit"], (season / "day-0").string());
+  ASSERT_EQ(day5_result["clusters"].size(), 2u);
+  for (const auto& c : day5_result["clusters"]) {
+    EXPECT_GT(c["memory"]["fruitlets"].get<int>(), 0) << c["memory"].dump();
+    EXPECT_GT(c["memory"]["views"].get<int>(), 0) << c["memory"].dump();
+  }
+  EXPECT_EQ(line["settings"]["remember_visits"], true);
   EXPECT_GT(line["score"]["fruitlets"].get<int>(), 0);
   // Every visit placed its clusters in their tags' frames (the start view sees each tag).
   std::ifstream season_json(season / "season.json");

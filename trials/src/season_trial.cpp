@@ -55,10 +55,11 @@ std::optional<nlohmann::json> finishedVisit(const TrialOptions& visit) {
   TrialOptions resolved = visit;
   resolved.register_views = registerViewsOf(visit);
   if (result.is_discarded() || !result.is_object() ||
-      result.value("settings", nlohmann::json()) != nlohmann::json(trialSettingsJson(resolved)))
+      result.value("settings", nlohmann::json()) != nlohmann::json(trialSettingsJson(resolved)) ||
+      result.value("remembered_visit", std::string()) != visit.remembered_visit.string())
     throw std::runtime_error(file.string() +
-                             ": not this visit's result (another seed, day or settings); "
-                             "another --out");
+                             ": not this visit's result (another seed, day, settings or "
+                             "remembered visit); another --out");
   return result;
 }
 
@@ -89,6 +90,7 @@ nlohmann::json seasonSettings(const SeasonTrialOptions& o) {
   settings.erase("seed");
   settings.erase("season_day");
   settings["caliper_sigma_mm"] = o.caliper_sigma_mm;
+  settings["remember_visits"] = o.remember_visits;
   return settings;
 }
 
@@ -102,6 +104,10 @@ nlohmann::json runSeasonTrial(const SeasonTrialOptions& o) {
     throw std::invalid_argument(
         "season: caliper_sigma_mm (--caliper-sigma-mm): expected at least " +
         dayText(host::season::kMinStandardErrorMm) + " mm");
+  if (o.remember_visits && o.out_dir.empty())
+    throw std::invalid_argument(
+        "season: remember_visits reads each visit's result from out_dir: set out_dir, or "
+        "remember_visits false");
   if (!o.out_dir.empty()) host::prepareOutputDirectory(o.out_dir, "season output directory");
   robot::sim::WorldConfig config =
       o.visit.world_config.empty() ? robot::sim::WorldConfig{}
@@ -115,6 +121,8 @@ nlohmann::json runSeasonTrial(const SeasonTrialOptions& o) {
     TrialOptions visit = o.visit;
     visit.season_day = day;
     if (!o.out_dir.empty()) visit.out_dir = o.out_dir / ("day-" + dayText(day));
+    if (o.remember_visits && !results.empty())
+      visit.remembered_visit = o.out_dir / ("day-" + dayText(o.days[results.size() - 1]));
     std::optional<nlohmann::json> kept = o.reuse_visits ? finishedVisit(visit) : std::nullopt;
     results.push_back(kept ? std::move(*kept) : runTrial(visit));
     config.season_day = day;

@@ -31,6 +31,7 @@
 #include "fvp/host/planner/view_planner.h"
 #include "fvp/host/report/session_report.h"
 #include "fvp/host/report/viewer_scene.h"
+#include "fvp/host/season/remembered_visit.h"
 #include "fvp/host/session/mapping_session.h"
 #include "fvp/robot/arm_model.h"
 #include "fvp/robot/sim/simulated_arm.h"
@@ -340,6 +341,8 @@ struct ClusterOutcome {
   double sizing_wall_s = 0.0, sizing_during_loop_s = 0.0;
   /// With the automatic stop: what the sizing guidance did (added to the events).
   nlohmann::json guidance_events = nlohmann::json::object();
+  /// With a remembered visit: what the cluster's memory did (null without one).
+  nlohmann::json memory;
 };
 
 namespace {
@@ -372,6 +375,7 @@ struct Trial::Impl {
     // The setup's checks, before the output directory is touched.
     setupOptions(options).validate();
     options.register_views = registerViewsOf(options);
+    const std::map<int, host::nbv::ClusterMemory> memory = readMemory();
     if (!options.out_dir.empty()) {
       host::prepareOutputDirectory(options.out_dir, "trial output directory");
       lock.emplace(options.out_dir, "trial output directory");
@@ -400,6 +404,26 @@ struct Trial::Impl {
     robot = std::make_unique<SimulatedRobot>(sim);
     world = &robot->world();
     camera = &robot->camera();
+    targets = robot->clusterTargets();
+    remember(memory);
+  }
+
+  /// The remembered visit's clusters (read before out_dir is cleared: it may be the same).
+  std::map<int, host::nbv::ClusterMemory> readMemory() const {
+    if (options.remembered_visit.empty()) return {};
+    const host::nbv::ClusterCompletionConfig stop = setupOptions(options).stop.completion;
+    return host::season::readVisitMemory(options.remembered_visit,
+                                         {stop.min_well_seen_images, stop.min_view_span_deg});
+  }
+
+  /// Each cluster's memory by its tag (a world of one cluster: the result's one cluster).
+  void remember(const std::map<int, host::nbv::ClusterMemory>& memory) {
+    for (std::size_t k = 0; k < targets.size(); ++k) {
+      const auto found = targets.size() == 1 && memory.size() == 1
+                             ? memory.begin()
+                             : memory.find(world->clusters()[k].tag.tag_id);
+      if (found != memory.end()) targets[k].memory = found->second;
+    }
   }
 
   // Cluster k's files go to out_dir/cluster_K (a world has at most 8 clusters).
@@ -500,6 +524,8 @@ struct Trial::Impl {
   std::unique_ptr<host::nbv::NbvSetup> setup;
   /// The simulator: world, camera, arm, clock.
   std::unique_ptr<SimulatedRobot> robot;
+  /// The robot's clusters, with what the remembered visit learned of each.
+  std::vector<host::nbv::ClusterTarget> targets;
   const World* world = nullptr;
   const SimulatedCamera* camera = nullptr;
   bool ran = false;
@@ -520,6 +546,12 @@ ClusterOutcome Trial::Impl::scored(host::nbv::ClusterRun run, TrialParts& cluste
   if (automatic)
     out.guidance_events = {{"sizing_views", run.sizing_views},
                            {"sizing_targets_dropped", run.sizing_targets_dropped}};
+  if (run.memory)
+    out.memory = {{"views", run.memory->views},
+                  {"views_taken", run.memory->views_taken},
+                  {"fruitlets", run.memory->fruitlets},
+                  {"found", run.memory->found},
+                  {"gone", run.memory->gone}};
   return out;
 }
 
@@ -543,6 +575,8 @@ nlohmann::json Trial::Impl::stopJson() const {
 void Trial::Impl::describeRun(nlohmann::json& result, const TrialLog& log,
                               const std::vector<Eigen::Vector3d>& camera_path) const {
   result["clock"] = nlohmann::json::parse(robot->clock().toJson());
+  if (!options.remembered_visit.empty())
+    result["remembered_visit"] = options.remembered_visit.string();
   // The clock's record stays in result.json only; its sums by stage go everywhere the trial
   // does (an experiment's trials.jsonl, where its time split is pooled).
   result["sim_time_by_stage_s"] = simulatedSecondsByStage(result["clock"]);
@@ -563,8 +597,7 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
   host::nbv::LoopClock& loop_clock = robot->loopClock();
   TrialLog log(*camera, options, wall_start);
   log.setClusterCenter(world->clusterCenter_m());
-  const std::unique_ptr<host::nbv::ClusterWork> work =
-      setup->makeWork(robot->clusterTargets().front());
+  const std::unique_ptr<host::nbv::ClusterWork> work = setup->makeWork(targets.front());
   TrialParts parts(options, setup->engine(), *work);
   const ClusterOutcome outcome =
       scored(setup->runCluster({loop_camera, loop_arm, loop_clock}, *work, &log), parts,
@@ -591,6 +624,7 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
   for (auto& [key, value] : outcome.sizing.items()) result[key] = value;
   result["events"] = eventsJson(run.events);
   result["events"].update(outcome.guidance_events);
+  if (!outcome.memory.is_null()) result["memory"] = outcome.memory;
   if (*options.register_views)
     result["anchor_offset"] = anchorOffsetJson(parts.session(), log.trueAnchorShift());
   result["wall_breakdown_s"] = {{"rendering", camera->totalRenderSeconds()},
@@ -672,7 +706,7 @@ nlohmann::json Trial::Impl::runTree(host::nbv::Camera& loop_camera, host::nbv::A
   host::report::ViewerScene scene(viewerTitle(), "");
   TourRecorder recorder(*this, log, tour, scene);
   const host::nbv::TourResult done =
-      setup->runTour({loop_camera, loop_arm, loop_clock}, robot->clusterTargets(), &recorder);
+      setup->runTour({loop_camera, loop_arm, loop_clock}, targets, &recorder);
   for (const auto& visit : done.visits) tour.order.push_back(visit.index);
   tour.transit_s = done.transit_s;
   tour.transit_motion_s = done.transit_motion_s;
@@ -741,6 +775,7 @@ void Trial::Impl::recordCluster(const host::nbv::ClusterVisit& visit, TrialParts
   tour.views += outcome.run.views;
   entry["events"] = eventsJson(outcome.run.events);
   entry["events"].update(outcome.guidance_events);
+  if (!outcome.memory.is_null()) entry["memory"] = outcome.memory;
   addNumbers(tour.events, entry["events"]);
   addNumbers(tour.wall, {{"perception", outcome.run.wall_s.perception},
                          {"mapping", outcome.run.wall_s.mapping},

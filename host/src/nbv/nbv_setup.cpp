@@ -11,6 +11,7 @@
 #include "fvp/host/map/map_engine_registry.h"
 #include "fvp/host/nbv/approach_sequence.h"
 #include "fvp/host/nbv/loop_observers.h"
+#include "fvp/host/nbv/remembered_views.h"
 #include "fvp/host/nbv/sizing_guidance.h"
 #include "fvp/host/nbv/tour_order.h"
 #include "fvp/host/planner/planner_registry.h"
@@ -114,6 +115,8 @@ void NbvSetupOptions::validate() const {
     throw std::invalid_argument("setting 'max_consecutive_dropped_frames': expected at least 1");
   if (!(loop.view_overhead_s >= 0.0) || !std::isfinite(loop.view_overhead_s))
     throw std::invalid_argument("setting 'view_overhead_s': expected a finite number >= 0");
+  if (!(remembered_max_shift_m > 0.0) || !std::isfinite(remembered_max_shift_m))
+    throw std::invalid_argument("setting 'remembered_max_shift_m': expected a finite number > 0");
 }
 
 NbvSetup::NbvSetup(NbvSetupOptions options) : options_(std::move(options)) {
@@ -129,6 +132,14 @@ NbvSetup::NbvSetup(NbvSetupOptions options) : options_(std::move(options)) {
 
 NbvSetup::~NbvSetup() = default;
 
+namespace {
+
+TagPoseFn tagPoseOf(const MappingSession& session) {
+  return [&session]() -> const std::optional<Eigen::Isometry3d>& { return session.T_world_tag(); };
+}
+
+}  // namespace
+
 std::unique_ptr<ClusterWork> NbvSetup::makeWork(const ClusterTarget& target, std::size_t index) {
   PerceptionConfig perception = options_.perception;
   if (target.tag_id) perception.tag.tag_id = *target.tag_id;
@@ -143,6 +154,13 @@ std::unique_ptr<ClusterWork> NbvSetup::makeWork(const ClusterTarget& target, std
                       ? std::move(first_planner_)
                       : planner::createPlanner(options_.planner, options_.planner_config,
                                                options_.planner_seed + index, backend_.get());
+  if (target.memory) {
+    auto remembered = std::make_unique<RememberedViews>(
+        std::move(work->planner), tagPoseOf(*work->session), target.memory->T_tag_camera);
+    work->remembered = remembered.get();
+    work->planner = std::move(remembered);
+    work->expected = target.memory->fruitlets;
+  }
   return work;
 }
 
@@ -163,7 +181,10 @@ ClusterRun NbvSetup::runCluster(const NbvRig& rig, ClusterWork& work, LoopObserv
     observers.add(&*completion);
     guidance.emplace(*completion, *work.planner, options_.sizing.well_seen_fraction);
     observers.add(&*guidance);  // after completion: it reads completion's sizing
-    completion->holdWhile([&g = *guidance] { return g.waitingOnUnconfirmed(); });
+    if (work.remembered)
+      guidance->expect(work.expected, tagPoseOf(*work.session), options_.remembered_max_shift_m);
+    completion->holdWhile(
+        [&g = *guidance] { return g.waitingOnUnconfirmed() || g.waitingOnExpected(); });
     if (spec.completion.release_left_out)
       completion->releaseWhen(
           [&g = *guidance](const FruitletSnapshot& f) { return g.leftOut(f.center_m); });
@@ -174,6 +195,16 @@ ClusterRun NbvSetup::runCluster(const NbvRig& rig, ClusterWork& work, LoopObserv
   }
   NbvLoop loop(*work.session, *work.planner, rig.camera, rig.arm, rig.clock, options_.loop);
   out.run = loop.run(stop, &observers);
+  if (work.remembered) {
+    out.memory.emplace();
+    out.memory->views = work.remembered->remembered();
+    out.memory->views_taken = work.remembered->taken();
+    out.memory->fruitlets = work.expected.size();
+    if (guidance) {
+      out.memory->found = guidance->expectedFound();
+      out.memory->gone = guidance->expectedGone();
+    }
+  }
   if (guidance) {
     out.sizing_views = guidance->aimedViews();
     out.sizing_targets_dropped = guidance->droppedTargets();

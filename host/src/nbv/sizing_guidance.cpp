@@ -1,8 +1,12 @@
 #include "fvp/host/nbv/sizing_guidance.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <utility>
+
+#include "fvp/host/core/one_to_one_assignment.h"
 
 namespace fvp::host::nbv {
 
@@ -54,7 +58,12 @@ void SizingGuidance::onPlan(const PlanEvent& event) {
       config_.release_left_out &&
       sizesSettled(history_, config_, [](const FruitletSnapshot&) { return true; });
   for (std::size_t t = 0; t < targets_.size(); ++t) {
-    if (int(t) != aimed_target && !target_unconfirmed_[t] && !only_evidence_holds) continue;
+    // A remembered fruitlet is looked for by every view but the remembered ones, which
+    // showed the cluster as it was and are all taken first.
+    const bool counts = target_expected_[t] ? chosen.kind != planner::CandidateKind::kRemembered
+                                            : int(t) == aimed_target || target_unconfirmed_[t] ||
+                                                  only_evidence_holds;
+    if (!counts) continue;
     if (Aim* aim = findAim(targets_[t].center_m))
       ++aim->views;
     else
@@ -62,9 +71,57 @@ void SizingGuidance::onPlan(const PlanEvent& event) {
   }
 }
 
+void SizingGuidance::expect(std::vector<RememberedFruitlet> fruitlets_tag, TagPoseFn T_world_tag,
+                            double max_shift_m) {
+  if (!(max_shift_m > 0.0) || !std::isfinite(max_shift_m))
+    throw std::invalid_argument("SizingGuidance::expect: max_shift_m: expected > 0");
+  if (!T_world_tag) throw std::invalid_argument("SizingGuidance::expect: no tag pose");
+  expected_ = std::move(fruitlets_tag);
+  T_world_tag_ = std::move(T_world_tag);
+  max_shift_m_ = max_shift_m;
+}
+
+void SizingGuidance::seekExpected() {
+  expected_found_ = expected_gone_ = 0;
+  if (expected_.empty()) return;
+  const std::optional<Eigen::Isometry3d>& T_world_tag = T_world_tag_();
+  if (!T_world_tag) return;
+  const SizingSnapshot& latest = history_.back();
+  std::vector<const FruitletSnapshot*> sized;
+  for (const FruitletSnapshot& f : latest.fruitlets) sized.push_back(&f);
+  for (const FruitletSnapshot& f : latest.unconfirmed) sized.push_back(&f);
+  // Where each was, in the maps' frame (the snapshot's centres are there).
+  std::vector<Eigen::Vector3d> where;
+  for (const RememberedFruitlet& f : expected_)
+    where.push_back(*T_world_tag * f.center_tag_m - latest.world_shift_m);
+  const std::vector<int> found = assignOneToOne(where.size(), sized.size(), [&](auto e, auto s) {
+    const double d = (where[e] - sized[s]->center_m).norm();
+    return d <= max_shift_m_ ? d : std::numeric_limits<double>::infinity();
+  });
+  for (std::size_t e = 0; e < where.size(); ++e) {
+    if (found[e] >= 0) {
+      ++expected_found_;
+      continue;
+    }
+    if (const Aim* aim = findAim(where[e]); aim && aim->views >= max_aimed_views_) {
+      ++expected_gone_;
+      continue;
+    }
+    planner::SizingTarget target;
+    target.center_m = where[e];
+    target.radius_m = 0.5e-3 * expected_[e].size_mm;
+    target.min_angle_deg = config_.min_view_span_deg;
+    target.min_visible_fraction = min_visible_fraction_;
+    targets_.push_back(std::move(target));
+    target_unconfirmed_.push_back(false);
+    target_expected_.push_back(true);
+  }
+}
+
 void SizingGuidance::onView(const ViewEvent& event) {
   targets_.clear();
   target_unconfirmed_.clear();
+  target_expected_.clear();
   // No sizing for this view (no Cluster Region yet): nothing to aim at.
   if (history_.empty() || history_.back().view != event.index) {
     planner_.setSizingTargets({});
@@ -96,7 +153,9 @@ void SizingGuidance::onView(const ViewEvent& event) {
     target.min_visible_fraction = min_visible_fraction_;
     targets_.push_back(std::move(target));
     target_unconfirmed_.push_back(f.unconfirmed);
+    target_expected_.push_back(false);
   }
+  seekExpected();
   planner_.setSizingTargets(targets_);
 }
 

@@ -105,6 +105,7 @@ PlanStep planAndMove(ViewPlanner& planner, map::MapEngine& map,
       ++step.move_attempts;
       if (move(step.candidates.at(i).T_world_camera)) {
         step.chosen = i;
+        planner.movedTo(step.candidates[i]);
         break;
       }
       ++step.failed_moves;

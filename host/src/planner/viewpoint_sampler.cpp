@@ -15,6 +15,8 @@ const char* toString(CandidateKind kind) {
       return "exploration";
     case CandidateKind::kSizing:
       return "sizing";
+    case CandidateKind::kRemembered:
+      return "remembered";
   }
   return "unknown";
 }

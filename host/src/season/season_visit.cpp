@@ -1,38 +1,25 @@
 #include "fvp/host/season/season_visit.h"
 
 #include <cmath>
-#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <stdexcept>
 
 #include "fvp/host/season/growth_rate.h"
+#include "json_fields.h"
 
 namespace fvp::host::season {
 namespace {
 
+using json_fields::fail;
+using json_fields::finiteNumber;
+using json_fields::tagIdOf;
+using json_fields::vector3;
 using nlohmann::json;
 
 /// More than a cluster holds by far (3-8 fruitlets): a file with more is not a cluster's
 /// sizing, and the association's exact search grows with it.
 constexpr std::size_t kMaxFruitletsPerCluster = 64;
-
-[[noreturn]] void fail(const std::string& source, const std::string& field,
-                       const std::string& expected) {
-  throw std::runtime_error(source + ": " + field + ": expected " + expected);
-}
-
-double finiteNumber(const json& j, const std::string& source, const std::string& field) {
-  if (!j.is_number() || !std::isfinite(j.get<double>())) fail(source, field, "a finite number");
-  return j.get<double>();
-}
-
-Eigen::Vector3d vector3(const json& j, const std::string& source, const std::string& field) {
-  if (!j.is_array() || j.size() != 3) fail(source, field, "an array of 3 numbers");
-  return {finiteNumber(j[0], source, field + "[0]"), finiteNumber(j[1], source, field + "[1]"),
-          finiteNumber(j[2], source, field + "[2]")};
-}
 
 SizedFruitlet sizedFruitlet(const json& f, const std::string& source, const std::string& field) {
   if (!f.is_object()) fail(source, field, "an object");
@@ -78,14 +65,6 @@ VisitCluster clusterOf(const json& sizing, int tag_id, const std::string& source
   return cluster;
 }
 
-int tagIdOf(const json& object, const std::string& source, const std::string& field) {
-  const auto id = object.find("tag_id");
-  if (id == object.end()) return 0;
-  if (!id->is_number_integer() || id->get<long long>() < 0 || id->get<long long>() > 1 << 20)
-    fail(source, field + "tag_id", "a tag id (an integer >= 0)");
-  return id->get<int>();
-}
-
 }  // namespace
 
 SeasonVisit parseSeasonVisit(const std::string& json_text, const std::string& source, double day) {
@@ -124,23 +103,8 @@ SeasonVisit parseSeasonVisit(const std::string& json_text, const std::string& so
 }
 
 SeasonVisit readSeasonVisit(const std::filesystem::path& path, double day) {
-  std::filesystem::path file = path;
-  if (!std::filesystem::exists(path))
-    throw std::runtime_error(path.string() +
-                             ": no such file or directory (expected a result.json, a "
-                             "fruitlets.json or a directory holding one)");
-  if (std::filesystem::is_directory(path)) {
-    file = path / "result.json";
-    if (!std::filesystem::exists(file)) file = path / "fruitlets.json";
-    if (!std::filesystem::exists(file))
-      throw std::runtime_error(path.string() +
-                               ": expected a result.json or fruitlets.json in the directory");
-  }
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw std::runtime_error(file.string() + ": cannot be read");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parseSeasonVisit(text.str(), file.string(), day);
+  const std::filesystem::path file = json_fields::visitFile(path);
+  return parseSeasonVisit(json_fields::fileText(file), file.string(), day);
 }
 
 }  // namespace fvp::host::season

@@ -32,6 +32,10 @@ struct SeasonTrialOptions {
   /// day; another is an error) instead of running it again: a season cut short resumes, and
   /// a finished one is rescored after its season_score.json is removed.
   bool reuse_visits = false;
+  /// Each visit after the first starts from the one before it (TrialOptions::remembered_visit,
+  /// docs/season.md "Visits remembered"): read from out_dir, which it needs. Off: each visit
+  /// starts afresh, as a first visit does.
+  bool remember_visits = true;
 };
 
 /// The days' check: two or more, finite, increasing, within season_day's range. Throws

@@ -70,6 +70,10 @@ struct TrialOptions {
   /// by information per second (host::nbv::NbvLoopOptions::view_overhead_s); 0: the
   /// planner's order.
   double view_overhead_s = host::planner::kDefaultViewOverheadS;
+  /// An earlier visit of the same tree (its result.json, or the directory holding it): each
+  /// cluster starts from what that visit learned, aligned through its tag (docs/season.md,
+  /// "Visits remembered"). Empty: none. Recorded in result.json's "remembered_visit".
+  std::filesystem::path remembered_visit;
   /// Where result.json, the maps, the TSDF surface, the clusters and report.md go; empty:
   /// nothing is written (the result is only returned).
   std::filesystem::path out_dir;

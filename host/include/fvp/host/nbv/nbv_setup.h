@@ -24,6 +24,7 @@
 #include "fvp/host/nbv/loop_clock.h"
 #include "fvp/host/nbv/nbv_loop.h"
 #include "fvp/host/nbv/stop_rule.h"
+#include "fvp/host/nbv/visit_memory.h"
 #include "fvp/host/perception/perception_pipeline.h"
 #include "fvp/host/planner/view_planner.h"
 #include "fvp/host/session/mapping_session.h"
@@ -60,6 +61,9 @@ struct ClusterTarget {
   Eigen::Isometry3d T_world_start_camera = Eigen::Isometry3d::Identity();
   /// About where the cluster is: approach views turn about the vertical through it.
   Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
+  /// What an earlier visit learned of it (docs/season.md, "Visits remembered"): its views are
+  /// taken first, and with the automatic stop its fruitlets are looked for.
+  std::optional<ClusterMemory> memory;
 };
 
 struct NbvSetupOptions {
@@ -72,6 +76,10 @@ struct NbvSetupOptions {
   /// Align each view to the earlier ones before fusing it (MappingSession::
   /// enableViewRegistration).
   bool register_views = false;
+  /// The farthest a remembered fruitlet's centre may stand from where an earlier visit saw it
+  /// and still be that fruitlet (season::AssociationConfig::max_center_shift_m's reason:
+  /// stems droop a few millimetres as fruitlets grow, plus each visit's registration error).
+  double remembered_max_shift_m = 0.008;
   /// Perception for every cluster; the target's tag id and region replace the tag's and
   /// region's.
   PerceptionConfig perception;
@@ -83,11 +91,24 @@ struct NbvSetupOptions {
   void validate() const;
 };
 
+class RememberedViews;
+
 /// One cluster's mapping session and planner: what the loop fills and the sizing reads.
 struct ClusterWork {
   std::unique_ptr<MappingSession> session;
   std::unique_ptr<planner::ViewPlanner> planner;
   map::MapConfig map_config;  ///< the maps' config, as the session got it
+  /// With the target's memory: the planner (a RememberedViews) and the fruitlets to expect.
+  RememberedViews* remembered = nullptr;
+  std::vector<RememberedFruitlet> expected;
+};
+
+/// What a cluster's memory did (ClusterTarget::memory).
+struct MemoryUse {
+  std::size_t views = 0, views_taken = 0;  ///< remembered views, and those the arm took
+  /// Remembered fruitlets, those the final sizing found within the gate, and those looked
+  /// for in vain (gone); the rest were neither (the stop ended first, or not the automatic one).
+  std::size_t fruitlets = 0, found = 0, gone = 0;
 };
 
 /// What running the loop on one cluster gave.
@@ -104,6 +125,7 @@ struct ClusterRun {
   /// Views of the tour's earlier approach views that showed no tag (their poses lead
   /// run.camera_poses and are counted in run.views).
   int approaches_without_tag = 0;
+  std::optional<MemoryUse> memory;  ///< with the target's memory
 };
 
 /// How a tour's visit of a cluster ended.

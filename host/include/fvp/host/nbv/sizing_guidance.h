@@ -8,13 +8,17 @@
 // a leaf the arm cannot see past), and the cluster must not wait on it.
 #pragma once
 
-#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cstddef>
+#include <functional>
+#include <optional>
 #include <vector>
 
 #include "fvp/host/nbv/cluster_completion.h"
 #include "fvp/host/nbv/nbv_loop.h"
+#include "fvp/host/nbv/remembered_views.h"
+#include "fvp/host/nbv/visit_memory.h"
 #include "fvp/host/planner/view_planner.h"
 
 namespace fvp::host::nbv {
@@ -49,6 +53,21 @@ class SizingGuidance : public LoopObserver {
     return std::find(target_unconfirmed_.begin(), target_unconfirmed_.end(), true) !=
            target_unconfirmed_.end();
   }
+  /// The fruitlets an earlier visit sized, in the tag's frame (visit_memory.h); T_world_tag
+  /// gives the tag's pose on this visit (empty until a view saw it) and must outlive this.
+  /// After each sizing, a remembered fruitlet that no fruitlet of the sizing (kept or
+  /// unconfirmed) stands within max_shift_m of, one to one, is a target the stop waits on
+  /// (waitingOnExpected); one still not found after max_aimed_views views other than
+  /// remembered ones is gone (expectedGone): looked for where it was, and not there.
+  void expect(std::vector<RememberedFruitlet> fruitlets_tag, TagPoseFn T_world_tag,
+              double max_shift_m);
+  bool waitingOnExpected() const {
+    return std::find(target_expected_.begin(), target_expected_.end(), true) !=
+           target_expected_.end();
+  }
+  /// After the last sizing: remembered fruitlets found, and those given up as gone.
+  std::size_t expectedFound() const { return expected_found_; }
+  std::size_t expectedGone() const { return expected_gone_; }
   /// Whether the fruitlet at center_m was left out: looked at max_aimed_views times without a
   /// new well-seen image (ClusterCompletion::releaseWhen takes it, with release_left_out).
   bool leftOut(const Eigen::Vector3d& center_m) const;
@@ -61,6 +80,8 @@ class SizingGuidance : public LoopObserver {
   };
   Aim* findAim(const Eigen::Vector3d& center_m);
   const Aim* findAim(const Eigen::Vector3d& center_m) const;
+  /// Adds the remembered fruitlets the latest sizing lacks to the targets (expect()).
+  void seekExpected();
 
   const std::vector<SizingSnapshot>& history_;
   const ClusterCompletionConfig& config_;
@@ -69,6 +90,11 @@ class SizingGuidance : public LoopObserver {
   int max_aimed_views_;
   std::vector<planner::SizingTarget> targets_;
   std::vector<bool> target_unconfirmed_;  ///< per target: an unconfirmed detection
+  std::vector<bool> target_expected_;     ///< per target: a remembered fruitlet not found
+  std::vector<RememberedFruitlet> expected_;
+  TagPoseFn T_world_tag_;
+  double max_shift_m_ = 0.0;
+  std::size_t expected_found_ = 0, expected_gone_ = 0;
   std::vector<Aim> aims_;
   std::size_t aimed_views_ = 0, dropped_ = 0;
 };

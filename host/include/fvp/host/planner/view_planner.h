@@ -24,8 +24,10 @@ class MapEngine;
 
 namespace fvp::host::planner {
 
-enum class CandidateKind { kRoi, kExploration, kSizing };
-/// "roi", "exploration" or "sizing" (plan.json's "kind").
+/// kRemembered: a view an earlier visit took that showed the cluster's fruitlets well
+/// (host/nbv/remembered_views.h).
+enum class CandidateKind { kRoi, kExploration, kSizing, kRemembered };
+/// "roi", "exploration", "sizing" or "remembered" (plan.json's "kind").
 const char* toString(CandidateKind kind);
 
 /// One viewpoint candidate: a full camera pose (OpenCV optical frame of the left camera,
@@ -101,6 +103,8 @@ class ViewPlanner {
   /// How the round's moves went: moved to one of its ranked views, or none (FVP decays
   /// its utility threshold then, Algorithm 1 line 18).
   virtual void roundDone(bool moved) { (void)moved; }
+  /// The round's view the arm moved to (called before roundDone(true)).
+  virtual void movedTo(const Candidate& chosen) { (void)chosen; }
   /// The planner's configuration as JSON text (printed into every result).
   virtual std::string configJson() const = 0;
   /// The fruitlets the automatic stop still waits for, after each sizing (sizing_target.h).
