@@ -12,7 +12,8 @@
   var COL = {
     roi: 0xe8506e, other: 0x7fa36a, mesh: 0xd8c8a4, matched: 0x3ddc84, unmatched: 0xffa23a,
     kept: 0x4aa8ff, dropped: 0x9098a8, truth: 0xffffff, region: 0x8c9bb3, tagFace: 0xcfd4dc,
-    tagCode: 0x30343c, reached: 0x3ddc84, missed: 0xff4d4d, seen: 0xffe14d, chosen: 0xffffff, dim: 0x454c59};
+    tagCode: 0x30343c, reached: 0x3ddc84, missed: 0xff4d4d, seen: 0xffe14d, chosen: 0xffffff, dim: 0x454c59,
+    fate_persists: 0x2ca02c, fate_abscises: 0xd62728, fate_gone: 0x7f7f7f, fate_unknown: 0x30343c, fate_unconfirmed: 0xffa23a};
   var FRUSTUM_DEPTH_M = 0.03;
 
   var diag = window.fvpDiag || { errors: [], warnings: [], blocked: [] };
@@ -122,7 +123,9 @@
     var sphere = new THREE.SphereBufferGeometry(1, 32, 16);
     dets.forEach(function (d, i) {
       var c = vec(d.center_m, 'detections[' + i + '].center_m'), r = Math.max(+d.size_mm || 0, 0.2) / 2000;
-      var status = !d.kept ? 'dropped' : d.matched === true ? 'matched' : d.matched === false ? 'unmatched' : 'kept';
+      // A season's fruitlet (season_viewer.html) is coloured by its predicted fate.
+      var status = COL['fate_' + d.fate] !== undefined ? 'fate_' + d.fate :
+        !d.kept ? 'dropped' : d.matched === true ? 'matched' : d.matched === false ? 'unmatched' : 'kept';
       var m = new THREE.Mesh(sphere, new THREE.MeshPhongMaterial({
         color: COL[status], transparent: true, opacity: d.kept ? 0.6 : 0.4, depthWrite: false }));
       m.position.copy(c);
@@ -325,6 +328,11 @@
     [['roi', css(COL.roi), 'ROI voxel (fruitlet)'], ['other', css(COL.other), 'other voxel'], ['mesh', css(COL.mesh), 'TSDF mesh'],
       ['matched', css(COL.matched), 'detection, matched'], ['unmatched', css(COL.unmatched), 'detection, no true fruitlet'],
       ['kept', css(COL.kept), 'detection, kept'], ['dropped', css(COL.dropped), 'detection, dropped'],
+      ['fate_persists', css(COL.fate_persists), 'fruitlet, predicted to persist'],
+      ['fate_abscises', css(COL.fate_abscises), 'fruitlet, predicted to drop'],
+      ['fate_gone', css(COL.fate_gone), 'fruitlet gone (where last seen)'],
+      ['fate_unknown', css(COL.fate_unknown), 'fruitlet, fate unknown'],
+      ['fate_unconfirmed', css(COL.fate_unconfirmed), 'fruitlet sized once (unconfirmed)'],
       ['truth', css(COL.truth), 'ground truth (wire), line to estimate'], ['region', css(COL.region), 'Cluster Region'],
       ['tag', 'linear-gradient(90deg,#f00 33%,#0f0 33% 66%,#00f 66%)', 'AprilTag, axes x y z'],
       ['cameras', 'linear-gradient(90deg,' + orderColor(0, 2).getStyle() + ',' + orderColor(1, 2).getStyle() + ')', 'view frusta, ' + order],
@@ -382,6 +390,8 @@
     if (d.matched !== undefined) row('ground truth', d.matched && gt ? (gt.label || gt.index) + ', ' + mm(gt.size_mm) : 'not matched');
     if (isFinite(d.error_mm)) row('error (est − true)', mm(d.error_mm));
     row('cluster', d.cluster);
+    if (d.fate !== undefined) row('predicted fate', d.fate);
+    if (isFinite(d.growth_mm_per_day)) row('growth', mm(d.growth_mm_per_day, 3) + '/day');
     row('sized images', s.sized_images);
     row('well seen images', s.well_seen_images);
     row('sphere fit rms', s.sphere_rms_mm >= 0 ? mm(s.sphere_rms_mm, 3) : 'no sphere fit');

@@ -146,7 +146,7 @@ TEST(RememberedVisit, BadFieldsAreErrorsNamingThem) {
   r["clusters"][0]["sized_fruitlets"][1]["per_image"][0]["view"] = "two";
   fails(r, "clusters[0].sized_fruitlets[1].per_image[0].view");
   r = treeResult();
-  r["clusters"][0]["T_world_tag"].erase("translation_m");
+  r["clusters"][0]["T_world_tag"]["translation_m"] = "here";
   fails(r, "clusters[0].T_world_tag.translation_m");
   EXPECT_THROW(parseVisitMemory("{", "r.json"), std::runtime_error);
   EXPECT_THROW(readVisitMemory("/nonexistent/visit"), std::runtime_error);

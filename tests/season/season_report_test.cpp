@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include "fvp/host/season/season_visit.h"
 
@@ -59,7 +60,34 @@ TEST(SeasonReport, WritesTheTextAndTheFigure) {
   png.read(magic, 4);
   EXPECT_EQ(std::string(magic + 1, 3), "PNG");
   EXPECT_TRUE(std::filesystem::exists(dir / "season.md"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "season_viewer.html"));
+  std::ifstream md(dir / "season.md");
+  const std::string text((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("](season_viewer.html)"), std::string::npos);
   std::filesystem::remove_all(dir);
+}
+
+TEST(SeasonReport, TheViewerShowsEveryFruitletWhereItsTagPutsItColouredByItsFate) {
+  const season::SeasonAnalysis s = treeSeason();
+  const nlohmann::json scene = seasonViewerScene(s);
+  std::size_t tracks = 0;
+  for (const season::ClusterSeason& c : s.clusters) tracks += c.tracks.size();
+  ASSERT_EQ(scene["detections"].size(), tracks);
+  ASSERT_EQ(scene["tags"].size(), s.clusters.size());
+  std::size_t d = 0;
+  for (const season::ClusterSeason& c : s.clusters) {
+    ASSERT_TRUE(c.T_world_tag.has_value()) << "the day-4 result gives every tag's pose";
+    for (const std::size_t t : c.tracks) {
+      const season::FruitletTrack& track = s.tracks[t];
+      const nlohmann::json& f = scene["detections"][d++];
+      const Eigen::Vector3d expected = *c.T_world_tag * track.sizes.back().sized.at.center_tag_m;
+      for (int i = 0; i < 3; ++i) EXPECT_NEAR(f["center_m"][i].get<double>(), expected[i], 1e-9);
+      const std::string fate = f["fate"];
+      EXPECT_EQ(fate, track.unconfirmed ? "unconfirmed"
+                      : track.gone      ? "gone"
+                                        : season::toString(track.fate.fate));
+    }
+  }
 }
 
 }  // namespace

@@ -1,11 +1,15 @@
 #include "fvp/host/report/season_report.h"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
 
 #include "fvp/host/core/atomic_file.h"
 #include "fvp/host/core/gnuplot.h"
+#include "fvp/host/perception/apriltag_detector.h"
+#include "fvp/host/report/viewer_page.h"
+#include "fvp/host/report/viewer_scene.h"
 
 namespace fvp::host::report {
 namespace {
@@ -48,7 +52,8 @@ std::string fruitSetText(const season::FruitSet& set) {
 }  // namespace
 
 std::string seasonMarkdown(const season::SeasonAnalysis& s, const std::string& figure,
-                           const std::vector<std::string>& viewers) {
+                           const std::vector<std::string>& viewers,
+                           const std::string& season_viewer) {
   std::ostringstream md;
   md << "# Season\n\n"
      << s.days.size() << " visits. Reference growth (the fastest fruitlets) "
@@ -57,6 +62,8 @@ std::string seasonMarkdown(const season::SeasonAnalysis& s, const std::string& f
      << " mm/day is predicted to drop (docs/season.md). Predicted fruit set of the sample: "
      << fruitSetText(s.fruit_set) << ".\n\n";
   if (!figure.empty()) md << "![size against day, by predicted fate](" << figure << ")\n\n";
+  if (!season_viewer.empty())
+    md << "[3-D viewer: the fruitlets by predicted fate](" << season_viewer << ")\n\n";
   md << "| visit | day | source | viewer |\n|---|---|---|---|\n";
   for (std::size_t v = 0; v < s.days.size(); ++v) {
     const bool viewer = v < viewers.size() && !viewers[v].empty();
@@ -111,6 +118,33 @@ std::string seasonFigureScript(const season::SeasonAnalysis& s) {
   return gp.str();
 }
 
+nlohmann::json seasonViewerScene(const season::SeasonAnalysis& season) {
+  std::ostringstream subtitle;
+  subtitle << "days";
+  for (std::size_t v = 0; v < season.days.size(); ++v)
+    subtitle << (v ? ", " : " ") << season.days[v];
+  subtitle << "; predicted fruit set " << fruitSetText(season.fruit_set)
+           << "; green persists, red drops, grey gone";
+  ViewerScene scene("fvp season: fruitlets by predicted fate", subtitle.str());
+  for (std::size_t c = 0; c < season.clusters.size(); ++c) {
+    const season::ClusterSeason& cluster = season.clusters[c];
+    if (!cluster.T_world_tag) continue;
+    const int index = static_cast<int>(c);
+    scene.addTag(*cluster.T_world_tag, kDefaultTagSizeM, cluster.tag_id, index);
+    for (std::size_t k = 0; k < cluster.tracks.size(); ++k) {
+      const FruitletTrack& t = season.tracks[cluster.tracks[k]];
+      const season::TrackedSize& last = t.sizes.back();
+      // Labelled as season.md numbers them: tag, then the track's place in its cluster.
+      std::ostringstream label;
+      label << "T" << cluster.tag_id << "." << k + 1;
+      scene.addSeasonFruitlet(*cluster.T_world_tag * last.sized.at.center_tag_m,
+                              last.sized.at.size_mm, label.str(), fateWord(t), t.rate.mm_per_day,
+                              index);
+    }
+  }
+  return scene.toJson();
+}
+
 bool writeSeasonReport(const season::SeasonAnalysis& season, const std::filesystem::path& dir,
                        const std::function<void(const std::string&)>& warning) {
   bool drawn = false;
@@ -132,8 +166,13 @@ bool writeSeasonReport(const season::SeasonAnalysis& season, const std::filesyst
         std::filesystem::exists(viewer, ec) ? std::filesystem::relative(viewer, dir, ec) : "";
     viewers.push_back(ec ? std::string() : link.generic_string());
   }
+  const bool any_pose = std::any_of(season.clusters.begin(), season.clusters.end(),
+                                    [](const auto& c) { return c.T_world_tag.has_value(); });
+  std::filesystem::remove(dir / "season_viewer.html");  // never a stale one
+  if (any_pose) writeViewerPage(seasonViewerScene(season), dir / "season_viewer.html");
   writeFileAtomically(dir / "season.md", "season report",
-                      seasonMarkdown(season, drawn ? "season.png" : "", viewers));
+                      seasonMarkdown(season, drawn ? "season.png" : "", viewers,
+                                     any_pose ? "season_viewer.html" : ""));
   return drawn;
 }
 

@@ -204,6 +204,16 @@ void ViewerScene::addSizing(const nlohmann::json& sizing, int view_offset,
   }
 }
 
+void ViewerScene::addSeasonFruitlet(const Eigen::Vector3d& center_m, double size_mm,
+                                    const std::string& label, const std::string& fate,
+                                    double growth_mm_per_day, std::optional<int> cluster) {
+  nlohmann::json j = {{"id", detections_.size()},       {"label", label},     {"kept", true},
+                      {"center_m", vec3Json(center_m)}, {"size_mm", size_mm}, {"fate", fate}};
+  if (std::isfinite(growth_mm_per_day)) j["growth_mm_per_day"] = growth_mm_per_day;
+  setCluster(j, cluster);
+  detections_.push_back(std::move(j));
+}
+
 nlohmann::json ViewerScene::toJson() const {
   nlohmann::json scene = {{"format", "fvp-viewer-scene"},
                           {"version", 1},

@@ -2,7 +2,7 @@
 // and what was expected (season_visit.cpp, remembered_visit.cpp).
 #pragma once
 
-#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -29,6 +29,30 @@ inline Eigen::Vector3d vector3(const nlohmann::json& j, const std::string& sourc
   if (!j.is_array() || j.size() != 3) fail(source, field, "an array of 3 numbers");
   return {finiteNumber(j[0], source, field + "[0]"), finiteNumber(j[1], source, field + "[1]"),
           finiteNumber(j[2], source, field + "[2]")};
+}
+
+inline Eigen::Quaterniond quaternionWxyz(const nlohmann::json& j, const std::string& source,
+                                         const std::string& field) {
+  if (!j.is_array() || j.size() != 4) fail(source, field, "an array of 4 numbers (w, x, y, z)");
+  const Eigen::Quaterniond q(
+      finiteNumber(j[0], source, field + "[0]"), finiteNumber(j[1], source, field + "[1]"),
+      finiteNumber(j[2], source, field + "[2]"), finiteNumber(j[3], source, field + "[3]"));
+  if (!(std::abs(q.norm() - 1.0) < 1e-3)) fail(source, field, "a unit quaternion");
+  return q.normalized();
+}
+
+/// A pose as results write it: {translation_key: [x, y, z], "quaternion_wxyz": [w, x, y, z]}.
+inline Eigen::Isometry3d poseOf(const nlohmann::json& j, const char* translation_key,
+                                const std::string& source, const std::string& field) {
+  if (!j.is_object()) fail(source, field, "an object");
+  const auto t = j.find(translation_key);
+  if (t == j.end()) fail(source, field + "." + translation_key, "a position in metres");
+  const auto q = j.find("quaternion_wxyz");
+  if (q == j.end()) fail(source, field + ".quaternion_wxyz", "an orientation");
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = quaternionWxyz(*q, source, field + ".quaternion_wxyz").toRotationMatrix();
+  pose.translation() = vector3(*t, source, field + "." + translation_key);
+  return pose;
 }
 
 /// A result's cluster's tag id ("tag_id"; 0 when absent: a result of one cluster without one).

@@ -14,34 +14,12 @@ namespace {
 
 using json_fields::fail;
 using json_fields::finiteNumber;
+using json_fields::poseOf;
 using json_fields::vector3;
 using nlohmann::json;
 
 /// More views than any visit takes (a cluster's cap is 180 s, a view at least a second).
 constexpr std::size_t kMaxViews = 100000;
-
-Eigen::Quaterniond quaternionWxyz(const json& j, const std::string& source,
-                                  const std::string& field) {
-  if (!j.is_array() || j.size() != 4) fail(source, field, "an array of 4 numbers (w, x, y, z)");
-  const Eigen::Quaterniond q(
-      finiteNumber(j[0], source, field + "[0]"), finiteNumber(j[1], source, field + "[1]"),
-      finiteNumber(j[2], source, field + "[2]"), finiteNumber(j[3], source, field + "[3]"));
-  if (!(std::abs(q.norm() - 1.0) < 1e-3)) fail(source, field, "a unit quaternion");
-  return q.normalized();
-}
-
-Eigen::Isometry3d poseOf(const json& j, const char* translation_key, const std::string& source,
-                         const std::string& field) {
-  if (!j.is_object()) fail(source, field, "an object");
-  const auto t = j.find(translation_key);
-  if (t == j.end()) fail(source, field + "." + translation_key, "a position in metres");
-  const auto q = j.find("quaternion_wxyz");
-  if (q == j.end()) fail(source, field + ".quaternion_wxyz", "an orientation");
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = quaternionWxyz(*q, source, field + ".quaternion_wxyz").toRotationMatrix();
-  pose.translation() = vector3(*t, source, field + "." + translation_key);
-  return pose;
-}
 
 /// The run's views by their index ("view_log"; none in a fruitlets.json).
 std::map<std::size_t, Eigen::Isometry3d> viewPoses(const json& root, const std::string& source) {
@@ -106,8 +84,9 @@ nbv::ClusterMemory memoryOf(const json& cluster, const VisitCluster& read,
   nbv::ClusterMemory memory;
   for (const SizedFruitlet& f : read.fruitlets)
     memory.fruitlets.push_back({f.at.center_tag_m, f.at.size_mm});
-  const Eigen::Isometry3d T_tag_world =
-      poseOf(cluster.at("T_world_tag"), "translation_m", source, field + "T_world_tag").inverse();
+  // Without the tag's pose the views cannot be carried over; the fruitlets still can.
+  if (!read.T_world_tag) return memory;
+  const Eigen::Isometry3d T_tag_world = read.T_world_tag->inverse();
   // The views the fruitlets name that the log holds, numbered densely for the cover.
   std::vector<std::vector<std::size_t>> seen = viewsOfFruitlets(cluster, source, field);
   std::vector<std::size_t> run_view;

@@ -49,6 +49,7 @@ void followCluster(int tag_id, const std::vector<SeasonVisit>& visits,
         continue;
       }
       ++cluster.visits_with_tag;
+      if (c.T_world_tag) cluster.T_world_tag = c.T_world_tag;
       std::vector<VisitFruitlet> earlier, later;
       std::vector<double> days_since;  // each track's growth gate: since its own last size
       for (const std::size_t t : cluster.tracks) {

@@ -53,6 +53,8 @@ VisitCluster clusterOf(const json& sizing, int tag_id, const std::string& source
   cluster.tag_id = tag_id;
   cluster.tag_seen = sizing.contains("T_world_tag");
   if (!cluster.tag_seen) return cluster;
+  if (const json& pose = sizing["T_world_tag"]; pose.is_object() && pose.contains("translation_m"))
+    cluster.T_world_tag = json_fields::poseOf(pose, "translation_m", source, field + "T_world_tag");
   const auto fruitlets = sizing.find("sized_fruitlets");
   if (fruitlets == sizing.end() || !fruitlets->is_array())
     fail(source, field + "sized_fruitlets", "an array of sized fruitlets");

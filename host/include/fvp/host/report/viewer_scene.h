@@ -56,6 +56,12 @@ class ViewerScene {
   /// (a tree's cluster numbers its views from its own first).
   void addSizing(const nlohmann::json& sizing, int view_offset, std::optional<int> cluster);
 
+  /// A fruitlet followed over a season (the season viewer): where it is (or was last seen, if
+  /// gone), its last size, its growth rate (NaN: none) and its predicted fate ("persists",
+  /// "abscises", "gone", "unknown", "unconfirmed"), which the page colours it by.
+  void addSeasonFruitlet(const Eigen::Vector3d& center_m, double size_mm, const std::string& label,
+                         const std::string& fate, double growth_mm_per_day,
+                         std::optional<int> cluster);
   std::size_t voxelCount() const { return voxels_.size(); }
   std::size_t detectionCount() const { return detections_.size(); }
   /// The scene JSON (format "fvp-viewer-scene", version 1).

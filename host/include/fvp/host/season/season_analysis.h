@@ -3,9 +3,11 @@
 // predicted fruit set of each cluster and of the whole sample.
 #pragma once
 
+#include <Eigen/Geometry>
 #include <cstddef>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <vector>
 
 #include "fvp/host/season/fruitlet_association.h"
@@ -57,6 +59,9 @@ struct FruitSet {
 
 struct ClusterSeason {
   int tag_id = 0;
+  /// The tag's pose on the cluster's last visit that saw it and gave it (that visit's world):
+  /// where the season viewer draws the cluster.
+  std::optional<Eigen::Isometry3d> T_world_tag;
   std::vector<std::size_t> tracks;  ///< indices into SeasonAnalysis::tracks
   std::size_t visits_with_tag = 0, visits_without_tag = 0;
   FruitSet fruit_set;

@@ -3,8 +3,10 @@
 // result.json (one cluster or a tree) or `fvp size`'s fruitlets.json.
 #pragma once
 
+#include <Eigen/Geometry>
 #include <filesystem>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,6 +27,9 @@ struct SizedFruitlet {
 struct VisitCluster {
   int tag_id = 0;
   bool tag_seen = true;
+  /// The tag's pose in the visit's world ("T_world_tag" with "translation_m" and
+  /// "quaternion_wxyz", as fvp's results write it); none when the file gives no pose.
+  std::optional<Eigen::Isometry3d> T_world_tag;
   std::vector<SizedFruitlet> fruitlets;
 };
 
