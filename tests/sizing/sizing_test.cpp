@@ -147,6 +147,11 @@ TEST(Matching, TagFrameCentresByHand) {
   EXPECT_NEAR(q[0].get<double>(), std::sqrt(0.5), 1e-12);
   EXPECT_NEAR(q[3].get<double>(), std::sqrt(0.5), 1e-12);
   EXPECT_EQ(details["T_world_tag"]["translation_m"], nlohmann::json({1.0, 0.0, 0.0}));
+  // Centres the sizing moved by an anchor shift go back into the maps' frame, where the tag is.
+  nlohmann::json shifted = {{"sized_fruitlets", {{{"center_m", {1.003, 0.02, 0.5}}}}}};
+  eval::addTagFrame(shifted, T_world_tag, Eigen::Vector3d(0.003, 0.0, 0.0));
+  EXPECT_NEAR(shifted["sized_fruitlets"][0]["center_tag_m"][0].get<double>(), 0.02, 1e-12);
+  EXPECT_NEAR(shifted["sized_fruitlets"][0]["center_tag_m"][1].get<double>(), 0.0, 1e-12);
 }
 
 TEST(SphereFit, RecoversCentreAndRadiusFromAHemisphere) {

@@ -45,6 +45,15 @@ nlohmann::json visitFigures(double day, const nlohmann::json& result) {
           {"wall_time_s", result.value("wall_time_s", 0.0)}};
 }
 
+/// The visit a result remembered, by its directory's name ("day-4"; empty: none): the season's
+/// directory may be spelled or placed otherwise on a resume.
+fs::path rememberedDay(const nlohmann::json& result) {
+  const auto it = result.find("remembered_visit");
+  if (it == result.end() || !it->is_string()) return {};
+  fs::path day = fs::path(it->get<std::string>()).lexically_normal();
+  return day.has_filename() ? day.filename() : day.parent_path().filename();
+}
+
 /// A visit's result.json already in its directory (a season cut short), when it is this
 /// visit's: the same settings, seed and day; another is an error naming the file.
 std::optional<nlohmann::json> finishedVisit(const TrialOptions& visit) {
@@ -56,7 +65,7 @@ std::optional<nlohmann::json> finishedVisit(const TrialOptions& visit) {
   resolved.register_views = registerViewsOf(visit);
   if (result.is_discarded() || !result.is_object() ||
       result.value("settings", nlohmann::json()) != nlohmann::json(trialSettingsJson(resolved)) ||
-      result.value("remembered_visit", std::string()) != visit.remembered_visit.string())
+      rememberedDay(result) != visit.remembered_visit.filename())
     throw std::runtime_error(file.string() +
                              ": not this visit's result (another seed, day, settings or "
                              "remembered visit); another --out");

@@ -128,7 +128,7 @@ nlohmann::json TrialParts::score(host::sizing::SizingResult sizing,
   nlohmann::json out = host::eval::scoreBothEstimators(sizing_, truth, estimator);
   // The details object must outlive the loop (items() of a temporary would dangle).
   nlohmann::json details = host::eval::sizingDetails(sizing_);
-  host::eval::addTagFrame(details, session().T_world_tag());
+  host::eval::addTagFrame(details, session().T_world_tag(), session().appliedAnchorShift_m());
   for (const auto& [key, value] : details.items()) out[key] = value;
   // No TSDF when no view ever saw the tag (nothing was sized then).
   const host::tsdf::TsdfVolume* tsdf = session().tsdf();

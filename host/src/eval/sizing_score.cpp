@@ -149,7 +149,8 @@ nlohmann::json sizingDetails(const sizing::SizingResult& sz) {
               {"overlapping_detections_merged", sz.events.overlapping_detections_merged}}}}}};
 }
 
-void addTagFrame(nlohmann::json& details, const std::optional<Eigen::Isometry3d>& T_world_tag) {
+void addTagFrame(nlohmann::json& details, const std::optional<Eigen::Isometry3d>& T_world_tag,
+                 const Eigen::Vector3d& applied_anchor_shift_m) {
   if (!T_world_tag) return;
   const Eigen::Quaterniond q(T_world_tag->rotation());
   details["T_world_tag"] = {{"translation_m", vec3(T_world_tag->translation())},
@@ -159,7 +160,7 @@ void addTagFrame(nlohmann::json& details, const std::optional<Eigen::Isometry3d>
     const auto& c = f.at("center_m");
     const Eigen::Vector3d center_m(c.at(0).get<double>(), c.at(1).get<double>(),
                                    c.at(2).get<double>());
-    f["center_tag_m"] = vec3(T_tag_world * center_m);
+    f["center_tag_m"] = vec3(T_tag_world * (center_m - applied_anchor_shift_m));
   }
 }
 

@@ -51,7 +51,7 @@ void ClusterCompletion::onView(const ViewEvent& event) {
   snapshot.now_s = clock_.now_s();
   snapshot.sizing_s = sizing_s;
   snapshot.camera_position_m = event.T_world_camera.translation();
-  if (session_.correctsAnchorOffset()) snapshot.world_shift_m = session_.anchorOffset().shift_m;
+  snapshot.world_shift_m = session_.appliedAnchorShift_m();
   const auto& views = session_.sizingViews();
   // Its images' directions (the well-seen ones, or every sized one of an unconfirmed
   // detection) and the widest angle between two.

@@ -24,7 +24,6 @@ std::optional<planner::Ranking> RememberedViews::rank(map::MapEngine& map,
   const std::optional<Eigen::Isometry3d>& T_world_tag = T_world_tag_();
   if (round == 0 && pending() && T_world_tag) {
     planner::Ranking ranking;
-    offered_views_.clear();
     const Eigen::Vector3d tag_m = T_world_tag->translation();
     for (std::size_t k = 0; k < T_tag_camera_.size(); ++k) {
       if (done_[k]) continue;
@@ -38,10 +37,10 @@ std::optional<planner::Ranking> RememberedViews::rank(map::MapEngine& map,
         ++skipped_;
         continue;
       }
-      c.ig = c.utility = 1.0;  // alike: the robot's time orders them
+      c.ig = c.utility = 1.0;                 // alike: the robot's time orders them
+      c.sizing_target = static_cast<int>(k);  // which remembered view (movedTo reads it)
       ranking.order.push_back(ranking.candidates.size());
       ranking.candidates.push_back(c);
-      offered_views_.push_back(k);
     }
     if (!ranking.candidates.empty()) {
       offered_ = round_remembered_ = true;
@@ -60,12 +59,11 @@ void RememberedViews::roundDone(bool moved) {
 
 void RememberedViews::movedTo(const planner::Candidate& chosen) {
   if (chosen.kind != planner::CandidateKind::kRemembered) return planner_->movedTo(chosen);
-  for (const std::size_t k : offered_views_)
-    if (!done_[k] && (*T_world_tag_() * T_tag_camera_[k]).isApprox(chosen.T_world_camera)) {
-      done_[k] = true;
-      ++taken_;
-      return;
-    }
+  const auto k = static_cast<std::size_t>(chosen.sizing_target);
+  if (chosen.sizing_target < 0 || k >= done_.size() || done_[k])
+    throw std::logic_error("RememberedViews::movedTo: not a view it offered");
+  done_[k] = true;
+  ++taken_;
 }
 
 }  // namespace fvp::host::nbv

@@ -58,8 +58,9 @@ void SizingGuidance::onPlan(const PlanEvent& event) {
       config_.release_left_out &&
       sizesSettled(history_, config_, [](const FruitletSnapshot&) { return true; });
   for (std::size_t t = 0; t < targets_.size(); ++t) {
-    // A remembered fruitlet is looked for by every view but the remembered ones, which
-    // showed the cluster as it was and are all taken first.
+    // A remembered fruitlet is looked for by every view but the remembered ones: they come
+    // first and show where the cluster was, so they cannot tell gone from not yet sized; the
+    // views after them, aimed at it or at the cluster, can.
     const bool counts = target_expected_[t] ? chosen.kind != planner::CandidateKind::kRemembered
                                             : int(t) == aimed_target || target_unconfirmed_[t] ||
                                                   only_evidence_holds;
@@ -90,10 +91,11 @@ void SizingGuidance::seekExpected() {
   std::vector<const FruitletSnapshot*> sized;
   for (const FruitletSnapshot& f : latest.fruitlets) sized.push_back(&f);
   for (const FruitletSnapshot& f : latest.unconfirmed) sized.push_back(&f);
-  // Where each was, in the maps' frame (the snapshot's centres are there).
+  // Where each was, in the maps' frame, where the snapshot's centres and the tag seen on this
+  // visit both are (remembered centres are in the tag frame of the earlier visit's maps:
+  // eval::addTagFrame).
   std::vector<Eigen::Vector3d> where;
-  for (const RememberedFruitlet& f : expected_)
-    where.push_back(*T_world_tag * f.center_tag_m - latest.world_shift_m);
+  for (const RememberedFruitlet& f : expected_) where.push_back(*T_world_tag * f.center_tag_m);
   const std::vector<int> found = assignOneToOne(where.size(), sized.size(), [&](auto e, auto s) {
     const double d = (where[e] - sized[s]->center_m).norm();
     return d <= max_shift_m_ ? d : std::numeric_limits<double>::infinity();

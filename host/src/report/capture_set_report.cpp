@@ -89,7 +89,7 @@ nlohmann::json sizeCaptureSet(const std::filesystem::path& captures_dir,
   }
   // The details object must outlive the loop (items() of a temporary would dangle).
   nlohmann::json details = eval::sizingDetails(sized);
-  eval::addTagFrame(details, session.T_world_tag());
+  eval::addTagFrame(details, session.T_world_tag(), session.appliedAnchorShift_m());
   for (const auto& [key, value] : details.items()) out[key] = value;
   out["captures"] = set.captures;
   out["cluster_region_found"] = session.region().has_value();

@@ -13,6 +13,8 @@
 
 namespace fvp::host::season::json_fields {
 
+inline constexpr double kMaxPoseDistanceM = 1e4;
+
 [[noreturn]] inline void fail(const std::string& source, const std::string& field,
                               const std::string& expected) {
   throw std::runtime_error(source + ": " + field + ": expected " + expected);
@@ -52,6 +54,9 @@ inline Eigen::Isometry3d poseOf(const nlohmann::json& j, const char* translation
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.linear() = quaternionWxyz(*q, source, field + ".quaternion_wxyz").toRotationMatrix();
   pose.translation() = vector3(*t, source, field + "." + translation_key);
+  // A robot's poses lie within metres of its base; far beyond, composing them overflows.
+  if (!(pose.translation().norm() <= kMaxPoseDistanceM))
+    fail(source, field + "." + translation_key, "a position within 10 km");
   return pose;
 }
 

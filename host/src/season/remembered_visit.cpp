@@ -68,7 +68,10 @@ std::vector<std::vector<std::size_t>> viewsOfFruitlets(const json& cluster,
           fail(source, where + ".view", "the view's number in the cluster (an integer >= 0)");
         const std::size_t index = first_view + view->get<std::size_t>();
         any.push_back(index);
-        if (image.value("well_seen", false)) well.push_back(index);
+        const auto well_seen = image.find("well_seen");
+        if (well_seen != image.end() && !well_seen->is_boolean())
+          fail(source, where + ".well_seen", "true or false");
+        if (well_seen != image.end() && well_seen->get<bool>()) well.push_back(index);
       }
     }
     out.push_back(well.empty() ? any : well);

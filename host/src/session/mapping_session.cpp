@@ -151,7 +151,7 @@ sizing::SizingResult MappingSession::sizeFruitletsInMapFrame(
 
 sizing::SizingResult MappingSession::sizeFruitlets(const sizing::SizingConfig& config) const {
   sizing::SizingResult result = sizeFruitletsInMapFrame(config);
-  if (correctsAnchorOffset()) sizing::translateDetections(result, anchorOffset().shift_m);
+  if (correctsAnchorOffset()) sizing::translateDetections(result, appliedAnchorShift_m());
   return result;
 }
 

@@ -43,7 +43,11 @@ nlohmann::json sizingDetails(const sizing::SizingResult& sizing);
 /// Adds to sizingDetails' output the cluster tag's pose, "T_world_tag": {"translation_m",
 /// "quaternion_wxyz"}, and each sized fruitlet's centre in the tag's frame, "center_tag_m":
 /// the frame in which a later visit finds the same fruitlets (docs/season.md). Nothing is
-/// added without a tag pose.
-void addTagFrame(nlohmann::json& details, const std::optional<Eigen::Isometry3d>& T_world_tag);
+/// added without a tag pose. The tag was seen in the registered maps' frame (the anchor
+/// view's), so the centres are taken back into it first by the anchor shift the sizing
+/// applied (MappingSession::appliedAnchorShift_m): tag and fruitlets then share the anchor
+/// view's pose error, which cancels in the tag's frame.
+void addTagFrame(nlohmann::json& details, const std::optional<Eigen::Isometry3d>& T_world_tag,
+                 const Eigen::Vector3d& applied_anchor_shift_m = Eigen::Vector3d::Zero());
 
 }  // namespace fvp::host::eval

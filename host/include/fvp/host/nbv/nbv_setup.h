@@ -106,7 +106,7 @@ struct ClusterWork {
 /// What a cluster's memory did (ClusterTarget::memory).
 struct MemoryUse {
   std::size_t views = 0, views_taken = 0;  ///< remembered views, and those the arm took
-  /// Remembered fruitlets, those the final sizing found within the gate, and those looked
+  /// Remembered fruitlets, those the loop's last sizing found within the gate, and those looked
   /// for in vain (gone); the rest were neither (the stop ended first, or not the automatic one).
   std::size_t fruitlets = 0, found = 0, gone = 0;
 };

@@ -49,9 +49,8 @@ class RememberedViews : public planner::ViewPlanner {
   std::vector<bool> done_;  ///< per remembered view: taken or found unreachable
   std::size_t taken_ = 0, skipped_ = 0;
   bool given_up_ = false;
-  bool offered_ = false;                    ///< this iteration's round 0 offered remembered views
-  bool round_remembered_ = false;           ///< the round now running offers them
-  std::vector<std::size_t> offered_views_;  ///< the offer's candidates, by remembered index
+  bool offered_ = false;           ///< this iteration's round 0 offered remembered views
+  bool round_remembered_ = false;  ///< the round now running offers them
 };
 
 }  // namespace fvp::host::nbv

@@ -39,7 +39,8 @@ struct Candidate {
   double ig = 0.0;       ///< information gain (planner-specific definition)
   double utility = 0.0;  ///< ig - cost (paper Eq. 3 for FVP)
   bool reachable = false;
-  /// kSizing: which of the planner's sizing targets it looks at (-1 for the other kinds).
+  /// kSizing: which of the planner's sizing targets it looks at; kRemembered: which
+  /// remembered view it is (-1 for the other kinds).
   int sizing_target = -1;
   Eigen::Vector3d position_m() const { return T_world_camera.translation(); }
 };

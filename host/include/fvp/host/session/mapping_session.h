@@ -107,6 +107,11 @@ class MappingSession {
   bool correctsAnchorOffset() const {
     return registration_ && registration_->config().correct_anchor_offset;
   }
+  /// The shift sizeFruitlets() moves positions by: anchorOffset().shift_m when it corrects
+  /// them, else zero.
+  Eigen::Vector3d appliedAnchorShift_m() const {
+    return correctsAnchorOffset() ? anchorOffset().shift_m : Eigen::Vector3d::Zero();
+  }
 
   /// Hands the map over (or the carried one it never needed: no view showed its tag); the
   /// session is done with it.
