@@ -54,7 +54,7 @@ struct SeasonsCommandOptions {
   trials::TrialOptions visit;
   int seasons = 10;
   std::uint64_t first_seed = 1;
-  bool resume = false, remember_visits = false;
+  bool resume = false, forget_visits = false;
   std::optional<double> caliper_sigma_mm;
   std::string days = "0,4,7", shard, out;
 };
@@ -87,9 +87,8 @@ void addSeasonsCommand(CLI::App& app) {
   cmd->add_option("--shard", opt->shard, "run shard i of n (0-based, 0 <= i < n), e.g. 0/2")
       ->check(shardText());
   cmd->add_flag("--resume", opt->resume, "keep the seasons already finished in --out");
-  cmd->add_flag("--remember-visits", opt->remember_visits,
-                "each visit starts from the one before it (fvp run --remember; default: every "
-                "visit afresh)");
+  cmd->add_flag("--forget-visits", opt->forget_visits,
+                "start every visit afresh (default: each starts from the one before it)");
   cmd->add_option("--out", opt->out, "output directory")->required()->check(nonEmptyPath());
   FVP_ON_RUN(cmd, [opt] {
     trials::SeasonExperimentOptions o;
@@ -99,7 +98,7 @@ void addSeasonsCommand(CLI::App& app) {
     o.seasons = opt->seasons;
     o.first_seed = opt->first_seed;
     o.resume = opt->resume;
-    o.season.remember_visits = opt->remember_visits;
+    o.season.remember_visits = !opt->forget_visits;
     if (!opt->shard.empty())
       std::tie(o.shard_index, o.shard_count) = trials::parseShard(opt->shard);
     o.out_dir = opt->out;

@@ -32,7 +32,6 @@ class SeasonTrial : public ::testing::Test {
     o.season.visit.clock = robot::sim::SimClock::Mode::kFixed;
     o.season.visit.max_views = 1;
     o.season.days = {0.0, 5.0};
-    o.season.remember_visits = true;
     o.seasons = 1;
     o.first_seed = 3;
     o.out_dir = dir_ / out;

@@ -33,10 +33,9 @@ struct SeasonTrialOptions {
   /// a finished one is rescored after its season_score.json is removed.
   bool reuse_visits = false;
   /// Each visit after the first starts from the one before it (TrialOptions::remembered_visit,
-  /// docs/season.md "Visits remembered"): read from out_dir, which it needs. Off (the default:
-  /// measured on the simulated seasons, remembering does not yet make a visit shorter or its
-  /// sizes better, docs/results.md): each visit starts afresh, as a first visit does.
-  bool remember_visits = false;
+  /// docs/season.md "Visits remembered"): read from out_dir, which it needs. Off: each visit
+  /// starts afresh, as a first visit does.
+  bool remember_visits = true;
 };
 
 /// The days' check: two or more, finite, increasing, within season_day's range. Throws
