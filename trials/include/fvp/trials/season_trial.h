@@ -34,7 +34,8 @@ struct SeasonTrialOptions {
   bool reuse_visits = false;
   /// Each visit after the first starts from the one before it (TrialOptions::remembered_visit,
   /// docs/season.md "Visits remembered"): read from out_dir, which it needs. Off: each visit
-  /// starts afresh, as a first visit does.
+  /// starts afresh, as a first visit does (docs/results.md: remembering gets the season's
+  /// fates right, and costs later visits time).
   bool remember_visits = true;
 };
 
