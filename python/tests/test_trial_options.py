@@ -13,6 +13,7 @@ RENAMED = {
     "--config": "planner_config",  # ditto: the planner's config, beside world_ and arm_config
     "--arm": "arm_config",         # ditto
     "--out": "out_dir",            # optional in Python (no files unless asked for)
+    "--remember": "remembered_visit",  # a keyword says what it holds: the earlier visit
 }
 # `fvp run` options with no keyword at all, each with why.
 NOT_KEYWORDS = {
@@ -106,10 +107,12 @@ def test_the_field_preset_runs_with_view_registration_unless_told_otherwise():
 
 def test_result_settings_are_the_keywords():
     # One list makes the keywords and result.json's settings: the same keys, and a trial's
-    # settings read back as keywords give the same settings.
+    # settings read back as keywords give the same settings. Where files go and the visit a
+    # trial remembers are not settings (a season's visits share settings; the remembered visit
+    # is the result's own "remembered_visit").
     result = fvp.sim.run_trial(seed=2, clock="fixed", max_views=1, backend="cpu")
     settings = result["settings"]
-    assert set(settings) == keywords(fvp.sim.Trial) - {"out_dir"}
+    assert set(settings) == keywords(fvp.sim.Trial) - {"out_dir", "remembered_visit"}
     assert settings["clock"] == "fixed" and settings["backend"] == "cpu"
     assert settings["max_views"] == 1 and settings["stop"] == "budget"
     again = fvp.sim.run_trial(**{k: v for k, v in settings.items() if v is not None})
