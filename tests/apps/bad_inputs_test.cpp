@@ -616,7 +616,9 @@ const std::vector<BadInput>& cases() {
        {"out/camera.yaml"}},
       {"WorldConfigNestedTooDeeply",
        [](const fs::path& d) {
-         writeText(d / "world.yaml", "max_fruitlets: " + std::string(5000, '[') + "\n");
+         std::string nested = "max_fruitlets: ";
+         nested.append(5000, '[').append("\n");
+         writeText(d / "world.yaml", nested);
          return std::vector<std::string>{"capture", "--world", p(d / "world.yaml"), "--seed",
                                          "1",       "--out",   p(d / "out")};
        },

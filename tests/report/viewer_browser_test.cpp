@@ -206,12 +206,13 @@ void ViewerInBrowser::checkOverlays() {
     if (!v.contains("sized")) continue;
     const int view = v.at("index").get<int>();
     EXPECT_TRUE(listed.count(view)) << view;
-    for (const auto& o : r.at("overlays"))
-      if (o.at("view") == view)
-        for (const auto& label : v.at("sized"))
-          EXPECT_NE(o.at("why").get<std::string>().find(label.get<std::string>()),
-                    std::string::npos)
-              << o.dump();
+    for (const auto& o : r.at("overlays")) {
+      if (o.at("view") != view) continue;
+      for (const auto& label : v.at("sized")) {
+        EXPECT_NE(o.at("why").get<std::string>().find(label.get<std::string>()), std::string::npos)
+            << o.dump();
+      }
+    }
   }
 }
 

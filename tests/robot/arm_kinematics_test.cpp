@@ -140,8 +140,9 @@ TEST(ArmModel, InverseAlongTravelIsSortedAndOnlyWithinTravel) {
     const double before_s = arm.travelTime_s(home, solutions[i - 1]);
     const double after_s = arm.travelTime_s(home, solutions[i]);
     EXPECT_LE(before_s, after_s);
-    if (before_s == after_s)
+    if (before_s == after_s) {
       EXPECT_LE(jointDistance(solutions[i - 1], home), jointDistance(solutions[i], home));
+    }
     EXPECT_TRUE(arm.withinLimits(solutions[i]));
   }
   // The order is the time's, not the distance's: a pose whose solutions the two rank apart.

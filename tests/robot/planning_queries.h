@@ -127,7 +127,9 @@ inline QueryStats runPlanningQueries(int worlds, int queries_per_world, std::uin
                 .duration_s());
         stats.blended += plan.trajectory.isBlended();
         stats.straight += plan.straight;
-        if (plan.straight) EXPECT_EQ(plan.trajectory.waypoints().size(), 2u);
+        if (plan.straight) {
+          EXPECT_EQ(plan.trajectory.waypoints().size(), 2u);
+        }
         const Eigen::Isometry3d reached = controller.cameraPose();
         EXPECT_LT((reached.translation() - T.translation()).norm(), 1e-6);
         EXPECT_LT((reached.linear() - T.linear()).norm(), 1e-6);

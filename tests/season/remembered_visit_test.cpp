@@ -60,10 +60,12 @@ TEST(RememberedVisit, ChosenViewsGiveEveryFruitletWhatAllTheViewsCould) {
                               !satisfied(all, f, cameras, centers, seen, rule));
       if (as_well) fewest = std::min(fewest, subset.size());
     }
-    for (std::size_t f = 0; f < fruitlets; ++f)
-      if (satisfied(all, f, cameras, centers, seen, rule))
+    for (std::size_t f = 0; f < fruitlets; ++f) {
+      if (satisfied(all, f, cameras, centers, seen, rule)) {
         EXPECT_TRUE(satisfied(chosen, f, cameras, centers, seen, rule))
             << "seed " << seed << ", fruitlet " << f;
+      }
+    }
     // A greedy cover, not the least one: within the greedy bound, and never every view for
     // nothing.
     EXPECT_LE(chosen.size(), 2 * fewest + 1) << "seed " << seed;

@@ -151,11 +151,13 @@ TEST(SeasonGrowth, GrownFruitletsKeepOffPlatesBranchesAndEachOther) {
       for (const BranchSegment& b : world.branches())
         EXPECT_GE(host::pointSegmentDistance(f.center_m, b.start_m, b.end_m), reach + b.radius_m)
             << "seed " << seed << ": a fruitlet in a branch";
-      for (const Fruitlet& g : world.fruitlets())
-        if (g.index > f.index)
+      for (const Fruitlet& g : world.fruitlets()) {
+        if (g.index > f.index) {
           EXPECT_GE((f.center_m - g.center_m).norm() + kMaxPressM + 1e-6,
                     f.boundingRadius_m() + g.boundingRadius_m())
               << "seed " << seed;
+        }
+      }
     }
   }
 }
