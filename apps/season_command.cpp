@@ -22,18 +22,34 @@
 namespace fvp::apps {
 namespace {
 
-/// DAY=PATH: a finite decimal day and a non-empty path (checked to exist when read).
+struct DayAndPath {
+  double day = 0.0;
+  std::string path;
+};
+
+/// DAY=PATH: a finite decimal day and a non-empty path (checked to exist when read); what was
+/// wrong in `error` when it is not.
+std::optional<DayAndPath> dayAndPath(const std::string& text, std::string& error) {
+  const auto eq = text.find('=');
+  if (eq == std::string::npos || eq + 1 == text.size()) {
+    error = "expected DAY=PATH (e.g. 4=out/day4), got '" + text + "'";
+    return std::nullopt;
+  }
+  const std::string day = text.substr(0, eq);
+  const double day_value = std::strtod(day.c_str(), nullptr);
+  if (!host::isDecimalNumberText(day, false) || !std::isfinite(day_value)) {
+    error = "expected a finite decimal day before '=', got '" + day + "'";
+    return std::nullopt;
+  }
+  return DayAndPath{day_value, text.substr(eq + 1)};
+}
+
 CLI::Validator seasonVisitText() {
   return CLI::Validator(
       [](std::string& text) -> std::string {
-        const auto eq = text.find('=');
-        if (eq == std::string::npos || eq + 1 == text.size())
-          return "expected DAY=PATH (e.g. 4=out/day4), got '" + text + "'";
-        const std::string day = text.substr(0, eq);
-        if (!host::isDecimalNumberText(day, false) ||
-            !std::isfinite(std::strtod(day.c_str(), nullptr)))
-          return "expected a finite decimal day before '=', got '" + day + "'";
-        return {};
+        std::string error;
+        dayAndPath(text, error);
+        return error;
       },
       "DAY=PATH", "seasonVisit");
 }
@@ -81,9 +97,10 @@ void addSeasonCommand(CLI::App& app) {
                                std::to_string(opt->visits.size()));
     std::vector<host::season::SeasonVisit> visits;
     for (const std::string& v : opt->visits) {
-      const auto eq = v.find('=');
-      visits.push_back(host::season::readSeasonVisit(
-          v.substr(eq + 1), std::strtod(v.substr(0, eq).c_str(), nullptr)));
+      std::string error;
+      const std::optional<DayAndPath> visit = dayAndPath(v, error);
+      if (!visit) throw std::runtime_error("--visit: " + error);  // the validator ran first
+      visits.push_back(host::season::readSeasonVisit(visit->path, visit->day));
     }
     const host::season::SeasonConfig config;
     const host::season::SeasonAnalysis season = host::season::analyzeSeason(visits, config);

@@ -174,6 +174,11 @@ std::optional<double> numberAt(const nlohmann::json& object, const char* key) {
   return it->get<double>();
 }
 
+/// A summary figure, or null where there was nothing to compute it from.
+nlohmann::json numberOrNull(bool defined, double value) {
+  return defined ? nlohmann::json(value) : nlohmann::json();
+}
+
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -260,19 +265,19 @@ nlohmann::json growersFigures(const std::vector<const nlohmann::json*>& trials) 
     if (const auto s = numberAt(t->value("tour", nlohmann::json()), "transit_sim_s"))
       transit += *s, ++tours;
   }
-  const auto opt = [](bool ok, double v) { return ok ? nlohmann::json(v) : nlohmann::json(); };
   const bool sized = clusters > 0;
-  return {{"clusters", clusters},
-          {"median_sim_s_per_cluster", opt(!sim_per_cluster.empty(), median(sim_per_cluster))},
-          {"worst_sim_s_per_cluster",
-           opt(!sim_per_cluster.empty(),
-               sim_per_cluster.empty()
-                   ? 0.0
-                   : *std::max_element(sim_per_cluster.begin(), sim_per_cluster.end()))},
-          {"views_per_cluster", opt(sized, sized ? views / clusters : 0.0)},
-          {"failed_moves_per_cluster", opt(sized, sized ? failed / clusters : 0.0)},
-          {"transit_s_per_tree", opt(tours > 0, tours > 0 ? transit / tours : 0.0)},
-          {"sim_time_percent", timeSplitPercent(trials)}};
+  return {
+      {"clusters", clusters},
+      {"median_sim_s_per_cluster", numberOrNull(!sim_per_cluster.empty(), median(sim_per_cluster))},
+      {"worst_sim_s_per_cluster",
+       numberOrNull(!sim_per_cluster.empty(),
+                    sim_per_cluster.empty()
+                        ? 0.0
+                        : *std::max_element(sim_per_cluster.begin(), sim_per_cluster.end()))},
+      {"views_per_cluster", numberOrNull(sized, sized ? views / clusters : 0.0)},
+      {"failed_moves_per_cluster", numberOrNull(sized, sized ? failed / clusters : 0.0)},
+      {"transit_s_per_tree", numberOrNull(tours > 0, tours > 0 ? transit / tours : 0.0)},
+      {"sim_time_percent", timeSplitPercent(trials)}};
 }
 
 /// Pools the fruitlets of some checked trials under one estimator's field names.
@@ -299,21 +304,21 @@ nlohmann::json pool(const std::vector<const nlohmann::json*>& trials, const char
       pct_sum += 100.0 * e / truth;
     }
   }
-  const auto opt = [](bool ok, double v) { return ok ? nlohmann::json(v) : nlohmann::json(); };
   const std::size_t n = trials.size();
   nlohmann::json pooled = {
       {"trials", n},
       {"gt_fruitlets", gt},
       {"matched", matched},
-      {"match_percent", opt(gt > 0, gt ? 100.0 * double(matched) / double(gt) : 0.0)},
-      {"mae_mm", opt(matched > 0, matched ? abs_sum / double(matched) : 0.0)},
-      {"mape_percent", opt(matched > 0, matched ? pct_sum / double(matched) : 0.0)},
+      {"match_percent", numberOrNull(gt > 0, gt ? 100.0 * double(matched) / double(gt) : 0.0)},
+      {"mae_mm", numberOrNull(matched > 0, matched ? abs_sum / double(matched) : 0.0)},
+      {"mape_percent", numberOrNull(matched > 0, matched ? pct_sum / double(matched) : 0.0)},
       {"precision_percent",
-       opt(detections > 0, detections ? 100.0 * double(matched) / double(detections) : 0.0)},
-      {"mean_views", opt(n > 0, n ? views / double(n) : 0.0)},
+       numberOrNull(detections > 0,
+                    detections ? 100.0 * double(matched) / double(detections) : 0.0)},
+      {"mean_views", numberOrNull(n > 0, n ? views / double(n) : 0.0)},
       // What the trials' whole time bought (a tree's moves between clusters included).
-      {"matched_per_sim_min", opt(sim > 0, sim > 0 ? 60.0 * matched_in_sim / sim : 0.0)},
-      {"wall_s_per_trial", opt(n > 0, n ? wall / double(n) : 0.0)}};
+      {"matched_per_sim_min", numberOrNull(sim > 0, sim > 0 ? 60.0 * matched_in_sim / sim : 0.0)},
+      {"wall_s_per_trial", numberOrNull(n > 0, n ? wall / double(n) : 0.0)}};
   // A cluster's time: the budget, or less with --stop auto; a tree's clusters each, the
   // moves between them not included.
   pooled.update(growersFigures(trials));

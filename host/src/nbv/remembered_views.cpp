@@ -34,7 +34,6 @@ std::optional<planner::Ranking> RememberedViews::rank(map::MapEngine& map,
       c.reachable = !reachable || reachable(c.T_world_camera);
       if (!c.reachable) {  // the robot stands elsewhere today: this view is out of reach
         done_[k] = true;
-        ++skipped_;
         continue;
       }
       c.ig = c.utility = 1.0;                 // alike: the robot's time orders them

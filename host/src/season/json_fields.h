@@ -11,7 +11,24 @@
 #include <stdexcept>
 #include <string>
 
+namespace fvp::host::season {
+struct SeasonVisit;
+}
+
 namespace fvp::host::season::json_fields {
+
+/// JSON text parsed, or an error naming the source.
+inline nlohmann::json parsed(const std::string& json_text, const std::string& source) {
+  try {
+    return nlohmann::json::parse(json_text);
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(source + ": not JSON: " + e.what());
+  }
+}
+
+/// parseSeasonVisit on a parsed document, for readers that go on to read more of it
+/// (season_visit.cpp).
+SeasonVisit seasonVisitOf(const nlohmann::json& root, const std::string& source, double day);
 
 inline constexpr double kMaxPoseDistanceM = 1e4;
 

@@ -168,8 +168,8 @@ std::map<int, nbv::ClusterMemory> parseVisitMemory(const std::string& json_text,
     throw std::invalid_argument(
         "remembered views: expected min_images >= 1 and min_span_deg from 0 to 180");
   // The fruitlets, the tags and the document's shape, checked once, as a season reads them.
-  const SeasonVisit visit = parseSeasonVisit(json_text, source, 0.0);
-  const json root = json::parse(json_text);
+  const json root = json_fields::parsed(json_text, source);
+  const SeasonVisit visit = json_fields::seasonVisitOf(root, source, 0.0);
   const std::map<std::size_t, Eigen::Isometry3d> poses = viewPoses(root, source);
   std::map<int, nbv::ClusterMemory> out;
   const auto clusters = root.find("clusters");

@@ -71,12 +71,11 @@ VisitCluster clusterOf(const json& sizing, int tag_id, const std::string& source
 
 SeasonVisit parseSeasonVisit(const std::string& json_text, const std::string& source, double day) {
   if (!std::isfinite(day)) fail(source, "day", "a finite number of days");
-  json root;
-  try {
-    root = json::parse(json_text);
-  } catch (const json::exception& e) {
-    throw std::runtime_error(source + ": not JSON: " + e.what());
-  }
+  return json_fields::seasonVisitOf(json_fields::parsed(json_text, source), source, day);
+}
+
+SeasonVisit json_fields::seasonVisitOf(const json& root, const std::string& source, double day) {
+  if (!std::isfinite(day)) fail(source, "day", "a finite number of days");
   if (!root.is_object())
     fail(source, "the document", "an object (a result.json or fruitlets.json)");
   SeasonVisit visit;

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -40,14 +41,16 @@ class RememberedViews : public planner::ViewPlanner {
   std::size_t remembered() const { return T_tag_camera_.size(); }
   std::size_t taken() const { return taken_; }
   /// Whether views remain to offer (none before the tag is seen counts as remaining).
-  bool pending() const { return !given_up_ && taken_ + skipped_ < T_tag_camera_.size(); }
+  bool pending() const {
+    return !given_up_ && std::find(done_.begin(), done_.end(), false) != done_.end();
+  }
 
  private:
   std::unique_ptr<planner::ViewPlanner> planner_;
   TagPoseFn T_world_tag_;
   std::vector<Eigen::Isometry3d> T_tag_camera_;
   std::vector<bool> done_;  ///< per remembered view: taken or found unreachable
-  std::size_t taken_ = 0, skipped_ = 0;
+  std::size_t taken_ = 0;
   bool given_up_ = false;
   bool offered_ = false;           ///< this iteration's round 0 offered remembered views
   bool round_remembered_ = false;  ///< the round now running offers them
