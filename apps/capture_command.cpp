@@ -24,6 +24,7 @@
 #include "fvp/robot/sim/occlusion_statistic.h"
 #include "fvp/robot/sim/stereo_renderer.h"
 #include "fvp/robot/sim/world.h"
+#include "stereo_bag_files.h"
 
 namespace fvp::apps {
 namespace {
@@ -150,6 +151,7 @@ struct CaptureCommandOptions {
   std::string world_file;
   std::string pose;
   std::string out;
+  std::string bag;  ///< also the set as a ROS bag
   int views = 1;
   double arc_deg = 90.0;
 };
@@ -205,6 +207,10 @@ void printPerceptionStats(const host::PerceptionResult& result) {
   if (opt->views > 1) {
     if (!opt->pose.empty()) throw std::invalid_argument("--pose and --views exclude each other");
     writeCaptureSet(opt->seed, opt->world_file, opt->views, opt->arc_deg, opt->out);
+    if (!opt->bag.empty()) {
+      writeCaptureSetAsBag(opt->out, opt->bag);
+      std::cout << "bag -> " << opt->bag << "\n";
+    }
     return;
   }
   const robot::sim::WorldConfig world_config =
@@ -286,7 +292,15 @@ void addCaptureCommand(CLI::App& app) {
   cmd->add_option("--out", opt->out, "capture directory (created)")
       ->required()
       ->check(nonEmptyPath());
-  FVP_ON_RUN(cmd, [opt] { runCaptureCommand(opt.get()); });
+  cmd->add_option("--bag", opt->bag,
+                  "also write the --views set as this ROS bag: stereo pairs, camera infos and tf "
+                  "(docs/ros.md)")
+      ->check(nonEmptyPath());
+  FVP_ON_RUN(cmd, [opt] {
+    if (!opt->bag.empty() && opt->views < 2)
+      throw std::invalid_argument("--bag: expected a set (--views 2 or more)");
+    runCaptureCommand(opt.get());
+  });
 }
 
 }  // namespace fvp::apps

@@ -1,4 +1,5 @@
 // `fvp size`: the sizing pipeline on stored captures (docs/capture-format.md, docs/sizing.md).
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -6,25 +7,41 @@
 #include "cli_checks.h"
 #include "commands.h"
 #include "fvp/accel/backend.h"
+#include "fvp/host/core/output_directory.h"
 #include "fvp/host/map/map_engine_registry.h"
 #include "fvp/host/report/capture_set_report.h"
+#include "stereo_bag_files.h"
 
 namespace fvp::apps {
 
 void addSizeCommand(CLI::App& app) {
   struct Options {
-    std::string captures, out, sizing = "ours", engine = "grid", config;
+    std::string captures, bag, bag_ns = "/stereo", world_frame = "world", out, sizing = "ours",
+                               engine = "grid", config;
     accel::BackendChoice backend = accel::BackendChoice::kAuto;
   };
   auto opt = optionStorage<Options>();
   auto* cmd =
       app.add_subcommand("size",
-                         "Size the fruitlets of a set of stored captures; write fruitlets.json, "
+                         "Size the fruitlets of a set of stored captures or of a ROS bag; write "
+                         "fruitlets.json, "
                          "surface.ply, mesh.ply, "
                          "clusters.ply, viewer.html (the set in 3-D) and overlays/ to --out");
-  cmd->add_option("--captures", opt->captures,
-                  "a capture directory, or a directory of them (used in name order)")
-      ->required();
+  auto* captures =
+      cmd->add_option("--captures", opt->captures,
+                      "a capture directory, or a directory of them (used in name order)");
+  auto* bag = cmd->add_option("--bag", opt->bag,
+                              "instead, a ROS bag of rectified stereo pairs, camera infos and tf "
+                              "(docs/ros.md); its pairs are written to --out/captures and sized")
+                  ->excludes(captures);
+  captures->excludes(bag);
+  cmd->add_option("--bag-ns", opt->bag_ns,
+                  "the bag's stereo namespace: NS/{left,right}/image_rect_color, "
+                  "NS/{left,right}/camera_info, NS/left/fruitlet_mask (optional)")
+      ->capture_default_str();
+  cmd->add_option("--world-frame", opt->world_frame,
+                  "the bag's tf frame that camera poses are looked up in")
+      ->capture_default_str();
   cmd->add_option("--sizing", opt->sizing, "estimator: ours | paper (both are reported)")
       ->check(CLI::IsMember({"ours", "paper"}))
       ->capture_default_str();
@@ -43,13 +60,21 @@ void addSizeCommand(CLI::App& app) {
     if (!opt->config.empty()) perception = host::PerceptionConfig::fromYamlFile(opt->config);
     std::unique_ptr<accel::Backend> backend;
     if (host::map::mapEngineNeedsBackend(opt->engine)) backend = accel::createBackend(opt->backend);
+    if (opt->captures.empty() == opt->bag.empty())
+      throw std::invalid_argument("expected --captures DIR or --bag FILE");
+    std::string captures_dir = opt->captures;
+    if (!opt->bag.empty()) {
+      host::prepareOutputDirectory(opt->out, "--out");
+      captures_dir = (std::filesystem::path(opt->out) / "captures").string();
+      extractBagCaptures(opt->bag, opt->bag_ns, opt->world_frame, captures_dir);
+    }
     host::CaptureSizingOptions o;
     o.perception = perception;
     o.estimator = host::sizing::parseSizingEstimator(opt->sizing);
     o.engine = opt->engine;
     o.out_dir = opt->out;
     o.on_warning = [](const std::string& text) { std::cerr << "fvp: warning: " << text << "\n"; };
-    const nlohmann::json r = host::sizeCaptureSet(opt->captures, o, backend.get());
+    const nlohmann::json r = host::sizeCaptureSet(captures_dir, o, backend.get());
     std::cout << r["captures"].size() << " captures, Cluster Region "
               << (r["cluster_region_found"].get<bool>()
                       ? "found"

@@ -1,0 +1,24 @@
+// Stereo bags in the CLI (docs/ros.md): `fvp size --bag` and `fvp capture --bag`. In a build
+// without the ROS layer (FVP_WITH_ROS) each says so and fails.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+
+namespace fvp::apps {
+
+/// Whether this fvp was built with the ROS layer.
+bool builtWithRos();
+
+/// Writes the capture set in captures_dir (listCaptures' order) as a stereo bag.
+void writeCaptureSetAsBag(const std::filesystem::path& captures_dir,
+                          const std::filesystem::path& bag);
+
+/// Writes the bag's stereo pairs as captures out_dir/000, 001, ... (out_dir emptied first) and
+/// returns how many; what it skipped is printed and, when it skipped anything, warned.
+std::size_t extractBagCaptures(const std::filesystem::path& bag, const std::string& stereo_ns,
+                               const std::string& world_frame,
+                               const std::filesystem::path& out_dir);
+
+}  // namespace fvp::apps

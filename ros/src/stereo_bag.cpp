@@ -1,0 +1,325 @@
+// Stereo bags <-> captures (docs/ros.md). C++17: ROS 1's message headers use
+// std::allocator<void>::rebind, which C++20 removed.
+#include "fvp/ros/stereo_bag.h"
+
+#include <cv_bridge/cv_bridge.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <stereo_msgs/DisparityImage.h>
+#include <tf2/buffer_core.h>
+#include <tf2/exceptions.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <boost/make_shared.hpp>
+#include <cmath>
+#include <map>
+#include <optional>
+#include <set>
+#include <stdexcept>
+
+namespace fvp::ros {
+namespace {
+
+using ImagePtr = sensor_msgs::Image::ConstPtr;
+
+[[noreturn]] void fail(const std::filesystem::path& bag, const std::string& what) {
+  throw std::runtime_error(bag.string() + ": " + what);
+}
+
+std::string stampText(const ::ros::Time& t) {
+  return std::to_string(t.sec) + "." + std::to_string(t.nsec / 1000000) + " s";
+}
+
+sensor_msgs::CameraInfo cameraInfo(const host::StereoIntrinsics& K, const std_msgs::Header& header,
+                                   bool right) {
+  sensor_msgs::CameraInfo info;
+  info.header = header;
+  info.width = K.width_px;
+  info.height = K.height_px;
+  info.distortion_model = "plumb_bob";
+  info.D.assign(5, 0.0);  // rectified: no distortion left
+  info.K = {K.fx_px, 0.0, K.cx_px, 0.0, K.fy_px, K.cy_px, 0.0, 0.0, 1.0};
+  info.R = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
+  info.P = {K.fx_px, 0.0,     K.cx_px, right ? -K.fx_px * K.baseline_m : 0.0,
+            0.0,     K.fy_px, K.cy_px, 0.0,
+            0.0,     0.0,     1.0,     0.0};
+  return info;
+}
+
+geometry_msgs::TransformStamped transformMsg(const Eigen::Isometry3d& T, const std_msgs::Header& h,
+                                             const std::string& child) {
+  geometry_msgs::TransformStamped t;
+  t.header = h;
+  t.child_frame_id = child;
+  t.transform.translation.x = T.translation().x();
+  t.transform.translation.y = T.translation().y();
+  t.transform.translation.z = T.translation().z();
+  const Eigen::Quaterniond q(T.linear());
+  t.transform.rotation.w = q.w();
+  t.transform.rotation.x = q.x();
+  t.transform.rotation.y = q.y();
+  t.transform.rotation.z = q.z();
+  return t;
+}
+
+Eigen::Isometry3d isometryOf(const geometry_msgs::Transform& t) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation() = Eigen::Vector3d(t.translation.x, t.translation.y, t.translation.z);
+  T.linear() = Eigen::Quaterniond(t.rotation.w, t.rotation.x, t.rotation.y, t.rotation.z)
+                   .normalized()
+                   .toRotationMatrix();
+  return T;
+}
+
+/// Every transform of the bag's /tf and /tf_static, kept for the whole bag.
+std::unique_ptr<tf2::BufferCore> bagTransforms(rosbag::Bag& bag) {
+  rosbag::View all(bag);
+  const double span_s = (all.getEndTime() - all.getBeginTime()).toSec();
+  auto buffer = std::make_unique<tf2::BufferCore>(::ros::Duration(span_s + 10.0));
+  rosbag::View tf(bag, rosbag::TopicQuery(std::vector<std::string>{"/tf", "/tf_static"}));
+  for (const rosbag::MessageInstance& m : tf) {
+    const auto message = m.instantiate<tf2_msgs::TFMessage>();
+    if (!message) continue;
+    const bool is_static = m.getTopic() == "/tf_static";
+    for (const geometry_msgs::TransformStamped& t : message->transforms)
+      buffer->setTransform(t, "bag", is_static);
+  }
+  return buffer;
+}
+
+/// The intrinsics of a rectified pair: the left camera's projection, the baseline from the
+/// right one's P[3] = -fx * baseline.
+host::StereoIntrinsics intrinsicsOf(const sensor_msgs::CameraInfo& left,
+                                    const sensor_msgs::CameraInfo& right,
+                                    const std::filesystem::path& bag, const std::string& where) {
+  host::StereoIntrinsics K;
+  K.width_px = int(left.width);
+  K.height_px = int(left.height);
+  K.fx_px = left.P[0];
+  K.fy_px = left.P[5];
+  K.cx_px = left.P[2];
+  K.cy_px = left.P[6];
+  if (!(K.fx_px > 0.0) || !(K.fy_px > 0.0))
+    fail(bag, where + ": camera_info P: expected a rectified projection with fx, fy > 0");
+  K.baseline_m = right.P[0] > 0.0 ? -right.P[3] / right.P[0] : 0.0;
+  if (!(K.baseline_m > 0.0))
+    fail(bag, where + ": right camera_info P[3]: expected -fx * baseline with a baseline > 0");
+  return K;
+}
+
+cv::Mat imageOf(const ImagePtr& image, const std::string& encoding,
+                const std::filesystem::path& bag, const std::string& where) {
+  try {
+    return encoding.empty() ? cv_bridge::toCvCopy(image)->image
+                            : cv_bridge::toCvCopy(image, encoding)->image;
+  } catch (const cv_bridge::Exception& e) {
+    fail(bag, where + ": encoding '" + image->encoding + "': " + e.what());
+  }
+}
+
+/// One stamp's messages, gathered as they come.
+struct Parts {
+  ImagePtr left, right, mask;
+  stereo_msgs::DisparityImage::ConstPtr disparity;
+  sensor_msgs::CameraInfo::ConstPtr left_info, right_info;
+};
+
+stereo_msgs::DisparityImage disparityMsg(const host::Capture& c, const std_msgs::Header& header) {
+  stereo_msgs::DisparityImage d;
+  d.header = header;
+  d.image = *cv_bridge::CvImage(header, "32FC1", c.disparity_px).toImageMsg();
+  d.f = float(c.intrinsics.fx_px);
+  d.T = float(c.intrinsics.baseline_m);
+  d.min_disparity = 0.0f;  // fvp's convention: 0 (or less) is no disparity
+  d.max_disparity = float(c.intrinsics.width_px);
+  d.delta_d = float(1.0 / c.disparity_scale);
+  return d;
+}
+
+/// A stereo_msgs/DisparityImage as a capture's disparity: CV_32F, 0 where invalid (not finite,
+/// or not above min_disparity).
+cv::Mat disparityOf(const stereo_msgs::DisparityImage& d, const std::filesystem::path& bag,
+                    const std::string& where) {
+  const auto image = boost::make_shared<sensor_msgs::Image>(d.image);
+  cv::Mat disparity = imageOf(image, "32FC1", bag, where);
+  const float floor = std::max(0.0f, d.min_disparity);
+  disparity.forEach<float>([floor](float& v, const int*) {
+    if (!std::isfinite(v) || v <= floor) v = 0.0f;
+  });
+  return disparity;
+}
+
+}  // namespace
+
+void writeStereoBag(const std::filesystem::path& bag_path,
+                    const std::vector<host::Capture>& captures, const StereoBagTopics& topics,
+                    const std::string& camera_frame, double start_s, double period_s) {
+  rosbag::Bag bag;
+  try {
+    bag.open(bag_path.string(), rosbag::bagmode::Write);
+  } catch (const rosbag::BagException& e) {
+    fail(bag_path, std::string("cannot be written: ") + e.what());
+  }
+  for (std::size_t i = 0; i < captures.size(); ++i) {
+    const host::Capture& c = captures[i];
+    std_msgs::Header header;
+    header.stamp = ::ros::Time(start_s + double(i) * period_s);
+    header.frame_id = camera_frame;
+    header.seq = std::uint32_t(i);
+    std_msgs::Header world = header;
+    world.frame_id = topics.world_frame;
+    tf2_msgs::TFMessage tf;
+    tf.transforms.push_back(transformMsg(c.T_world_camera, world, camera_frame));
+    bag.write("/tf", header.stamp, tf);
+    bag.write(topics.left_info, header.stamp, cameraInfo(c.intrinsics, header, false));
+    bag.write(topics.right_info, header.stamp, cameraInfo(c.intrinsics, header, true));
+    bag.write(topics.left_image, header.stamp,
+              cv_bridge::CvImage(header, "bgr8", c.left_bgr).toImageMsg());
+    bag.write(topics.right_image, header.stamp,
+              cv_bridge::CvImage(header, "bgr8", c.right_bgr).toImageMsg());
+    if (!c.disparity_px.empty()) bag.write(topics.disparity, header.stamp, disparityMsg(c, header));
+    if (!c.fruitlet_mask.empty())
+      bag.write(topics.fruitlet_mask, header.stamp,
+                cv_bridge::CvImage(header, c.fruitlet_mask.depth() == CV_16U ? "mono16" : "mono8",
+                                   c.fruitlet_mask)
+                    .toImageMsg());
+  }
+  bag.close();
+}
+
+namespace {
+
+/// The capture of one stamp's messages, or why there is none (counted in stats).
+class PairReader {
+ public:
+  PairReader(const std::filesystem::path& bag, const StereoBagTopics& topics,
+             const tf2::BufferCore& tf, StereoBagStats& stats)
+      : bag_(bag), topics_(topics), tf_(tf), stats_(stats) {}
+
+  void add(const rosbag::MessageInstance& m) {
+    const std::string& topic = m.getTopic();
+    if (topic == topics_.left_info || topic == topics_.right_info) {
+      const auto info = m.instantiate<sensor_msgs::CameraInfo>();
+      if (!info) fail(bag_, topic + ": expected sensor_msgs/CameraInfo");
+      Parts& parts = pending_[info->header.stamp];
+      (topic == topics_.left_info ? parts.left_info : parts.right_info) = info;
+      (topic == topics_.left_info ? latest_left_info_ : latest_right_info_) = info;
+    } else if (topic == topics_.disparity) {
+      const auto d = m.instantiate<stereo_msgs::DisparityImage>();
+      if (!d) fail(bag_, topic + ": expected stereo_msgs/DisparityImage");
+      pending_[d->header.stamp].disparity = d;
+    } else {
+      const ImagePtr image = m.instantiate<sensor_msgs::Image>();
+      if (!image) fail(bag_, topic + ": expected sensor_msgs/Image");
+      Parts& parts = pending_[image->header.stamp];
+      (topic == topics_.left_image    ? parts.left
+       : topic == topics_.right_image ? parts.right
+                                      : parts.mask) = image;
+    }
+  }
+
+  /// Gives every gathered stamp older than `before` (all of them by default) to `each`.
+  void flush(const std::function<void(host::Capture&&)>& each,
+             ::ros::Time before = ::ros::TIME_MAX) {
+    while (!pending_.empty() && pending_.begin()->first < before) {
+      const auto& [stamp, parts] = *pending_.begin();
+      if (parts.left && parts.right) {
+        if (std::optional<host::Capture> capture = captureOf(stamp, parts))
+          each(std::move(*capture));
+      } else if (parts.left || parts.right) {
+        ++stats_.unpaired_images;
+      }
+      pending_.erase(pending_.begin());
+    }
+  }
+
+ private:
+  std::optional<host::Capture> captureOf(const ::ros::Time& stamp, const Parts& p) {
+    const std::string where = topics_.left_image + " at " + stampText(stamp);
+    const auto left_info = p.left_info ? p.left_info : latest_left_info_;
+    const auto right_info = p.right_info ? p.right_info : latest_right_info_;
+    if (!left_info || !right_info) {
+      ++stats_.without_info;
+      return std::nullopt;
+    }
+    host::Capture capture;
+    try {
+      capture.T_world_camera = isometryOf(
+          tf_.lookupTransform(topics_.world_frame, p.left->header.frame_id, stamp).transform);
+    } catch (const tf2::TransformException&) {
+      ++stats_.without_pose;
+      return std::nullopt;
+    }
+    capture.intrinsics = intrinsicsOf(*left_info, *right_info, bag_, where);
+    capture.left_bgr = imageOf(p.left, "bgr8", bag_, where);
+    capture.right_bgr =
+        imageOf(p.right, "bgr8", bag_, topics_.right_image + " at " + stampText(stamp));
+    const cv::Size size(capture.intrinsics.width_px, capture.intrinsics.height_px);
+    for (const cv::Mat* image : {&capture.left_bgr, &capture.right_bgr})
+      if (image->size() != size)
+        fail(bag_, where + ": image size: expected the camera_info's " +
+                       std::to_string(size.width) + " x " + std::to_string(size.height));
+    if (p.mask) {
+      const std::string mask_where = topics_.fruitlet_mask + " at " + stampText(stamp);
+      capture.fruitlet_mask = imageOf(p.mask, "", bag_, mask_where);
+      if (capture.fruitlet_mask.size() != size ||
+          (capture.fruitlet_mask.type() != CV_8U && capture.fruitlet_mask.type() != CV_16U))
+        fail(bag_, mask_where + ": expected a mono8 or mono16 image of the left image's size");
+      ++stats_.with_mask;
+    }
+    if (p.disparity) {
+      const std::string d_where = topics_.disparity + " at " + stampText(stamp);
+      capture.disparity_px = disparityOf(*p.disparity, bag_, d_where);
+      if (capture.disparity_px.size() != size)
+        fail(bag_, d_where + ": image size: expected the left image's");
+      ++stats_.with_disparity;
+    }
+    ++stats_.pairs;
+    return capture;
+  }
+
+  const std::filesystem::path& bag_;
+  const StereoBagTopics& topics_;
+  const tf2::BufferCore& tf_;
+  StereoBagStats& stats_;
+  std::map<::ros::Time, Parts> pending_;
+  sensor_msgs::CameraInfo::ConstPtr latest_left_info_, latest_right_info_;
+};
+
+}  // namespace
+
+StereoBagStats readStereoBag(const std::filesystem::path& bag_path, const StereoBagTopics& topics,
+                             const std::function<void(host::Capture&&)>& each) {
+  rosbag::Bag bag;
+  try {
+    bag.open(bag_path.string(), rosbag::bagmode::Read);
+  } catch (const rosbag::BagException& e) {
+    fail(bag_path, std::string("not a readable ROS bag: ") + e.what());
+  }
+  const std::unique_ptr<tf2::BufferCore> tf = bagTransforms(bag);
+  const std::vector<std::string> wanted = {topics.left_image,    topics.right_image,
+                                           topics.left_info,     topics.right_info,
+                                           topics.fruitlet_mask, topics.disparity};
+  rosbag::View view(bag, rosbag::TopicQuery(wanted));
+  std::set<std::string> present;
+  for (const rosbag::ConnectionInfo* c : view.getConnections()) present.insert(c->topic);
+  for (const std::string& topic : {topics.left_image, topics.right_image})
+    if (!present.count(topic))
+      fail(bag_path, topic + ": expected images on this topic, found none");
+  StereoBagStats stats;
+  PairReader reader(bag_path, topics, *tf, stats);
+  const ::ros::Duration window(kGatherWindowS);
+  for (const rosbag::MessageInstance& m : view) {
+    if (m.getTime() > ::ros::Time(0) + window) reader.flush(each, m.getTime() - window);
+    reader.add(m);
+  }
+  reader.flush(each);
+  return stats;
+}
+
+}  // namespace fvp::ros

@@ -1,0 +1,21 @@
+# cmake -P script: two fvp size results sized the same fruitlets, exactly (the same count, and
+# each fruitlet's size_mm and center_m as written).
+#   A, B  fruitlets.json files
+file(READ "${A}" a)
+file(READ "${B}" b)
+string(JSON na LENGTH "${a}" sized_fruitlets)
+string(JSON nb LENGTH "${b}" sized_fruitlets)
+if(NOT na EQUAL nb OR na EQUAL 0)
+  message(FATAL_ERROR "${A}: ${na} fruitlets sized, ${B}: ${nb} (expected the same, not 0)")
+endif()
+math(EXPR last "${na} - 1")
+foreach(i RANGE ${last})
+  foreach(field size_mm center_m)
+    string(JSON va GET "${a}" sized_fruitlets ${i} ${field})
+    string(JSON vb GET "${b}" sized_fruitlets ${i} ${field})
+    if(NOT va STREQUAL vb)
+      message(FATAL_ERROR "sized_fruitlets[${i}].${field}: ${va} in ${A}, ${vb} in ${B}")
+    endif()
+  endforeach()
+endforeach()
+message(STATUS "${na} fruitlets sized the same")
