@@ -37,10 +37,12 @@ void addSizeCommand(CLI::App& app) {
   captures->excludes(bag);
   cmd->add_option("--bag-ns", opt->bag_ns,
                   "the bag's stereo namespace: NS/{left,right}/image_rect_color, "
-                  "NS/{left,right}/camera_info, NS/left/fruitlet_mask (optional)")
+                  "NS/{left,right}/camera_info, NS/left/fruitlet_mask, NS/disparity (optional)")
+      ->needs(bag)
       ->capture_default_str();
   cmd->add_option("--world-frame", opt->world_frame,
                   "the bag's tf frame that camera poses are looked up in")
+      ->needs(bag)
       ->capture_default_str();
   cmd->add_option("--sizing", opt->sizing, "estimator: ours | paper (both are reported)")
       ->check(CLI::IsMember({"ours", "paper"}))

@@ -21,18 +21,6 @@ namespace {
 /// The file that marks a captures directory as written by fvp size --bag.
 constexpr const char* kBagCapturesMarker = ".fvp-bag-captures";
 
-ros::StereoBagTopics topicsUnder(const std::string& ns, const std::string& world_frame) {
-  ros::StereoBagTopics topics;
-  topics.left_image = ns + "/left/image_rect_color";
-  topics.right_image = ns + "/right/image_rect_color";
-  topics.left_info = ns + "/left/camera_info";
-  topics.right_info = ns + "/right/camera_info";
-  topics.fruitlet_mask = ns + "/left/fruitlet_mask";
-  topics.disparity = ns + "/disparity";
-  topics.world_frame = world_frame;
-  return topics;
-}
-
 }  // namespace
 
 bool builtWithRos() {
@@ -45,7 +33,7 @@ void writeCaptureSetAsBag(const std::filesystem::path& captures_dir,
   for (const auto& dir : host::listCaptures(captures_dir))
     captures.push_back(host::readCapture(dir));
   const std::filesystem::path tmp = bag.string() + ".tmp";
-  ros::writeStereoBag(tmp, captures, topicsUnder("/stereo", "world"));
+  ros::writeStereoBag(tmp, captures, ros::StereoBagTopics{});
   std::filesystem::rename(tmp, bag);  // a bag is there whole or not at all
 }
 
@@ -56,30 +44,41 @@ std::size_t extractBagCaptures(const std::filesystem::path& bag, const std::stri
     throw std::runtime_error("--bag '" + bag.string() + "': expected a ROS bag file");
   // Only a directory an earlier --bag run wrote (its marker says so) is replaced: a user's own
   // folder of that name is never deleted.
-  const std::filesystem::path marker = out_dir / kBagCapturesMarker;
   if (std::filesystem::exists(out_dir) && !std::filesystem::is_empty(out_dir) &&
-      !std::filesystem::exists(marker))
+      !std::filesystem::exists(out_dir / kBagCapturesMarker))
     throw std::runtime_error("--out: '" + out_dir.string() +
                              "' exists and fvp size --bag did not write it: move it, or choose "
                              "another --out");
-  std::filesystem::remove_all(out_dir);
-  std::filesystem::create_directories(out_dir);
-  std::ofstream(marker) << "captures read from " << bag.string() << " by fvp size --bag\n";
+  // Read into a temporary directory, swapped in whole: a bad bag leaves earlier captures be.
+  const std::filesystem::path tmp = out_dir.string() + ".tmp";
+  std::filesystem::remove_all(tmp);
+  std::filesystem::create_directories(tmp);
   std::size_t index = 0;
-  const ros::StereoBagStats stats =
-      ros::readStereoBag(bag, topicsUnder(stereo_ns, world_frame), [&](host::Capture&& capture) {
-        char name[24];
-        std::snprintf(name, sizeof(name), "%03zu", index++);
-        host::writeCapture(out_dir / name, capture);
+  const ros::StereoBagStats stats = ros::readStereoBag(
+      bag, ros::StereoBagTopics::under(stereo_ns, world_frame), [&](host::Capture&& capture) {
+        char name[24];  // six digits: name order is capture order up to a million pairs
+        std::snprintf(name, sizeof(name), "%06zu", index++);
+        host::writeCapture(tmp / name, capture);
       });
   std::cout << bag.string() << ": " << stats.pairs << " stereo pairs (" << stats.with_mask
             << " with a fruitlet mask, " << stats.with_disparity << " with a disparity) -> "
             << out_dir.string() << "; skipped: " << stats.unpaired_images << " unpaired images, "
             << stats.without_pose << " pairs without a pose in '" << world_frame << "', "
             << stats.without_info << " pairs before the camera infos\n";
-  if (stats.pairs == 0)
+  if (stats.pairs == 0) {
+    std::filesystem::remove_all(tmp);
     throw std::runtime_error("--bag '" + bag.string() + "': no stereo pair with a pose in '" +
                              world_frame + "' under " + stereo_ns);
+  }
+  const std::size_t skipped = stats.unpaired_images + stats.without_pose + stats.without_info;
+  if (skipped > 0)
+    std::cerr << "fvp: warning: " << bag.string() << ": " << skipped
+              << " images or pairs skipped (counted above)\n";
+  if (!(std::ofstream(tmp / kBagCapturesMarker)
+        << "captures read from " << bag.string() << " by fvp size --bag\n"))
+    throw std::runtime_error("--out: cannot write in '" + tmp.string() + "'");
+  std::filesystem::remove_all(out_dir);
+  std::filesystem::rename(tmp, out_dir);
   return stats.pairs;
 }
 

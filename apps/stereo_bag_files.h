@@ -15,8 +15,9 @@ bool builtWithRos();
 void writeCaptureSetAsBag(const std::filesystem::path& captures_dir,
                           const std::filesystem::path& bag);
 
-/// Writes the bag's stereo pairs as captures out_dir/000, 001, ... (out_dir emptied first) and
-/// returns how many; what it skipped is printed and, when it skipped anything, warned.
+/// Writes the bag's stereo pairs as captures out_dir/000000, 000001, ... (read into
+/// out_dir.tmp, then swapped in whole) and returns how many; what it skipped is printed, and
+/// warned on stderr when it skipped anything.
 std::size_t extractBagCaptures(const std::filesystem::path& bag, const std::string& stereo_ns,
                                const std::string& world_frame,
                                const std::filesystem::path& out_dir);

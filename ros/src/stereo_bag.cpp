@@ -2,6 +2,8 @@
 // std::allocator<void>::rebind, which C++20 removed.
 #include "fvp/ros/stereo_bag.h"
 
+#include "fvp/ros/bag_structure.h"
+
 #include <cv_bridge/cv_bridge.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <rosbag/bag.h>
@@ -17,6 +19,7 @@
 #include <algorithm>
 #include <boost/make_shared.hpp>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <optional>
 #include <set>
@@ -32,7 +35,14 @@ using ImagePtr = sensor_msgs::Image::ConstPtr;
 }
 
 std::string stampText(const ::ros::Time& t) {
-  return std::to_string(t.sec) + "." + std::to_string(t.nsec / 1000000) + " s";
+  char text[40];
+  std::snprintf(text, sizeof(text), "%u.%03u s", t.sec, t.nsec / 1000000);
+  return text;
+}
+
+/// tf2 keeps frame ids without a leading '/' (ROS 1's old style) and refuses to look one up.
+std::string frameId(const std::string& id) {
+  return !id.empty() && id[0] == '/' ? id.substr(1) : id;
 }
 
 sensor_msgs::CameraInfo cameraInfo(const host::StereoIntrinsics& K, const std_msgs::Header& header,
@@ -76,14 +86,31 @@ Eigen::Isometry3d isometryOf(const geometry_msgs::Transform& t) {
   return T;
 }
 
+/// The message, when it is of type T and its serialized bytes hold what they state
+/// (serializedMessageFits: roscpp allocates by stated lengths); else null for another type, and
+/// an error naming the bag and topic for bytes that do not hold together.
+template <typename T>
+boost::shared_ptr<T> checkedMessage(const rosbag::MessageInstance& m, BagMessage type,
+                                    const std::filesystem::path& bag) {
+  if (!m.isType<T>()) return nullptr;
+  std::vector<std::uint8_t> bytes(m.size());
+  ::ros::serialization::OStream stream(bytes.data(), std::uint32_t(bytes.size()));
+  m.write(stream);
+  if (!serializedMessageFits(type, bytes.data(), bytes.size()))
+    fail(bag, m.getTopic() + " at " + stampText(m.getTime()) + ": expected a whole " +
+                  m.getDataType() + " (a length inside it runs past its end)");
+  return m.instantiate<T>();
+}
+
 /// Every transform of the bag's /tf and /tf_static, kept for the whole bag.
-std::unique_ptr<tf2::BufferCore> bagTransforms(rosbag::Bag& bag) {
+std::unique_ptr<tf2::BufferCore> bagTransforms(rosbag::Bag& bag,
+                                               const std::filesystem::path& path) {
   rosbag::View all(bag);
-  const double span_s = (all.getEndTime() - all.getBeginTime()).toSec();
+  const double span_s = all.size() == 0 ? 0.0 : (all.getEndTime() - all.getBeginTime()).toSec();
   auto buffer = std::make_unique<tf2::BufferCore>(::ros::Duration(span_s + 10.0));
   rosbag::View tf(bag, rosbag::TopicQuery(std::vector<std::string>{"/tf", "/tf_static"}));
   for (const rosbag::MessageInstance& m : tf) {
-    const auto message = m.instantiate<tf2_msgs::TFMessage>();
+    const auto message = checkedMessage<tf2_msgs::TFMessage>(m, BagMessage::kTf, path);
     if (!message) continue;
     const bool is_static = m.getTopic() == "/tf_static";
     for (const geometry_msgs::TransformStamped& t : message->transforms)
@@ -96,7 +123,9 @@ std::unique_ptr<tf2::BufferCore> bagTransforms(rosbag::Bag& bag) {
 /// right one's P[3] = -fx * baseline.
 host::StereoIntrinsics intrinsicsOf(const sensor_msgs::CameraInfo& left,
                                     const sensor_msgs::CameraInfo& right,
-                                    const std::filesystem::path& bag, const std::string& where) {
+                                    const std::filesystem::path& bag,
+                                    const StereoBagTopics& topics) {
+  const std::string where = topics.left_info + " at " + stampText(left.header.stamp);
   host::StereoIntrinsics K;
   K.width_px = int(left.width);
   K.height_px = int(left.height);
@@ -106,9 +135,15 @@ host::StereoIntrinsics intrinsicsOf(const sensor_msgs::CameraInfo& left,
   K.cy_px = left.P[6];
   if (!(K.fx_px > 0.0) || !(K.fy_px > 0.0))
     fail(bag, where + ": camera_info P: expected a rectified projection with fx, fy > 0");
-  K.baseline_m = right.P[0] > 0.0 ? -right.P[3] / right.P[0] : 0.0;
+  const std::string right_where = topics.right_info + " at " + stampText(right.header.stamp);
+  // A rectified pair shares its projection; only the right one's P[3] differs.
+  for (const int i : {0, 2, 5, 6})
+    if (!(std::abs(right.P[i] - left.P[i]) <= 1e-6 * std::abs(left.P[i]) + 1e-9))
+      fail(bag, right_where + ": P[" + std::to_string(i) +
+                    "]: expected the left camera_info's (a rectified pair shares fx, fy, cx, cy)");
+  K.baseline_m = -right.P[3] / right.P[0];
   if (!(K.baseline_m > 0.0))
-    fail(bag, where + ": right camera_info P[3]: expected -fx * baseline with a baseline > 0");
+    fail(bag, right_where + ": P[3]: expected -fx * baseline with a baseline > 0");
   return K;
 }
 
@@ -204,24 +239,29 @@ class PairReader {
   void add(const rosbag::MessageInstance& m) {
     const std::string& topic = m.getTopic();
     if (topic == topics_.left_info || topic == topics_.right_info) {
-      const auto info = m.instantiate<sensor_msgs::CameraInfo>();
+      const auto info = checkedMessage<sensor_msgs::CameraInfo>(m, BagMessage::kCameraInfo, bag_);
       if (!info) fail(bag_, topic + ": expected sensor_msgs/CameraInfo");
       Parts& parts = pending_[info->header.stamp];
       (topic == topics_.left_info ? parts.left_info : parts.right_info) = info;
       (topic == topics_.left_info ? latest_left_info_ : latest_right_info_) = info;
     } else if (topic == topics_.disparity) {
-      const auto d = m.instantiate<stereo_msgs::DisparityImage>();
+      const auto d =
+          checkedMessage<stereo_msgs::DisparityImage>(m, BagMessage::kDisparityImage, bag_);
       if (!d) fail(bag_, topic + ": expected stereo_msgs/DisparityImage");
       pending_[d->header.stamp].disparity = d;
     } else {
-      const ImagePtr image = m.instantiate<sensor_msgs::Image>();
+      const ImagePtr image = checkedMessage<sensor_msgs::Image>(m, BagMessage::kImage, bag_);
       if (!image) fail(bag_, topic + ": expected sensor_msgs/Image");
+      newest_image_ = std::max(newest_image_, image->header.stamp);
       Parts& parts = pending_[image->header.stamp];
       (topic == topics_.left_image    ? parts.left
        : topic == topics_.right_image ? parts.right
                                       : parts.mask) = image;
     }
   }
+
+  /// The newest image stamp seen so far.
+  ::ros::Time newestImage() const { return newest_image_; }
 
   /// Gives every gathered stamp older than `before` (all of them by default) to `each`.
   void flush(const std::function<void(host::Capture&&)>& each,
@@ -250,12 +290,13 @@ class PairReader {
     host::Capture capture;
     try {
       capture.T_world_camera = isometryOf(
-          tf_.lookupTransform(topics_.world_frame, p.left->header.frame_id, stamp).transform);
+          tf_.lookupTransform(frameId(topics_.world_frame), frameId(p.left->header.frame_id), stamp)
+              .transform);
     } catch (const tf2::TransformException&) {
       ++stats_.without_pose;
       return std::nullopt;
     }
-    capture.intrinsics = intrinsicsOf(*left_info, *right_info, bag_, where);
+    capture.intrinsics = intrinsicsOf(*left_info, *right_info, bag_, topics_);
     capture.left_bgr = imageOf(p.left, "bgr8", bag_, where);
     capture.right_bgr =
         imageOf(p.right, "bgr8", bag_, topics_.right_image + " at " + stampText(stamp));
@@ -289,19 +330,14 @@ class PairReader {
   StereoBagStats& stats_;
   std::map<::ros::Time, Parts> pending_;
   sensor_msgs::CameraInfo::ConstPtr latest_left_info_, latest_right_info_;
+  ::ros::Time newest_image_;
 };
 
-}  // namespace
-
-StereoBagStats readStereoBag(const std::filesystem::path& bag_path, const StereoBagTopics& topics,
-                             const std::function<void(host::Capture&&)>& each) {
+StereoBagStats readCheckedBag(const std::filesystem::path& bag_path, const StereoBagTopics& topics,
+                              const std::function<void(host::Capture&&)>& each) {
   rosbag::Bag bag;
-  try {
-    bag.open(bag_path.string(), rosbag::bagmode::Read);
-  } catch (const rosbag::BagException& e) {
-    fail(bag_path, std::string("not a readable ROS bag: ") + e.what());
-  }
-  const std::unique_ptr<tf2::BufferCore> tf = bagTransforms(bag);
+  bag.open(bag_path.string(), rosbag::bagmode::Read);
+  const std::unique_ptr<tf2::BufferCore> tf = bagTransforms(bag, bag_path);
   const std::vector<std::string> wanted = {topics.left_image,    topics.right_image,
                                            topics.left_info,     topics.right_info,
                                            topics.fruitlet_mask, topics.disparity};
@@ -315,11 +351,25 @@ StereoBagStats readStereoBag(const std::filesystem::path& bag_path, const Stereo
   PairReader reader(bag_path, topics, *tf, stats);
   const ::ros::Duration window(kGatherWindowS);
   for (const rosbag::MessageInstance& m : view) {
-    if (m.getTime() > ::ros::Time(0) + window) reader.flush(each, m.getTime() - window);
     reader.add(m);
+    // Stamps, not record times: a camera's clock may run apart from the recorder's.
+    if (reader.newestImage() > ::ros::Time(0) + window)
+      reader.flush(each, reader.newestImage() - window);
   }
   reader.flush(each);
   return stats;
+}
+
+}  // namespace
+
+StereoBagStats readStereoBag(const std::filesystem::path& bag_path, const StereoBagTopics& topics,
+                             const std::function<void(host::Capture&&)>& each) {
+  checkBagStructure(bag_path);  // rosbag trusts the lengths a file states
+  try {
+    return readCheckedBag(bag_path, topics, each);
+  } catch (const ::ros::Exception& e) {  // rosbag's, rostime's: their messages name no file
+    fail(bag_path, std::string("not a readable ROS bag: ") + e.what());
+  }
 }
 
 }  // namespace fvp::ros

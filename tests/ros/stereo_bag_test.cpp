@@ -2,6 +2,8 @@
 // back as it went in, what cannot be used is counted, bad input names the bag, topic and field.
 #include "fvp/ros/stereo_bag.h"
 
+#include "fvp/ros/bag_structure.h"
+
 #include <gtest/gtest.h>
 #include <rosbag/bag.h>
 #include <sensor_msgs/CameraInfo.h>
@@ -12,6 +14,7 @@
 #include <Eigen/Geometry>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <opencv2/core.hpp>
 #include <stdexcept>
 #include <string>
@@ -178,6 +181,38 @@ TEST(StereoBag, CountsImagesWithoutAPartnerAPoseOrACameraInfo) {
   fs::remove(no_info);
 }
 
+// A camera's stamps need not be the recorder's clock: here every message is recorded 5 s after
+// its stamp (the right image 0.3 s after the left), far beyond the 1 s gather window; pairs
+// are gathered by stamp. The frames are named in ROS 1's old style, with a leading '/', which
+// tf2 does not look up as given.
+TEST(StereoBag, PairsByStampWhateverTheRecordTimeAndFrameIdStyle) {
+  const fs::path path = scratch("clock.bag");
+  {
+    HandBag b(path);
+    for (const double s : {1.0, 2.0, 3.0}) {
+      const ::ros::Time t(s);
+      tf2_msgs::TFMessage tf = pose(t);
+      tf.transforms[0].child_frame_id = "/cam";
+      const ::ros::Time recorded = t + ::ros::Duration(5.0);
+      b.bag.write("/tf", recorded, tf);
+      b.bag.write(b.topics.left_info, recorded, info(t, false));
+      b.bag.write(b.topics.right_info, recorded, info(t, true));
+      sensor_msgs::Image left = image(t, 8), right = image(t, 8);
+      left.header.frame_id = right.header.frame_id = "/cam";
+      b.bag.write(b.topics.left_image, recorded, left);
+      b.bag.write(b.topics.right_image, recorded + ::ros::Duration(0.3), right);
+    }
+  }
+  StereoBagTopics topics;
+  topics.world_frame = "/world";
+  std::size_t captures = 0;
+  const StereoBagStats stats = readStereoBag(path, topics, [&](host::Capture&&) { ++captures; });
+  EXPECT_EQ(stats.pairs, 3u);
+  EXPECT_EQ(captures, 3u);
+  EXPECT_EQ(stats.unpaired_images + stats.without_pose + stats.without_info, 0u);
+  fs::remove(path);
+}
+
 std::string errorOf(const fs::path& path) {
   try {
     readAll(path);
@@ -212,6 +247,52 @@ TEST(StereoBag, BadInputNamesTheBagTheTopicAndTheField) {
   std::ofstream(not_a_bag) << "#ROSBAG V2.0 but nothing after\n";
   EXPECT_NE(errorOf(not_a_bag).find("not a readable ROS bag"), std::string::npos);
   for (const fs::path& p : {wrong_size, no_right, not_a_bag}) fs::remove(p);
+}
+
+std::string bytesOf(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+void writeBytes(const fs::path& p, const std::string& bytes) {
+  std::ofstream(p, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+std::string structureError(const fs::path& p) {
+  try {
+    checkBagStructure(p);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// rosbag trusts the lengths a file states (a 4 GB header length made it allocate 4 GB: the
+// fuzz regression connection_header_len_4GB_oom); the walk refuses them first.
+TEST(BagStructure, RefusesLengthsThatLeaveTheFile) {
+  const fs::path good = scratch("structure.bag");
+  writeStereoBag(good, {capture(0)}, StereoBagTopics{});
+  EXPECT_EQ(structureError(good), "");
+  const std::string bytes = bytesOf(good);
+
+  const fs::path bad = scratch("structure_bad.bag");
+  std::string huge = bytes;
+  const std::size_t first_record = 13;  // after "#ROSBAG V2.0\n": the bag header's header_len
+  for (int i = 0; i < 4; ++i) huge[first_record + std::size_t(i)] = char(0xff);
+  writeBytes(bad, huge);
+  const std::string error = structureError(bad);
+  EXPECT_NE(error.find(bad.string()), std::string::npos) << error;
+  EXPECT_NE(error.find("at byte 13, header_len 4294967295"), std::string::npos) << error;
+
+  writeBytes(bad, bytes.substr(0, bytes.size() - 100));
+  EXPECT_NE(structureError(bad).find("not a readable ROS bag"), std::string::npos);
+  writeBytes(bad, "#ROSBAG V1.2\n" + bytes.substr(13));
+  EXPECT_NE(structureError(bad).find("#ROSBAG V2.0"), std::string::npos);
+  // readStereoBag checks first: the same error, not rosbag's allocation.
+  writeBytes(bad, huge);
+  EXPECT_NE(errorOf(bad).find("header_len"), std::string::npos);
+  fs::remove(good);
+  fs::remove(bad);
 }
 
 }  // namespace

@@ -27,6 +27,16 @@ struct StereoBagTopics {
   /// as a capture's disparity.png is (SGBM runs only where there is none).
   std::string disparity = "/stereo/disparity";
   std::string world_frame = "world";
+
+  /// The same names under another stereo namespace (e.g. "/camera"), in another world frame.
+  static StereoBagTopics under(const std::string& ns, const std::string& world_frame) {
+    StereoBagTopics t;
+    for (std::string* topic : {&t.left_image, &t.right_image, &t.left_info, &t.right_info,
+                               &t.fruitlet_mask, &t.disparity})
+      *topic = ns + topic->substr(std::string("/stereo").size());
+    t.world_frame = world_frame;
+    return t;
+  }
 };
 
 /// What a bag held, and what of it could not be used: expected events, counted, never errors.
@@ -52,9 +62,9 @@ void writeStereoBag(const std::filesystem::path& bag, const std::vector<host::Ca
 /// Calls `each` with every usable stereo pair of the bag, in stamp order, as a capture: the pair
 /// (converted to bgr8), its intrinsics from the camera infos (baseline from the right one's P),
 /// T_world_camera from the bag's /tf and /tf_static at the left image's stamp, and the mask and
-/// disparity of the same stamp when there are. A stamp's messages are gathered until the bag's
-/// record time is kGatherWindowS past it (a recorder receives a pair's topics within that),
-/// so memory holds only that window of images. Returns what was read and skipped. Throws
+/// disparity of the same stamp when there are. A stamp's messages are gathered until the bag
+/// holds an image stamped kGatherWindowS later (a recorder receives a pair's topics well within
+/// that), so memory holds only that window of images. Returns what was read and skipped. Throws
 /// std::runtime_error naming the bag, the topic, the stamp and the field for input that is not
 /// a stereo bag (no image on a topic, an image whose size is not its camera info's, an encoding
 /// that is not an image).
