@@ -9,6 +9,7 @@
 #include "cli_checks.h"
 #include "commands.h"
 #include "fvp/trials/trial.h"
+#include "stereo_bag_files.h"
 #include "trial_cli.h"
 
 namespace fvp::apps {
@@ -17,6 +18,7 @@ void addRunCommand(CLI::App& app) {
   struct Options {
     trials::TrialOptions trial;
     std::string out;
+    std::string bag;  ///< also the trial's frames as a ROS bag
   };
   auto opt = optionStorage<Options>();
   auto* cmd = app.add_subcommand("run",
@@ -27,9 +29,21 @@ void addRunCommand(CLI::App& app) {
                   "an earlier visit of the same tree (its result.json or --out directory): "
                   "each cluster starts from what it learned (docs/season.md)")
       ->check(nonEmptyPath());
+  cmd->add_option("--bag", opt->bag,
+                  "also record every frame the trial captured as this ROS bag: stereo pairs, "
+                  "camera infos and the told pose on tf, stamped 1 s + simulated time "
+                  "(docs/ros.md; fvp size --bag sizes it)")
+      ->check(nonEmptyPath());
   cmd->add_option("--out", opt->out, "output directory")->required()->check(nonEmptyPath());
   FVP_ON_RUN(cmd, [opt] {
     trials::TrialOptions trial = opt->trial;
+    std::unique_ptr<TrialBagRecorder> recorder;
+    if (!opt->bag.empty()) {
+      recorder = std::make_unique<TrialBagRecorder>(opt->bag);
+      trial.on_frame = [&recorder](const host::StereoFrame& frame, double sim_time_s) {
+        recorder->add(frame, sim_time_s);
+      };
+    }
     trial.out_dir = opt->out;
     const bool tty = isatty(STDERR_FILENO);
     trial.on_progress = [tty](const trials::TrialProgress& p) {
@@ -46,6 +60,10 @@ void addRunCommand(CLI::App& app) {
               << "report: " << (std::filesystem::path(opt->out) / "report.md").string() << "\n"
               << "3-D viewer: " << (std::filesystem::path(opt->out) / "viewer.html").string()
               << " (open it in a browser)\n";
+    if (recorder) {
+      const std::size_t pairs = recorder->finish();
+      std::cout << "bag -> " << opt->bag << " (" << pairs << " stereo pairs)\n";
+    }
     // The result is kept; an extra that could not be written (a full disk) still fails the
     // command, so that a script notices.
     if (const auto it = result.find("unwritten_outputs"); it != result.end())

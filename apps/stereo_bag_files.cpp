@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "fvp/host/perception/capture.h"
+#include "fvp/host/perception/stereo_frame.h"
 #include "fvp/host/session/capture_sizing.h"
 #ifdef FVP_HAVE_ROS
 #include "fvp/ros/stereo_bag.h"
@@ -25,6 +26,42 @@ constexpr const char* kBagCapturesMarker = ".fvp-bag-captures";
 
 bool builtWithRos() {
   return true;
+}
+
+struct TrialBagRecorder::Writer {
+  std::filesystem::path bag, tmp;
+  ros::StereoBagWriter writer;
+  Writer(const std::filesystem::path& bag_path, const std::filesystem::path& tmp_path)
+      : bag(bag_path), tmp(tmp_path), writer(tmp_path, ros::StereoBagTopics{}) {}
+};
+
+TrialBagRecorder::TrialBagRecorder(const std::filesystem::path& bag)
+    : writer_(std::make_unique<Writer>(bag, bag.string() + ".tmp")) {}
+
+TrialBagRecorder::~TrialBagRecorder() {
+  if (!writer_) return;
+  writer_->writer.close();
+  std::error_code ignored;  // an unfinished recording (the trial failed) is not kept
+  std::filesystem::remove(writer_->tmp, ignored);
+}
+
+void TrialBagRecorder::add(const host::StereoFrame& frame, double sim_time_s) {
+  host::Capture capture;
+  capture.left_bgr = frame.left_bgr;
+  capture.right_bgr = frame.right_bgr;
+  capture.intrinsics = frame.intrinsics;
+  capture.T_world_camera = frame.T_world_camera;
+  capture.fruitlet_mask = frame.fruitlet_mask;
+  capture.disparity_px = frame.disparity_px;
+  writer_->writer.add(capture, 1.0 + sim_time_s);
+}
+
+std::size_t TrialBagRecorder::finish() {
+  writer_->writer.close();
+  const std::size_t pairs = writer_->writer.pairs();
+  std::filesystem::rename(writer_->tmp, writer_->bag);
+  writer_.reset();
+  return pairs;
 }
 
 void writeCaptureSetAsBag(const std::filesystem::path& captures_dir,
@@ -94,6 +131,17 @@ namespace {
 
 bool builtWithRos() {
   return false;
+}
+struct TrialBagRecorder::Writer {};
+TrialBagRecorder::TrialBagRecorder(const std::filesystem::path&) {
+  noRos();
+}
+TrialBagRecorder::~TrialBagRecorder() = default;
+void TrialBagRecorder::add(const host::StereoFrame&, double) {
+  noRos();
+}
+std::size_t TrialBagRecorder::finish() {
+  noRos();
 }
 void writeCaptureSetAsBag(const std::filesystem::path&, const std::filesystem::path&) {
   noRos();

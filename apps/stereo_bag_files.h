@@ -4,7 +4,12 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <memory>
 #include <string>
+
+namespace fvp::host {
+struct StereoFrame;
+}
 
 namespace fvp::apps {
 
@@ -14,6 +19,23 @@ bool builtWithRos();
 /// Writes the capture set in captures_dir (listCaptures' order) as a stereo bag.
 void writeCaptureSetAsBag(const std::filesystem::path& captures_dir,
                           const std::filesystem::path& bag);
+
+/// Records a trial's frames as a stereo bag (fvp run --bag), each stamped 1 s + its simulated
+/// time (tf reads a stamp of 0 as "the latest"); written under a temporary name and renamed by
+/// finish(), so a bag is there whole or not at all.
+class TrialBagRecorder {
+ public:
+  explicit TrialBagRecorder(const std::filesystem::path& bag);
+  ~TrialBagRecorder();
+  /// What the trial calls with each frame (trials::TrialOptions::on_frame).
+  void add(const host::StereoFrame& frame, double sim_time_s);
+  /// Closes the bag and renames it into place; returns the pairs written.
+  std::size_t finish();
+
+ private:
+  struct Writer;
+  std::unique_ptr<Writer> writer_;
+};
 
 /// Writes the bag's stereo pairs as captures out_dir/000000, 000001, ... (read into
 /// out_dir.tmp, then swapped in whole) and returns how many; what it skipped is printed, and

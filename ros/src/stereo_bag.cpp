@@ -191,40 +191,76 @@ cv::Mat disparityOf(const stereo_msgs::DisparityImage& d, const std::filesystem:
 
 }  // namespace
 
-void writeStereoBag(const std::filesystem::path& bag_path,
-                    const std::vector<host::Capture>& captures, const StereoBagTopics& topics,
-                    const std::string& camera_frame, double start_s, double period_s) {
+struct StereoBagWriter::Bag {
+  std::filesystem::path path;
   rosbag::Bag bag;
+};
+
+StereoBagWriter::StereoBagWriter(const std::filesystem::path& bag, StereoBagTopics topics,
+                                 std::string camera_frame)
+    : bag_(std::make_unique<Bag>()),
+      topics_(std::move(topics)),
+      camera_frame_(std::move(camera_frame)) {
+  bag_->path = bag;
   try {
-    bag.open(bag_path.string(), rosbag::bagmode::Write);
-  } catch (const rosbag::BagException& e) {
-    fail(bag_path, std::string("cannot be written: ") + e.what());
+    bag_->bag.open(bag.string(), rosbag::bagmode::Write);
+  } catch (const ::ros::Exception& e) {
+    fail(bag, std::string("cannot be written: ") + e.what());
   }
-  for (std::size_t i = 0; i < captures.size(); ++i) {
-    const host::Capture& c = captures[i];
-    std_msgs::Header header;
-    header.stamp = ::ros::Time(start_s + double(i) * period_s);
-    header.frame_id = camera_frame;
-    header.seq = std::uint32_t(i);
-    std_msgs::Header world = header;
-    world.frame_id = topics.world_frame;
-    tf2_msgs::TFMessage tf;
-    tf.transforms.push_back(transformMsg(c.T_world_camera, world, camera_frame));
+}
+
+StereoBagWriter::~StereoBagWriter() {
+  try {
+    close();
+  } catch (const std::exception&) {
+    // A destructor must not throw; close() explicitly to hear of it.
+  }
+}
+
+void StereoBagWriter::close() {
+  if (bag_) bag_->bag.close();
+  bag_.reset();
+}
+
+void StereoBagWriter::add(const host::Capture& c, double stamp_s) {
+  if (!bag_) throw std::logic_error("StereoBagWriter::add after close");
+  std_msgs::Header header;
+  header.stamp = ::ros::Time(stamp_s);
+  header.frame_id = camera_frame_;
+  header.seq = std::uint32_t(pairs_);
+  std_msgs::Header world = header;
+  world.frame_id = topics_.world_frame;
+  tf2_msgs::TFMessage tf;
+  tf.transforms.push_back(transformMsg(c.T_world_camera, world, camera_frame_));
+  rosbag::Bag& bag = bag_->bag;
+  try {
     bag.write("/tf", header.stamp, tf);
-    bag.write(topics.left_info, header.stamp, cameraInfo(c.intrinsics, header, false));
-    bag.write(topics.right_info, header.stamp, cameraInfo(c.intrinsics, header, true));
-    bag.write(topics.left_image, header.stamp,
+    bag.write(topics_.left_info, header.stamp, cameraInfo(c.intrinsics, header, false));
+    bag.write(topics_.right_info, header.stamp, cameraInfo(c.intrinsics, header, true));
+    bag.write(topics_.left_image, header.stamp,
               cv_bridge::CvImage(header, "bgr8", c.left_bgr).toImageMsg());
-    bag.write(topics.right_image, header.stamp,
+    bag.write(topics_.right_image, header.stamp,
               cv_bridge::CvImage(header, "bgr8", c.right_bgr).toImageMsg());
-    if (!c.disparity_px.empty()) bag.write(topics.disparity, header.stamp, disparityMsg(c, header));
+    if (!c.disparity_px.empty())
+      bag.write(topics_.disparity, header.stamp, disparityMsg(c, header));
     if (!c.fruitlet_mask.empty())
-      bag.write(topics.fruitlet_mask, header.stamp,
+      bag.write(topics_.fruitlet_mask, header.stamp,
                 cv_bridge::CvImage(header, c.fruitlet_mask.depth() == CV_16U ? "mono16" : "mono8",
                                    c.fruitlet_mask)
                     .toImageMsg());
+  } catch (const ::ros::Exception& e) {
+    fail(bag_->path, std::string("cannot be written: ") + e.what());
   }
-  bag.close();
+  ++pairs_;
+}
+
+void writeStereoBag(const std::filesystem::path& bag_path,
+                    const std::vector<host::Capture>& captures, const StereoBagTopics& topics,
+                    const std::string& camera_frame, double start_s, double period_s) {
+  StereoBagWriter writer(bag_path, topics, camera_frame);
+  for (std::size_t i = 0; i < captures.size(); ++i)
+    writer.add(captures[i], start_s + double(i) * period_s);
+  writer.close();
 }
 
 namespace {

@@ -1,6 +1,6 @@
-# cmake -P script: two fvp size results sized the same fruitlets, exactly (the same count, and
-# each fruitlet's size_mm and center_m as written).
-#   A, B  fruitlets.json files
+# cmake -P script: two results sized the same fruitlets, exactly (the same count, and each
+# fruitlet's size_mm and center_m as written).
+#   A, B  fvp size's fruitlets.json or a trial's result.json (both hold sized_fruitlets)
 file(READ "${A}" a)
 file(READ "${B}" b)
 string(JSON na LENGTH "${a}" sized_fruitlets)

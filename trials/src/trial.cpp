@@ -155,6 +155,7 @@ class TrialLog : public host::nbv::LoopObserver {
     }
     if (options_.on_progress)
       options_.on_progress({index + 1, e.now_s, options_.budget_s, secondsSince(wall_start_)});
+    if (options_.on_frame && e.frame) options_.on_frame(*e.frame, e.now_s);
     host::throwIfInterrupted();  // a signal ends the loop after the view
   }
 

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,28 @@ struct StereoBagStats {
   std::size_t unpaired_images = 0;  ///< a left or right image with no partner of its stamp
   std::size_t without_pose = 0;     ///< pairs tf could not place in world_frame at their stamp
   std::size_t without_info = 0;     ///< pairs with no camera info of either side yet
+};
+
+/// A stereo bag written a pair at a time (writeStereoBag, fvp run --bag): each add() writes the
+/// pair, its camera infos, the pose on /tf and the mask and disparity when present, stamped
+/// stamp_s. close() finishes the bag (the destructor closes it too).
+class StereoBagWriter {
+ public:
+  StereoBagWriter(const std::filesystem::path& bag, StereoBagTopics topics,
+                  std::string camera_frame = "stereo_left_optical");
+  ~StereoBagWriter();
+  StereoBagWriter(const StereoBagWriter&) = delete;
+  StereoBagWriter& operator=(const StereoBagWriter&) = delete;
+  void add(const host::Capture& capture, double stamp_s);
+  void close();
+  std::size_t pairs() const { return pairs_; }
+
+ private:
+  struct Bag;
+  std::unique_ptr<Bag> bag_;
+  StereoBagTopics topics_;
+  std::string camera_frame_;
+  std::size_t pairs_ = 0;
 };
 
 /// Writes each capture as one stereo pair stamped start_s + i * period_s: both images (bgr8),

@@ -18,6 +18,10 @@
 #include "fvp/host/planner/view_overhead.h"
 #include "fvp/robot/sim/sim_clock.h"
 
+namespace fvp::host {
+struct StereoFrame;
+}
+
 namespace fvp::host::nbv {
 class Arm;
 class Camera;
@@ -78,6 +82,10 @@ struct TrialOptions {
   /// nothing is written (the result is only returned).
   std::filesystem::path out_dir;
   std::function<void(const TrialProgress&)> on_progress;  ///< called after every view
+  /// Called with every frame the trial captured, as the camera gave it (its told pose, and a
+  /// mask or disparity where the camera gives them), and the simulated time it was mapped at:
+  /// to record a trial (fvp run --bag).
+  std::function<void(const host::StereoFrame&, double sim_time_s)> on_frame;
   /// Called with each warning as it happens (a rebuilt workspace cache, a figure not
   /// drawn, a view without fruitlet pixels); every warning is also in result["warnings"].
   std::function<void(const std::string&)> on_warning;
