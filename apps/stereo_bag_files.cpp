@@ -46,14 +46,7 @@ TrialBagRecorder::~TrialBagRecorder() {
 }
 
 void TrialBagRecorder::add(const host::StereoFrame& frame, double sim_time_s) {
-  host::Capture capture;
-  capture.left_bgr = frame.left_bgr;
-  capture.right_bgr = frame.right_bgr;
-  capture.intrinsics = frame.intrinsics;
-  capture.T_world_camera = frame.T_world_camera;
-  capture.fruitlet_mask = frame.fruitlet_mask;
-  capture.disparity_px = frame.disparity_px;
-  writer_->writer.add(capture, 1.0 + sim_time_s);
+  writer_->writer.add(host::captureOfFrame(frame), 1.0 + sim_time_s);
 }
 
 std::size_t TrialBagRecorder::finish() {

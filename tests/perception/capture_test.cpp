@@ -111,6 +111,12 @@ TEST(Capture, InstanceMaskRoundTripsAsItsIds) {
   // The frame keeps the ids; the pipeline's mask is their union, its instances the ids.
   const StereoFrame frame = toStereoFrame(r);
   EXPECT_NO_THROW(checkStereoFrame(frame, "capture"));
+  // And back: the frame as a capture holds the same parts.
+  const Capture again = captureOfFrame(frame);
+  EXPECT_EQ(cv::norm(again.fruitlet_mask, c.fruitlet_mask, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(again.left_bgr, r.left_bgr, cv::NORM_INF), 0.0);
+  EXPECT_TRUE(again.T_world_camera.isApprox(r.T_world_camera, 0.0));
+  EXPECT_EQ(again.intrinsics.fx_px, r.intrinsics.fx_px);
   const PerceptionResult perceived = PerceptionPipeline().process(frame);
   EXPECT_EQ(cv::countNonZero(perceived.fruitlet_mask), 2 * 80);
   EXPECT_EQ(cv::norm(perceived.fruitlet_instances, c.fruitlet_mask, cv::NORM_INF), 0.0);

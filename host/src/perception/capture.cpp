@@ -297,6 +297,17 @@ void writeCapture(const fs::path& dir, const Capture& c) {
   writeFileAtomically(dir / kCamera, "camera", cameraYaml(c));
 }
 
+Capture captureOfFrame(const StereoFrame& frame) {
+  Capture c;
+  c.left_bgr = frame.left_bgr;
+  c.right_bgr = frame.right_bgr;
+  c.intrinsics = frame.intrinsics;
+  c.T_world_camera = frame.T_world_camera;
+  c.fruitlet_mask = frame.fruitlet_mask;
+  c.disparity_px = frame.disparity_px;
+  return c;
+}
+
 StereoFrame toStereoFrame(const Capture& c) {
   StereoFrame frame;
   frame.left_bgr = c.left_bgr;

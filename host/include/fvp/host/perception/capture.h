@@ -62,6 +62,9 @@ void writeCapture(const std::filesystem::path& dir, const Capture& capture);
 /// own mask and disparity (used as given when present).
 StereoFrame toStereoFrame(const Capture& capture);
 
+/// Its inverse: the frame as a capture (no clouds, no ground truth), to be written.
+Capture captureOfFrame(const StereoFrame& frame);
+
 /// Reads and validates a capture; throws std::runtime_error whose message names the file,
 /// the field and what was expected.
 Capture readCapture(const std::filesystem::path& dir);
