@@ -18,6 +18,9 @@ RENAMED = {
 # `fvp run` options with no keyword at all, each with why.
 NOT_KEYWORDS = {
     "--help": "the CLI's own",
+    # The CLI's ROS bag recorder (apps/stereo_bag_files.h, over TrialOptions::on_frame); the
+    # Python module does not link the ROS layer, and has no frame hook yet.
+    "--bag": "the CLI's ROS bag recorder",
 }
 
 
