@@ -3,6 +3,7 @@
 #include "fvp/ros/stereo_bag.h"
 
 #include "fvp/ros/bag_structure.h"
+#include "fvp/ros/stereo_messages.h"
 
 #include <cv_bridge/cv_bridge.h>
 #include <geometry_msgs/TransformStamped.h>
@@ -34,58 +35,6 @@ using ImagePtr = sensor_msgs::Image::ConstPtr;
   throw std::runtime_error(bag.string() + ": " + what);
 }
 
-std::string stampText(const ::ros::Time& t) {
-  char text[40];
-  std::snprintf(text, sizeof(text), "%u.%03u s", t.sec, t.nsec / 1000000);
-  return text;
-}
-
-/// tf2 keeps frame ids without a leading '/' (ROS 1's old style) and refuses to look one up.
-std::string frameId(const std::string& id) {
-  return !id.empty() && id[0] == '/' ? id.substr(1) : id;
-}
-
-sensor_msgs::CameraInfo cameraInfo(const host::StereoIntrinsics& K, const std_msgs::Header& header,
-                                   bool right) {
-  sensor_msgs::CameraInfo info;
-  info.header = header;
-  info.width = K.width_px;
-  info.height = K.height_px;
-  info.distortion_model = "plumb_bob";
-  info.D.assign(5, 0.0);  // rectified: no distortion left
-  info.K = {K.fx_px, 0.0, K.cx_px, 0.0, K.fy_px, K.cy_px, 0.0, 0.0, 1.0};
-  info.R = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
-  info.P = {K.fx_px, 0.0,     K.cx_px, right ? -K.fx_px * K.baseline_m : 0.0,
-            0.0,     K.fy_px, K.cy_px, 0.0,
-            0.0,     0.0,     1.0,     0.0};
-  return info;
-}
-
-geometry_msgs::TransformStamped transformMsg(const Eigen::Isometry3d& T, const std_msgs::Header& h,
-                                             const std::string& child) {
-  geometry_msgs::TransformStamped t;
-  t.header = h;
-  t.child_frame_id = child;
-  t.transform.translation.x = T.translation().x();
-  t.transform.translation.y = T.translation().y();
-  t.transform.translation.z = T.translation().z();
-  const Eigen::Quaterniond q(T.linear());
-  t.transform.rotation.w = q.w();
-  t.transform.rotation.x = q.x();
-  t.transform.rotation.y = q.y();
-  t.transform.rotation.z = q.z();
-  return t;
-}
-
-Eigen::Isometry3d isometryOf(const geometry_msgs::Transform& t) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.translation() = Eigen::Vector3d(t.translation.x, t.translation.y, t.translation.z);
-  T.linear() = Eigen::Quaterniond(t.rotation.w, t.rotation.x, t.rotation.y, t.rotation.z)
-                   .normalized()
-                   .toRotationMatrix();
-  return T;
-}
-
 /// The message, when it is of type T and its serialized bytes hold what they state
 /// (serializedMessageFits: roscpp allocates by stated lengths); else null for another type, and
 /// an error naming the bag and topic for bytes that do not hold together.
@@ -94,12 +43,16 @@ boost::shared_ptr<T> checkedMessage(const rosbag::MessageInstance& m, BagMessage
                                     const std::filesystem::path& bag) {
   if (!m.isType<T>()) return nullptr;
   std::vector<std::uint8_t> bytes(m.size());
-  ::ros::serialization::OStream stream(bytes.data(), std::uint32_t(bytes.size()));
-  m.write(stream);
+  ::ros::serialization::OStream out(bytes.data(), std::uint32_t(bytes.size()));
+  m.write(out);
   if (!serializedMessageFits(type, bytes.data(), bytes.size()))
     fail(bag, m.getTopic() + " at " + stampText(m.getTime()) + ": expected a whole " +
                   m.getDataType() + " (a length inside it runs past its end)");
-  return m.instantiate<T>();
+  // From the checked bytes: the bag is read once per message.
+  auto message = boost::make_shared<T>();
+  ::ros::serialization::IStream in(bytes.data(), std::uint32_t(bytes.size()));
+  ::ros::serialization::deserialize(in, *message);
+  return message;
 }
 
 /// Every transform of the bag's /tf and /tf_static, kept for the whole bag.
@@ -117,76 +70,6 @@ std::unique_ptr<tf2::BufferCore> bagTransforms(rosbag::Bag& bag,
       buffer->setTransform(t, "bag", is_static);
   }
   return buffer;
-}
-
-/// The intrinsics of a rectified pair: the left camera's projection, the baseline from the
-/// right one's P[3] = -fx * baseline.
-host::StereoIntrinsics intrinsicsOf(const sensor_msgs::CameraInfo& left,
-                                    const sensor_msgs::CameraInfo& right,
-                                    const std::filesystem::path& bag,
-                                    const StereoBagTopics& topics) {
-  const std::string where = topics.left_info + " at " + stampText(left.header.stamp);
-  host::StereoIntrinsics K;
-  K.width_px = int(left.width);
-  K.height_px = int(left.height);
-  K.fx_px = left.P[0];
-  K.fy_px = left.P[5];
-  K.cx_px = left.P[2];
-  K.cy_px = left.P[6];
-  if (!(K.fx_px > 0.0) || !(K.fy_px > 0.0))
-    fail(bag, where + ": camera_info P: expected a rectified projection with fx, fy > 0");
-  const std::string right_where = topics.right_info + " at " + stampText(right.header.stamp);
-  // A rectified pair shares its projection; only the right one's P[3] differs.
-  for (const int i : {0, 2, 5, 6})
-    if (!(std::abs(right.P[i] - left.P[i]) <= 1e-6 * std::abs(left.P[i]) + 1e-9))
-      fail(bag, right_where + ": P[" + std::to_string(i) +
-                    "]: expected the left camera_info's (a rectified pair shares fx, fy, cx, cy)");
-  K.baseline_m = -right.P[3] / right.P[0];
-  if (!(K.baseline_m > 0.0))
-    fail(bag, right_where + ": P[3]: expected -fx * baseline with a baseline > 0");
-  return K;
-}
-
-cv::Mat imageOf(const ImagePtr& image, const std::string& encoding,
-                const std::filesystem::path& bag, const std::string& where) {
-  try {
-    return encoding.empty() ? cv_bridge::toCvCopy(image)->image
-                            : cv_bridge::toCvCopy(image, encoding)->image;
-  } catch (const cv_bridge::Exception& e) {
-    fail(bag, where + ": encoding '" + image->encoding + "': " + e.what());
-  }
-}
-
-/// One stamp's messages, gathered as they come.
-struct Parts {
-  ImagePtr left, right, mask;
-  stereo_msgs::DisparityImage::ConstPtr disparity;
-  sensor_msgs::CameraInfo::ConstPtr left_info, right_info;
-};
-
-stereo_msgs::DisparityImage disparityMsg(const host::Capture& c, const std_msgs::Header& header) {
-  stereo_msgs::DisparityImage d;
-  d.header = header;
-  d.image = *cv_bridge::CvImage(header, "32FC1", c.disparity_px).toImageMsg();
-  d.f = float(c.intrinsics.fx_px);
-  d.T = float(c.intrinsics.baseline_m);
-  d.min_disparity = 0.0f;  // fvp's convention: 0 (or less) is no disparity
-  d.max_disparity = float(c.intrinsics.width_px);
-  d.delta_d = float(1.0 / c.disparity_scale);
-  return d;
-}
-
-/// A stereo_msgs/DisparityImage as a capture's disparity: CV_32F, 0 where invalid (not finite,
-/// or not above min_disparity).
-cv::Mat disparityOf(const stereo_msgs::DisparityImage& d, const std::filesystem::path& bag,
-                    const std::string& where) {
-  const auto image = boost::make_shared<sensor_msgs::Image>(d.image);
-  cv::Mat disparity = imageOf(image, "32FC1", bag, where);
-  const float floor = std::max(0.0f, d.min_disparity);
-  disparity.forEach<float>([floor](float& v, const int*) {
-    if (!std::isfinite(v) || v <= floor) v = 0.0f;
-  });
-  return disparity;
 }
 
 }  // namespace
@@ -232,22 +115,16 @@ void StereoBagWriter::add(const host::Capture& c, double stamp_s) {
   world.frame_id = topics_.world_frame;
   tf2_msgs::TFMessage tf;
   tf.transforms.push_back(transformMsg(c.T_world_camera, world, camera_frame_));
+  const StereoMessages m = stereoMessagesOf(c, header);
   rosbag::Bag& bag = bag_->bag;
   try {
     bag.write("/tf", header.stamp, tf);
-    bag.write(topics_.left_info, header.stamp, cameraInfo(c.intrinsics, header, false));
-    bag.write(topics_.right_info, header.stamp, cameraInfo(c.intrinsics, header, true));
-    bag.write(topics_.left_image, header.stamp,
-              cv_bridge::CvImage(header, "bgr8", c.left_bgr).toImageMsg());
-    bag.write(topics_.right_image, header.stamp,
-              cv_bridge::CvImage(header, "bgr8", c.right_bgr).toImageMsg());
-    if (!c.disparity_px.empty())
-      bag.write(topics_.disparity, header.stamp, disparityMsg(c, header));
-    if (!c.fruitlet_mask.empty())
-      bag.write(topics_.fruitlet_mask, header.stamp,
-                cv_bridge::CvImage(header, c.fruitlet_mask.depth() == CV_16U ? "mono16" : "mono8",
-                                   c.fruitlet_mask)
-                    .toImageMsg());
+    bag.write(topics_.left_info, header.stamp, m.left_info);
+    bag.write(topics_.right_info, header.stamp, m.right_info);
+    bag.write(topics_.left_image, header.stamp, m.left);
+    bag.write(topics_.right_image, header.stamp, m.right);
+    if (m.disparity) bag.write(topics_.disparity, header.stamp, m.disparity);
+    if (m.mask) bag.write(topics_.fruitlet_mask, header.stamp, m.mask);
   } catch (const ::ros::Exception& e) {
     fail(bag_->path, std::string("cannot be written: ") + e.what());
   }
@@ -277,7 +154,7 @@ class PairReader {
     if (topic == topics_.left_info || topic == topics_.right_info) {
       const auto info = checkedMessage<sensor_msgs::CameraInfo>(m, BagMessage::kCameraInfo, bag_);
       if (!info) fail(bag_, topic + ": expected sensor_msgs/CameraInfo");
-      Parts& parts = pending_[info->header.stamp];
+      StereoMessages& parts = pending_[info->header.stamp];
       (topic == topics_.left_info ? parts.left_info : parts.right_info) = info;
       (topic == topics_.left_info ? latest_left_info_ : latest_right_info_) = info;
     } else if (topic == topics_.disparity) {
@@ -289,7 +166,7 @@ class PairReader {
       const ImagePtr image = checkedMessage<sensor_msgs::Image>(m, BagMessage::kImage, bag_);
       if (!image) fail(bag_, topic + ": expected sensor_msgs/Image");
       newest_image_ = std::max(newest_image_, image->header.stamp);
-      Parts& parts = pending_[image->header.stamp];
+      StereoMessages& parts = pending_[image->header.stamp];
       (topic == topics_.left_image    ? parts.left
        : topic == topics_.right_image ? parts.right
                                       : parts.mask) = image;
@@ -315,47 +192,25 @@ class PairReader {
   }
 
  private:
-  std::optional<host::Capture> captureOf(const ::ros::Time& stamp, const Parts& p) {
-    const std::string where = topics_.left_image + " at " + stampText(stamp);
-    const auto left_info = p.left_info ? p.left_info : latest_left_info_;
-    const auto right_info = p.right_info ? p.right_info : latest_right_info_;
-    if (!left_info || !right_info) {
+  std::optional<host::Capture> captureOf(const ::ros::Time& stamp, StereoMessages p) {
+    if (!p.left_info) p.left_info = latest_left_info_;
+    if (!p.right_info) p.right_info = latest_right_info_;
+    if (!p.left_info || !p.right_info) {
       ++stats_.without_info;
       return std::nullopt;
     }
-    host::Capture capture;
+    Eigen::Isometry3d T_world_camera;
     try {
-      capture.T_world_camera = isometryOf(
+      T_world_camera = isometryOf(
           tf_.lookupTransform(frameId(topics_.world_frame), frameId(p.left->header.frame_id), stamp)
               .transform);
     } catch (const tf2::TransformException&) {
       ++stats_.without_pose;
       return std::nullopt;
     }
-    capture.intrinsics = intrinsicsOf(*left_info, *right_info, bag_, topics_);
-    capture.left_bgr = imageOf(p.left, "bgr8", bag_, where);
-    capture.right_bgr =
-        imageOf(p.right, "bgr8", bag_, topics_.right_image + " at " + stampText(stamp));
-    const cv::Size size(capture.intrinsics.width_px, capture.intrinsics.height_px);
-    for (const cv::Mat* image : {&capture.left_bgr, &capture.right_bgr})
-      if (image->size() != size)
-        fail(bag_, where + ": image size: expected the camera_info's " +
-                       std::to_string(size.width) + " x " + std::to_string(size.height));
-    if (p.mask) {
-      const std::string mask_where = topics_.fruitlet_mask + " at " + stampText(stamp);
-      capture.fruitlet_mask = imageOf(p.mask, "", bag_, mask_where);
-      if (capture.fruitlet_mask.size() != size ||
-          (capture.fruitlet_mask.type() != CV_8U && capture.fruitlet_mask.type() != CV_16U))
-        fail(bag_, mask_where + ": expected a mono8 or mono16 image of the left image's size");
-      ++stats_.with_mask;
-    }
-    if (p.disparity) {
-      const std::string d_where = topics_.disparity + " at " + stampText(stamp);
-      capture.disparity_px = disparityOf(*p.disparity, bag_, d_where);
-      if (capture.disparity_px.size() != size)
-        fail(bag_, d_where + ": image size: expected the left image's");
-      ++stats_.with_disparity;
-    }
+    host::Capture capture = captureOfMessages(p, T_world_camera, topics_, bag_.string());
+    if (!capture.fruitlet_mask.empty()) ++stats_.with_mask;
+    if (!capture.disparity_px.empty()) ++stats_.with_disparity;
     ++stats_.pairs;
     return capture;
   }
@@ -364,7 +219,7 @@ class PairReader {
   const StereoBagTopics& topics_;
   const tf2::BufferCore& tf_;
   StereoBagStats& stats_;
-  std::map<::ros::Time, Parts> pending_;
+  std::map<::ros::Time, StereoMessages> pending_;
   sensor_msgs::CameraInfo::ConstPtr latest_left_info_, latest_right_info_;
   ::ros::Time newest_image_;
 };

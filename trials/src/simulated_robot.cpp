@@ -120,6 +120,9 @@ const SimulatedCamera& SimulatedRobot::camera() const {
 host::nbv::Arm& SimulatedRobot::arm() {
   return *impl_->sim_arm;
 }
+SimulatedArm& SimulatedRobot::simulatedArm() {
+  return *impl_->sim_arm;
+}
 host::nbv::LoopClock& SimulatedRobot::loopClock() {
   return *impl_->loop_clock;
 }

@@ -171,6 +171,9 @@ ClusterRun NbvSetup::runCluster(const NbvRig& rig, ClusterWork& work, LoopObserv
   // The budget is a time on the run's clock: this cluster's cap from its arrival.
   StopCondition stop = StopCondition::budget(out.start_s + spec.budget_s);
   if (spec.max_views) stop = stop || StopCondition::views(*spec.max_views);
+  if (spec.cancel)
+    stop = stop || StopCondition([&cancel = spec.cancel](const LoopState&) { return cancel(); },
+                                 "cancelled");
   LoopObservers observers;
   observers.add(observer);
   UnchargedClock observing_clock(rig.clock);  // before completion: it outlives it
@@ -249,6 +252,7 @@ TourResult NbvSetup::runTour(const NbvRig& rig, const std::vector<ClusterTarget>
   std::vector<bool> visited(targets.size(), false);
   std::unique_ptr<map::MapEngine> carried_map;
   for (std::size_t step = 0; step < targets.size(); ++step) {
+    if (options_.stop.cancel && options_.stop.cancel()) break;
     const auto ordering = Clock::now();
     const std::size_t k = nextOnTour(rig.arm, targets, visited);
     // Compute a robot spends too (IK for every pair of start views); none for the last.

@@ -7,9 +7,13 @@ namespace fvp::robot::sim {
 ExecutionResult SimulatedTrajectoryExecutor::execute(const Trajectory& trajectory) {
   if (trajectory.empty())
     throw std::invalid_argument("SimulatedTrajectoryExecutor: an empty trajectory");
-  clock_.chargeMotion(trajectory.duration_s());
-  joints_.set(trajectory.waypoints().back());
+  run(trajectory.duration_s(), trajectory.waypoints().back());
   return {ExecutionStatus::kDone, {}};
+}
+
+void SimulatedTrajectoryExecutor::run(double duration_s, const JointVector& end) {
+  clock_.chargeMotion(duration_s);
+  joints_.set(end);
 }
 
 }  // namespace fvp::robot::sim

@@ -256,4 +256,6 @@ std::string WorldConfig::toJson() const {
   return host::yamlConfigJson(yamlKeys(), *this).dump();
 }
 
+bool operator==(const WorldConfig&, const WorldConfig&) = default;
+
 }  // namespace fvp::robot::sim

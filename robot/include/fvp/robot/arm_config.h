@@ -8,7 +8,6 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
-#include <numbers>
 #include <string>
 #include <vector>
 
@@ -26,9 +25,9 @@ inline constexpr double kDefaultSliderMaxAccelerationMS2 = 1.0;
 // UR5 (CB3 datasheet): +-360 deg on every joint, 180 deg/s. The elbow is held to +-180 deg as
 // ur_description does (beyond that the arm folds into itself). The datasheet gives no joint
 // acceleration; 1.4 rad/s^2 is URScript's movej default.
-inline constexpr double kDefaultJointLimitRad = 2.0 * std::numbers::pi;
-inline constexpr double kDefaultElbowLimitRad = std::numbers::pi;
-inline constexpr double kDefaultJointMaxVelocityRadS = std::numbers::pi;
+inline constexpr double kDefaultJointLimitRad = 2.0 * double(EIGEN_PI);
+inline constexpr double kDefaultElbowLimitRad = double(EIGEN_PI);
+inline constexpr double kDefaultJointMaxVelocityRadS = double(EIGEN_PI);
 inline constexpr double kDefaultJointMaxAccelerationRadS2 = 1.4;
 // Hand-eye: left camera 2.5 cm left of the flange axis (half the 5 cm baseline), 6 cm out.
 inline const Eigen::Vector3d kDefaultHandEyeTranslationM{-0.025, 0.0, 0.06};

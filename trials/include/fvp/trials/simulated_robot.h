@@ -22,6 +22,7 @@
 
 namespace fvp::robot::sim {
 class World;
+class SimulatedArm;
 class SimulatedCamera;
 }  // namespace fvp::robot::sim
 
@@ -56,6 +57,8 @@ class SimulatedRobot {
   const robot::sim::SimulatedCamera& camera() const;
   /// The UR5 on its slider: workspace-tree reachability, IK + OMPL, charged moves.
   host::nbv::Arm& arm();
+  /// The same arm, with what a driver does besides the loop's moves (the ROS bridge).
+  robot::sim::SimulatedArm& simulatedArm();
   /// The simulated clock as the loop's clock.
   host::nbv::LoopClock& loopClock();
   const robot::sim::SimClock& clock() const;

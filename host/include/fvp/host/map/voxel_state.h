@@ -21,7 +21,11 @@ inline VoxelClass classifyLogOdds(float log_odds, float occupied_log_odds) {
 struct VoxelState {
   VoxelClass occupancy = VoxelClass::kUnknown;
   bool roi = false;
-  friend bool operator==(const VoxelState&, const VoxelState&) = default;
+  // Written out, not defaulted: the C++17 ROS layer includes this header (ros/CMakeLists.txt).
+  friend bool operator==(const VoxelState& a, const VoxelState& b) {
+    return a.occupancy == b.occupancy && a.roi == b.roi;
+  }
+  friend bool operator!=(const VoxelState& a, const VoxelState& b) { return !(a == b); }
 };
 
 }  // namespace fvp::host::map

@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -47,6 +48,10 @@ struct StopSpec {
   /// under kBudget, where they are an observation, not part of the loop: not charged to the
   /// clock. Always on with kAuto.
   bool record_size_history = false;
+  /// The caller's request to end the run (an action's cancel, a shutdown), asked between the
+  /// loop's steps: the cluster's loop stops ("cancelled") and a tour visits no further cluster.
+  /// Empty: never.
+  std::function<bool()> cancel;
   /// Throws std::invalid_argument naming the bad field.
   void validate() const;
 };

@@ -51,6 +51,9 @@ class SimulatedArm : public host::nbv::Arm {
     arm_.setReproducibleMotionPlanning(seed);
   }
   JointVector joints() const { return joint_state_.jointPositions(); }
+  /// A motion the arm's driver was sent from outside the loop (the ROS bridge's joint
+  /// trajectories), as its duration and end: charged as motion, the joints left at `end`.
+  void runSentMotion(double duration_s, const JointVector& end) { executor_.run(duration_s, end); }
   PlannedArm& planned() { return arm_; }
   const PlannedArm& planned() const { return arm_; }
 

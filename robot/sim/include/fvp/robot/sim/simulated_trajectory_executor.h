@@ -16,6 +16,9 @@ class SimulatedTrajectoryExecutor : public TrajectoryExecutor {
 
   /// Throws std::invalid_argument for an empty trajectory (PlannedArm never sends one).
   ExecutionResult execute(const Trajectory& trajectory) override;
+  /// The same for a trajectory that came from elsewhere as its duration and end (the ROS
+  /// bridge's joint trajectory messages): charged as motion, the joints left at `end`.
+  void run(double duration_s, const JointVector& end);
 
  private:
   SimClock& clock_;

@@ -140,7 +140,8 @@ struct WorldConfig {
   /// The config as a JSON object text {key: value, ...} (for ground truth and results).
   std::string toJson() const;
 
-  bool operator==(const WorldConfig&) const = default;
+  /// Field by field (defaulted in world_config.cpp: the C++17 ROS layer includes this header).
+  friend bool operator==(const WorldConfig&, const WorldConfig&);
 };
 
 }  // namespace fvp::robot::sim

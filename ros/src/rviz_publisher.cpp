@@ -1,0 +1,207 @@
+#include "fvp/ros/rviz_publisher.h"
+
+#include <sensor_msgs/PointCloud2.h>
+#include <sensor_msgs/point_cloud2_iterator.h>
+
+#include <cstdio>
+
+#include "fvp/host/map/map_engine.h"
+#include "fvp/host/session/mapping_session.h"
+
+namespace fvp::ros {
+namespace {
+
+geometry_msgs::Point pointOf(const Eigen::Vector3d& p) {
+  geometry_msgs::Point out;
+  out.x = p.x();
+  out.y = p.y();
+  out.z = p.z();
+  return out;
+}
+
+std_msgs::ColorRGBA colour(float r, float g, float b, float a) {
+  std_msgs::ColorRGBA c;
+  c.r = r;
+  c.g = g;
+  c.b = b;
+  c.a = a;
+  return c;
+}
+
+void setPose(visualization_msgs::Marker& m, const Eigen::Isometry3d& T) {
+  m.pose.position = pointOf(T.translation());
+  const Eigen::Quaterniond q(T.linear());
+  m.pose.orientation.w = q.w();
+  m.pose.orientation.x = q.x();
+  m.pose.orientation.y = q.y();
+  m.pose.orientation.z = q.z();
+}
+
+sensor_msgs::PointCloud2 cloudOf(const std::vector<Eigen::Vector3f>& points_m,
+                                 const std::string& frame) {
+  sensor_msgs::PointCloud2 cloud;
+  cloud.header.frame_id = frame;
+  cloud.header.stamp = ::ros::Time::now();
+  sensor_msgs::PointCloud2Modifier modifier(cloud);
+  modifier.setPointCloud2FieldsByString(1, "xyz");
+  modifier.resize(points_m.size());
+  sensor_msgs::PointCloud2Iterator<float> x(cloud, "x"), y(cloud, "y"), z(cloud, "z");
+  for (const Eigen::Vector3f& p : points_m) {
+    *x = p.x();
+    *y = p.y();
+    *z = p.z();
+    ++x, ++y, ++z;
+  }
+  return cloud;
+}
+
+}  // namespace
+
+visualization_msgs::Marker fruitletSphere(const host::sizing::FruitletEstimate& f, bool kept,
+                                          const std::string& frame, int id) {
+  visualization_msgs::Marker m;
+  m.header.frame_id = frame;
+  m.ns = kept ? "fruitlets" : "dropped_detections";
+  m.id = id;
+  m.type = visualization_msgs::Marker::SPHERE;
+  m.action = visualization_msgs::Marker::ADD;
+  m.pose.position = pointOf(f.center_m);
+  m.pose.orientation.w = 1.0;
+  const double diameter_m = f.size_mm * 1e-3;
+  m.scale.x = m.scale.y = m.scale.z = diameter_m;
+  m.color = kept ? colour(0.2f, 0.8f, 0.2f, 0.8f) : colour(0.9f, 0.2f, 0.2f, 0.4f);
+  return m;
+}
+
+RvizPublisher::RvizPublisher(::ros::NodeHandle& node, std::string world_frame)
+    : world_frame_(std::move(world_frame)) {
+  markers_ = node.advertise<visualization_msgs::MarkerArray>(RvizTopics::kMarkers, 10, true);
+  occupied_ = node.advertise<sensor_msgs::PointCloud2>(RvizTopics::kOccupied, 1, true);
+  surface_ = node.advertise<sensor_msgs::PointCloud2>(RvizTopics::kSurface, 1, true);
+}
+
+visualization_msgs::Marker RvizPublisher::marker(const std::string& ns, int id, int type) const {
+  visualization_msgs::Marker m;
+  m.header.frame_id = world_frame_;
+  m.header.stamp = ::ros::Time::now();
+  m.ns = ns;
+  m.id = id;
+  m.type = type;
+  m.action = visualization_msgs::Marker::ADD;
+  m.pose.orientation.w = 1.0;
+  return m;
+}
+
+void RvizPublisher::clear() {
+  visualization_msgs::MarkerArray all;
+  visualization_msgs::Marker wipe;
+  wipe.header.frame_id = world_frame_;
+  wipe.action = visualization_msgs::Marker::DELETEALL;
+  all.markers.push_back(wipe);
+  markers_.publish(all);
+  path_m_.clear();
+  occupied_m_.clear();
+  surface_m_.clear();
+  occupied_.publish(cloudOf(occupied_m_, world_frame_));
+  surface_.publish(cloudOf(surface_m_, world_frame_));
+  next_id_ = 0;
+}
+
+void RvizPublisher::onView(const host::nbv::ViewEvent& event) {
+  path_m_.push_back(event.T_world_camera.translation());
+  visualization_msgs::MarkerArray out;
+  visualization_msgs::Marker path =
+      marker("camera_path", 0, visualization_msgs::Marker::LINE_STRIP);
+  path.scale.x = 0.005;
+  path.color = colour(0.2f, 0.5f, 1.0f, 1.0f);
+  for (const Eigen::Vector3d& p : path_m_) path.points.push_back(pointOf(p));
+  out.markers.push_back(path);
+  // The view: an arrow along the optical axis, 10 cm.
+  visualization_msgs::Marker view =
+      marker("views", int(path_m_.size()) - 1, visualization_msgs::Marker::ARROW);
+  view.points = {pointOf(event.T_world_camera.translation()),
+                 pointOf(event.T_world_camera * Eigen::Vector3d(0.0, 0.0, 0.1))};
+  view.scale.x = 0.006;
+  view.scale.y = 0.012;
+  view.color = colour(0.2f, 0.5f, 1.0f, 1.0f);
+  out.markers.push_back(view);
+  markers_.publish(out);
+}
+
+void RvizPublisher::onPlan(const host::nbv::PlanEvent& event) {
+  if (!event.step) return;
+  visualization_msgs::Marker candidates =
+      marker("candidates", 0, visualization_msgs::Marker::SPHERE_LIST);
+  candidates.scale.x = candidates.scale.y = candidates.scale.z = 0.006;
+  for (const host::planner::Candidate& c : event.step->candidates) {
+    candidates.points.push_back(pointOf(c.position_m()));
+    candidates.colors.push_back(c.reachable ? colour(1.0f, 0.8f, 0.1f, 0.8f)
+                                            : colour(0.5f, 0.5f, 0.5f, 0.4f));
+  }
+  visualization_msgs::MarkerArray out;
+  out.markers.push_back(candidates);
+  if (event.step->chosen) {
+    const auto& T = event.step->candidates[*event.step->chosen].T_world_camera;
+    visualization_msgs::Marker chosen = marker("chosen_view", 0, visualization_msgs::Marker::ARROW);
+    chosen.points = {pointOf(T.translation()), pointOf(T * Eigen::Vector3d(0.0, 0.0, 0.15))};
+    chosen.scale.x = 0.008;
+    chosen.scale.y = 0.016;
+    chosen.color = colour(1.0f, 0.5f, 0.0f, 1.0f);
+    out.markers.push_back(chosen);
+  }
+  markers_.publish(out);
+}
+
+void RvizPublisher::onClusterDone(const host::nbv::ClusterVisit& visit,
+                                  const host::nbv::ClusterWork& work) {
+  const host::MappingSession& session = *work.session;
+  visualization_msgs::MarkerArray out;
+  const int k = int(visit.index);
+  if (session.region()) {
+    visualization_msgs::Marker region =
+        marker("cluster_regions", k, visualization_msgs::Marker::SPHERE);
+    region.pose.position = pointOf(session.region()->center_m());
+    region.scale.x = region.scale.y = region.scale.z = 2.0 * session.region()->radius_m();
+    region.color = colour(0.6f, 0.3f, 0.9f, 0.15f);
+    out.markers.push_back(region);
+  }
+  if (session.T_world_tag()) {
+    visualization_msgs::Marker tag = marker("tags", k, visualization_msgs::Marker::CUBE);
+    setPose(tag, *session.T_world_tag());
+    tag.scale.x = tag.scale.y = 0.04;  // about a printed tag's side; its frame's z is its normal
+    tag.scale.z = 0.002;
+    tag.color = colour(0.1f, 0.1f, 0.1f, 1.0f);
+    out.markers.push_back(tag);
+  }
+  if (visit.run) {
+    const host::sizing::SizingResult& sizing = visit.run->sizing;
+    for (const auto* list : {&sizing.fruitlets, &sizing.unsupported}) {
+      const bool kept = list == &sizing.fruitlets;
+      for (const host::sizing::FruitletEstimate& f : *list) {
+        const int id = next_id_++;
+        out.markers.push_back(fruitletSphere(f, kept, world_frame_, id));
+        visualization_msgs::Marker label = marker(kept ? "fruitlet_sizes" : "dropped_sizes", id,
+                                                  visualization_msgs::Marker::TEXT_VIEW_FACING);
+        label.pose.position = pointOf(f.center_m + Eigen::Vector3d(0.0, 0.0, 0.02));
+        label.scale.z = 0.012;
+        label.color = kept ? colour(1.0f, 1.0f, 1.0f, 1.0f) : colour(1.0f, 0.5f, 0.5f, 1.0f);
+        char text[32];
+        std::snprintf(text, sizeof(text), "%.1f mm", f.size_mm);
+        label.text = text;
+        out.markers.push_back(label);
+      }
+    }
+  }
+  markers_.publish(out);
+  if (const host::map::MapEngine* map = session.map()) {
+    const host::map::GridGeometry& grid = map->gridGeometry(host::map::MapLevel::kFine);
+    for (const auto& index : map->occupiedVoxels(host::map::MapLevel::kFine))
+      occupied_m_.push_back(grid.voxelCenter_m(index).cast<float>());
+    occupied_.publish(cloudOf(occupied_m_, world_frame_));
+  }
+  const std::vector<Eigen::Vector3f> surface = session.surfacePoints();
+  surface_m_.insert(surface_m_.end(), surface.begin(), surface.end());
+  surface_.publish(cloudOf(surface_m_, world_frame_));
+}
+
+}  // namespace fvp::ros
