@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <iomanip>
@@ -328,6 +329,15 @@ int WorkspaceTree::count(const Eigen::Vector3d& p_world_m,
 std::uint64_t WorkspaceTree::nonEmptyBins() const {
   return static_cast<std::uint64_t>(std::count_if(
       counts_.begin(), counts_.end(), [&](std::uint16_t c) { return c >= min_count_; }));
+}
+
+std::string defaultCacheDir() {
+  if (const char* dir = std::getenv("FVP_CACHE_DIR"); dir && *dir) return dir;
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
+    return (std::filesystem::path(xdg) / "fvp").string();
+  if (const char* home = std::getenv("HOME"); home && *home)
+    return (std::filesystem::path(home) / ".cache" / "fvp").string();
+  return (std::filesystem::temp_directory_path() / "fvp-cache").string();
 }
 
 }  // namespace fvp::robot

@@ -16,7 +16,6 @@
 #include "fvp/ros/rviz_publisher.h"
 #include "fvp/ros/size_clusters_server.h"
 #include "fvp/ros/stereo_topic_camera.h"
-#include "fvp/trials/simulated_robot.h"
 
 namespace {
 
@@ -36,7 +35,7 @@ int run() {
                                          ? fvp::robot::ArmConfig{}
                                          : fvp::robot::ArmConfig::fromYamlFile(settings.arm_config);
   if (arm_config.workspace_cache_dir.empty())
-    arm_config.workspace_cache_dir = fvp::trials::defaultCacheDir();
+    arm_config.workspace_cache_dir = fvp::robot::defaultCacheDir();
   const fvp::robot::ArmModel arm(arm_config);
   const fvp::robot::WorkspaceTree workspace = workspaceOf(arm);
   tf2_ros::Buffer tf;

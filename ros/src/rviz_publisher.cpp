@@ -7,17 +7,10 @@
 
 #include "fvp/host/map/map_engine.h"
 #include "fvp/host/session/mapping_session.h"
+#include "fvp/ros/stereo_messages.h"
 
 namespace fvp::ros {
 namespace {
-
-geometry_msgs::Point pointOf(const Eigen::Vector3d& p) {
-  geometry_msgs::Point out;
-  out.x = p.x();
-  out.y = p.y();
-  out.z = p.z();
-  return out;
-}
 
 std_msgs::ColorRGBA colour(float r, float g, float b, float a) {
   std_msgs::ColorRGBA c;
@@ -26,15 +19,6 @@ std_msgs::ColorRGBA colour(float r, float g, float b, float a) {
   c.b = b;
   c.a = a;
   return c;
-}
-
-void setPose(visualization_msgs::Marker& m, const Eigen::Isometry3d& T) {
-  m.pose.position = pointOf(T.translation());
-  const Eigen::Quaterniond q(T.linear());
-  m.pose.orientation.w = q.w();
-  m.pose.orientation.x = q.x();
-  m.pose.orientation.y = q.y();
-  m.pose.orientation.z = q.z();
 }
 
 sensor_msgs::PointCloud2 cloudOf(const std::vector<Eigen::Vector3f>& points_m,
@@ -65,7 +49,7 @@ visualization_msgs::Marker fruitletSphere(const host::sizing::FruitletEstimate& 
   m.id = id;
   m.type = visualization_msgs::Marker::SPHERE;
   m.action = visualization_msgs::Marker::ADD;
-  m.pose.position = pointOf(f.center_m);
+  m.pose.position = pointMsg(f.center_m);
   m.pose.orientation.w = 1.0;
   const double diameter_m = f.size_mm * 1e-3;
   m.scale.x = m.scale.y = m.scale.z = diameter_m;
@@ -114,13 +98,13 @@ void RvizPublisher::onView(const host::nbv::ViewEvent& event) {
       marker("camera_path", 0, visualization_msgs::Marker::LINE_STRIP);
   path.scale.x = 0.005;
   path.color = colour(0.2f, 0.5f, 1.0f, 1.0f);
-  for (const Eigen::Vector3d& p : path_m_) path.points.push_back(pointOf(p));
+  for (const Eigen::Vector3d& p : path_m_) path.points.push_back(pointMsg(p));
   out.markers.push_back(path);
   // The view: an arrow along the optical axis, 10 cm.
   visualization_msgs::Marker view =
       marker("views", int(path_m_.size()) - 1, visualization_msgs::Marker::ARROW);
-  view.points = {pointOf(event.T_world_camera.translation()),
-                 pointOf(event.T_world_camera * Eigen::Vector3d(0.0, 0.0, 0.1))};
+  view.points = {pointMsg(event.T_world_camera.translation()),
+                 pointMsg(event.T_world_camera * Eigen::Vector3d(0.0, 0.0, 0.1))};
   view.scale.x = 0.006;
   view.scale.y = 0.012;
   view.color = colour(0.2f, 0.5f, 1.0f, 1.0f);
@@ -134,7 +118,7 @@ void RvizPublisher::onPlan(const host::nbv::PlanEvent& event) {
       marker("candidates", 0, visualization_msgs::Marker::SPHERE_LIST);
   candidates.scale.x = candidates.scale.y = candidates.scale.z = 0.006;
   for (const host::planner::Candidate& c : event.step->candidates) {
-    candidates.points.push_back(pointOf(c.position_m()));
+    candidates.points.push_back(pointMsg(c.position_m()));
     candidates.colors.push_back(c.reachable ? colour(1.0f, 0.8f, 0.1f, 0.8f)
                                             : colour(0.5f, 0.5f, 0.5f, 0.4f));
   }
@@ -143,7 +127,7 @@ void RvizPublisher::onPlan(const host::nbv::PlanEvent& event) {
   if (event.step->chosen) {
     const auto& T = event.step->candidates[*event.step->chosen].T_world_camera;
     visualization_msgs::Marker chosen = marker("chosen_view", 0, visualization_msgs::Marker::ARROW);
-    chosen.points = {pointOf(T.translation()), pointOf(T * Eigen::Vector3d(0.0, 0.0, 0.15))};
+    chosen.points = {pointMsg(T.translation()), pointMsg(T * Eigen::Vector3d(0.0, 0.0, 0.15))};
     chosen.scale.x = 0.008;
     chosen.scale.y = 0.016;
     chosen.color = colour(1.0f, 0.5f, 0.0f, 1.0f);
@@ -160,14 +144,14 @@ void RvizPublisher::onClusterDone(const host::nbv::ClusterVisit& visit,
   if (session.region()) {
     visualization_msgs::Marker region =
         marker("cluster_regions", k, visualization_msgs::Marker::SPHERE);
-    region.pose.position = pointOf(session.region()->center_m());
+    region.pose.position = pointMsg(session.region()->center_m());
     region.scale.x = region.scale.y = region.scale.z = 2.0 * session.region()->radius_m();
     region.color = colour(0.6f, 0.3f, 0.9f, 0.15f);
     out.markers.push_back(region);
   }
   if (session.T_world_tag()) {
     visualization_msgs::Marker tag = marker("tags", k, visualization_msgs::Marker::CUBE);
-    setPose(tag, *session.T_world_tag());
+    tag.pose = poseMsg(*session.T_world_tag());
     tag.scale.x = tag.scale.y = 0.04;  // about a printed tag's side; its frame's z is its normal
     tag.scale.z = 0.002;
     tag.color = colour(0.1f, 0.1f, 0.1f, 1.0f);
@@ -182,7 +166,7 @@ void RvizPublisher::onClusterDone(const host::nbv::ClusterVisit& visit,
         out.markers.push_back(fruitletSphere(f, kept, world_frame_, id));
         visualization_msgs::Marker label = marker(kept ? "fruitlet_sizes" : "dropped_sizes", id,
                                                   visualization_msgs::Marker::TEXT_VIEW_FACING);
-        label.pose.position = pointOf(f.center_m + Eigen::Vector3d(0.0, 0.0, 0.02));
+        label.pose.position = pointMsg(f.center_m + Eigen::Vector3d(0.0, 0.0, 0.02));
         label.scale.z = 0.012;
         label.color = kept ? colour(1.0f, 1.0f, 1.0f, 1.0f) : colour(1.0f, 0.5f, 0.5f, 1.0f);
         char text[32];

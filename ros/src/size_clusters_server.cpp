@@ -7,20 +7,13 @@
 
 #include "fvp/host/session/mapping_session.h"
 #include "fvp/ros/ros_loop_clock.h"
+#include "fvp/ros/stereo_messages.h"
 
 namespace fvp::ros {
 namespace {
 
 Eigen::Vector3d vectorOf(const geometry_msgs::Point& p) {
   return {p.x, p.y, p.z};
-}
-
-geometry_msgs::Point pointOf(const Eigen::Vector3d& p) {
-  geometry_msgs::Point out;
-  out.x = p.x();
-  out.y = p.y();
-  out.z = p.z();
-  return out;
 }
 
 bool finite(const geometry_msgs::Point& p) {
@@ -30,7 +23,7 @@ bool finite(const geometry_msgs::Point& p) {
 fvp_ros::SizedFruitlet sizedFruitlet(const host::sizing::FruitletEstimate& f, std::size_t cluster) {
   fvp_ros::SizedFruitlet out;
   out.cluster_index = std::uint32_t(cluster);
-  out.center = pointOf(f.center_m);
+  out.center = pointMsg(f.center_m);
   out.diameter_mm = f.size_mm;
   out.points = std::uint32_t(f.points);
   out.well_seen_images = std::uint32_t(f.support.well_seen_images);
@@ -137,12 +130,12 @@ fvp_ros::SizeClustersGoal goalOfClusterTable(XmlRpc::XmlRpcValue& table) {
     fvp_ros::ClusterGoal c;
     c.use_tag_id = table.size() > 1;
     c.tag_id = int(v[0]);
-    c.start_camera_pose.position = pointOf({v[1], v[2], v[3]});
+    c.start_camera_pose.position = pointMsg({v[1], v[2], v[3]});
     c.start_camera_pose.orientation.x = v[4];
     c.start_camera_pose.orientation.y = v[5];
     c.start_camera_pose.orientation.z = v[6];
     c.start_camera_pose.orientation.w = v[7];
-    c.center = pointOf({v[8], v[9], v[10]});
+    c.center = pointMsg({v[8], v[9], v[10]});
     goal.clusters.push_back(c);
   }
   return goal;
@@ -163,16 +156,8 @@ fvp_ros::SizeClustersResult resultOfTour(const host::nbv::TourResult& tour,
     if (visit.run) {
       outcome.stop_reason = visit.run->run.stop_reason;
       outcome.views = std::uint32_t(visit.run->run.views);
-      for (const Eigen::Isometry3d& T : visit.run->run.camera_poses) {
-        geometry_msgs::Pose pose;
-        pose.position = pointOf(T.translation());
-        const Eigen::Quaterniond q(T.linear());
-        pose.orientation.w = q.w();
-        pose.orientation.x = q.x();
-        pose.orientation.y = q.y();
-        pose.orientation.z = q.z();
-        outcome.camera_poses.push_back(pose);
-      }
+      for (const Eigen::Isometry3d& T : visit.run->run.camera_poses)
+        outcome.camera_poses.push_back(poseMsg(T));
       result.views += outcome.views;
       result.dropped_frames += std::uint32_t(visit.run->run.events.dropped_frames);
       for (const auto& f : visit.run->sizing.fruitlets)

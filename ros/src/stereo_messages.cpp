@@ -133,6 +133,25 @@ Eigen::Isometry3d isometryOf(const geometry_msgs::Transform& t) {
   return T;
 }
 
+geometry_msgs::Point pointMsg(const Eigen::Vector3d& p) {
+  geometry_msgs::Point out;
+  out.x = p.x();
+  out.y = p.y();
+  out.z = p.z();
+  return out;
+}
+
+geometry_msgs::Pose poseMsg(const Eigen::Isometry3d& T) {
+  geometry_msgs::Pose pose;
+  pose.position = pointMsg(T.translation());
+  const Eigen::Quaterniond q(T.linear());
+  pose.orientation.w = q.w();
+  pose.orientation.x = q.x();
+  pose.orientation.y = q.y();
+  pose.orientation.z = q.z();
+  return pose;
+}
+
 StereoMessages stereoMessagesOf(const host::Capture& c, const std_msgs::Header& header) {
   StereoMessages m;
   m.left_info =

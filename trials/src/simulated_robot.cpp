@@ -22,15 +22,6 @@ namespace fvp::trials {
 using namespace fvp::robot;
 using namespace fvp::robot::sim;
 
-std::string defaultCacheDir() {
-  if (const char* dir = std::getenv("FVP_CACHE_DIR"); dir && *dir) return dir;
-  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
-    return (std::filesystem::path(xdg) / "fvp").string();
-  if (const char* home = std::getenv("HOME"); home && *home)
-    return (std::filesystem::path(home) / ".cache" / "fvp").string();
-  return (std::filesystem::temp_directory_path() / "fvp-cache").string();
-}
-
 namespace {
 
 std::vector<host::nbv::ClusterTarget> targetsOf(const World& world) {

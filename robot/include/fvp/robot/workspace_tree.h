@@ -23,6 +23,11 @@
 
 namespace fvp::robot {
 
+/// Where a workspace tree is cached between runs when the arm config names no directory (the
+/// simulator's trials, the ROS node): $FVP_CACHE_DIR, else $XDG_CACHE_HOME/fvp, else
+/// ~/.cache/fvp, else a directory under the system temp dir.
+std::string defaultCacheDir();
+
 class WorkspaceTree : public Reachability {
  public:
   /// Samples config.workspace_samples configurations of `arm` (OpenMP threads).

@@ -3,6 +3,7 @@
 // message headers are.
 #pragma once
 
+#include <geometry_msgs/Pose.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
@@ -41,6 +42,8 @@ geometry_msgs::TransformStamped transformMsg(const Eigen::Isometry3d& T_parent_c
                                              const std_msgs::Header& parent,
                                              const std::string& child_frame);
 Eigen::Isometry3d isometryOf(const geometry_msgs::Transform& transform);
+geometry_msgs::Point pointMsg(const Eigen::Vector3d& p);
+geometry_msgs::Pose poseMsg(const Eigen::Isometry3d& T);
 
 /// tf2 keeps frame ids without a leading '/' (ROS 1's old style) and refuses to look one up.
 std::string frameId(const std::string& id);

@@ -19,6 +19,7 @@
 #include "fvp/host/nbv/nbv_setup.h"
 #include "fvp/robot/arm_config.h"
 #include "fvp/robot/sim/sim_clock.h"
+#include "fvp/robot/workspace_tree.h"
 
 namespace fvp::robot::sim {
 class World;
@@ -73,8 +74,7 @@ class SimulatedRobot {
   std::unique_ptr<Impl> impl_;
 };
 
-/// Where the workspace tree is cached between runs: $FVP_CACHE_DIR, else
-/// $XDG_CACHE_HOME/fvp, else ~/.cache/fvp, else a directory under the system temp dir.
-std::string defaultCacheDir();
+/// Where the workspace tree is cached between runs (robot/workspace_tree.h).
+using robot::defaultCacheDir;
 
 }  // namespace fvp::trials
