@@ -31,8 +31,8 @@ void addRunCommand(CLI::App& app) {
       ->check(nonEmptyPath());
   cmd->add_option("--bag", opt->bag,
                   "also record every frame the trial captured as this ROS bag: stereo pairs, "
-                  "camera infos and the told pose on tf, stamped 1 s + simulated time "
-                  "(docs/ros.md; fvp size --bag sizes it)")
+                  "camera infos and the told pose on tf, stamped 1 s + simulated time, and its "
+                  "RViz markers (docs/ros.md; fvp size --bag sizes it)")
       ->check(nonEmptyPath());
   cmd->add_option("--out", opt->out, "output directory")->required()->check(nonEmptyPath());
   FVP_ON_RUN(cmd, [opt] {
@@ -61,7 +61,7 @@ void addRunCommand(CLI::App& app) {
               << "3-D viewer: " << (std::filesystem::path(opt->out) / "viewer.html").string()
               << " (open it in a browser)\n";
     if (recorder) {
-      const std::size_t pairs = recorder->finish();
+      const std::size_t pairs = recorder->finish(result);
       std::cout << "bag -> " << opt->bag << " (" << pairs << " stereo pairs)\n";
     }
     // The result is kept; an extra that could not be written (a full disk) still fails the

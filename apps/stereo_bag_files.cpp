@@ -49,7 +49,31 @@ void TrialBagRecorder::add(const host::StereoFrame& frame, double sim_time_s) {
   writer_->writer.add(host::captureOfFrame(frame), 1.0 + sim_time_s);
 }
 
-std::size_t TrialBagRecorder::finish() {
+namespace {
+
+/// A trial's detections (result.json's sized_fruitlets and unsupported_detections, each cluster's
+/// in a tour) as the bag's markers draw them.
+std::vector<ros::BagDetection> detectionsOf(const nlohmann::json& result) {
+  std::vector<ros::BagDetection> out;
+  const auto add = [&out](const nlohmann::json& part) {
+    for (const auto& [key, kept] :
+         {std::pair{"sized_fruitlets", true}, {"unsupported_detections", false}})
+      for (const auto& f : part.value(key, nlohmann::json::array())) {
+        const auto& c = f.at("center_m");
+        out.push_back(
+            {Eigen::Vector3d(c.at(0).get<double>(), c.at(1).get<double>(), c.at(2).get<double>()),
+             f.at("size_mm").get<double>(), kept});
+      }
+  };
+  add(result);
+  for (const auto& cluster : result.value("clusters", nlohmann::json::array())) add(cluster);
+  return out;
+}
+
+}  // namespace
+
+std::size_t TrialBagRecorder::finish(const nlohmann::json& result) {
+  writer_->writer.addMarkers(detectionsOf(result), 1.0 + result.value("sim_time_s", 0.0));
   writer_->writer.close();
   const std::size_t pairs = writer_->writer.pairs();
   std::filesystem::rename(writer_->tmp, writer_->bag);
@@ -133,7 +157,7 @@ TrialBagRecorder::~TrialBagRecorder() = default;
 void TrialBagRecorder::add(const host::StereoFrame&, double) {
   noRos();
 }
-std::size_t TrialBagRecorder::finish() {
+std::size_t TrialBagRecorder::finish(const nlohmann::json&) {
   noRos();
 }
 void writeCaptureSetAsBag(const std::filesystem::path&, const std::filesystem::path&) {

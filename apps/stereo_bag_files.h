@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 
 namespace fvp::host {
@@ -21,7 +22,8 @@ void writeCaptureSetAsBag(const std::filesystem::path& captures_dir,
                           const std::filesystem::path& bag);
 
 /// Records a trial's frames as a stereo bag (fvp run --bag), each stamped 1 s + its simulated
-/// time (tf reads a stamp of 0 as "the latest"); written under a temporary name and renamed by
+/// time (tf reads a stamp of 0 as "the latest"), and at the end the trial's RViz markers (its
+/// views, camera path and sized detections); written under a temporary name and renamed by
 /// finish(), so a bag is there whole or not at all.
 class TrialBagRecorder {
  public:
@@ -29,8 +31,10 @@ class TrialBagRecorder {
   ~TrialBagRecorder();
   /// What the trial calls with each frame (trials::TrialOptions::on_frame).
   void add(const host::StereoFrame& frame, double sim_time_s);
-  /// Closes the bag and renames it into place; returns the pairs written.
-  std::size_t finish();
+  /// Writes the markers of the trial's result.json object (its sized and dropped detections,
+  /// per cluster in a tour) stamped at its end, closes the bag and renames it into place;
+  /// returns the pairs written.
+  std::size_t finish(const nlohmann::json& result);
 
  private:
   struct Writer;

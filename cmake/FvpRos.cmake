@@ -4,6 +4,7 @@
 set(FVP_ROS_LIBRARIES rosbag_storage roscpp_serialization rostime cpp_common tf2 cv_bridge
     console_bridge class_loader)
 set(FVP_ROS_HEADERS rosbag/bag.h tf2/buffer_core.h cv_bridge/cv_bridge.h sensor_msgs/Image.h
+    visualization_msgs/MarkerArray.h
     stereo_msgs/DisparityImage.h tf2_msgs/TFMessage.h pluginlib/class_loader.hpp class_loader/class_loader.hpp
     rcutils/types.h rcpputils/shared_library.hpp ament_index_cpp/get_resource.hpp)
 

@@ -92,7 +92,9 @@ int main(int argc, char** argv) {
                  "the simulator bridge node (e.g. /fvp_sim_bridge): its world's clusters");
   app.add_option("--tags", tags, "AprilTag ids of clusters, each from where the camera is");
   app.add_option("--out", out, "write the result as JSON here");
-  app.add_option("--timeout-s", timeout_s, "wall seconds to wait")->capture_default_str();
+  app.add_option("--timeout-s", timeout_s,
+                 "seconds of ROS time to wait (simulated time under the bridge)")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   if (bridge.empty() && tags.empty()) {
     std::cerr << "fvp_size_clusters: give --from-bridge or --tags\n";

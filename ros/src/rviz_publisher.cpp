@@ -3,23 +3,13 @@
 #include <sensor_msgs/PointCloud2.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
 
-#include <cstdio>
-
 #include "fvp/host/map/map_engine.h"
 #include "fvp/host/session/mapping_session.h"
+#include "fvp/ros/rviz_markers.h"
 #include "fvp/ros/stereo_messages.h"
 
 namespace fvp::ros {
 namespace {
-
-std_msgs::ColorRGBA colour(float r, float g, float b, float a) {
-  std_msgs::ColorRGBA c;
-  c.r = r;
-  c.g = g;
-  c.b = b;
-  c.a = a;
-  return c;
-}
 
 sensor_msgs::PointCloud2 cloudOf(const std::vector<Eigen::Vector3f>& points_m,
                                  const std::string& frame) {
@@ -41,22 +31,6 @@ sensor_msgs::PointCloud2 cloudOf(const std::vector<Eigen::Vector3f>& points_m,
 
 }  // namespace
 
-visualization_msgs::Marker fruitletSphere(const host::sizing::FruitletEstimate& f, bool kept,
-                                          const std::string& frame, int id) {
-  visualization_msgs::Marker m;
-  m.header.frame_id = frame;
-  m.ns = kept ? "fruitlets" : "dropped_detections";
-  m.id = id;
-  m.type = visualization_msgs::Marker::SPHERE;
-  m.action = visualization_msgs::Marker::ADD;
-  m.pose.position = pointMsg(f.center_m);
-  m.pose.orientation.w = 1.0;
-  const double diameter_m = f.size_mm * 1e-3;
-  m.scale.x = m.scale.y = m.scale.z = diameter_m;
-  m.color = kept ? colour(0.2f, 0.8f, 0.2f, 0.8f) : colour(0.9f, 0.2f, 0.2f, 0.4f);
-  return m;
-}
-
 RvizPublisher::RvizPublisher(::ros::NodeHandle& node, std::string world_frame)
     : world_frame_(std::move(world_frame)) {
   markers_ = node.advertise<visualization_msgs::MarkerArray>(RvizTopics::kMarkers, 10, true);
@@ -65,14 +39,8 @@ RvizPublisher::RvizPublisher(::ros::NodeHandle& node, std::string world_frame)
 }
 
 visualization_msgs::Marker RvizPublisher::marker(const std::string& ns, int id, int type) const {
-  visualization_msgs::Marker m;
-  m.header.frame_id = world_frame_;
+  visualization_msgs::Marker m = rvizMarker(world_frame_, ns, id, type);
   m.header.stamp = ::ros::Time::now();
-  m.ns = ns;
-  m.id = id;
-  m.type = type;
-  m.action = visualization_msgs::Marker::ADD;
-  m.pose.orientation.w = 1.0;
   return m;
 }
 
@@ -94,21 +62,8 @@ void RvizPublisher::clear() {
 void RvizPublisher::onView(const host::nbv::ViewEvent& event) {
   path_m_.push_back(event.T_world_camera.translation());
   visualization_msgs::MarkerArray out;
-  visualization_msgs::Marker path =
-      marker("camera_path", 0, visualization_msgs::Marker::LINE_STRIP);
-  path.scale.x = 0.005;
-  path.color = colour(0.2f, 0.5f, 1.0f, 1.0f);
-  for (const Eigen::Vector3d& p : path_m_) path.points.push_back(pointMsg(p));
-  out.markers.push_back(path);
-  // The view: an arrow along the optical axis, 10 cm.
-  visualization_msgs::Marker view =
-      marker("views", int(path_m_.size()) - 1, visualization_msgs::Marker::ARROW);
-  view.points = {pointMsg(event.T_world_camera.translation()),
-                 pointMsg(event.T_world_camera * Eigen::Vector3d(0.0, 0.0, 0.1))};
-  view.scale.x = 0.006;
-  view.scale.y = 0.012;
-  view.color = colour(0.2f, 0.5f, 1.0f, 1.0f);
-  out.markers.push_back(view);
+  out.markers.push_back(cameraPathMarker(path_m_, world_frame_));
+  out.markers.push_back(viewMarker(event.T_world_camera, world_frame_, int(path_m_.size()) - 1));
   markers_.publish(out);
 }
 
@@ -119,8 +74,8 @@ void RvizPublisher::onPlan(const host::nbv::PlanEvent& event) {
   candidates.scale.x = candidates.scale.y = candidates.scale.z = 0.006;
   for (const host::planner::Candidate& c : event.step->candidates) {
     candidates.points.push_back(pointMsg(c.position_m()));
-    candidates.colors.push_back(c.reachable ? colour(1.0f, 0.8f, 0.1f, 0.8f)
-                                            : colour(0.5f, 0.5f, 0.5f, 0.4f));
+    candidates.colors.push_back(c.reachable ? rvizColour(1.0f, 0.8f, 0.1f, 0.8f)
+                                            : rvizColour(0.5f, 0.5f, 0.5f, 0.4f));
   }
   visualization_msgs::MarkerArray out;
   out.markers.push_back(candidates);
@@ -130,7 +85,7 @@ void RvizPublisher::onPlan(const host::nbv::PlanEvent& event) {
     chosen.points = {pointMsg(T.translation()), pointMsg(T * Eigen::Vector3d(0.0, 0.0, 0.15))};
     chosen.scale.x = 0.008;
     chosen.scale.y = 0.016;
-    chosen.color = colour(1.0f, 0.5f, 0.0f, 1.0f);
+    chosen.color = rvizColour(1.0f, 0.5f, 0.0f, 1.0f);
     out.markers.push_back(chosen);
   }
   markers_.publish(out);
@@ -146,7 +101,7 @@ void RvizPublisher::onClusterDone(const host::nbv::ClusterVisit& visit,
         marker("cluster_regions", k, visualization_msgs::Marker::SPHERE);
     region.pose.position = pointMsg(session.region()->center_m());
     region.scale.x = region.scale.y = region.scale.z = 2.0 * session.region()->radius_m();
-    region.color = colour(0.6f, 0.3f, 0.9f, 0.15f);
+    region.color = rvizColour(0.6f, 0.3f, 0.9f, 0.15f);
     out.markers.push_back(region);
   }
   if (session.T_world_tag()) {
@@ -154,27 +109,15 @@ void RvizPublisher::onClusterDone(const host::nbv::ClusterVisit& visit,
     tag.pose = poseMsg(*session.T_world_tag());
     tag.scale.x = tag.scale.y = 0.04;  // about a printed tag's side; its frame's z is its normal
     tag.scale.z = 0.002;
-    tag.color = colour(0.1f, 0.1f, 0.1f, 1.0f);
+    tag.color = rvizColour(0.1f, 0.1f, 0.1f, 1.0f);
     out.markers.push_back(tag);
   }
   if (visit.run) {
     const host::sizing::SizingResult& sizing = visit.run->sizing;
-    for (const auto* list : {&sizing.fruitlets, &sizing.unsupported}) {
-      const bool kept = list == &sizing.fruitlets;
-      for (const host::sizing::FruitletEstimate& f : *list) {
-        const int id = next_id_++;
-        out.markers.push_back(fruitletSphere(f, kept, world_frame_, id));
-        visualization_msgs::Marker label = marker(kept ? "fruitlet_sizes" : "dropped_sizes", id,
-                                                  visualization_msgs::Marker::TEXT_VIEW_FACING);
-        label.pose.position = pointMsg(f.center_m + Eigen::Vector3d(0.0, 0.0, 0.02));
-        label.scale.z = 0.012;
-        label.color = kept ? colour(1.0f, 1.0f, 1.0f, 1.0f) : colour(1.0f, 0.5f, 0.5f, 1.0f);
-        char text[32];
-        std::snprintf(text, sizeof(text), "%.1f mm", f.size_mm);
-        label.text = text;
-        out.markers.push_back(label);
-      }
-    }
+    for (const auto& f : sizing.fruitlets)
+      addFruitletMarkers(out, f.center_m, f.size_mm, true, world_frame_, next_id_++);
+    for (const auto& f : sizing.unsupported)
+      addFruitletMarkers(out, f.center_m, f.size_mm, false, world_frame_, next_id_++);
   }
   markers_.publish(out);
   if (const host::map::MapEngine* map = session.map()) {

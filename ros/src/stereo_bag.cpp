@@ -3,6 +3,7 @@
 #include "fvp/ros/stereo_bag.h"
 
 #include "fvp/ros/bag_structure.h"
+#include "fvp/ros/rviz_markers.h"
 #include "fvp/ros/stereo_messages.h"
 
 #include <cv_bridge/cv_bridge.h>
@@ -129,6 +130,27 @@ void StereoBagWriter::add(const host::Capture& c, double stamp_s) {
     fail(bag_->path, std::string("cannot be written: ") + e.what());
   }
   ++pairs_;
+  camera_poses_.push_back(c.T_world_camera);
+}
+
+void StereoBagWriter::addMarkers(const std::vector<BagDetection>& detections, double stamp_s) {
+  if (!bag_) throw std::logic_error("StereoBagWriter::addMarkers after close");
+  const std::string& frame = topics_.world_frame;
+  visualization_msgs::MarkerArray markers;
+  std::vector<Eigen::Vector3d> path_m;
+  for (std::size_t i = 0; i < camera_poses_.size(); ++i) {
+    path_m.push_back(camera_poses_[i].translation());
+    markers.markers.push_back(viewMarker(camera_poses_[i], frame, int(i)));
+  }
+  markers.markers.push_back(cameraPathMarker(path_m, frame));
+  for (std::size_t i = 0; i < detections.size(); ++i)
+    addFruitletMarkers(markers, detections[i].center_m, detections[i].size_mm, detections[i].kept,
+                       frame, int(i));
+  try {
+    bag_->bag.write(kBagMarkersTopic, ::ros::Time(stamp_s), markers);
+  } catch (const ::ros::Exception& e) {
+    fail(bag_->path, std::string("cannot be written: ") + e.what());
+  }
 }
 
 void writeStereoBag(const std::filesystem::path& bag_path,

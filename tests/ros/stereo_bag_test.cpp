@@ -6,15 +6,18 @@
 
 #include <gtest/gtest.h>
 #include <rosbag/bag.h>
+#include <rosbag/view.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <tf2_msgs/TFMessage.h>
 #include <unistd.h>
+#include <visualization_msgs/MarkerArray.h>
 
 #include <Eigen/Geometry>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <opencv2/core.hpp>
 #include <stdexcept>
 #include <string>
@@ -91,6 +94,44 @@ TEST(StereoBag, EveryPartOfACaptureComesBackAsItWentIn) {
     EXPECT_LT((b.T_world_camera.matrix() - a.T_world_camera.matrix()).cwiseAbs().maxCoeff(), 1e-12)
         << i;
   }
+  fs::remove(bag);
+}
+
+TEST(StereoBag, ARecordingCarriesItsViewsAndDetectionsForRViz) {
+  const fs::path bag = scratch("markers.bag");
+  {
+    StereoBagWriter writer(bag, StereoBagTopics{});
+    writer.add(capture(0), 1.0);
+    writer.add(capture(1), 2.0);
+    writer.addMarkers({{Eigen::Vector3d(0.1, 0.2, 1.0), 12.5, true},
+                       {Eigen::Vector3d(0.1, 0.3, 1.0), 7.0, false}},
+                      3.0);
+    writer.close();
+  }
+  rosbag::Bag reader(bag.string(), rosbag::bagmode::Read);
+  rosbag::View view(reader, rosbag::TopicQuery(std::vector<std::string>{kBagMarkersTopic}));
+  ASSERT_EQ(view.size(), 1u);
+  const auto markers = view.begin()->instantiate<visualization_msgs::MarkerArray>();
+  ASSERT_TRUE(markers);
+  std::map<std::string, int> per_namespace;
+  for (const auto& m : markers->markers) {
+    ++per_namespace[m.ns];
+    EXPECT_EQ(m.header.frame_id, "world");
+    if (m.ns == "fruitlets") {
+      EXPECT_DOUBLE_EQ(m.scale.x, 0.0125);  // its diameter
+    }
+    if (m.ns == "fruitlet_sizes") {
+      EXPECT_EQ(m.text, "12.5 mm");
+    }
+  }
+  EXPECT_EQ(per_namespace["views"], 2);
+  EXPECT_EQ(per_namespace["camera_path"], 1);
+  EXPECT_EQ(per_namespace["fruitlets"], 1);
+  EXPECT_EQ(per_namespace["dropped_detections"], 1);
+  EXPECT_EQ(per_namespace["dropped_sizes"], 1);
+  reader.close();
+  // The stereo reader takes the pairs as before.
+  EXPECT_EQ(readStereoBag(bag, StereoBagTopics{}, [](host::Capture&&) {}).pairs, 2u);
   fs::remove(bag);
 }
 

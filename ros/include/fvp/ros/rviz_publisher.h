@@ -23,10 +23,6 @@ struct RvizTopics {
   static constexpr const char* kSurface = "tsdf_surface";      ///< PointCloud2, latched
 };
 
-/// A sized detection as an RViz marker pair (sphere + label): for tests and for the publisher.
-visualization_msgs::Marker fruitletSphere(const host::sizing::FruitletEstimate& fruitlet, bool kept,
-                                          const std::string& frame, int id);
-
 class RvizPublisher : public host::nbv::TourObserver {
  public:
   RvizPublisher(::ros::NodeHandle& private_node, std::string world_frame);

@@ -50,6 +50,16 @@ struct StereoBagStats {
   std::size_t without_info = 0;     ///< pairs with no camera info of either side yet
 };
 
+/// A detection drawn in a recording (StereoBagWriter::addMarkers).
+struct BagDetection {
+  Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
+  double size_mm = 0.0;
+  bool kept = true;  ///< false: a detection the support rule dropped
+};
+
+/// Where a recording's RViz markers go: the fvp node's own marker topic.
+inline constexpr const char* kBagMarkersTopic = "/fvp/markers";
+
 /// A stereo bag written a pair at a time (writeStereoBag, fvp run --bag): each add() writes the
 /// pair, its camera infos, the pose on /tf and the mask and disparity when present, stamped
 /// stamp_s. close() finishes the bag (the destructor closes it too).
@@ -61,6 +71,10 @@ class StereoBagWriter {
   StereoBagWriter(const StereoBagWriter&) = delete;
   StereoBagWriter& operator=(const StereoBagWriter&) = delete;
   void add(const host::Capture& capture, double stamp_s);
+  /// Writes on kBagMarkersTopic, stamped stamp_s, what RViz shows of the recording
+  /// (visualization_msgs/MarkerArray, docs/ros.md "RViz"): the camera path and a view arrow per
+  /// pair added so far, and the detections as spheres with their sizes.
+  void addMarkers(const std::vector<BagDetection>& detections, double stamp_s);
   void close();
   std::size_t pairs() const { return pairs_; }
 
@@ -70,6 +84,7 @@ class StereoBagWriter {
   StereoBagTopics topics_;
   std::string camera_frame_;
   std::size_t pairs_ = 0;
+  std::vector<Eigen::Isometry3d> camera_poses_;  ///< of the pairs added, for addMarkers
 };
 
 /// Writes each capture as one stereo pair stamped start_s + i * period_s: both images (bgr8),
