@@ -19,6 +19,8 @@ sensor_msgs::PointCloud2 cloudOf(const std::vector<Eigen::Vector3f>& points_m,
   sensor_msgs::PointCloud2Modifier modifier(cloud);
   modifier.setPointCloud2FieldsByString(1, "xyz");
   modifier.resize(points_m.size());
+  // The iterators take the address of the first byte: none in an empty cloud (UBSan).
+  if (points_m.empty()) return cloud;
   sensor_msgs::PointCloud2Iterator<float> x(cloud, "x"), y(cloud, "y"), z(cloud, "z");
   for (const Eigen::Vector3f& p : points_m) {
     *x = p.x();
