@@ -97,7 +97,13 @@ TEST_F(MappingSessionTest, ViewsBeforeTheTagAreIntegratedInOrderOnceItIsSeen) {
   }
 }
 
-TEST_F(MappingSessionTest, WithRegistrationDetectionsAreMovedByTheAnchorsOffset) {
+// Without the pose graph (estimateAnchorOffset) and with it (the graph's frame error).
+class MappingSessionRegistrationTest : public MappingSessionTest,
+                                       public ::testing::WithParamInterface<bool> {};
+INSTANTIATE_TEST_SUITE_P(PoseGraph, MappingSessionRegistrationTest, ::testing::Bool());
+
+TEST_P(MappingSessionRegistrationTest, DetectionsAreMovedByTheAnchorsOffset) {
+  const bool pose_graph = GetParam();
   // The tagged view anchors; the other is told a pose 2 mm off, so registration moves it
   // back. Two views leave no hand-eye term: the offset is their mean frame's, minus half the
   // correction. Detections move by it, sizes and the clustered points stay; the same
@@ -111,6 +117,7 @@ TEST_F(MappingSessionTest, WithRegistrationDetectionsAreMovedByTheAnchorsOffset)
     MappingSession session({}, "grid", map::MapConfig{}, cpu.get());
     ViewRegistrationConfig config;
     config.correct_anchor_offset = correct;
+    config.use_pose_graph = pose_graph;
     session.enableViewRegistration(config);
     session.enableTsdf();
     session.addView(tagged());
@@ -123,8 +130,18 @@ TEST_F(MappingSessionTest, WithRegistrationDetectionsAreMovedByTheAnchorsOffset)
     offset[correct] = session.anchorOffset();
     EXPECT_TRUE(offset[correct].valid);
     EXPECT_EQ(offset[correct].views, 2u);
-    EXPECT_TRUE(
-        offset[correct].shift_m.isApprox(-0.5 * moved.registration->centroid_shift_m, 1e-12));
+    if (pose_graph) {
+      // The graph's frame error: the anchor's and the aligned view's, as the graph sees them.
+      ASSERT_NE(session.poseGraph(), nullptr);
+      EXPECT_EQ(offset[correct].shift_m, session.poseGraph()->mapFrameError_m());
+      EXPECT_TRUE(moved.registration->predicted_m.has_value());
+      EXPECT_TRUE(moved.registration->placement_m.isApprox(
+          *moved.registration->predicted_m + moved.registration->centroid_shift_m, 1e-12));
+    } else {
+      EXPECT_EQ(session.poseGraph(), nullptr);
+      EXPECT_TRUE(
+          offset[correct].shift_m.isApprox(-0.5 * moved.registration->centroid_shift_m, 1e-12));
+    }
     sized[correct] = session.sizeFruitlets({});
     if (correct) in_map_frame = session.sizeFruitletsInMapFrame({});
   }

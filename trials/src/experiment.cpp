@@ -581,6 +581,8 @@ const std::map<std::string, std::string>& rowNames() {
       {"rvp", "RVP (ours)"},
       {"fvp-octomap", "FVP on the octomap engine"},
       {"fvp-paper-sizing", "FVP, paper's sizing estimator"},
+      {"fvp-tag-frame", "FVP, in the tag's frame"},
+      {"rvp-tag-frame", "RVP, in the tag's frame"},
       {"rvp-paper-sizing", "RVP, paper's sizing estimator"},
       {"fvp-octomap-paper-sizing", "FVP on octomap, paper's sizing estimator"}};
   return names;
@@ -640,6 +642,9 @@ nlohmann::json summarize(const std::vector<nlohmann::json>& trials) {
     bool paper = true;
     for (const auto* t : list) paper &= t->contains("fruitlets_paper_sizing");
     if (paper) summary[key + "-paper-sizing"] = pool(list, "fruitlets_paper_sizing");
+    bool tag_frame = true;
+    for (const auto* t : list) tag_frame &= t->contains("fruitlets_tag_frame");
+    if (tag_frame) summary[key + "-tag-frame"] = pool(list, "fruitlets_tag_frame");
   }
   return summary;
 }

@@ -388,6 +388,7 @@ void checkTrial(const nlohmann::json& trial, const std::string& where) {
   if (!member(trial, "fruitlets")) fieldError(where, "fruitlets", "an array of fruitlets", nullptr);
   checkFruitlets(trial, "fruitlets", where);
   checkFruitlets(trial, "fruitlets_paper_sizing", where);
+  checkFruitlets(trial, "fruitlets_tag_frame", where);
 }
 
 std::string trialRowKey(const nlohmann::json& trial) {

@@ -71,16 +71,31 @@ nlohmann::json poseErrorJson(const Eigen::Isometry3d& T_told, const Eigen::Isome
 /// whether the reported positions were moved by it, and, where the simulator has pose
 /// errors, the anchor frame's true error at the cluster's centre before and after.
 nlohmann::json anchorOffsetJson(const host::MappingSession& session,
-                                const std::optional<Eigen::Vector3d>& true_anchor_error_m) {
+                                const std::optional<Eigen::Vector3d>& true_anchor_error_m,
+                                const std::optional<Eigen::Vector3d>& true_frame_error_m) {
   const host::AnchorOffset offset = session.anchorOffset();
   nlohmann::json j = {{"shift_mm", vec3Json(1000.0 * offset.shift_m)},
                       {"hand_eye_mm", vec3Json(1000.0 * offset.hand_eye_m)},
                       {"views", offset.views},
                       {"valid", offset.valid},
                       {"applied", session.correctsAnchorOffset() && offset.valid}};
+  if (const host::ClusterPoseGraph* graph = session.poseGraph()) {
+    nlohmann::json disagreeing = nlohmann::json::array();
+    std::size_t tag_views = 0;
+    for (std::size_t k = 0; k < graph->size(); ++k) {
+      if (graph->estimate(k).disagrees) disagreeing.push_back(k);
+      tag_views += graph->view(k).tag.has_value();
+    }
+    j["pose_graph"] = {
+        {"views", graph->size()}, {"tag_views", tag_views}, {"disagreeing_views", disagreeing}};
+  }
   if (true_anchor_error_m) {
     j["anchor_error_mm"] = 1000.0 * true_anchor_error_m->norm();
     j["corrected_error_mm"] = 1000.0 * (*true_anchor_error_m - offset.shift_m).norm();
+  }
+  if (true_frame_error_m) {
+    j["frame_error_mm"] = 1000.0 * true_frame_error_m->norm();
+    j["corrected_frame_error_mm"] = 1000.0 * (*true_frame_error_m - offset.shift_m).norm();
   }
   return j;
 }
@@ -103,6 +118,7 @@ class TrialLog : public host::nbv::LoopObserver {
     first_view_ = static_cast<int>(views_.size());
     cluster_center_m_ = center_m;
     anchor_shifts_m_.clear();
+    placed_errors_m_.clear();
   }
 
   void onView(const host::nbv::ViewEvent& e) override {
@@ -133,6 +149,12 @@ class TrialLog : public host::nbv::LoopObserver {
         views_.back()["true_shift_mm"] = vec3Json(1000.0 * shift);
         if (!v.registration || v.registration->status == host::RegistrationStatus::kNoModel)
           anchor_shifts_m_.push_back(shift);
+        // Where the view's points were fused, off the truth: the maps' frame error as this
+        // view carries it (the same in every view when the views agree).
+        const Eigen::Vector3d placed =
+            shift - (v.registration ? v.registration->placement_m : Eigen::Vector3d::Zero());
+        views_.back()["placed_error_mm"] = vec3Json(1000.0 * placed);
+        placed_errors_m_.push_back(placed);
       }
     }
     if (v.registration) {
@@ -146,7 +168,10 @@ class TrialLog : public host::nbv::LoopObserver {
           {"rotation_deg", r.rotation_deg},
           {"rms_before_mm", 1000.0 * r.rms_before_m},
           {"rms_after_mm", 1000.0 * r.rms_after_m},
-          {"pairs", r.pairs}};
+          {"pairs", r.pairs},
+          {"placement_mm", vec3Json(1000.0 * r.placement_m)}};
+      if (r.predicted_m)
+        views_.back()["registration"]["predicted_mm"] = vec3Json(1000.0 * *r.predicted_m);
     }
     if (!options_.out_dir.empty()) {
       view_pngs_.emplace_back(index, encodeViewImage(index, *e.frame));
@@ -196,6 +221,14 @@ class TrialLog : public host::nbv::LoopObserver {
     for (const auto& d : anchor_shifts_m_) sum += d;
     return sum / double(anchor_shifts_m_.size());
   }
+  /// With pose errors: the fused maps' true frame error at the cluster's centre, the mean of
+  /// the views' placed errors (what the reported shift should be).
+  std::optional<Eigen::Vector3d> trueFrameError() const {
+    if (placed_errors_m_.empty()) return std::nullopt;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const auto& d : placed_errors_m_) sum += d;
+    return sum / double(placed_errors_m_.size());
+  }
   /// The views' images for the overlays (kept only with an output directory).
   const ViewImages& images() const { return images_; }
   /// views/NNN.png of each view so far (index, PNG bytes), written after result.json.
@@ -214,6 +247,7 @@ class TrialLog : public host::nbv::LoopObserver {
   int cluster_ = -1, first_view_ = 0;  ///< -1: a one-cluster world
   std::optional<Eigen::Vector3d> cluster_center_m_;
   std::vector<Eigen::Vector3d> anchor_shifts_m_;
+  std::vector<Eigen::Vector3d> placed_errors_m_;
   nlohmann::json views_ = nlohmann::json::array(), plans_ = nlohmann::json::array();
 };
 
@@ -539,7 +573,7 @@ ClusterOutcome Trial::Impl::scored(host::nbv::ClusterRun run, TrialParts& cluste
   out.sizing_wall_s = run.sizing_wall_s;
   out.sizing_during_loop_s = run.sizing_during_loop_s;
   out.sizing = cluster_parts.score(std::move(run.sizing), setup->options().sizing.estimator, *world,
-                                   cluster.fruitlet_indices);
+                                   cluster.fruitlet_indices, cluster.tag.T_world_tag);
   const bool automatic = options.stop == host::nbv::StopRule::kAuto;
   if (automatic || options.record_size_history)
     out.size_history =
@@ -627,7 +661,8 @@ nlohmann::json Trial::Impl::run(host::nbv::Camera& loop_camera, host::nbv::Arm& 
   result["events"].update(outcome.guidance_events);
   if (!outcome.memory.is_null()) result["memory"] = outcome.memory;
   if (*options.register_views)
-    result["anchor_offset"] = anchorOffsetJson(parts.session(), log.trueAnchorShift());
+    result["anchor_offset"] =
+        anchorOffsetJson(parts.session(), log.trueAnchorShift(), log.trueFrameError());
   result["wall_breakdown_s"] = {{"rendering", camera->totalRenderSeconds()},
                                 {"perception", run.wall_s.perception},
                                 {"mapping", run.wall_s.mapping},
@@ -751,7 +786,8 @@ void Trial::Impl::recordCluster(const host::nbv::ClusterVisit& visit, TrialParts
   const std::size_t k = visit.index;
   entry["approaches_without_tag"] = visit.run->approaches_without_tag;
   if (*options.register_views)
-    entry["anchor_offset"] = anchorOffsetJson(cluster_parts.session(), log.trueAnchorShift());
+    entry["anchor_offset"] =
+        anchorOffsetJson(cluster_parts.session(), log.trueAnchorShift(), log.trueFrameError());
   entry["status"] = host::nbv::toString(visit.status);
   ++tour.cluster_status[entry["status"].get<std::string>()];
   entry["views"] = outcome.run.views;
@@ -833,7 +869,8 @@ void Trial::Impl::scoreSkippedClusters(TourRecord& tour, host::report::ViewerSce
                                      {"est_size_mm", nullptr},
                                      {"cluster", c.at("index")}};
       tour.scored["fruitlets"].push_back(missed);
-      for (const char* other : {"fruitlets_paper_sizing", "fruitlets_ours_sizing"})
+      for (const char* other :
+           {"fruitlets_paper_sizing", "fruitlets_ours_sizing", "fruitlets_tag_frame"})
         if (tour.scored.contains(other)) tour.scored[other].push_back(missed);
       cluster_missed.push_back(missed);
     }

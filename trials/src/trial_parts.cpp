@@ -122,10 +122,30 @@ namespace fvp::trials {
 
 nlohmann::json TrialParts::score(host::sizing::SizingResult sizing,
                                  host::sizing::SizingEstimator estimator, const World& world,
-                                 const std::vector<int>& fruitlet_indices) {
+                                 const std::vector<int>& fruitlet_indices,
+                                 const std::optional<Eigen::Isometry3d>& T_world_tag_true) {
   sizing_ = std::move(sizing);
   const std::vector<host::eval::GroundTruthFruitlet> truth = groundTruthOf(world, fruitlet_indices);
   nlohmann::json out = host::eval::scoreBothEstimators(sizing_, truth, estimator);
+  if (T_world_tag_true) {
+    // Each detection's centre in the seen tag's frame (the maps' frame, as addTagFrame
+    // reports it), put in the world through the true tag; with no tag seen, nothing placed.
+    host::sizing::SizingResult in_tag_frame = sizing_;
+    if (const auto& T_seen = session().T_world_tag()) {
+      const Eigen::Isometry3d via_tag = *T_world_tag_true * T_seen->inverse() *
+                                        Eigen::Translation3d(-session().appliedAnchorShift_m());
+      for (auto& f : in_tag_frame.fruitlets) {
+        f.center_m = via_tag * f.center_m;
+        f.sphere_center_m = via_tag * f.sphere_center_m;
+        f.centroid_m = via_tag * f.centroid_m;
+      }
+    } else {
+      in_tag_frame.fruitlets.clear();
+    }
+    const nlohmann::json scored = host::eval::scoreSizing(in_tag_frame, truth, estimator);
+    out["fruitlets_tag_frame"] = scored.at("fruitlets");
+    out["metrics_tag_frame"] = scored.at("metrics");
+  }
   // The details object must outlive the loop (items() of a temporary would dangle).
   nlohmann::json details = host::eval::sizingDetails(sizing_);
   host::eval::addTagFrame(details, session().T_world_tag(), session().appliedAnchorShift_m());

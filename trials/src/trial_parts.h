@@ -10,6 +10,7 @@
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -54,9 +55,13 @@ class TrialParts {
   nlohmann::json configJson(const host::sizing::SizingConfig& sizing_config) const;
   /// The cluster's sizing scored against the ground truth of the fruitlets with these
   /// indices in the world (the cluster's): {"fruitlets", "detections", "metrics", ...} of
-  /// result.json. Kept for writeClusterFiles.
+  /// result.json. Kept for writeClusterFiles. With the cluster's true tag pose and a tag
+  /// seen, also "metrics_tag_frame": the same scoring with each detection placed in the world
+  /// through the true tag from its centre in the seen tag's frame (what a grower with tagged
+  /// clusters can check: the shared pose error cancels).
   nlohmann::json score(host::sizing::SizingResult sizing, host::sizing::SizingEstimator estimator,
-                       const robot::sim::World& world, const std::vector<int>& fruitlet_indices);
+                       const robot::sim::World& world, const std::vector<int>& fruitlet_indices,
+                       const std::optional<Eigen::Isometry3d>& T_world_tag_true = std::nullopt);
   /// The cluster's files from the last score, each atomically, into dir: fine.ot (while
   /// the session holds its map), surface.ply, mesh.ply and clusters.ply.
   void writeClusterFiles(const std::filesystem::path& dir, const ExtraWriter& extra) const;

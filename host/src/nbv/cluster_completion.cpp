@@ -86,7 +86,17 @@ void ClusterCompletion::onView(const ViewEvent& event) {
 }
 
 bool ClusterCompletion::done() const {
-  return sizesSettled(history_, config_, released_) && !(hold_ && hold_());
+  return sizesSettled(history_, config_, released_) && !(hold_ && hold_()) &&
+         !(config_.hold_while_views_disagree && recentViewsDisagree());
+}
+
+bool ClusterCompletion::recentViewsDisagree() const {
+  const ClusterPoseGraph* graph = session_.poseGraph();
+  if (!graph) return false;
+  const std::size_t window = std::min(graph->size(), std::size_t(config_.stable_views) + 1);
+  for (std::size_t k = graph->size() - window; k < graph->size(); ++k)
+    if (graph->estimate(k).disagrees) return true;
+  return false;
 }
 
 StopCondition ClusterCompletion::stopCondition() const {

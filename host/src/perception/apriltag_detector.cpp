@@ -134,10 +134,22 @@ std::vector<TagDetection> AprilTagDetector::detectAll(
     d.tag_id = det->id;
     d.hamming = det->hamming;
     d.decision_margin = det->decision_margin;
-    for (int k = 0; k < 4; ++k) d.corners_px[k] = {det->p[k][0], det->p[k][1]};
-    d.center_px = {det->c[0], det->c[1]};
+    // libapriltag puts pixel centres at +0.5 (AprilRobotics/apriltag#121; measured here as
+    // +0.47 px on the simulator's renders, tag_render_test.cpp), OpenCV and StereoIntrinsics
+    // at integers: corners are reported in ours, and the pose is estimated with the principal
+    // point moved into libapriltag's, which is the same thing for a pinhole camera.
+    constexpr double kLibapriltagPixelCentre = 0.5;
+    for (int k = 0; k < 4; ++k)
+      d.corners_px[k] = {det->p[k][0] - kLibapriltagPixelCentre,
+                         det->p[k][1] - kLibapriltagPixelCentre};
+    d.center_px = {det->c[0] - kLibapriltagPixelCentre, det->c[1] - kLibapriltagPixelCentre};
 
-    apriltag_detection_info_t info{det, config_.tag_size_m, K.fx_px, K.fy_px, K.cx_px, K.cy_px};
+    apriltag_detection_info_t info{det,
+                                   config_.tag_size_m,
+                                   K.fx_px,
+                                   K.fy_px,
+                                   K.cx_px + kLibapriltagPixelCentre,
+                                   K.cy_px + kLibapriltagPixelCentre};
     apriltag_pose_t pose{nullptr, nullptr};
     d.object_space_error = estimate_tag_pose(&info, &pose);
     // A degenerate quad can leave no pose (NaN errors pick a missing second solution).

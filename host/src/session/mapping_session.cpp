@@ -43,23 +43,25 @@ ViewResult MappingSession::addView(const StereoFrame& frame, PerceptionResult* p
   views_.push_back(view);
 
   Eigen::Isometry3d T_world_camera = frame.T_world_camera;
+  if (pose_graph_) pose_graph_->addView(frame.T_world_camera, perceived.tag, frame.intrinsics);
   if (registration_ && region_) {
-    // Align the view to the model of the views before it, then fuse it where it aligned.
-    const RegistrationResult r = registration_->align(pointsInRegion(perceived.clouds));
+    const RegistrationResult r = registerView(view.index, perceived.clouds);
     views_.back().registration = r;
-    if (r.status == RegistrationStatus::kApplied) {
-      moveClouds(perceived.clouds, r.correction);
-      T_world_camera = r.correction * T_world_camera;
-    }
-    registration_->addToModel(pointsInRegion(perceived.clouds));
+    T_world_camera = r.correction * T_world_camera;
   }
   if (!region_ && perceived.region) {
     region_ = perceived.region;
     if (registration_) {
-      // The views up to this one anchor the model.
+      // The views up to this one anchor the model, fused as they were told.
       for (const auto& [index, clouds] : pending_)
         registration_->addToModel(pointsInRegion(clouds));
       registration_->addToModel(pointsInRegion(perceived.clouds));
+    }
+    if (pose_graph_) {
+      pose_graph_->setClusterCentre(region_->center_m());
+      for (std::size_t k = 0; k < views_.size(); ++k)
+        pose_graph_->place(k, Eigen::Vector3d::Zero(), {});
+      pose_graph_->solve();
     }
     if (perceived.tag) T_world_tag_ = perceived.tag->T_world_tag;
     if (carried_map_) {
@@ -97,6 +99,52 @@ ViewResult MappingSession::addView(const StereoFrame& frame, PerceptionResult* p
 
 void MappingSession::enableViewRegistration(const ViewRegistrationConfig& config) {
   registration_.emplace(config);
+  if (config.use_pose_graph)
+    pose_graph_.emplace(config.pose_graph, perception_.config().tag.tag_size_m);
+}
+
+RegistrationResult MappingSession::registerView(std::size_t index, LabeledClouds& clouds) {
+  if (!pose_graph_) {
+    // Align the view to the model of the views before it, then fuse it where it aligned.
+    RegistrationResult r = registration_->align(pointsInRegion(clouds));
+    if (r.status == RegistrationStatus::kApplied) {
+      moveClouds(clouds, r.correction);
+      r.placement_m = r.centroid_shift_m;
+    } else {
+      r.correction = Eigen::Isometry3d::Identity();
+    }
+    registration_->addToModel(pointsInRegion(clouds));
+    return r;
+  }
+  // Place the view where the graph expects it (its tag included), align it from there, and
+  // keep the alignment's refinement only where the graph's uncertainty allows it.
+  pose_graph_->solve();
+  const Eigen::Vector3d predicted = pose_graph_->predictedPlacement(index);
+  const Eigen::Vector3d sigma = pose_graph_->predictedPlacementSigma(index);
+  moveClouds(clouds, Eigen::Isometry3d(Eigen::Translation3d(predicted)));
+  RegistrationResult r = registration_->align(pointsInRegion(clouds));
+  r.predicted_m = predicted;
+  Eigen::Vector3d placement = predicted;
+  std::vector<std::size_t> aligned_to;
+  if (r.status == RegistrationStatus::kApplied) {
+    const double align = pose_graph_->config().alignment_sigma_m;
+    const Eigen::Vector3d gate =
+        pose_graph_->config().outlier_sigmas * (sigma.array().square() + align * align).sqrt();
+    if ((r.centroid_shift_m.cwiseAbs().array() <= gate.array()).all()) {
+      moveClouds(clouds, Eigen::Isometry3d(Eigen::Translation3d(r.centroid_shift_m)));
+      placement += r.centroid_shift_m;
+      for (std::size_t j = 0; j < index; ++j)
+        if (pose_graph_->view(j).placed) aligned_to.push_back(j);
+    } else {
+      r.status = RegistrationStatus::kDisagrees;
+    }
+  }
+  pose_graph_->place(index, placement, std::move(aligned_to));
+  pose_graph_->solve();
+  r.placement_m = placement;
+  r.correction = Eigen::Isometry3d(Eigen::Translation3d(placement));
+  registration_->addToModel(pointsInRegion(clouds));
+  return r;
 }
 
 std::vector<Eigen::Vector3f> MappingSession::pointsInRegion(const LabeledClouds& clouds) const {
@@ -157,6 +205,16 @@ sizing::SizingResult MappingSession::sizeFruitlets(const sizing::SizingConfig& c
 
 AnchorOffset MappingSession::anchorOffset() const {
   if (!registration_) return {};
+  if (pose_graph_) {
+    AnchorOffset offset;
+    offset.views = pose_graph_->placedViews();
+    offset.shift_m = pose_graph_->mapFrameError_m();
+    offset.hand_eye_m = pose_graph_->handEyeAtCentre_m();
+    offset.valid =
+        offset.views >= 2 && offset.shift_m.norm() <= registration_->config().max_translation_m;
+    if (!offset.valid) offset.shift_m.setZero();
+    return offset;
+  }
   std::vector<RegisteredView> views;
   for (const ViewResult& v : views_)
     views.push_back(

@@ -149,6 +149,7 @@ AnchorOffset estimateAnchorOffset(const std::vector<RegisteredView>& views,
         break;
       case RegistrationStatus::kTooFewPairs:
       case RegistrationStatus::kBeyondBounds:
+      case RegistrationStatus::kDisagrees:
         continue;
     }
     Eigen::Matrix<double, 3, 6> A;
@@ -210,6 +211,7 @@ void ViewRegistrationConfig::validate() const {
   if (min_pairs < 3) throw std::invalid_argument("view registration: min_pairs must be at least 3");
   if (!(min_rms_reduction >= 0.0 && min_rms_reduction < 1.0))
     throw std::invalid_argument("view registration: min_rms_reduction must be in [0, 1)");
+  pose_graph.validate();
 }
 
 std::string toString(RegistrationStatus status) {
@@ -224,6 +226,8 @@ std::string toString(RegistrationStatus status) {
       return "beyond_bounds";
     case RegistrationStatus::kNoImprovement:
       return "no_improvement";
+    case RegistrationStatus::kDisagrees:
+      return "disagrees";
   }
   return "unknown";
 }

@@ -75,6 +75,11 @@ struct ClusterCompletionConfig {
   /// it only spends the cap. Its size must still be stable. Off (before 8c37611): it holds the stop
   /// to the cap.
   bool release_left_out = true;
+  /// With the cluster's pose graph (view registration): not done while any of the last
+  /// stable_views + 1 views disagrees with the rest (its alignment or tag residual beyond
+  /// the graph's outlier_sigmas): the maps' frame is still moving, so sizes that look
+  /// settled may be sized in a frame the next view corrects. The cap still ends the cluster.
+  bool hold_while_views_disagree = true;
   /// Throws std::invalid_argument naming the bad field.
   void validate() const;
 };
@@ -128,6 +133,9 @@ class ClusterCompletion : public LoopObserver {
 
   /// Whether the sizes have settled (see ClusterCompletionConfig) and no hold holds.
   bool done() const;
+  /// Whether one of the last stable_views + 1 views disagrees in the session's pose graph
+  /// (false without one).
+  bool recentViewsDisagree() const;
   /// The cluster is not done while `pending` returns true (SizingGuidance::
   /// waitingOnUnconfirmed): `pending` must outlive this.
   void holdWhile(std::function<bool()> pending) { hold_ = std::move(pending); }

@@ -17,6 +17,7 @@
 #include "fvp/host/map/map_engine.h"
 #include "fvp/host/perception/perception_pipeline.h"
 #include "fvp/host/perception/stereo_frame.h"
+#include "fvp/host/session/cluster_pose_graph.h"
 #include "fvp/host/session/view_registration.h"
 #include "fvp/host/sizing/fruitlet_sizer.h"
 #include "fvp/host/tsdf/tsdf_volume.h"
@@ -103,6 +104,8 @@ class MappingSession {
   /// estimateAnchorOffset); with ViewRegistrationConfig::correct_anchor_offset,
   /// sizeFruitlets() reports positions moved by its shift. Zero without registration.
   AnchorOffset anchorOffset() const;
+  /// The cluster's pose graph (registration with use_pose_graph); null otherwise.
+  const ClusterPoseGraph* poseGraph() const { return pose_graph_ ? &*pose_graph_ : nullptr; }
   /// Whether sizeFruitlets() reports positions corrected by anchorOffset().
   bool correctsAnchorOffset() const {
     return registration_ && registration_->config().correct_anchor_offset;
@@ -130,6 +133,9 @@ class MappingSession {
   /// The clouds' points inside the Cluster Region (none before it is known).
   std::vector<Eigen::Vector3f> pointsInRegion(const LabeledClouds& clouds) const;
   static void moveClouds(LabeledClouds& clouds, const Eigen::Isometry3d& T);
+  /// Registration of a view once the region is known: where it is fused (the correction its
+  /// clouds were moved by is applied to them here).
+  RegistrationResult registerView(std::size_t index, LabeledClouds& clouds);
   /// Fuses sizing_views_[i] into the TSDF; returns the seconds it took.
   double integrateTsdf(std::size_t sizing_view);
 
@@ -146,6 +152,7 @@ class MappingSession {
   std::vector<std::pair<std::size_t, LabeledClouds>> pending_;
   std::optional<tsdf::TsdfConfig> tsdf_config_;
   std::optional<ViewRegistration> registration_;
+  std::optional<ClusterPoseGraph> pose_graph_;
   std::unique_ptr<tsdf::TsdfVolume> tsdf_;
   std::vector<sizing::SizingView> sizing_views_;
 };

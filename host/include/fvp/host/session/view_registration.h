@@ -10,9 +10,12 @@
 #include <Eigen/Geometry>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <unordered_set>
 #include <vector>
+
+#include "fvp/host/session/cluster_pose_graph.h"
 
 namespace fvp::host {
 
@@ -45,6 +48,13 @@ struct ViewRegistrationConfig {
   /// and 0.3 degrees turning points 0.3 m away by 1.6 mm, about 2.2 mm together). Measured
   /// on 10 field worlds, 1-3 mm gave the same.
   double hand_eye_prior_sigma_m = 0.002;
+  /// true: each view is placed where the cluster's pose graph (cluster_pose_graph.h) puts it
+  /// (the told pose, the hand-eye error the views have told so far, the tag and the earlier
+  /// views' alignments), then aligned from there; an alignment the graph does not expect is
+  /// not applied (kDisagrees), and the maps' frame error is the graph's. false: each view is
+  /// aligned from its told pose and the frame's error is estimateAnchorOffset's.
+  bool use_pose_graph = true;
+  PoseGraphConfig pose_graph;
 
   /// Throws std::invalid_argument naming the bad field.
   void validate() const;
@@ -56,6 +66,9 @@ enum class RegistrationStatus {
   kTooFewPairs,    ///< fewer than min_pairs pairs within max_pair_distance_m
   kBeyondBounds,   ///< the correction was larger than a calibration error
   kNoImprovement,  ///< the pairs' RMS did not fall by min_rms_reduction
+  /// The alignment moved the view farther from where the pose graph placed it than the
+  /// graph's uncertainty allows: a wrong match, not applied (the graph's placement stands).
+  kDisagrees,
 };
 std::string toString(RegistrationStatus status);
 
@@ -71,6 +84,11 @@ struct RegistrationResult {
   double rms_before_m = 0.0, rms_after_m = 0.0;
   std::size_t pairs = 0;
   int iterations = 0;
+  /// With the pose graph: where the graph placed the view before it was aligned, and the
+  /// whole translation its points were fused with (the graph's placement and the alignment's
+  /// refinement; `correction` is this translation).
+  std::optional<Eigen::Vector3d> predicted_m;
+  Eigen::Vector3d placement_m = Eigen::Vector3d::Zero();
 };
 
 /// A view as registration left it: the orientation it was told and what registration did.
