@@ -512,9 +512,26 @@ TEST(Sizing, ViewAgreementTellsAFruitletFromAPatchOneMaskCalledFruitlet) {
     const auto two = sizing::sizeFruitlets({views[0], views[2]}, pts, nullptr, config);
     ASSERT_EQ(two.fruitlets.size(), 2u);
     for (const auto& f : two.fruitlets) EXPECT_GT(f.support.view_agreement, 0.95);
+    // The agreement rule, for registered views only: the patch (agreement about 0.5, sized
+    // well by fewer than two images) is denied at a threshold of 0.7, the fruitlet kept.
+    sizing::SizingConfig rule = config;
+    rule.min_view_agreement_registered = 0.7;
+    const auto unregistered = sizing::sizeFruitlets(views, pts, nullptr, rule);
+    EXPECT_EQ(unregistered.fruitlets.size(), 2u);
+    EXPECT_EQ(unregistered.events.denied_by_views, 0u);
+    rule.registered_views = true;
+    const auto registered = sizing::sizeFruitlets(views, pts, nullptr, rule);
+    ASSERT_EQ(registered.fruitlets.size(), 1u);
+    EXPECT_GT(registered.fruitlets[0].points, 81u);
+    EXPECT_EQ(registered.events.denied_by_views, 1u);
+    ASSERT_EQ(registered.unsupported.size(), 1u);
+    EXPECT_EQ(registered.unsupported[0].points, 81u);
   }
   sizing::SizingConfig bad;
   bad.view_agreement_disparity_px = 0.0;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+  bad = {};
+  bad.min_view_agreement_registered = 1.5;
   EXPECT_THROW(bad.validate(), std::invalid_argument);
 }
 

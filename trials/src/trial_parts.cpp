@@ -52,7 +52,8 @@ nlohmann::json TrialParts::configJson(const host::sizing::SizingConfig& sizing_c
             {"min_support_area_fraction", sizing_config.min_support_area_fraction},
             {"sphere_fit_support_area_fraction", sizing_config.sphere_fit_support_area_fraction},
             {"max_detection_overlap_fraction", sizing_config.max_detection_overlap_fraction},
-            {"view_agreement_disparity_px", sizing_config.view_agreement_disparity_px}}}};
+            {"view_agreement_disparity_px", sizing_config.view_agreement_disparity_px},
+            {"min_view_agreement_registered", sizing_config.min_view_agreement_registered}}}};
 }
 
 std::vector<host::eval::GroundTruthFruitlet> groundTruthOf(const World& world,

@@ -146,6 +146,7 @@ nlohmann::json sizingDetails(const sizing::SizingResult& sz) {
               {"clusters_split_off", sz.events.clusters_split_off},
               {"instance_parts_split_off", sz.events.instance_parts_split_off},
               {"unsupported_detections", sz.events.unsupported_detections},
+              {"denied_by_views", sz.events.denied_by_views},
               {"overlapping_detections_merged", sz.events.overlapping_detections_merged}}}}}};
 }
 

@@ -48,6 +48,7 @@ ViewResult MappingSession::addView(const StereoFrame& frame, PerceptionResult* p
     const RegistrationResult r = registerView(view.index, perceived.clouds);
     views_.back().registration = r;
     T_world_camera = r.correction * T_world_camera;
+    refreshTagFromPoseGraph();
   }
   if (!region_ && perceived.region) {
     region_ = perceived.region;
@@ -64,6 +65,7 @@ ViewResult MappingSession::addView(const StereoFrame& frame, PerceptionResult* p
       pose_graph_->solve();
     }
     if (perceived.tag) T_world_tag_ = perceived.tag->T_world_tag;
+    refreshTagFromPoseGraph();
     if (carried_map_) {
       map_ = std::move(carried_map_);
       map_->moveToRegion(*region_);
@@ -101,6 +103,13 @@ void MappingSession::enableViewRegistration(const ViewRegistrationConfig& config
   registration_.emplace(config);
   if (config.use_pose_graph)
     pose_graph_.emplace(config.pose_graph, perception_.config().tag.tag_size_m);
+}
+
+void MappingSession::refreshTagFromPoseGraph() {
+  if (!pose_graph_) return;
+  // Every view that saw the tag, in the maps' frame (the graph's estimate is the world's).
+  if (const std::optional<Eigen::Isometry3d> T = pose_graph_->T_world_tag())
+    T_world_tag_ = Eigen::Translation3d(-pose_graph_->mapFrameError_m()) * *T;
 }
 
 RegistrationResult MappingSession::registerView(std::size_t index, LabeledClouds& clouds) {
@@ -194,6 +203,7 @@ sizing::SizingResult MappingSession::sizeFruitletsInMapFrame(
   };
   sizing::SizingConfig own = config;
   own.surface_voxel_size_m = tsdf_config_->voxel_size_m;
+  own.registered_views = pose_graph_.has_value();
   return sizing::sizeFruitlets(sizing_views_, surfacePoints(), in_roi_voxel, own);
 }
 

@@ -336,6 +336,11 @@ class DetectionSizer {
       if (f.per_image.size() == 1) ++result_.events.single_image_fruitlets;
       if (!(f.sphere_radius_m > 0.0)) ++result_.events.failed_sphere_fits;
       measureViewAgreement(*sized_[ci].second, views_, config_, f.support);
+      if (deniedByTheViews(f)) {
+        ++result_.events.denied_by_views;
+        result_.unsupported.push_back(std::move(f));
+        continue;
+      }
       result_.fruitlets.push_back(std::move(f));
     }
   }
@@ -366,6 +371,15 @@ class DetectionSizer {
     aggregate(f, config_);
     f.support.merged_detections = merged_into_[ci];
     return f;
+  }
+
+  // The agreement rule (SizingConfig::min_view_agreement_registered).
+  bool deniedByTheViews(const FruitletEstimate& f) const {
+    constexpr int kImagesThatAgreeOrReveal = 2;
+    return config_.registered_views && config_.min_view_agreement_registered > 0.0 &&
+           f.support.view_agreement >= 0.0 &&
+           f.support.view_agreement < config_.min_view_agreement_registered &&
+           f.support.well_seen_images < kImagesThatAgreeOrReveal;
   }
 
   static double supportRatio(const FruitletEstimate& f) {
@@ -588,6 +602,8 @@ void SizingConfig::validate() const {
     throw std::invalid_argument("sizing: max_detection_overlap_fraction >= 0");
   if (!(view_agreement_disparity_px > 0.0))
     throw std::invalid_argument("sizing: view_agreement_disparity_px > 0");
+  if (!(min_view_agreement_registered >= 0.0 && min_view_agreement_registered <= 1.0))
+    throw std::invalid_argument("sizing: min_view_agreement_registered in [0, 1]");
   if (use_instances) instance_split.validate();
   if (split_merged_clusters && min_cluster_points < 4)
     throw std::invalid_argument("sizing: min_cluster_points >= 4 (a sphere needs 4 points)");

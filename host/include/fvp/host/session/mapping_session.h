@@ -62,7 +62,9 @@ class MappingSession {
 
   /// Null / empty until a view's tag was detected.
   const std::optional<ClusterRegion>& region() const { return region_; }
-  /// The tag pose seen when the region was placed; empty until then, or when no tag was seen.
+  /// The tag's pose in the maps' frame: as the view that placed the region saw it, or with
+  /// the pose graph its estimate from every view that saw it; empty until the region is
+  /// placed, or when no tag was seen.
   const std::optional<Eigen::Isometry3d>& T_world_tag() const { return T_world_tag_; }
   map::MapEngine* map() { return map_.get(); }
   const map::MapEngine* map() const { return map_.get(); }
@@ -136,6 +138,8 @@ class MappingSession {
   /// Registration of a view once the region is known: where it is fused (the correction its
   /// clouds were moved by is applied to them here).
   RegistrationResult registerView(std::size_t index, LabeledClouds& clouds);
+  /// T_world_tag_ from the pose graph's estimate, when it has one.
+  void refreshTagFromPoseGraph();
   /// Fuses sizing_views_[i] into the TSDF; returns the seconds it took.
   double integrateTsdf(std::size_t sizing_view);
 

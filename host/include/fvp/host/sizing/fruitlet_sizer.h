@@ -92,6 +92,15 @@ struct SizingConfig {
   /// within this. SGBM resolves whole pixels (refined to 1/16); the fused surface is the
   /// average of many views: 1 px is 1.6 mm of depth at 0.3 m with the default rig.
   double view_agreement_disparity_px = 1.0;
+  /// The agreement rule (docs/sizing.md, "Whether the views agree it is a fruitlet"): with
+  /// views placed by the cluster's pose graph (registered_views), a detection that most of
+  /// the views' evidence denies (view_agreement below this) and that fewer than two images
+  /// size well (one image is one sample of its error) is not reported. Without
+  /// registration a 1-2 mm pose error moves a point's projection past the pixel of
+  /// tolerance, so the rule waits for registered views. 0: off.
+  double min_view_agreement_registered = 0.5;
+  /// Set by MappingSession: the views were placed by its pose graph.
+  bool registered_views = false;
   void validate() const;
 };
 
@@ -173,8 +182,9 @@ struct SizingEvents {
   std::size_t unsized_clusters = 0;    ///< no image gave a size (dropped)
   std::size_t failed_sphere_fits = 0;  ///< centre fell back to the centroid
   std::size_t clusters_split_off = 0;  ///< parts of DBSCAN clusters split off (one per fruitlet)
-  std::size_t instance_parts_split_off = 0;       ///< parts split off by the views' instances
-  std::size_t unsupported_detections = 0;         ///< too little surface for their size (dropped)
+  std::size_t instance_parts_split_off = 0;  ///< parts split off by the views' instances
+  std::size_t unsupported_detections = 0;    ///< dropped: too little surface, or denied_by_views
+  std::size_t denied_by_views = 0;           ///< of them, by the agreement rule (registered views)
   std::size_t overlapping_detections_merged = 0;  ///< one fruitlet seen twice (overlap rule)
 };
 
