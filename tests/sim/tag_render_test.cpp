@@ -38,16 +38,24 @@ TEST(TagImage, MatchesLibapriltagsOwnImage) {
   EXPECT_THROW(tag36h11Image(587), std::out_of_range);
 }
 
+// libapriltag's tag36h11 detector, as the tests here use it.
+struct Tag36h11Detector {
+  std::unique_ptr<apriltag_family_t, decltype(&tag36h11_destroy)> family{tag36h11_create(),
+                                                                         &tag36h11_destroy};
+  std::unique_ptr<apriltag_detector_t, decltype(&apriltag_detector_destroy)> detector{
+      apriltag_detector_create(), &apriltag_detector_destroy};
+  Tag36h11Detector() {
+    apriltag_detector_add_family(detector.get(), family.get());
+    detector->nthreads = 2;
+  }
+};
+
 // Smoke test: libapriltag finds the rendered tag in the start view's left image with the
 // right id, and its pose agrees with the world's (frame convention check; the accuracy test
 // belongs to perception).
 TEST(TagRender, DetectedInStartViewWithRightIdAndPose) {
-  std::unique_ptr<apriltag_family_t, decltype(&tag36h11_destroy)> family(tag36h11_create(),
-                                                                         &tag36h11_destroy);
-  std::unique_ptr<apriltag_detector_t, decltype(&apriltag_detector_destroy)> detector(
-      apriltag_detector_create(), &apriltag_detector_destroy);
-  apriltag_detector_add_family(detector.get(), family.get());
-  detector->nthreads = 2;
+  const Tag36h11Detector tags;
+  apriltag_detector_t* detector = tags.detector.get();
 
   for (const std::uint64_t seed : {1u, 2u}) {
     WorldConfig config;
@@ -59,7 +67,7 @@ TEST(TagRender, DetectedInStartViewWithRightIdAndPose) {
     cv::Mat grey;
     cv::cvtColor(frame.left_bgr, grey, cv::COLOR_BGR2GRAY);
     image_u8_t image{grey.cols, grey.rows, static_cast<int32_t>(grey.step), grey.data};
-    zarray_t* detections = apriltag_detector_detect(detector.get(), &image);
+    zarray_t* detections = apriltag_detector_detect(detector, &image);
     ASSERT_EQ(zarray_size(detections), 1) << "seed " << seed;
     apriltag_detection_t* detection = nullptr;
     zarray_get(detections, 0, &detection);
@@ -100,12 +108,8 @@ TEST(TagRender, DetectedInStartViewWithRightIdAndPose) {
 // pose graph's tag_corner_sigma_px (cluster_pose_graph.h): each corner against the true
 // corner projected through the exact pose, over the start views of eight worlds.
 TEST(TagRender, CornerPixelErrorIsBelowThePoseGraphsSigma) {
-  std::unique_ptr<apriltag_family_t, decltype(&tag36h11_destroy)> family(tag36h11_create(),
-                                                                         &tag36h11_destroy);
-  std::unique_ptr<apriltag_detector_t, decltype(&apriltag_detector_destroy)> detector(
-      apriltag_detector_create(), &apriltag_detector_destroy);
-  apriltag_detector_add_family(detector.get(), family.get());
-  detector->nthreads = 2;
+  const Tag36h11Detector tags;
+  apriltag_detector_t* detector = tags.detector.get();
   double sum_sq = 0.0;
   int corners = 0;
   Eigen::Vector2d mean_d = Eigen::Vector2d::Zero();
@@ -116,7 +120,7 @@ TEST(TagRender, CornerPixelErrorIsBelowThePoseGraphsSigma) {
     cv::Mat grey;
     cv::cvtColor(frame.left_bgr, grey, cv::COLOR_BGR2GRAY);
     image_u8_t image{grey.cols, grey.rows, static_cast<int32_t>(grey.step), grey.data};
-    zarray_t* detections = apriltag_detector_detect(detector.get(), &image);
+    zarray_t* detections = apriltag_detector_detect(detector, &image);
     ASSERT_EQ(zarray_size(detections), 1) << "seed " << seed;
     apriltag_detection_t* detection = nullptr;
     zarray_get(detections, 0, &detection);
