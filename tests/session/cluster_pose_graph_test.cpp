@@ -200,6 +200,22 @@ TEST(ClusterPoseGraph, RefusesBadConfigAndPlacements) {
   // No centre: nothing solved, nothing moved.
   graph.solve();
   EXPECT_EQ(graph.mapFrameError_m(), Eigen::Vector3d::Zero());
+  EXPECT_THROW(graph.predictedPlacement(5), std::out_of_range);
+  EXPECT_THROW(graph.predictedPlacementSigma(5), std::out_of_range);
+}
+
+TEST(ClusterPoseGraph, FollowsTheFirstTagItSaw) {
+  const Scene scene(3, 5);
+  std::mt19937 rng(3);
+  ClusterPoseGraph graph(PoseGraphConfig{}, scene.tag_size_m);
+  TagDetection own = scene.tag(0, rng, 0.2), other = scene.tag(1, rng, 0.2);
+  other.tag_id = own.tag_id + 1;  // another cluster's tag in view
+  graph.addView(scene.told[0], own, scene.intrinsics);
+  graph.addView(scene.told[1], other, scene.intrinsics);
+  graph.addView(scene.told[2], scene.tag(2, rng, 0.2), scene.intrinsics);
+  EXPECT_TRUE(graph.view(0).tag.has_value());
+  EXPECT_FALSE(graph.view(1).tag.has_value());
+  EXPECT_TRUE(graph.view(2).tag.has_value());
 }
 
 }  // namespace

@@ -163,6 +163,16 @@ TEST_P(MappingSessionRegistrationTest, DetectionsAreMovedByTheAnchorsOffset) {
   EXPECT_EQ(sized[true].points, sized[false].points);
 }
 
+TEST_F(MappingSessionTest, RegistrationIsEnabledBeforeTheFirstViewAndWithoutRotation) {
+  auto cpu = accel::createBackend(accel::BackendKind::kCpu);
+  MappingSession session({}, "grid", map::MapConfig{}, cpu.get());
+  ViewRegistrationConfig rotating;
+  rotating.estimate_rotation = true;  // the pose graph places views by translation
+  EXPECT_THROW(session.enableViewRegistration(rotating), std::invalid_argument);
+  session.addView(tagged());
+  EXPECT_THROW(session.enableViewRegistration(), std::logic_error);
+}
+
 TEST(MappingSession, RejectsABadEngineBeforeAnyView) {
   EXPECT_THROW(MappingSession({}, "voxblox", map::MapConfig{}, nullptr), std::invalid_argument);
   EXPECT_THROW(MappingSession({}, "grid", map::MapConfig{}, nullptr), std::invalid_argument);

@@ -128,10 +128,15 @@ ClusterPoseGraph::ClusterPoseGraph(PoseGraphConfig config, double tag_size_m)
 std::size_t ClusterPoseGraph::addView(const Eigen::Isometry3d& T_world_camera_told,
                                       const std::optional<TagDetection>& tag,
                                       const StereoIntrinsics& intrinsics) {
-  views_.push_back({T_world_camera_told, tag, intrinsics, false, Eigen::Vector3d::Zero(), {}});
+  // One tag: with "any tag" a view could see another cluster's; the first one seen is this
+  // cluster's.
+  std::optional<TagDetection> own_tag = tag;
+  if (own_tag && tag_id_ && own_tag->tag_id != *tag_id_) own_tag.reset();
+  if (own_tag) tag_id_ = own_tag->tag_id;
+  views_.push_back({T_world_camera_told, own_tag, intrinsics, false, Eigen::Vector3d::Zero(), {}});
   estimates_.emplace_back();
   arm_offsets_m_.push_back(Eigen::Vector3d::Zero());
-  if (tag && !tag_pose_) tag_pose_ = poseVector(T_world_camera_told * tag->T_camera_tag);
+  if (own_tag && !tag_pose_) tag_pose_ = poseVector(T_world_camera_told * own_tag->T_camera_tag);
   return views_.size() - 1;
 }
 
@@ -144,7 +149,7 @@ void ClusterPoseGraph::place(std::size_t k, const Eigen::Vector3d& placement_m,
     if (j == k || j >= views_.size() || !views_[j].placed)
       throw std::invalid_argument("ClusterPoseGraph::place: view " + std::to_string(k) +
                                   " aligned to view " + std::to_string(j) +
-                                  ", which is not an earlier placed view");
+                                  ", which is not another placed view");
   v.placed = true;
   v.placement_m = placement_m;
   v.aligned_to = std::move(aligned_to);
@@ -176,6 +181,7 @@ Eigen::Vector3d ClusterPoseGraph::mapFrameError_m() const {
 }
 
 Eigen::Vector3d ClusterPoseGraph::predictedPlacement(std::size_t k) const {
+  if (k >= views_.size()) throw std::out_of_range("ClusterPoseGraph: no view " + std::to_string(k));
   return errorAtCentre(k) - mapFrameError_m();
 }
 
@@ -271,6 +277,8 @@ void ClusterPoseGraph::solve() {
   options.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
+  covariance_.resize(0, 0);  // until this solve's is known: predictions fall back to the prior
+  if (!summary.IsSolutionUsable()) return;
 
   // Per view: its residuals in sigmas.
   for (std::size_t k = 0; k < views_.size(); ++k) {
@@ -297,21 +305,26 @@ void ClusterPoseGraph::solve() {
   std::vector<double*> order = {w, t};
   for (Eigen::Vector3d& a : arm_offsets_m_) order.push_back(a.data());
   const int n = 3 * static_cast<int>(order.size());
-  if (tag_pose_ && problem.HasParameterBlock(tag_pose_->data())) order.push_back(tag_pose_->data());
+  const bool with_tag = tag_pose_ && problem.HasParameterBlock(tag_pose_->data());
+  if (with_tag) order.push_back(tag_pose_->data());
   ceres::Problem::EvaluateOptions evaluate;
   evaluate.parameter_blocks = order;
   ceres::CRSMatrix crs;
-  problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs);
+  if (!problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs) ||
+      crs.num_cols != n + (with_tag ? 6 : 0))
+    return;
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
   for (int r = 0; r < crs.num_rows; ++r)
     for (int i = crs.rows[r]; i < crs.rows[r + 1]; ++i) J(r, crs.cols[i]) = crs.values[i];
-  const Eigen::MatrixXd information = J.transpose() * J;
-  covariance_ = information.ldlt()
-                    .solve(Eigen::MatrixXd::Identity(crs.num_cols, crs.num_cols))
-                    .topLeftCorner(n, n);
+  const Eigen::LDLT<Eigen::MatrixXd> information(J.transpose() * J);
+  if (information.info() != Eigen::Success) return;
+  const Eigen::MatrixXd covariance =
+      information.solve(Eigen::MatrixXd::Identity(crs.num_cols, crs.num_cols));
+  if (covariance.allFinite()) covariance_ = covariance.topLeftCorner(n, n);
 }
 
 Eigen::Vector3d ClusterPoseGraph::predictedPlacementSigma(std::size_t k) const {
+  if (k >= views_.size()) throw std::out_of_range("ClusterPoseGraph: no view " + std::to_string(k));
   const int n = 3 * static_cast<int>(views_.size() + 2);
   if (covariance_.rows() != n) return Eigen::Vector3d::Constant(config_.arm_position_sigma_m);
   // predictedPlacement(k) = e_k - mean over placed j of (e_j - C_j): linear in (w, t, a).

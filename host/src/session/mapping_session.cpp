@@ -100,6 +100,13 @@ ViewResult MappingSession::addView(const StereoFrame& frame, PerceptionResult* p
 }
 
 void MappingSession::enableViewRegistration(const ViewRegistrationConfig& config) {
+  // The pose graph holds a view per session view, from the first.
+  if (!views_.empty())
+    throw std::logic_error("MappingSession::enableViewRegistration: call before the first view");
+  if (config.use_pose_graph && config.estimate_rotation)
+    throw std::invalid_argument(
+        "view registration: estimate_rotation needs use_pose_graph off (the graph places views "
+        "by translation)");
   registration_.emplace(config);
   if (config.use_pose_graph)
     pose_graph_.emplace(config.pose_graph, perception_.config().tag.tag_size_m);

@@ -333,14 +333,14 @@ class DetectionSizer {
         ++result_.events.unsized_clusters;
         continue;
       }
-      if (f.per_image.size() == 1) ++result_.events.single_image_fruitlets;
-      if (!(f.sphere_radius_m > 0.0)) ++result_.events.failed_sphere_fits;
       measureViewAgreement(*sized_[ci].second, views_, config_, f.support);
       if (deniedByTheViews(f)) {
         ++result_.events.denied_by_views;
         result_.unsupported.push_back(std::move(f));
         continue;
       }
+      if (f.per_image.size() == 1) ++result_.events.single_image_fruitlets;
+      if (!(f.sphere_radius_m > 0.0)) ++result_.events.failed_sphere_fits;
       result_.fruitlets.push_back(std::move(f));
     }
   }

@@ -42,7 +42,9 @@ struct PoseGraphConfig {
   /// renders, measured on exact-pose views (cluster_pose_graph_test.cpp), with margin.
   double tag_corner_sigma_px = 0.5;
   /// Residuals beyond this many sigmas are down-weighted (Huber), and a view whose alignment
-  /// or tag lies beyond it counts as disagreeing with the rest.
+  /// or tag residual, as an RMS per component, lies beyond it counts as disagreeing with the
+  /// rest (a view whose alignment was refused, RegistrationStatus::kDisagrees, is placed
+  /// where the graph predicts it and so does not).
   double outlier_sigmas = 3.0;
 
   /// Throws std::invalid_argument naming the bad field.
@@ -82,7 +84,8 @@ class ClusterPoseGraph {
   void setClusterCentre(const Eigen::Vector3d& centre_m) { centre_m_ = centre_m; }
   bool hasClusterCentre() const { return centre_m_.has_value(); }
 
-  /// Adds a view (not yet placed); returns its index.
+  /// Adds a view (not yet placed); returns its index. A tag of another id than the first
+  /// one seen is left out.
   std::size_t addView(const Eigen::Isometry3d& T_world_camera_told,
                       const std::optional<TagDetection>& tag, const StereoIntrinsics& intrinsics);
   /// Records where view k was fused: its points moved by placement_m, aligned against the
@@ -127,6 +130,7 @@ class ClusterPoseGraph {
   Eigen::Vector3d hand_eye_rotation_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d hand_eye_translation_m_ = Eigen::Vector3d::Zero();
   std::optional<Eigen::Matrix<double, 6, 1>> tag_pose_;
+  std::optional<int> tag_id_;  ///< the tag the graph follows: the first one a view saw
   std::vector<Eigen::Vector3d> arm_offsets_m_;
   // Marginal covariance of (w, t, a_0..a_n) from the last solve.
   Eigen::MatrixXd covariance_;

@@ -74,7 +74,8 @@ std::string toString(RegistrationStatus status);
 
 struct RegistrationResult {
   RegistrationStatus status = RegistrationStatus::kNoModel;
-  /// World-frame correction: p_aligned = correction * p (identity unless applied).
+  /// World-frame correction: p_aligned = correction * p (identity unless applied; with the
+  /// pose graph, the whole placement the view was fused with).
   Eigen::Isometry3d correction = Eigen::Isometry3d::Identity();
   double translation_m = 0.0;  ///< how far the correction moves the view's centroid
   /// The correction's displacement of the view's centroid (with rotation estimated, the
