@@ -48,6 +48,13 @@ struct Tag36h11Detector {
     apriltag_detector_add_family(detector.get(), family.get());
     detector->nthreads = 2;
   }
+  // The detections in a BGR image (free with apriltag_detections_destroy).
+  zarray_t* detect(const cv::Mat& bgr) const {
+    cv::Mat grey;
+    cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+    image_u8_t image{grey.cols, grey.rows, static_cast<int32_t>(grey.step), grey.data};
+    return apriltag_detector_detect(detector.get(), &image);
+  }
 };
 
 // Smoke test: libapriltag finds the rendered tag in the start view's left image with the
@@ -55,7 +62,6 @@ struct Tag36h11Detector {
 // belongs to perception).
 TEST(TagRender, DetectedInStartViewWithRightIdAndPose) {
   const Tag36h11Detector tags;
-  apriltag_detector_t* detector = tags.detector.get();
 
   for (const std::uint64_t seed : {1u, 2u}) {
     WorldConfig config;
@@ -64,10 +70,7 @@ TEST(TagRender, DetectedInStartViewWithRightIdAndPose) {
     RenderOptions options;
     const StereoRenderer renderer(world);
     const host::StereoFrame frame = renderer.render(world.startCameraPose(), options);
-    cv::Mat grey;
-    cv::cvtColor(frame.left_bgr, grey, cv::COLOR_BGR2GRAY);
-    image_u8_t image{grey.cols, grey.rows, static_cast<int32_t>(grey.step), grey.data};
-    zarray_t* detections = apriltag_detector_detect(detector, &image);
+    zarray_t* detections = tags.detect(frame.left_bgr);
     ASSERT_EQ(zarray_size(detections), 1) << "seed " << seed;
     apriltag_detection_t* detection = nullptr;
     zarray_get(detections, 0, &detection);
@@ -109,7 +112,6 @@ TEST(TagRender, DetectedInStartViewWithRightIdAndPose) {
 // corner projected through the exact pose, over the start views of eight worlds.
 TEST(TagRender, CornerPixelErrorIsBelowThePoseGraphsSigma) {
   const Tag36h11Detector tags;
-  apriltag_detector_t* detector = tags.detector.get();
   double sum_sq = 0.0;
   int corners = 0;
   Eigen::Vector2d mean_d = Eigen::Vector2d::Zero();
@@ -117,10 +119,7 @@ TEST(TagRender, CornerPixelErrorIsBelowThePoseGraphsSigma) {
     const World world = World::generate(WorldConfig{}, seed);
     const StereoRenderer renderer(world);
     const host::StereoFrame frame = renderer.render(world.startCameraPose(), RenderOptions{});
-    cv::Mat grey;
-    cv::cvtColor(frame.left_bgr, grey, cv::COLOR_BGR2GRAY);
-    image_u8_t image{grey.cols, grey.rows, static_cast<int32_t>(grey.step), grey.data};
-    zarray_t* detections = apriltag_detector_detect(detector, &image);
+    zarray_t* detections = tags.detect(frame.left_bgr);
     ASSERT_EQ(zarray_size(detections), 1) << "seed " << seed;
     apriltag_detection_t* detection = nullptr;
     zarray_get(detections, 0, &detection);
