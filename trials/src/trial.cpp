@@ -215,20 +215,10 @@ class TrialLog : public host::nbv::LoopObserver {
   /// With pose errors and the cluster's centre known: the mean of the anchor views' true
   /// displacement there (what the registered map's shift should be).
   void setClusterCenter(const Eigen::Vector3d& c) { cluster_center_m_ = c; }
-  std::optional<Eigen::Vector3d> trueAnchorShift() const {
-    if (anchor_shifts_m_.empty()) return std::nullopt;
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (const auto& d : anchor_shifts_m_) sum += d;
-    return sum / double(anchor_shifts_m_.size());
-  }
+  std::optional<Eigen::Vector3d> trueAnchorShift() const { return meanOf(anchor_shifts_m_); }
   /// With pose errors: the fused maps' true frame error at the cluster's centre, the mean of
   /// the views' placed errors (what the reported shift should be).
-  std::optional<Eigen::Vector3d> trueFrameError() const {
-    if (placed_errors_m_.empty()) return std::nullopt;
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (const auto& d : placed_errors_m_) sum += d;
-    return sum / double(placed_errors_m_.size());
-  }
+  std::optional<Eigen::Vector3d> trueFrameError() const { return meanOf(placed_errors_m_); }
   /// The views' images for the overlays (kept only with an output directory).
   const ViewImages& images() const { return images_; }
   /// views/NNN.png of each view so far (index, PNG bytes), written after result.json.
@@ -244,6 +234,13 @@ class TrialLog : public host::nbv::LoopObserver {
   std::vector<std::pair<int, std::string>> view_pngs_;
   std::optional<host::StereoIntrinsics> intrinsics_;
   Clock::time_point wall_start_;
+  static std::optional<Eigen::Vector3d> meanOf(const std::vector<Eigen::Vector3d>& shifts_m) {
+    if (shifts_m.empty()) return std::nullopt;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const auto& d : shifts_m) sum += d;
+    return sum / double(shifts_m.size());
+  }
+
   int cluster_ = -1, first_view_ = 0;  ///< -1: a one-cluster world
   std::optional<Eigen::Vector3d> cluster_center_m_;
   std::vector<Eigen::Vector3d> anchor_shifts_m_;

@@ -202,17 +202,6 @@ std::optional<Eigen::Isometry3d> ClusterPoseGraph::T_world_tag() const {
   return T;
 }
 
-namespace {
-
-// The alignment of view k to the views it was aligned against, as a linear factor in sigmas:
-// its frame error e_k - C_k equals the mean of theirs.
-struct AlignmentFactor {
-  std::vector<Eigen::MatrixXd> jacobians;  // w, t, a_k, then each a_j
-  Eigen::VectorXd b;
-};
-
-}  // namespace
-
 void ClusterPoseGraph::solve() {
   if (!centre_m_ || views_.empty()) return;
   const double inv_align = 1.0 / config_.alignment_sigma_m;
@@ -283,7 +272,6 @@ void ClusterPoseGraph::solve() {
   // Per view: its residuals in sigmas.
   for (std::size_t k = 0; k < views_.size(); ++k) {
     PoseGraphViewEstimate& e = estimates_[k];
-    e.error_at_centre_m = errorAtCentre(k);
     e.alignment_sigmas = e.tag_sigmas = -1.0;
     if (align_blocks[k]) {
       Eigen::Vector3d r;
@@ -340,11 +328,6 @@ Eigen::Vector3d ClusterPoseGraph::predictedPlacementSigma(std::size_t k) const {
   for (std::size_t j = 0; j < views_.size(); ++j)
     if (views_[j].placed) add(j, -1.0 / m);
   return (G * covariance_ * G.transpose()).diagonal().cwiseMax(0.0).cwiseSqrt();
-}
-
-std::size_t ClusterPoseGraph::disagreeingViews() const {
-  return std::count_if(estimates_.begin(), estimates_.end(),
-                       [](const auto& e) { return e.disagrees; });
 }
 
 }  // namespace fvp::host

@@ -66,8 +66,6 @@ struct PoseGraphView {
 
 /// What the graph says of one view after a solve.
 struct PoseGraphViewEstimate {
-  /// e_k: what moves a point the told pose put at the cluster's centre to the truth.
-  Eigen::Vector3d error_at_centre_m = Eigen::Vector3d::Zero();
   /// Normalised residuals (in sigmas, RMS over the factor's components); negative: no factor.
   double alignment_sigmas = -1.0;
   double tag_sigmas = -1.0;
@@ -113,8 +111,6 @@ class ClusterPoseGraph {
   std::size_t placedViews() const;
   const PoseGraphView& view(std::size_t k) const { return views_.at(k); }
   const PoseGraphViewEstimate& estimate(std::size_t k) const { return estimates_.at(k); }
-  /// Views with a residual beyond outlier_sigmas at the last solve.
-  std::size_t disagreeingViews() const;
 
  private:
   Eigen::Vector3d errorAtCentre(std::size_t k) const;
