@@ -107,6 +107,7 @@ ExperimentManifest manifestOf(const ExperimentOptions& o) {
   // that budget experiments from before they existed still resume and merge.
   const bool automatic = o.trial.stop == host::nbv::StopRule::kAuto;
   m.settings.confirm_detections = automatic && o.trial.confirm_detections;
+  m.settings.seek_partly_seen = automatic && o.trial.seek_partly_seen;
   m.settings.release_left_out = automatic && o.trial.release_left_out;
   m.error_scale = o.error_scale;
   m.configs = {{"world_config", stampOf(o.trial.world_config, "world config")},

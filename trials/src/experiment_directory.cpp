@@ -166,8 +166,8 @@ void visitManifestSettings(Options& settings, Visitor&& visit) {
 /// manifest of format 1 the run's own engine and backend.
 bool mayBeAbsent(std::string_view key, bool merged) {
   for (const std::string_view k :
-       {"stop", "register_views", "confirm_detections", "release_left_out", "arm_config",
-        "size_history", "view_overhead_s", "season_day"})
+       {"stop", "register_views", "confirm_detections", "seek_partly_seen", "release_left_out",
+        "arm_config", "size_history", "view_overhead_s", "season_day"})
     if (key == k) return true;
   return merged && (key == "engine" || key == "backend");
 }

@@ -393,6 +393,7 @@ host::nbv::NbvSetupOptions setupOptions(const TrialOptions& o) {
   s.stop.max_views = o.max_views;
   s.stop.record_size_history = o.record_size_history;
   s.stop.completion.confirm_detections = o.confirm_detections;
+  s.stop.completion.seek_partly_seen = o.seek_partly_seen;
   s.stop.completion.release_left_out = o.release_left_out;
   s.loop.view_overhead_s = o.view_overhead_s;
   return s;
@@ -601,6 +602,7 @@ nlohmann::json Trial::Impl::stopJson() const {
           {"min_stable_span_deg", c.min_stable_span_deg},
           {"max_iterations_without_view", c.max_iterations_without_view},
           {"confirm_detections", c.confirm_detections},
+          {"seek_partly_seen", c.seek_partly_seen},
           {"release_left_out", c.release_left_out}};
 }
 

@@ -6,6 +6,8 @@
 #include <optional>
 #include <stdexcept>
 
+#include "fvp/host/sizing/sphere_ransac.h"
+
 namespace fvp::host::nbv {
 
 void ClusterCompletionConfig::validate() const {
@@ -79,9 +81,10 @@ void ClusterCompletion::onView(const ViewEvent& event) {
     return out;
   };
   for (const auto& f : sized.fruitlets) snapshot.fruitlets.push_back(snapshotOf(f, false));
-  if (config_.confirm_detections)
-    for (const auto& f : sized.unsupported)
-      if (f.support.unconfirmed) snapshot.unconfirmed.push_back(snapshotOf(f, true));
+  for (const auto& f : sized.unsupported)
+    if ((config_.confirm_detections && f.support.unconfirmed) ||
+        (config_.seek_partly_seen && partlySeen(f, sized.fruitlets)))
+      snapshot.unconfirmed.push_back(snapshotOf(f, true));
   history_.push_back(std::move(snapshot));
 }
 
@@ -108,6 +111,18 @@ bool lacksEvidence(const FruitletSnapshot& fruitlet, const ClusterCompletionConf
   return (fruitlet.unconfirmed || fruitlet.size_source != sizing::SizeSource::kSphereFit) &&
          (fruitlet.well_seen_images < config.min_well_seen_images ||
           fruitlet.view_span_deg < config.min_view_span_deg);
+}
+
+bool partlySeen(const sizing::FruitletEstimate& detection,
+                const std::vector<sizing::FruitletEstimate>& kept) {
+  if (detection.support.unconfirmed || detection.per_image.empty() ||
+      !(double(detection.points) < detection.support.required_points))
+    return false;
+  for (const auto& k : kept)
+    if ((detection.center_m - k.center_m).norm() <
+        0.5e-3 * k.size_mm + sizing::kDefaultMinFruitletRadius_m)
+      return false;
+  return true;
 }
 
 std::size_t discoveryWindow(const std::vector<SizingSnapshot>& history,

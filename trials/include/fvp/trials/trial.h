@@ -67,6 +67,10 @@ struct TrialOptions {
   /// With stop auto: look again at unconfirmed detections (dropped by the hemisphere rule
   /// alone) before a cluster is done (host::nbv::ClusterCompletionConfig::confirm_detections).
   bool confirm_detections = true;
+  /// With stop auto: look again at partly seen detections (dropped by the support rule, apart
+  /// from every kept fruitlet) before a cluster is done
+  /// (host::nbv::ClusterCompletionConfig::seek_partly_seen).
+  bool seek_partly_seen = true;
   /// With stop auto: a fruitlet the planner looked for twice in vain no longer holds the stop
   /// (host::nbv::ClusterCompletionConfig::release_left_out).
   bool release_left_out = true;

@@ -53,6 +53,7 @@ void visitTrialFields(Options& o, Visitor&& visit) {
   visit(f::kEngine, o.engine);
   visit(f::kStop, o.stop);
   visit(f::kConfirmDetections, o.confirm_detections);
+  visit(f::kSeekPartlySeen, o.seek_partly_seen);
   visit(f::kReleaseLeftOut, o.release_left_out);
   visit(f::kRegisterViews, o.register_views);
   visit(f::kViewOverhead, o.view_overhead_s);

@@ -69,6 +69,14 @@ struct ClusterCompletionConfig {
   /// it like a fruitlet short of well-seen images (holdWhile: the stop waits while it does).
   /// Off (the rule before 8c37611): the stop rule and the planner see the kept detections only.
   bool confirm_detections = true;
+  /// Look again, the same way, at partly seen detections (partlySeen: dropped by the support
+  /// rule, less than the quarter of their sphere seen, and apart from every kept fruitlet).
+  /// Such a detection is a fruitlet seen through a gap or round a leaf's edge, or a phantom;
+  /// a view aimed at it shows more of it or nothing there. Without it, views that happen to
+  /// see no more of a half-hidden fruitlet count as "nothing found" and the stop leaves it
+  /// unsized. Each holds the stop for max_aimed_views views at most. Off (before this rule):
+  /// only unconfirmed detections are looked at again.
+  bool seek_partly_seen = true;
   /// A kept fruitlet that lacks the evidence (lacksEvidence) no longer holds the stop once
   /// the planner has looked for it max_aimed_views times in vain (SizingGuidance::leftOut,
   /// handed over by releaseWhen): no reachable view shows it as the rule asks, so waiting on
@@ -95,8 +103,9 @@ struct FruitletSnapshot {
   double size_stderr_mm = -1.0;
   /// Unit vectors from the fruitlet towards the cameras of its well-seen images.
   std::vector<Eigen::Vector3d> well_seen_directions;
-  /// An unconfirmed detection (ClusterCompletionConfig::confirm_detections): well_seen_images,
-  /// view_span_deg and well_seen_directions then count every image that sized it.
+  /// An unconfirmed or partly seen detection (ClusterCompletionConfig::confirm_detections,
+  /// seek_partly_seen): well_seen_images, view_span_deg and well_seen_directions then count
+  /// every image that sized it.
   bool unconfirmed = false;
 };
 
@@ -112,7 +121,8 @@ struct SizingSnapshot {
   /// final sizing reports them (MappingSession::anchorOffset; zero without the correction).
   Eigen::Vector3d world_shift_m = Eigen::Vector3d::Zero();
   std::vector<FruitletSnapshot> fruitlets;
-  /// The unconfirmed detections, with confirm_detections (not compared by sizesSettled).
+  /// The unconfirmed detections, with confirm_detections, and the partly seen ones, with
+  /// seek_partly_seen (not compared by sizesSettled).
   std::vector<FruitletSnapshot> unconfirmed;
 };
 
@@ -167,6 +177,15 @@ class ClusterCompletion : public LoopObserver {
 /// well-seen images from directions min_view_span_deg apart (sphere-fit sizes need none; an
 /// unconfirmed detection needs as many sized images, as far apart).
 bool lacksEvidence(const FruitletSnapshot& fruitlet, const ClusterCompletionConfig& config);
+
+/// Whether a detection the sizing dropped may be a fruitlet not yet seen enough
+/// (ClusterCompletionConfig::seek_partly_seen): dropped by the support rule (fewer points than
+/// required, not the hemisphere rule's unconfirmed ones), sized in at least one image, and
+/// its centre outside every kept fruitlet's sphere by at least the smallest fruitlet's radius
+/// (sphere_ransac.h): fruitlets do not overlap, so a centre closer than that is a piece of the
+/// kept fruitlet's own surface.
+bool partlySeen(const sizing::FruitletEstimate& detection,
+                const std::vector<sizing::FruitletEstimate>& kept);
 
 /// How many of history's latest snapshots the found-or-lost check spans: at least
 /// config.stable_views + 1, and back until their cameras span config.min_stable_span_deg seen

@@ -70,6 +70,10 @@ inline constexpr RunField kConfirmDetections{
     "confirm_detections", "--confirm-detections",
     "with the automatic stop: look again at detections sized by a sphere fit to less than a "
     "hemisphere before a cluster is done (docs/nbv-loop.md)"};
+inline constexpr RunField kSeekPartlySeen{
+    "seek_partly_seen", "--seek-partly-seen",
+    "with the automatic stop: look again at detections too little of which was seen to keep "
+    "them, apart from every kept fruitlet, before a cluster is done (docs/nbv-loop.md)"};
 inline constexpr RunField kReleaseLeftOut{
     "release_left_out", "--release-left-out",
     "with the automatic stop: a fruitlet the planner has looked for twice in vain no longer "
@@ -138,6 +142,7 @@ void visitSetupFields(Options& o, Visitor&& visit) {
   visit(f::kMaxViews, o.stop.max_views);
   visit(f::kSizeHistory, o.stop.record_size_history);
   visit(f::kConfirmDetections, o.stop.completion.confirm_detections);
+  visit(f::kSeekPartlySeen, o.stop.completion.seek_partly_seen);
   visit(f::kReleaseLeftOut, o.stop.completion.release_left_out);
   visit(f::kRegisterViews, o.register_views);
   visit(f::kViewOverhead, o.loop.view_overhead_s);
