@@ -73,26 +73,31 @@ def test_automatic_stop_switches_default_as_the_cli(fvp_exe):
     defaults = keyword_defaults(fvp.sim.Trial)
     assert defaults["confirm_detections"] == "true"
     assert defaults["release_left_out"] == "true"
+    assert defaults["seek_partly_seen"] == "true"
     help_text = subprocess.run([fvp_exe, "run", "--help"], check=True, capture_output=True,
                                text=True).stdout
     # The CLI's flags are on unless negated (TrialOptions' defaults).
     assert "--confirm-detections,--no-confirm-detections" in help_text
     assert "--release-left-out,--no-release-left-out" in help_text
+    assert "--seek-partly-seen,--no-seek-partly-seen" in help_text
 
 
-@pytest.mark.parametrize("confirm,release", [(False, True), (True, False)])
-def test_automatic_stop_switches_reach_the_trial(confirm, release):
+@pytest.mark.parametrize("confirm,release,seek", [(False, True, True), (True, False, False)])
+def test_automatic_stop_switches_reach_the_trial(confirm, release, seek):
     result = fvp.sim.run_trial(seed=2, clock="fixed", stop="auto", max_views=1,
-                               confirm_detections=confirm, release_left_out=release)
+                               confirm_detections=confirm, release_left_out=release,
+                               seek_partly_seen=seek)
     assert result["stop"]["rule"] == "auto"
     assert result["stop"]["confirm_detections"] is confirm
     assert result["stop"]["release_left_out"] is release
+    assert result["stop"]["seek_partly_seen"] is seek
 
 
 def test_automatic_stop_switches_default_on():
     result = fvp.sim.Trial(seed=2, clock="fixed", stop="auto", max_views=1).run()
     assert result["stop"]["confirm_detections"] is True
     assert result["stop"]["release_left_out"] is True
+    assert result["stop"]["seek_partly_seen"] is True
 
 
 def test_the_field_preset_runs_with_view_registration_unless_told_otherwise():

@@ -1,7 +1,7 @@
 // The automatic stop's rule on constructed sizing histories: settled sizes stop; a fruitlet
 // found late, one not yet well seen, one seen from a single direction, a size still moving
-// and an empty cluster do not. Then the observer on real frames: it sizes after each view and
-// charges the sizing to the loop clock.
+// and an empty cluster do not; which dropped detections are looked at again. Then the observer on
+// real frames: it sizes after each view and charges the sizing to the loop clock.
 #include "fvp/host/nbv/cluster_completion.h"
 
 #include <gtest/gtest.h>
@@ -166,6 +166,41 @@ TEST(ClusterCompletion, AnUnconfirmedDetectionNeedsSizedImagesFromTwoDirections)
   u.view_span_deg = 0.0;
   for (auto& s : h) s.unconfirmed = {u};
   EXPECT_TRUE(sizesSettled(h, config)) << "not compared with the kept fruitlets";
+}
+
+// A detection the support rule dropped is worth another look when it could be a fruitlet of
+// its own: sized in an image, and its fitted centre outside every kept fruitlet's sphere by the
+// smallest radius the sizing keeps (1.5 mm).
+TEST(ClusterCompletion, APartlySeenDetectionLiesApartFromEveryKeptFruitlet) {
+  sizing::FruitletEstimate kept;
+  kept.sphere_center_m = Eigen::Vector3d(0.0, 0.0, 0.3);
+  kept.size_ours_mm = 10.0;  // radius 5 mm: another fruitlet's centre lies 6.5 mm away or more
+  kept.center_m = kept.sphere_center_m - Eigen::Vector3d(0.0, 0.0, 0.004);  // the paper's centroid
+  sizing::FruitletEstimate dropped;
+  dropped.points = 100;
+  dropped.support.required_points = 400.0;
+  dropped.per_image.resize(1);
+  const auto at = [&](const Eigen::Vector3d& offset_m) {
+    dropped.sphere_center_m = dropped.center_m = kept.sphere_center_m + offset_m;
+  };
+  at({0.0066, 0.0, 0.0});
+  EXPECT_TRUE(partlySeen(dropped, {kept}));
+  EXPECT_TRUE(partlySeen(dropped, {})) << "nothing kept: anything may be a fruitlet";
+  at({0.0, 0.0064, 0.0});
+  EXPECT_FALSE(partlySeen(dropped, {kept})) << "a piece of the kept fruitlet's surface";
+  at({0.0, 0.0, -0.0066});
+  EXPECT_TRUE(partlySeen(dropped, {kept})) << "measured from the fitted centre, not the centroid";
+  at({std::nan(""), 0.0, 0.0});
+  EXPECT_FALSE(partlySeen(dropped, {kept})) << "a NaN centre is never apart";
+  at({0.02, 0.0, 0.0});
+  dropped.support.unconfirmed = true;
+  EXPECT_FALSE(partlySeen(dropped, {kept})) << "the hemisphere rule's: confirm_detections'";
+  dropped.support.unconfirmed = false;
+  dropped.points = 400;
+  EXPECT_FALSE(partlySeen(dropped, {kept})) << "enough seen: dropped by another rule";
+  dropped.points = 100;
+  dropped.per_image.clear();
+  EXPECT_FALSE(partlySeen(dropped, {kept})) << "never sized in an image";
 }
 
 TEST(ClusterCompletion, NaNSizesAndTwoDetectionsOnOneEarlierFruitletNeverSettle) {

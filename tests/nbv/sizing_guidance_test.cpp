@@ -1,6 +1,7 @@
 // The sizing guidance on constructed sizing histories: only fruitlets short of the stop's
 // evidence become targets, with their well-seen directions; a fruitlet aimed at twice without
-// a new well-seen image is dropped, and one that gains an image is aimed at again.
+// a new well-seen image is dropped, and one that gains an image is aimed at again; detections
+// not kept (unconfirmed, partly seen) are looked at for a bounded number of views.
 #include "fvp/host/nbv/sizing_guidance.h"
 
 #include <gtest/gtest.h>
@@ -220,6 +221,58 @@ TEST(SizingGuidance, AnUnconfirmedDetectionHoldsTheClusterForAtMostTwoViews) {
   other.onView({.index = 0});
   EXPECT_TRUE(planner.targets_.empty());
   EXPECT_FALSE(other.waitingOnUnconfirmed());
+}
+
+// A detection looked at while unconfirmed or partly seen, then kept, is a fruitlet the
+// planner has not yet aimed at as one: its count (of sized images, every view) starts again.
+TEST(SizingGuidance, ADetectionKeptAfterItsLooksAsUnconfirmedIsAimedAtAgain) {
+  const ClusterCompletionConfig config;
+  std::vector<SizingSnapshot> history;
+  RecordingPlanner planner;
+  SizingGuidance guidance(history, config, planner, 0.6);
+  planner::PlanStep elsewhere = aimedAt(0);
+  elsewhere.candidates[0].kind = planner::CandidateKind::kRoi;
+  for (int view = 0; view < 3; ++view) {
+    SizingSnapshot s = snapshot(view, {fruitlet(0.0, 4, 60.0)});
+    FruitletSnapshot u = fruitlet(0.02, 1, 0.0);
+    u.unconfirmed = u.partly_seen = true;
+    s.unconfirmed = {u};
+    history.push_back(s);
+    guidance.onView({.index = view});
+    if (view < 2) guidance.onPlan({.step = &elsewhere});
+  }
+  EXPECT_FALSE(guidance.waitingOnUnconfirmed()) << "looked at twice: no longer waited on";
+  history.push_back(snapshot(3, {fruitlet(0.0, 4, 60.0), fruitlet(0.02, 1, 0.0)}));
+  guidance.onView({.index = 3});
+  ASSERT_EQ(planner.targets_.size(), 1u) << "kept now: a target of its own";
+  EXPECT_FALSE(guidance.leftOut(Eigen::Vector3d(0.02, 0.0, 0.3)));
+}
+
+// A partly seen detection near where a remembered fruitlet was is not that fruitlet found:
+// the remembered one is still sought.
+TEST(SizingGuidance, APartlySeenDetectionDoesNotFindARememberedFruitlet) {
+  const ClusterCompletionConfig config;
+  std::vector<SizingSnapshot> history;
+  RecordingPlanner planner;
+  SizingGuidance guidance(history, config, planner, 0.6);
+  const std::optional<Eigen::Isometry3d> T_world_tag = Eigen::Isometry3d::Identity();
+  guidance.expect(
+      {{Eigen::Vector3d(0.02, 0.0, 0.3), 8.0}},
+      [&]() -> const std::optional<Eigen::Isometry3d>& { return T_world_tag; }, 0.008);
+  SizingSnapshot s = snapshot(0, {fruitlet(0.0, 4, 60.0)});
+  FruitletSnapshot u = fruitlet(0.021, 1, 0.0);
+  u.unconfirmed = u.partly_seen = true;
+  s.unconfirmed = {u};
+  history.push_back(s);
+  guidance.onView({.index = 0});
+  EXPECT_EQ(guidance.expectedFound(), 0u);
+  EXPECT_TRUE(guidance.waitingOnExpected());
+  u.partly_seen = false;  // the hemisphere rule's unconfirmed detection: it may be the fruitlet
+  history.push_back(s);
+  history.back().view = 1;
+  history.back().unconfirmed = {u};
+  guidance.onView({.index = 1});
+  EXPECT_EQ(guidance.expectedFound(), 1u);
 }
 
 TEST(SizingGuidance, ARememberedFruitletNotFoundIsSoughtThenGone) {

@@ -81,10 +81,12 @@ void ClusterCompletion::onView(const ViewEvent& event) {
     return out;
   };
   for (const auto& f : sized.fruitlets) snapshot.fruitlets.push_back(snapshotOf(f, false));
-  for (const auto& f : sized.unsupported)
-    if ((config_.confirm_detections && f.support.unconfirmed) ||
-        (config_.seek_partly_seen && partlySeen(f, sized.fruitlets)))
-      snapshot.unconfirmed.push_back(snapshotOf(f, true));
+  for (const auto& f : sized.unsupported) {
+    const bool partly_seen = config_.seek_partly_seen && partlySeen(f, sized.fruitlets);
+    if (!partly_seen && !(config_.confirm_detections && f.support.unconfirmed)) continue;
+    snapshot.unconfirmed.push_back(snapshotOf(f, true));
+    snapshot.unconfirmed.back().partly_seen = partly_seen;
+  }
   history_.push_back(std::move(snapshot));
 }
 
@@ -118,9 +120,11 @@ bool partlySeen(const sizing::FruitletEstimate& detection,
   if (detection.support.unconfirmed || detection.per_image.empty() ||
       !(double(detection.points) < detection.support.required_points))
     return false;
+  // Fitted centres and our sizes, whichever estimator reports: the paper's centroid lies
+  // nearer the camera than the centre. A NaN never counts as apart.
   for (const auto& k : kept)
-    if ((detection.center_m - k.center_m).norm() <
-        0.5e-3 * k.size_mm + sizing::kDefaultMinFruitletRadius_m)
+    if (!((detection.sphere_center_m - k.sphere_center_m).norm() >=
+          0.5e-3 * k.size_ours_mm + sizing::kDefaultMinFruitletRadius_m))
       return false;
   return true;
 }

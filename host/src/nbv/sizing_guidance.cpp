@@ -68,7 +68,8 @@ void SizingGuidance::onPlan(const PlanEvent& event) {
     if (Aim* aim = findAim(targets_[t].center_m))
       ++aim->views;
     else
-      aims_.push_back({targets_[t].center_m, static_cast<int>(targets_[t].seen_from.size()), 1});
+      aims_.push_back({targets_[t].center_m, static_cast<int>(targets_[t].seen_from.size()), 1,
+                       target_unconfirmed_[t]});
   }
 }
 
@@ -90,7 +91,10 @@ void SizingGuidance::seekExpected() {
   const SizingSnapshot& latest = history_.back();
   std::vector<const FruitletSnapshot*> sized;
   for (const FruitletSnapshot& f : latest.fruitlets) sized.push_back(&f);
-  for (const FruitletSnapshot& f : latest.unconfirmed) sized.push_back(&f);
+  // A partly seen detection is not the remembered fruitlet found: it may be a scrap of leaf
+  // near where the fruitlet was, and the final sizing does not report it.
+  for (const FruitletSnapshot& f : latest.unconfirmed)
+    if (!f.partly_seen) sized.push_back(&f);
   // Where each was, in the maps' frame, where the snapshot's centres and the tag seen on this
   // visit both are (remembered centres are in the tag frame of the earlier visit's maps:
   // eval::addTagFrame).
@@ -136,8 +140,10 @@ void SizingGuidance::onView(const ViewEvent& event) {
     const FruitletSnapshot& f = *candidate;
     if (!lacksEvidence(f, config_)) continue;
     if (Aim* aim = findAim(f.center_m)) {
-      if (!f.unconfirmed && f.well_seen_images > aim->well_seen_images) {
-        *aim = aims_.back();  // a new well-seen image: the count starts again
+      // A new well-seen image, or a detection kept now that was looked at as unconfirmed or
+      // partly seen (its count was of sized images, not well-seen ones): the count starts again.
+      if (!f.unconfirmed && (aim->for_unconfirmed || f.well_seen_images > aim->well_seen_images)) {
+        *aim = aims_.back();
         aims_.pop_back();
       } else if (aim->views >= max_aimed_views_) {
         if (aim->views == max_aimed_views_) {

@@ -107,6 +107,8 @@ struct FruitletSnapshot {
   /// seek_partly_seen): well_seen_images, view_span_deg and well_seen_directions then count
   /// every image that sized it.
   bool unconfirmed = false;
+  /// Of those, a partly seen one (partlySeen), not the hemisphere rule's.
+  bool partly_seen = false;
 };
 
 /// The cluster sized after one view.
@@ -183,7 +185,8 @@ bool lacksEvidence(const FruitletSnapshot& fruitlet, const ClusterCompletionConf
 /// required, not the hemisphere rule's unconfirmed ones), sized in at least one image, and
 /// its centre outside every kept fruitlet's sphere by at least the smallest fruitlet's radius
 /// (sphere_ransac.h): fruitlets do not overlap, so a centre closer than that is a piece of the
-/// kept fruitlet's own surface.
+/// kept fruitlet's own surface. Fitted centres and our sizes (sphere_center_m, size_ours_mm)
+/// whichever estimator reports.
 bool partlySeen(const sizing::FruitletEstimate& detection,
                 const std::vector<sizing::FruitletEstimate>& kept);
 

@@ -56,9 +56,10 @@ class SizingGuidance : public LoopObserver {
   /// The fruitlets an earlier visit sized, in the tag's frame (visit_memory.h); T_world_tag
   /// gives the tag's pose on this visit (empty until a view saw it) and must outlive this.
   /// After each sizing, a remembered fruitlet that no fruitlet of the sizing (kept or
-  /// unconfirmed) stands within max_shift_m of, one to one, is a target the stop waits on
-  /// (waitingOnExpected); one still not found after max_aimed_views views other than
-  /// remembered ones is gone (expectedGone): looked for where it was, and not there.
+  /// unconfirmed; a partly seen detection is not one) stands within max_shift_m of, one to one, is
+  /// a target the stop waits on (waitingOnExpected); one still not found after max_aimed_views
+  /// views other than remembered ones is gone (expectedGone): looked for where it was, and not
+  /// there.
   void expect(std::vector<RememberedFruitlet> fruitlets_tag, TagPoseFn T_world_tag,
               double max_shift_m);
   bool waitingOnExpected() const {
@@ -77,6 +78,7 @@ class SizingGuidance : public LoopObserver {
     Eigen::Vector3d center_m;
     int well_seen_images = 0;  ///< when first aimed at
     int views = 0;
+    bool for_unconfirmed = false;  ///< first aimed at as an unconfirmed detection
   };
   Aim* findAim(const Eigen::Vector3d& center_m);
   const Aim* findAim(const Eigen::Vector3d& center_m) const;
