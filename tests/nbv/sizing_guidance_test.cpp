@@ -47,6 +47,11 @@ SizingSnapshot snapshot(int view, std::vector<FruitletSnapshot> fruitlets) {
   return s;
 }
 
+// The tag's pose as the guidance asks for it: T must outlive the function.
+TagPoseFn tagPoseOf(const std::optional<Eigen::Isometry3d>& T) {
+  return [&T]() -> const std::optional<Eigen::Isometry3d>& { return T; };
+}
+
 // A plan step that moved to a sizing candidate aimed at target t.
 planner::PlanStep aimedAt(int t) {
   planner::PlanStep step;
@@ -256,9 +261,7 @@ TEST(SizingGuidance, APartlySeenDetectionDoesNotFindARememberedFruitlet) {
   RecordingPlanner planner;
   SizingGuidance guidance(history, config, planner, 0.6);
   const std::optional<Eigen::Isometry3d> T_world_tag = Eigen::Isometry3d::Identity();
-  guidance.expect(
-      {{Eigen::Vector3d(0.02, 0.0, 0.3), 8.0}},
-      [&]() -> const std::optional<Eigen::Isometry3d>& { return T_world_tag; }, 0.008);
+  guidance.expect({{Eigen::Vector3d(0.02, 0.0, 0.3), 8.0}}, tagPoseOf(T_world_tag), 0.008);
   SizingSnapshot s = snapshot(0, {fruitlet(0.0, 4, 60.0)});
   FruitletSnapshot u = fruitlet(0.021, 1, 0.0);
   u.unconfirmed = u.partly_seen = true;
@@ -282,9 +285,8 @@ TEST(SizingGuidance, ARememberedFruitletNotFoundIsSoughtThenGone) {
   SizingGuidance guidance(history, config, planner, 0.6);
   std::optional<Eigen::Isometry3d> T_world_tag;
   // The earlier visit's two fruitlets; the tag stands 1 m along x in this visit's world.
-  guidance.expect(
-      {{Eigen::Vector3d(-1.0, 0.0, 0.3), 8.0}, {Eigen::Vector3d(-0.98, 0.0, 0.3), 6.0}},
-      [&]() -> const std::optional<Eigen::Isometry3d>& { return T_world_tag; }, 0.008);
+  guidance.expect({{Eigen::Vector3d(-1.0, 0.0, 0.3), 8.0}, {Eigen::Vector3d(-0.98, 0.0, 0.3), 6.0}},
+                  tagPoseOf(T_world_tag), 0.008);
   int view = 0;
   const auto sized = [&](std::vector<FruitletSnapshot> fruitlets) {
     history.push_back(snapshot(view, std::move(fruitlets)));
@@ -333,9 +335,8 @@ TEST(SizingGuidance, OneFruitletIsNotTwoRememberedOnes) {
   RecordingPlanner planner;
   SizingGuidance guidance(history, config, planner, 0.6);
   const std::optional<Eigen::Isometry3d> T_world_tag = Eigen::Isometry3d::Identity();
-  guidance.expect(
-      {{Eigen::Vector3d(0.0, 0.0, 0.3), 8.0}, {Eigen::Vector3d(0.006, 0.0, 0.3), 8.0}},
-      [&]() -> const std::optional<Eigen::Isometry3d>& { return T_world_tag; }, 0.008);
+  guidance.expect({{Eigen::Vector3d(0.0, 0.0, 0.3), 8.0}, {Eigen::Vector3d(0.006, 0.0, 0.3), 8.0}},
+                  tagPoseOf(T_world_tag), 0.008);
   // One fruitlet within the gate of both: it is the nearer one's; the other is sought.
   history.push_back(snapshot(0, {fruitlet(0.005, 4, 60.0)}));
   guidance.onView({.index = 0});
@@ -343,10 +344,7 @@ TEST(SizingGuidance, OneFruitletIsNotTwoRememberedOnes) {
   ASSERT_EQ(planner.targets_.size(), 1u);
   EXPECT_NEAR(planner.targets_[0].center_m.x(), 0.0, 1e-12);
   EXPECT_THROW(guidance.expect({}, {}, 0.008), std::invalid_argument);
-  EXPECT_THROW(
-      guidance.expect(
-          {}, [&]() -> const std::optional<Eigen::Isometry3d>& { return T_world_tag; }, 0.0),
-      std::invalid_argument);
+  EXPECT_THROW(guidance.expect({}, tagPoseOf(T_world_tag), 0.0), std::invalid_argument);
 }
 
 TEST(SizingGuidance, RejectsBadSettings) {
