@@ -215,6 +215,32 @@ TEST(ClusterCompletion, NaNSizesAndTwoDetectionsOnOneEarlierFruitletNeverSettle)
   EXPECT_FALSE(sizesSettled(split, config));
 }
 
+TEST(ClusterCompletion, ViewsThatSizedNothingDoNotSettleTheCluster) {
+  const ClusterCompletionConfig config;  // 3 views, 30 degrees
+  // The second fruitlet is found at view 2; views 3 to 5 size no image (leaves hide the
+  // cluster), so the sizing after each is view 2's.
+  auto h = history(6);
+  h[0].fruitlets.pop_back();
+  h[1].fruitlets.pop_back();
+  for (int v = 3; v < 6; ++v) h[v].fruitlets = h[2].fruitlets;
+  EXPECT_TRUE(sizesSettled(h, config)) << "counted, they pass for views that found nothing new";
+  for (int v = 3; v < 6; ++v) h[v].sized_images = false;
+  EXPECT_FALSE(sizesSettled(h, config));
+  // Views that size the fruitlets again, 40 degrees and more from view 2, do settle it.
+  for (int v = 6; v < 9; ++v) {
+    SizingSnapshot s = h[2];
+    s.view = v;
+    s.camera_position_m = cameraAt(20.0 * v);
+    h.push_back(s);
+    EXPECT_EQ(sizesSettled(h, config), v == 8) << "after view " << v;
+  }
+  // A view that sized nothing at the end does not unsettle it either.
+  h.push_back(h.back());
+  h.back().sized_images = false;
+  h.back().fruitlets.clear();
+  EXPECT_TRUE(sizesSettled(h, config));
+}
+
 TEST(ClusterCompletion, AnEmptyClusterIsNeverDone) {
   std::vector<SizingSnapshot> empty(8);
   EXPECT_FALSE(sizesSettled(empty, {}));
@@ -284,6 +310,8 @@ TEST(ClusterCompletion, SizesTheSessionAfterEveryMappedViewAndChargesTheClock) {
   EXPECT_EQ(int(completion.history().size()), clock.sizing_charges);
   EXPECT_EQ(completion.history().back().view, 2);
   EXPECT_FALSE(completion.history().back().fruitlets.empty());
+  for (const auto& snapshot : completion.history())
+    EXPECT_TRUE(snapshot.sized_images) << "view " << snapshot.view << " shows the cluster";
   EXPECT_GT(clock.sizing_s, 0.0);
   // Three views cannot show three quiet ones after the first sizing.
   EXPECT_FALSE(completion.done());

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iterator>
 #include <optional>
 #include <stdexcept>
 
@@ -80,6 +81,15 @@ void ClusterCompletion::onView(const ViewEvent& event) {
     out.unconfirmed = unconfirmed;
     return out;
   };
+  // Whether this view sized an image of any detection: its sizing view is the latest.
+  const int latest_view = int(views.size()) - 1;
+  const auto sizedByLatest = [&](const sizing::FruitletEstimate& f) {
+    return std::any_of(f.per_image.begin(), f.per_image.end(),
+                       [&](const sizing::ImageSize& image) { return image.view == latest_view; });
+  };
+  snapshot.sized_images =
+      std::any_of(sized.fruitlets.begin(), sized.fruitlets.end(), sizedByLatest) ||
+      std::any_of(sized.unsupported.begin(), sized.unsupported.end(), sizedByLatest);
   for (const auto& f : sized.fruitlets) snapshot.fruitlets.push_back(snapshotOf(f, false));
   for (const auto& f : sized.unsupported) {
     const bool partly_seen = config_.seek_partly_seen && partlySeen(f, sized.fruitlets);
@@ -151,8 +161,10 @@ std::size_t discoveryWindow(const std::vector<SizingSnapshot>& history,
   return 0;
 }
 
-bool sizesSettled(const std::vector<SizingSnapshot>& history, const ClusterCompletionConfig& config,
-                  const std::function<bool(const FruitletSnapshot&)>& released) {
+namespace {
+
+bool settledOver(const std::vector<SizingSnapshot>& history, const ClusterCompletionConfig& config,
+                 const std::function<bool(const FruitletSnapshot&)>& released) {
   // A cluster with nothing sized is not done: its fruitlets are still to be found (the
   // budget ends a cluster that has none). discoveryWindow is 0 then.
   const std::size_t window = discoveryWindow(history, config);
@@ -184,6 +196,22 @@ bool sizesSettled(const std::vector<SizingSnapshot>& history, const ClusterCompl
     }
   }
   return true;
+}
+
+}  // namespace
+
+bool sizesSettled(const std::vector<SizingSnapshot>& history, const ClusterCompletionConfig& config,
+                  const std::function<bool(const FruitletSnapshot&)>& released) {
+  // A view that sized nothing (its fruitlets all hidden behind leaves, or out of frame) did
+  // not look at the cluster: counted, it would let views that saw nothing stand for views
+  // that found nothing new.
+  const auto sized_nothing = [](const SizingSnapshot& s) { return !s.sized_images; };
+  if (std::none_of(history.begin(), history.end(), sized_nothing))
+    return settledOver(history, config, released);
+  std::vector<SizingSnapshot> looked;
+  std::copy_if(history.begin(), history.end(), std::back_inserter(looked),
+               [&](const SizingSnapshot& s) { return !sized_nothing(s); });
+  return settledOver(looked, config, released);
 }
 
 }  // namespace fvp::host::nbv
