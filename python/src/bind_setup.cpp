@@ -33,6 +33,7 @@ py::dict snapshotToDict(const host::nbv::SizingSnapshot& s) {
   py::dict d;
   d["view"] = s.view;
   d["now_s"] = s.now_s;
+  d["sized_any_image"] = s.sized_any_image;
   d["fruitlets"] = fruitlets;
   return d;
 }

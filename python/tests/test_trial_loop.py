@@ -109,6 +109,9 @@ def test_run_trial_with_the_automatic_stop_records_each_sizing():
     # One sizing per view once the tag placed the region; the last is the trial's own sizing.
     assert 1 <= len(history) <= result["views"]
     assert [h["view"] for h in history] == sorted(h["view"] for h in history)
+    # Whether the view sized an image: some view sized the fruitlets the last sizing holds.
+    assert all(isinstance(h["sized_any_image"], bool) for h in history)
+    assert any(h["sized_any_image"] for h in history)
     last = sorted(f["size_mm"] for f in history[-1]["fruitlets"])
     final = sorted(f["size_mm"] for f in result["sized_fruitlets"])
     assert np.allclose(last, final)

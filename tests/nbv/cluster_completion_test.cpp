@@ -224,7 +224,7 @@ TEST(ClusterCompletion, ViewsThatSizedNothingDoNotSettleTheCluster) {
   h[1].fruitlets.pop_back();
   for (int v = 3; v < 6; ++v) h[v].fruitlets = h[2].fruitlets;
   EXPECT_TRUE(sizesSettled(h, config)) << "counted, they pass for views that found nothing new";
-  for (int v = 3; v < 6; ++v) h[v].sized_images = false;
+  for (int v = 3; v < 6; ++v) h[v].sized_any_image = false;
   EXPECT_FALSE(sizesSettled(h, config));
   // Views that size the fruitlets again, 40 degrees and more from view 2, do settle it.
   for (int v = 6; v < 9; ++v) {
@@ -234,11 +234,18 @@ TEST(ClusterCompletion, ViewsThatSizedNothingDoNotSettleTheCluster) {
     h.push_back(s);
     EXPECT_EQ(sizesSettled(h, config), v == 8) << "after view " << v;
   }
-  // A view that sized nothing at the end does not unsettle it either.
+  // A view that sized nothing at the end leaves it settled while the sizing after it holds
+  // the same sizes; what it fused may still change them, and then it does not.
   h.push_back(h.back());
-  h.back().sized_images = false;
-  h.back().fruitlets.clear();
+  h.back().sized_any_image = false;
   EXPECT_TRUE(sizesSettled(h, config));
+  h.back().fruitlets[1].size_mm += 0.5;
+  EXPECT_FALSE(sizesSettled(h, config));
+  h.back().fruitlets.pop_back();
+  EXPECT_FALSE(sizesSettled(h, config));
+  // No view that sized an image: nothing to settle.
+  for (auto& s : h) s.sized_any_image = false;
+  EXPECT_FALSE(sizesSettled(h, config));
 }
 
 TEST(ClusterCompletion, AnEmptyClusterIsNeverDone) {
@@ -297,21 +304,25 @@ TEST(ClusterCompletion, SizesTheSessionAfterEveryMappedViewAndChargesTheClock) {
   session.enableTsdf();
   CountingClock clock;
   ClusterCompletion completion(session, clock, {});
-  // View 0 shows no tag; view 1 does (and is captured twice).
-  const std::size_t frames[] = {0, 1, 1};
-  for (int i = 0; i < 3; ++i) {
-    session.addView(test::seed2OrbitFrame(frames[i]));
+  // View 0 shows no tag; view 1 does (and is captured twice); the last is view 1 again with
+  // every fruitlet hidden (an empty fruitlet mask, as if leaves covered them).
+  const std::size_t frames[] = {0, 1, 1, 1};
+  for (int i = 0; i < 4; ++i) {
+    auto frame = test::seed2OrbitFrame(frames[i]);
+    if (i == 3) frame.fruitlet_mask = cv::Mat::zeros(frame.left_bgr.size(), CV_8U);
+    session.addView(frame);
     ViewEvent event;
     event.index = i;
     completion.onView(event);
   }
   // The view before the tag was seen had nothing to size; every later one was sized.
-  ASSERT_EQ(completion.history().size(), 2u);
+  ASSERT_EQ(completion.history().size(), 3u);
+  EXPECT_FALSE(completion.history().back().sized_any_image) << "it showed no fruitlet";
   EXPECT_EQ(int(completion.history().size()), clock.sizing_charges);
-  EXPECT_EQ(completion.history().back().view, 2);
+  EXPECT_EQ(completion.history().back().view, 3);
   EXPECT_FALSE(completion.history().back().fruitlets.empty());
-  for (const auto& snapshot : completion.history())
-    EXPECT_TRUE(snapshot.sized_images) << "view " << snapshot.view << " shows the cluster";
+  for (std::size_t k = 0; k + 1 < completion.history().size(); ++k)
+    EXPECT_TRUE(completion.history()[k].sized_any_image) << "snapshot " << k;
   EXPECT_GT(clock.sizing_s, 0.0);
   // Three views cannot show three quiet ones after the first sizing.
   EXPECT_FALSE(completion.done());

@@ -304,6 +304,7 @@ nlohmann::json sizeHistoryJson(const std::vector<host::nbv::SizingSnapshot>& his
     out.push_back({{"view", snapshot.view},
                    {"sim_time_s", snapshot.now_s - t0_s},
                    {"sizing_wall_s", snapshot.sizing_s},
+                   {"sized_any_image", snapshot.sized_any_image},
                    {"fruitlets", fruitlets},
                    {"match_percent", m.match_percent},
                    {"mae_mm", opt(m.mae_mm)},

@@ -87,7 +87,7 @@ void ClusterCompletion::onView(const ViewEvent& event) {
     return std::any_of(f.per_image.begin(), f.per_image.end(),
                        [&](const sizing::ImageSize& image) { return image.view == latest_view; });
   };
-  snapshot.sized_images =
+  snapshot.sized_any_image =
       std::any_of(sized.fruitlets.begin(), sized.fruitlets.end(), sizedByLatest) ||
       std::any_of(sized.unsupported.begin(), sized.unsupported.end(), sizedByLatest);
   for (const auto& f : sized.fruitlets) snapshot.fruitlets.push_back(snapshotOf(f, false));
@@ -139,21 +139,24 @@ bool partlySeen(const sizing::FruitletEstimate& detection,
   return true;
 }
 
-std::size_t discoveryWindow(const std::vector<SizingSnapshot>& history,
-                            const ClusterCompletionConfig& config) {
+namespace {
+
+/// discoveryWindow over the snapshots history points to.
+std::size_t discoveryWindowOf(const std::vector<const SizingSnapshot*>& history,
+                              const ClusterCompletionConfig& config) {
   const std::size_t least = std::size_t(config.stable_views) + 1;
-  if (history.size() < least || history.back().fruitlets.empty()) return 0;
+  if (history.size() < least || history.back()->fruitlets.empty()) return 0;
   if (config.min_stable_span_deg <= 0.0) return least;
   Eigen::Vector3d centroid_m = Eigen::Vector3d::Zero();
-  for (const auto& f : history.back().fruitlets) centroid_m += f.center_m;
-  centroid_m /= double(history.back().fruitlets.size());
+  for (const auto& f : history.back()->fruitlets) centroid_m += f.center_m;
+  centroid_m /= double(history.back()->fruitlets.size());
   const double min_cos = std::cos(config.min_stable_span_deg * M_PI / 180.0);
   // Every pair is compared once, when its later (older) snapshot joins the window.
   std::vector<Eigen::Vector3d> directions;
   bool spans = false;
   for (std::size_t n = 1; n <= history.size(); ++n) {
     const Eigen::Vector3d direction =
-        (history[history.size() - n].camera_position_m - centroid_m).normalized();
+        (history[history.size() - n]->camera_position_m - centroid_m).normalized();
     for (const auto& d : directions) spans = spans || d.dot(direction) <= min_cos;
     if (spans && n >= least) return n;
     directions.push_back(direction);
@@ -161,56 +164,76 @@ std::size_t discoveryWindow(const std::vector<SizingSnapshot>& history,
   return 0;
 }
 
-namespace {
+std::vector<const SizingSnapshot*> pointersTo(const std::vector<SizingSnapshot>& history) {
+  std::vector<const SizingSnapshot*> out;
+  for (const auto& s : history) out.push_back(&s);
+  return out;
+}
 
-bool settledOver(const std::vector<SizingSnapshot>& history, const ClusterCompletionConfig& config,
+/// Whether `earlier` holds the fruitlets of `latest`, one to one, with sizes within
+/// tolerance of the latest.
+bool sameSizes(const SizingSnapshot& latest, const SizingSnapshot& earlier,
+               const ClusterCompletionConfig& config) {
+  if (earlier.fruitlets.size() != latest.fruitlets.size()) return false;
+  std::vector<bool> taken(earlier.fruitlets.size(), false);
+  for (const auto& f : latest.fruitlets) {
+    std::optional<std::size_t> nearest;
+    double nearest_m = config.same_fruitlet_m;
+    for (std::size_t g = 0; g < earlier.fruitlets.size(); ++g)
+      if (const double d = (earlier.fruitlets[g].center_m - f.center_m).norm();
+          !taken[g] && d <= nearest_m)
+        nearest = g, nearest_m = d;
+    const double tolerance_mm = config.tolerate_standard_error
+                                    ? std::max(config.size_tolerance_mm, f.size_stderr_mm)
+                                    : config.size_tolerance_mm;
+    // A NaN size never agrees.
+    if (!nearest || !(std::abs(earlier.fruitlets[*nearest].size_mm - f.size_mm) <= tolerance_mm))
+      return false;
+    taken[*nearest] = true;
+  }
+  return true;
+}
+
+bool settledOver(const std::vector<const SizingSnapshot*>& history,
+                 const ClusterCompletionConfig& config,
                  const std::function<bool(const FruitletSnapshot&)>& released) {
   // A cluster with nothing sized is not done: its fruitlets are still to be found (the
   // budget ends a cluster that has none). discoveryWindow is 0 then.
-  const std::size_t window = discoveryWindow(history, config);
+  const std::size_t window = discoveryWindowOf(history, config);
   if (window == 0) return false;
-  const SizingSnapshot& latest = history.back();
+  const SizingSnapshot& latest = *history.back();
   for (const auto& f : latest.fruitlets)
     if (lacksEvidence(f, config) && !(released && released(f))) return false;
   for (std::size_t k = 1; k < window; ++k) {
-    const SizingSnapshot& earlier = history[history.size() - 1 - k];
-    // A fruitlet found or lost: the cluster is still changing.
-    if (earlier.fruitlets.size() != latest.fruitlets.size()) return false;
-    // Past the last stable_views + 1 only the count: early centres may sit a few mm off.
-    if (k > std::size_t(config.stable_views)) continue;
-    std::vector<bool> taken(earlier.fruitlets.size(), false);  // one-to-one
-    for (const auto& f : latest.fruitlets) {
-      std::optional<std::size_t> nearest;
-      double nearest_m = config.same_fruitlet_m;
-      for (std::size_t g = 0; g < earlier.fruitlets.size(); ++g)
-        if (const double d = (earlier.fruitlets[g].center_m - f.center_m).norm();
-            !taken[g] && d <= nearest_m)
-          nearest = g, nearest_m = d;
-      const double tolerance_mm = config.tolerate_standard_error
-                                      ? std::max(config.size_tolerance_mm, f.size_stderr_mm)
-                                      : config.size_tolerance_mm;
-      // A NaN size never agrees.
-      if (!nearest || !(std::abs(earlier.fruitlets[*nearest].size_mm - f.size_mm) <= tolerance_mm))
-        return false;
-      taken[*nearest] = true;
-    }
+    const SizingSnapshot& earlier = *history[history.size() - 1 - k];
+    // A fruitlet found or lost: the cluster is still changing. Past the last stable_views + 1
+    // only the count: early centres may sit a few mm off.
+    if (k > std::size_t(config.stable_views) ? earlier.fruitlets.size() != latest.fruitlets.size()
+                                             : !sameSizes(latest, earlier, config))
+      return false;
   }
   return true;
 }
 
 }  // namespace
 
+std::size_t discoveryWindow(const std::vector<SizingSnapshot>& history,
+                            const ClusterCompletionConfig& config) {
+  return discoveryWindowOf(pointersTo(history), config);
+}
+
 bool sizesSettled(const std::vector<SizingSnapshot>& history, const ClusterCompletionConfig& config,
                   const std::function<bool(const FruitletSnapshot&)>& released) {
-  // A view that sized nothing (its fruitlets all hidden behind leaves, or out of frame) did
+  // A view that sized no image (its fruitlets all hidden behind leaves, or out of frame) did
   // not look at the cluster: counted, it would let views that saw nothing stand for views
-  // that found nothing new.
-  const auto sized_nothing = [](const SizingSnapshot& s) { return !s.sized_images; };
-  if (std::none_of(history.begin(), history.end(), sized_nothing))
-    return settledOver(history, config, released);
-  std::vector<SizingSnapshot> looked;
-  std::copy_if(history.begin(), history.end(), std::back_inserter(looked),
-               [&](const SizingSnapshot& s) { return !sized_nothing(s); });
+  // that found nothing new. What it fused may still change the sizing (pixels too few to
+  // size, occupancy), so views after the last that sized an image must leave its sizes.
+  std::vector<const SizingSnapshot*> looked;
+  for (const auto& s : history)
+    if (s.sized_any_image) looked.push_back(&s);
+  if (looked.empty()) return false;
+  for (auto s = history.rbegin(); s != history.rend() && &*s != looked.back(); ++s)
+    if (!sameSizes(*s, *looked.back(), config)) return false;
   return settledOver(looked, config, released);
 }
 

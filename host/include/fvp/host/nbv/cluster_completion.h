@@ -129,7 +129,7 @@ struct SizingSnapshot {
   /// The view sized at least one image of some detection, kept or not. One that sized none
   /// (no fruitlet in its images, or every one hidden or cut off) shows nothing of the
   /// cluster: sizesSettled leaves it out rather than read it as a look that found nothing.
-  bool sized_images = true;
+  bool sized_any_image = true;
 };
 
 /// A loop observer that sizes the session's cluster after every view and a stop condition
@@ -203,7 +203,7 @@ std::size_t discoveryWindow(const std::vector<SizingSnapshot>& history,
 
 /// Whether the latest snapshots of history agree (the rule of done()): the same fruitlets
 /// over discoveryWindow, sizes within tolerance over the last config.stable_views + 1.
-/// Snapshots of views that sized no image (SizingSnapshot::sized_images) are left out.
+/// Snapshots of views that sized no image (SizingSnapshot::sized_any_image) are left out.
 /// `released` (optional): fruitlets that need not show the evidence.
 bool sizesSettled(const std::vector<SizingSnapshot>& history, const ClusterCompletionConfig& config,
                   const std::function<bool(const FruitletSnapshot&)>& released = {});
