@@ -163,6 +163,44 @@ TEST_P(MappingSessionRegistrationTest, DetectionsAreMovedByTheAnchorsOffset) {
   EXPECT_EQ(sized[true].points, sized[false].points);
 }
 
+TEST_F(MappingSessionTest, TheTsdfIsFusedAgainWhereThePoseGraphNowPlacesItsViews) {
+  // The untagged view first (fused as told once the tagged one places the region), then the
+  // tagged one, then the untagged one told 2 mm off: each solve moves the earlier views.
+  StereoFrame off = untagged();
+  off.T_world_camera.translation() += Eigen::Vector3d(0.002, -0.001, 0.0);
+  auto cpu = accel::createBackend(accel::BackendKind::kCpu);
+  for (const double beyond_m : {0.0, 1e-9, 1.0}) {
+    SCOPED_TRACE(beyond_m);
+    MappingSession session({}, "grid", map::MapConfig{}, cpu.get());
+    ViewRegistrationConfig config;
+    config.refuse_tsdf_beyond_m = beyond_m;
+    session.enableViewRegistration(config);
+    session.enableTsdf();
+    const StereoFrame* frames[] = {&untagged(), &tagged(), &off};
+    for (const StereoFrame* frame : frames) session.addView(*frame);
+    ASSERT_NE(session.poseGraph(), nullptr);
+    const ClusterPoseGraph& graph = *session.poseGraph();
+    const bool refused = beyond_m > 0.0 && beyond_m < 1e-3;
+    EXPECT_EQ(session.tsdfRefusions() > 0, refused);
+    EXPECT_FALSE(session.surfacePoints().empty());
+    // Fused again, every view is where the last solve places it; otherwise where it was
+    // first fused.
+    for (std::size_t k = 0; k < 3; ++k) {
+      const Eigen::Vector3d placed = session.sizingViews()[k].T_world_camera.translation() -
+                                     frames[k]->T_world_camera.translation();
+      if (refused) {
+        EXPECT_TRUE(placed.isApprox(graph.predictedPlacement(k), 1e-9)) << "view " << k;
+      } else if (k == 2) {
+        EXPECT_TRUE(placed.isApprox(graph.view(k).placement_m, 1e-12));
+      }
+    }
+  }
+  ViewRegistrationConfig bad;
+  bad.refuse_tsdf_beyond_m = -1.0;
+  MappingSession session({}, "grid", map::MapConfig{}, cpu.get());
+  EXPECT_THROW(session.enableViewRegistration(bad), std::invalid_argument);
+}
+
 TEST_F(MappingSessionTest, RegistrationIsEnabledBeforeTheFirstViewAndWithoutRotation) {
   auto cpu = accel::createBackend(accel::BackendKind::kCpu);
   MappingSession session({}, "grid", map::MapConfig{}, cpu.get());

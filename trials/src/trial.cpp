@@ -86,8 +86,10 @@ nlohmann::json anchorOffsetJson(const host::MappingSession& session,
       if (graph->estimate(k).disagrees) disagreeing.push_back(k);
       tag_views += graph->view(k).tag.has_value();
     }
-    j["pose_graph"] = {
-        {"views", graph->size()}, {"tag_views", tag_views}, {"disagreeing_views", disagreeing}};
+    j["pose_graph"] = {{"views", graph->size()},
+                       {"tag_views", tag_views},
+                       {"disagreeing_views", disagreeing},
+                       {"tsdf_refusions", session.tsdfRefusions()}};
   }
   if (true_anchor_error_m) {
     j["anchor_error_mm"] = 1000.0 * true_anchor_error_m->norm();

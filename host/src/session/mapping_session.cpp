@@ -1,5 +1,6 @@
 #include "fvp/host/session/mapping_session.h"
 
+#include <algorithm>
 #include <chrono>
 #include <stdexcept>
 
@@ -86,14 +87,15 @@ ViewResult MappingSession::addView(const StereoFrame& frame, PerceptionResult* p
     // region bounds the TSDF (views seen before the tag are fused when it is found).
     sizing_views_.push_back({perceived.fruitlet_mask, perceived.disparity.disparity_px,
                              frame.intrinsics, T_world_camera, perceived.fruitlet_instances});
+    sizing_view_index_.push_back(view.index);
     if (region_ && !tsdf_) {
-      const Eigen::Vector3d half = Eigen::Vector3d::Constant(region_->radius_m());
-      tsdf_ = std::make_unique<tsdf::TsdfVolume>(
-          *tsdf_config_,
-          Eigen::AlignedBox3d(region_->center_m() - half, region_->center_m() + half), backend_);
+      tsdf_ = newTsdf();
       for (std::size_t i = 0; i + 1 < sizing_views_.size(); ++i) integrateTsdf(i);
     }
-    if (tsdf_) views_.back().tsdf_s = integrateTsdf(sizing_views_.size() - 1);
+    if (tsdf_) {
+      views_.back().tsdf_s = integrateTsdf(sizing_views_.size() - 1);
+      views_.back().tsdf_s += refuseTsdfWhereViewsMoved();
+    }
   }
   if (perceived_out) *perceived_out = std::move(perceived);
   return views_.back();
@@ -188,6 +190,52 @@ double MappingSession::integrateTsdf(std::size_t sizing_view) {
   const sizing::SizingView& v = sizing_views_[sizing_view];
   const cv::Mat depth = tsdf::depthFromDisparity(v.disparity_px, v.intrinsics);
   return tsdf_->integrate(depth, v.fruitlet_mask, v.intrinsics, v.T_world_camera).seconds;
+}
+
+std::unique_ptr<tsdf::TsdfVolume> MappingSession::newTsdf() const {
+  const Eigen::Vector3d half = Eigen::Vector3d::Constant(region_->radius_m());
+  return std::make_unique<tsdf::TsdfVolume>(
+      *tsdf_config_, Eigen::AlignedBox3d(region_->center_m() - half, region_->center_m() + half),
+      backend_);
+}
+
+double MappingSession::refuseTsdfWhereViewsMoved() {
+  if (!tsdf_ || !pose_graph_ || !(registration_->config().refuse_tsdf_beyond_m > 0.0)) return 0.0;
+  // How far the graph now moves each fused view from where it was fused (placement_m: the
+  // translation its points were moved by, so T_world_camera = Trans(placement) * told).
+  std::vector<Eigen::Vector3d> placements(sizing_views_.size());
+  std::vector<Eigen::Vector3d> moved(sizing_views_.size());
+  Eigen::Vector3d mean_moved = Eigen::Vector3d::Zero();
+  std::size_t placed = 0;
+  for (std::size_t i = 0; i < sizing_views_.size(); ++i) {
+    const std::size_t k = sizing_view_index_[i];
+    if (!pose_graph_->view(k).placed) continue;
+    placements[i] = pose_graph_->predictedPlacement(k);
+    moved[i] = placements[i] - (sizing_views_[i].T_world_camera.translation() -
+                                views_[k].T_world_camera_told.translation());
+    mean_moved += moved[i];
+    ++placed;
+  }
+  if (placed < 2) return 0.0;
+  mean_moved /= double(placed);
+  // A shift common to every view moves the surface, not its shape, and the maps' frame
+  // error accounts for it: only views moved relative to the others blur it.
+  double most_m = 0.0;
+  for (std::size_t i = 0; i < sizing_views_.size(); ++i)
+    if (pose_graph_->view(sizing_view_index_[i]).placed)
+      most_m = std::max(most_m, (moved[i] - mean_moved).norm());
+  if (most_m <= registration_->config().refuse_tsdf_beyond_m) return 0.0;
+  const auto start = std::chrono::steady_clock::now();
+  tsdf_ = newTsdf();
+  for (std::size_t i = 0; i < sizing_views_.size(); ++i) {
+    const std::size_t k = sizing_view_index_[i];
+    if (pose_graph_->view(k).placed)
+      sizing_views_[i].T_world_camera =
+          Eigen::Translation3d(placements[i]) * views_[k].T_world_camera_told;
+    integrateTsdf(i);
+  }
+  ++tsdf_refusions_;
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 std::vector<Eigen::Vector3f> MappingSession::surfacePoints() const {

@@ -211,6 +211,9 @@ void ViewRegistrationConfig::validate() const {
   if (min_pairs < 3) throw std::invalid_argument("view registration: min_pairs must be at least 3");
   if (!(min_rms_reduction >= 0.0 && min_rms_reduction < 1.0))
     throw std::invalid_argument("view registration: min_rms_reduction must be in [0, 1)");
+  if (!(refuse_tsdf_beyond_m >= 0.0) || !std::isfinite(refuse_tsdf_beyond_m))
+    throw std::invalid_argument(
+        "view registration: refuse_tsdf_beyond_m must be 0 (off) or a positive distance");
   pose_graph.validate();
 }
 

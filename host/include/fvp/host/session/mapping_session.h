@@ -91,6 +91,8 @@ class MappingSession {
   /// The TSDF's zero level set as a mesh (marching cubes); empty while there is no TSDF.
   tsdf::TriangleMesh surfaceMesh() const;
   const std::vector<sizing::SizingView>& sizingViews() const { return sizing_views_; }
+  /// How often the TSDF was fused again (ViewRegistrationConfig::refuse_tsdf_beyond_m).
+  std::size_t tsdfRefusions() const { return tsdf_refusions_; }
   /// The sizing chain on the session's TSDF surface and views, keeping surface points in
   /// ROI-occupied fine voxels. Needs enableTsdf(); without a map no point is kept. With view
   /// registration and its correct_anchor_offset, the detections' positions (centres) are
@@ -140,8 +142,13 @@ class MappingSession {
   RegistrationResult registerView(std::size_t index, LabeledClouds& clouds);
   /// T_world_tag_ from the pose graph's estimate, when it has one.
   void refreshTagFromPoseGraph();
+  /// An empty TSDF over the Cluster Region's cube (the region must be known).
+  std::unique_ptr<tsdf::TsdfVolume> newTsdf() const;
   /// Fuses sizing_views_[i] into the TSDF; returns the seconds it took.
   double integrateTsdf(std::size_t sizing_view);
+  /// ViewRegistrationConfig::refuse_tsdf_beyond_m: fuses the TSDF again with every view
+  /// where the pose graph now places it, when one has moved that far; the seconds it took.
+  double refuseTsdfWhereViewsMoved();
 
   PerceptionPipeline perception_;
   std::string engine_;
@@ -159,6 +166,8 @@ class MappingSession {
   std::optional<ClusterPoseGraph> pose_graph_;
   std::unique_ptr<tsdf::TsdfVolume> tsdf_;
   std::vector<sizing::SizingView> sizing_views_;
+  std::vector<std::size_t> sizing_view_index_;  ///< the session view of each sizing view
+  std::size_t tsdf_refusions_ = 0;
 };
 
 }  // namespace fvp::host
