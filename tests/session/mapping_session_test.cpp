@@ -182,7 +182,32 @@ TEST_F(MappingSessionTest, TheTsdfIsFusedAgainWhereThePoseGraphNowPlacesItsViews
     const ClusterPoseGraph& graph = *session.poseGraph();
     const bool refused = beyond_m > 0.0 && beyond_m < 1e-3;
     EXPECT_EQ(session.tsdfRefusions() > 0, refused);
-    EXPECT_FALSE(session.surfacePoints().empty());
+    // Fused again or not, the TSDF is the views fused, in order, where the sizing views say
+    // they are: a TSDF built from scratch from them holds the same surface.
+    const map::GridGeometry& grid = session.tsdf()->geometry();
+    Eigen::Vector3d lo, hi;
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = double(grid.first_voxel[a]) * grid.voxel_size_m;
+      hi[a] = double(grid.first_voxel[a] + grid.dims[a]) * grid.voxel_size_m;
+    }
+    tsdf::TsdfVolume scratch(session.tsdf()->config(), Eigen::AlignedBox3d(lo, hi), cpu.get());
+    for (const auto& v : session.sizingViews())
+      scratch.integrate(tsdf::depthFromDisparity(v.disparity_px, v.intrinsics), v.fruitlet_mask,
+                        v.intrinsics, v.T_world_camera);
+    // Bricks may be allocated in another order: the same points, sorted.
+    const auto sortedPoints = [](std::vector<Eigen::Vector3f> points) {
+      std::sort(points.begin(), points.end(), [](const auto& a, const auto& b) {
+        return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+      });
+      return points;
+    };
+    const auto fused = sortedPoints(session.surfacePoints());
+    const auto expected = sortedPoints(scratch.extractSurfacePoints());
+    ASSERT_FALSE(fused.empty());
+    ASSERT_EQ(fused.size(), expected.size());
+    std::size_t apart = 0;
+    for (std::size_t i = 0; i < fused.size(); ++i) apart += (fused[i] - expected[i]).norm() > 1e-6f;
+    EXPECT_EQ(apart, 0u) << "of " << fused.size();
     // Fused again, every view is where the last solve places it; otherwise where it was
     // first fused.
     for (std::size_t k = 0; k < 3; ++k) {

@@ -44,7 +44,7 @@ void ClusterCompletion::onView(const ViewEvent& event) {
   if (!session_.tsdf()) return;  // no Cluster Region yet: nothing to size
   const auto start = std::chrono::steady_clock::now();
   // Compared over time in the maps' own frame: the anchor offset's estimate moves as views
-  // arrive, the maps do not.
+  // arrive, the maps' frame does not (a TSDF fused again keeps it).
   const sizing::SizingResult sized = session_.sizeFruitletsInMapFrame(sizing_config_);
   const double sizing_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -201,37 +201,28 @@ std::unique_ptr<tsdf::TsdfVolume> MappingSession::newTsdf() const {
 
 double MappingSession::refuseTsdfWhereViewsMoved() {
   if (!tsdf_ || !pose_graph_ || !(registration_->config().refuse_tsdf_beyond_m > 0.0)) return 0.0;
-  // How far the graph now moves each fused view from where it was fused (placement_m: the
-  // translation its points were moved by, so T_world_camera = Trans(placement) * told).
+  // The graph's placements average to the fused ones over all its views (predictedPlacement
+  // is e_k less the mean of e_j - C_j), so a TSDF of every view fused at them keeps the maps'
+  // frame. One enabled after the first view holds only some of them: left as fused.
+  if (sizing_views_.size() != views_.size()) return 0.0;
+  // How far the graph now moves each fused view from where it was fused (its placement: the
+  // translation its points were moved by, T_world_camera = Trans(placement) * told).
   std::vector<Eigen::Vector3d> placements(sizing_views_.size());
-  std::vector<Eigen::Vector3d> moved(sizing_views_.size());
-  Eigen::Vector3d mean_moved = Eigen::Vector3d::Zero();
-  std::size_t placed = 0;
+  double most_m = 0.0;
   for (std::size_t i = 0; i < sizing_views_.size(); ++i) {
     const std::size_t k = sizing_view_index_[i];
-    if (!pose_graph_->view(k).placed) continue;
+    if (!pose_graph_->view(k).placed) return 0.0;  // not before the region places them all
     placements[i] = pose_graph_->predictedPlacement(k);
-    moved[i] = placements[i] - (sizing_views_[i].T_world_camera.translation() -
-                                views_[k].T_world_camera_told.translation());
-    mean_moved += moved[i];
-    ++placed;
+    const Eigen::Vector3d fused_m =
+        sizing_views_[i].T_world_camera.translation() - views_[k].T_world_camera_told.translation();
+    most_m = std::max(most_m, (placements[i] - fused_m).norm());
   }
-  if (placed < 2) return 0.0;
-  mean_moved /= double(placed);
-  // A shift common to every view moves the surface, not its shape, and the maps' frame
-  // error accounts for it: only views moved relative to the others blur it.
-  double most_m = 0.0;
-  for (std::size_t i = 0; i < sizing_views_.size(); ++i)
-    if (pose_graph_->view(sizing_view_index_[i]).placed)
-      most_m = std::max(most_m, (moved[i] - mean_moved).norm());
   if (most_m <= registration_->config().refuse_tsdf_beyond_m) return 0.0;
   const auto start = std::chrono::steady_clock::now();
   tsdf_ = newTsdf();
   for (std::size_t i = 0; i < sizing_views_.size(); ++i) {
-    const std::size_t k = sizing_view_index_[i];
-    if (pose_graph_->view(k).placed)
-      sizing_views_[i].T_world_camera =
-          Eigen::Translation3d(placements[i]) * views_[k].T_world_camera_told;
+    sizing_views_[i].T_world_camera =
+        Eigen::Translation3d(placements[i]) * views_[sizing_view_index_[i]].T_world_camera_told;
     integrateTsdf(i);
   }
   ++tsdf_refusions_;

@@ -42,7 +42,9 @@ struct ViewResult {
   map::ScanStats scan;
   /// Earlier views this call integrated (the region became known with this view).
   std::size_t earlier_views_integrated = 0;
-  double tsdf_s = 0.0;  ///< TSDF integration of this view's ROI depth (0 without a TSDF)
+  /// TSDF integration of this view's ROI depth (0 without a TSDF), and of every view again
+  /// when this view's solve moved them (ViewRegistrationConfig::refuse_tsdf_beyond_m).
+  double tsdf_s = 0.0;
   /// With view registration on and the region known: the alignment tried for this view.
   std::optional<RegistrationResult> registration;
 };
