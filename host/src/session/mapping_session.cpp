@@ -87,7 +87,6 @@ ViewResult MappingSession::addView(const StereoFrame& frame, PerceptionResult* p
     // region bounds the TSDF (views seen before the tag are fused when it is found).
     sizing_views_.push_back({perceived.fruitlet_mask, perceived.disparity.disparity_px,
                              frame.intrinsics, T_world_camera, perceived.fruitlet_instances});
-    sizing_view_index_.push_back(view.index);
     if (region_ && !tsdf_) {
       tsdf_ = newTsdf();
       for (std::size_t i = 0; i + 1 < sizing_views_.size(); ++i) integrateTsdf(i);
@@ -203,18 +202,18 @@ double MappingSession::refuseTsdfWhereViewsMoved() {
   if (!tsdf_ || !pose_graph_ || !(registration_->config().refuse_tsdf_beyond_m > 0.0)) return 0.0;
   // The graph's placements average to the fused ones over all its views (predictedPlacement
   // is e_k less the mean of e_j - C_j), so a TSDF of every view fused at them keeps the maps'
-  // frame. One enabled after the first view holds only some of them: left as fused.
+  // frame. One enabled after the first view holds only some of them: left as fused. Past
+  // this check sizing view i is session view i.
   if (sizing_views_.size() != views_.size()) return 0.0;
   // How far the graph now moves each fused view from where it was fused (its placement: the
   // translation its points were moved by, T_world_camera = Trans(placement) * told).
   std::vector<Eigen::Vector3d> placements(sizing_views_.size());
   double most_m = 0.0;
   for (std::size_t i = 0; i < sizing_views_.size(); ++i) {
-    const std::size_t k = sizing_view_index_[i];
-    if (!pose_graph_->view(k).placed) return 0.0;  // not before the region places them all
-    placements[i] = pose_graph_->predictedPlacement(k);
+    if (!pose_graph_->view(i).placed) return 0.0;  // not before the region places them all
+    placements[i] = pose_graph_->predictedPlacement(i);
     const Eigen::Vector3d fused_m =
-        sizing_views_[i].T_world_camera.translation() - views_[k].T_world_camera_told.translation();
+        sizing_views_[i].T_world_camera.translation() - views_[i].T_world_camera_told.translation();
     most_m = std::max(most_m, (placements[i] - fused_m).norm());
   }
   if (most_m <= registration_->config().refuse_tsdf_beyond_m) return 0.0;
@@ -222,7 +221,7 @@ double MappingSession::refuseTsdfWhereViewsMoved() {
   tsdf_ = newTsdf();
   for (std::size_t i = 0; i < sizing_views_.size(); ++i) {
     sizing_views_[i].T_world_camera =
-        Eigen::Translation3d(placements[i]) * views_[sizing_view_index_[i]].T_world_camera_told;
+        Eigen::Translation3d(placements[i]) * views_[i].T_world_camera_told;
     integrateTsdf(i);
   }
   ++tsdf_refusions_;

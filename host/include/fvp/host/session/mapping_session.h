@@ -168,7 +168,6 @@ class MappingSession {
   std::optional<ClusterPoseGraph> pose_graph_;
   std::unique_ptr<tsdf::TsdfVolume> tsdf_;
   std::vector<sizing::SizingView> sizing_views_;
-  std::vector<std::size_t> sizing_view_index_;  ///< the session view of each sizing view
   std::size_t tsdf_refusions_ = 0;
 };
 

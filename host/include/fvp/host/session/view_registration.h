@@ -58,9 +58,8 @@ struct ViewRegistrationConfig {
   /// With the pose graph: once the graph, solved after a view, moves an earlier view's
   /// placement by more than this since the view was fused into the TSDF, the TSDF is fused
   /// again from every view where the graph now places it (its time charged as the view's
-  /// TSDF time). A view fused a millimetre off its neighbours blurs
-  /// the fruitlet's surface, and its sphere's centre with it. 0: off (each view stays where
-  /// it was first fused).
+  /// TSDF time). A view fused a millimetre off its neighbours blurs the fruitlet's surface,
+  /// and its sphere's centre with it. 0: off (each view stays where it was first fused).
   double refuse_tsdf_beyond_m = 0.00025;
 
   /// Throws std::invalid_argument naming the bad field.
