@@ -10,14 +10,15 @@
 // match the world's fruitlets (each within 1 mm, its centre inside it), and every backend
 // ranks the same best view and gives the same sizes and centres as the cpu backend, bit for
 // bit (the determinism contract, docs/kernels.md). Counters: each stage's milliseconds
-// (of_which_stereo_ms is part of perception_ms). Not in it: the arm's obstacle update and
-// goal checks (the arm's work, BM_MotionPlan), and later sampling rounds when round 0 ranks
-// nothing worth a move.
+// (of_which_stereo_ms is part of perception_ms, planning_<stage>_ms of planning_ms). Not in it: the
+// arm's obstacle update and goal checks (the arm's work, BM_MotionPlan), and later sampling rounds
+// when round 0 ranks nothing worth a move.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -74,6 +75,7 @@ const Workload& workload() {
 struct ViewOutcome {
   double perception_s = 0, stereo_s = 0, mapping_s = 0, tsdf_s = 0, session_other_s = 0;
   double sizing_s = 0, guidance_s = 0, planning_s = 0;
+  std::map<std::string, double> planning_stages_s;  ///< PlanStep::timings_s by name
   std::optional<Eigen::Isometry3d> best_view;
   std::vector<double> sizes_mm;
   std::vector<Eigen::Vector3d> centers_m;
@@ -125,6 +127,7 @@ struct ViewLoop {
     const auto ranking =
         work->planner->rank(*work->session->map(), frame.T_world_camera, all, 0, step);
     out.planning_s = secondsSince(t_plan);
+    for (const auto& [name, seconds] : step.timings_s) out.planning_stages_s[name] += seconds;
     if (ranking && !ranking->order.empty())
       out.best_view = ranking->candidates[ranking->order.front()].T_world_camera;
     for (const host::nbv::FruitletSnapshot& f : completion->history().back().fruitlets) {
@@ -193,6 +196,8 @@ void reportStages(benchmark::State& state, const ViewOutcome& sum, std::size_t f
   state.counters["sizing_ms"] = sum.sizing_s * ms_per_view;
   state.counters["guidance_ms"] = sum.guidance_s * ms_per_view;
   state.counters["planning_ms"] = sum.planning_s * ms_per_view;
+  for (const auto& [name, seconds] : sum.planning_stages_s)
+    state.counters["planning_" + name + "_ms"] = seconds * ms_per_view;
   state.counters["fruitlets_sized"] = double(fruitlets);
 }
 
@@ -217,6 +222,8 @@ void BM_View(benchmark::State& state, accel::BackendKind kind) {
       sum.sizing_s += view.sizing_s;
       sum.guidance_s += view.guidance_s;
       sum.planning_s += view.planning_s;
+      for (const auto& [name, seconds] : view.planning_stages_s)
+        sum.planning_stages_s[name] += seconds;
     }
     if (!same) throw std::runtime_error("the best view or the sizes differ from the cpu's");
     reportStages(state, sum, reference.sizes_mm.size());
