@@ -79,6 +79,17 @@ struct ViewOutcome {
   std::optional<Eigen::Isometry3d> best_view;
   std::vector<double> sizes_mm;
   std::vector<Eigen::Vector3d> centers_m;
+  void addTimes(const ViewOutcome& o) {
+    perception_s += o.perception_s;
+    stereo_s += o.stereo_s;
+    mapping_s += o.mapping_s;
+    tsdf_s += o.tsdf_s;
+    session_other_s += o.session_other_s;
+    sizing_s += o.sizing_s;
+    guidance_s += o.guidance_s;
+    planning_s += o.planning_s;
+    for (const auto& [name, seconds] : o.planning_stages_s) planning_stages_s[name] += seconds;
+  }
   /// Stereo matching is part of perception, so it is not added again.
   double total_s() const {
     return perception_s + mapping_s + tsdf_s + session_other_s + sizing_s + guidance_s + planning_s;
@@ -214,16 +225,7 @@ void BM_View(benchmark::State& state, accel::BackendKind kind) {
       const ViewOutcome view = runView(setup, options);
       state.SetIterationTime(view.total_s());
       same = same && sameOutcome(view, reference);
-      sum.perception_s += view.perception_s;
-      sum.stereo_s += view.stereo_s;
-      sum.mapping_s += view.mapping_s;
-      sum.tsdf_s += view.tsdf_s;
-      sum.session_other_s += view.session_other_s;
-      sum.sizing_s += view.sizing_s;
-      sum.guidance_s += view.guidance_s;
-      sum.planning_s += view.planning_s;
-      for (const auto& [name, seconds] : view.planning_stages_s)
-        sum.planning_stages_s[name] += seconds;
+      sum.addTimes(view);
     }
     if (!same) throw std::runtime_error("the best view or the sizes differ from the cpu's");
     reportStages(state, sum, reference.sizes_mm.size());
