@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "bench_common.h"
+#include "fvp/accel/backend_choice.h"
 #include "fvp/host/nbv/cluster_completion.h"
 #include "fvp/host/nbv/loop_clock.h"
 #include "fvp/host/nbv/nbv_setup.h"
@@ -160,9 +161,7 @@ ViewOutcome runView(NbvSetup& setup, const NbvSetupOptions& options) {
 
 NbvSetupOptions optionsFor(accel::BackendKind kind) {
   NbvSetupOptions options;
-  options.backend = kind == accel::BackendKind::kCpu      ? accel::BackendChoice::kCpu
-                    : kind == accel::BackendKind::kOpenCl ? accel::BackendChoice::kOpenCl
-                                                          : accel::BackendChoice::kVulkan;
+  options.backend = *accel::parseBackendChoice(accel::toString(kind));  // the same names
   return options;
 }
 
