@@ -7,12 +7,13 @@
 // 1, six views on a 120 degree orbit rendered once; each iteration starts a fresh cluster,
 // takes the first five views untimed (so the planner's snapshot is refreshed incrementally,
 // as in a trial) and times the sixth. Checks: the cpu backend's sizes after the six views
-// match the world's fruitlets (each within 1 mm, its centre inside it), and every backend
-// ranks the same best view and gives the same sizes and centres as the cpu backend, bit for
-// bit (the determinism contract, docs/kernels.md). Counters: each stage's milliseconds
-// (of_which_stereo_ms is part of perception_ms, planning_<stage>_ms of planning_ms). Not in it: the
-// arm's obstacle update and goal checks (the arm's work, BM_MotionPlan), and later sampling rounds
-// when round 0 ranks nothing worth a move.
+// match the world's fruitlets (one to one as the trials score them, each within 1 mm, its
+// centre inside it), and every backend ranks the same best view and gives the same sizes and
+// centres as the cpu backend, bit for bit (the determinism contract, docs/kernels.md).
+// Counters: each stage's milliseconds (of_which_stereo_ms is part of perception_ms,
+// planning_<stage>_ms of planning_ms). Not in it: the arm's obstacle update and goal checks
+// (the arm's work, BM_MotionPlan), and later sampling rounds when round 0 ranks nothing
+// worth a move.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -27,6 +28,7 @@
 
 #include "bench_common.h"
 #include "fvp/accel/backend_choice.h"
+#include "fvp/host/eval/fruitlet_matching.h"
 #include "fvp/host/nbv/cluster_completion.h"
 #include "fvp/host/nbv/loop_clock.h"
 #include "fvp/host/nbv/nbv_setup.h"
@@ -165,16 +167,19 @@ NbvSetupOptions optionsFor(accel::BackendKind kind) {
   return options;
 }
 
-/// Every world fruitlet has a sized fruitlet whose centre lies inside it and whose size is
-/// within kSizeToleranceMm of its own (empty: so).
+/// Every world fruitlet matched to a sized one as the trials score them (one to one,
+/// eval::matchFruitlets), the sized centre inside the fruitlet and its size within
+/// kSizeToleranceMm of the truth (empty: so).
 std::string checkAgainstTruth(const ViewOutcome& cpu) {
-  for (const robot::sim::Fruitlet& f : workload().world.fruitlets()) {
-    bool found = false;
-    for (std::size_t i = 0; i < cpu.sizes_mm.size(); ++i)
-      found = found || ((cpu.centers_m[i] - f.center_m).norm() < f.radius_m &&
-                        std::abs(cpu.sizes_mm[i] - f.gtSizeMm()) <= kSizeToleranceMm);
-    if (!found)
-      return "fruitlet " + std::to_string(f.index) + " not sized within " +
+  const std::vector<robot::sim::Fruitlet>& truth = workload().world.fruitlets();
+  std::vector<Eigen::Vector3d> truth_centers_m;
+  for (const robot::sim::Fruitlet& f : truth) truth_centers_m.push_back(f.center_m);
+  const std::vector<int> match = host::eval::matchFruitlets(cpu.centers_m, truth_centers_m);
+  for (std::size_t g = 0; g < truth.size(); ++g) {
+    const int d = match[g];
+    if (d < 0 || (cpu.centers_m[d] - truth[g].center_m).norm() >= truth[g].radius_m ||
+        std::abs(cpu.sizes_mm[d] - truth[g].gtSizeMm()) > kSizeToleranceMm)
+      return "fruitlet " + std::to_string(truth[g].index) + " not sized within " +
              std::to_string(kSizeToleranceMm) + " mm";
   }
   return {};
