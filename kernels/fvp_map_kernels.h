@@ -75,7 +75,7 @@ typedef struct fvp_edt_params {
   int radius_vox; /* the cap: distances beyond it read as the cap */
   unsigned int slot_count;
   int axis; /* the pass: 0 seeds from the ROI channel, 1 and 2 read the previous pass */
-  /* Bricks the pass computes (work item i: voxel i % 512 of brick work_bricks[i / 512]):
+  /* Bricks the pass computes (work item i: line i % 64 of brick work_bricks[i / 64]):
    * those closer than the radius to a brick holding ROI. The host fills every other slot's
    * pass values with FVP_EDT_FAR and its distance with the cap. */
   unsigned int work_brick_count;
@@ -183,50 +183,6 @@ FVP_FN void fvp_scan_update_item(const fvp_update_params* p, unsigned int item,
   FVP_FLAG(&changed_bricks[first / FVP_BRICK_VOXELS]);
 }
 
-/* One term of a pass's minimum: the squared distance through the voxel k steps along the
- * pass's axis, FVP_EDT_FAR where there is none. */
-FVP_FN unsigned int fvp_edt_term(const fvp_edt_params* p, int x, int y, int z, int k,
-                                 FVP_GLOBAL const int* table, FVP_GLOBAL const float* roi,
-                                 FVP_GLOBAL const unsigned int* sq_in) {
-  int axis = p->axis;
-  int nx = x + (axis == 0 ? k : 0), ny = y + (axis == 1 ? k : 0), nz = z + (axis == 2 ? k : 0);
-  int slot;
-  unsigned int v;
-  if (nx < 0 || ny < 0 || nz < 0 || nx >= p->map.grid.dim_x || ny >= p->map.grid.dim_y ||
-      nz >= p->map.grid.dim_z)
-    return FVP_EDT_FAR;
-  slot = fvp_slot(&p->map, table, nx, ny, nz);
-  if (slot < 0) return FVP_EDT_FAR;
-  if (axis == 0) {
-    if (!(roi[slot] > 0.0f)) return FVP_EDT_FAR; /* NaN (unknown) fails too */
-    v = 0u;
-  } else {
-    v = sq_in[slot];
-    if (v == FVP_EDT_FAR) return FVP_EDT_FAR;
-  }
-  return v + (unsigned int)(k * k);
-}
-
-/* ROI distance field, one separable pass for one voxel (exact squared Euclidean distance
- * within the cap radius; Felzenszwalb-style min-plus over a window). axis 0 seeds from
- * the ROI log-odds (known ROI: roi > 0); axes 1 and 2 read the previous pass. */
-/* The minimum over k in [-radius, radius] of the terms, nearest k first: every term at
- * |k| = d is at least d^2, so the scan stops once d^2 reaches the best found (the same
- * minimum). */
-FVP_FN unsigned int fvp_edt_pass_voxel(const fvp_edt_params* p, int x, int y, int z,
-                                       FVP_GLOBAL const int* table, FVP_GLOBAL const float* roi,
-                                       FVP_GLOBAL const unsigned int* sq_in) {
-  unsigned int best = fvp_edt_term(p, x, y, z, 0, table, roi, sq_in), v;
-  int d;
-  for (d = 1; d <= p->radius_vox && (unsigned int)(d * d) < best; ++d) {
-    v = fvp_edt_term(p, x, y, z, -d, table, roi, sq_in);
-    if (v < best) best = v;
-    v = fvp_edt_term(p, x, y, z, d, table, roi, sq_in);
-    if (v < best) best = v;
-  }
-  return best;
-}
-
 /* Distance in voxels from a squared distance, capped at the radius; correctly rounded
  * (fvp_exact.h), since the gain's weights are read from it. */
 FVP_FN float fvp_edt_distance_vox(unsigned int sq, int radius_vox) {
@@ -234,11 +190,90 @@ FVP_FN float fvp_edt_distance_vox(unsigned int sq, int radius_vox) {
   return fvp_sqrt_rn((float)sq);
 }
 
-FVP_FN int fvp_voxel_unknown(const fvp_bricked_grid* m, FVP_GLOBAL const int* table,
-                             FVP_GLOBAL const float* occupancy, int x, int y, int z) {
-  int slot = fvp_slot(m, table, x, y, z);
-  if (slot < 0) return 1;
-  return occupancy[slot] != occupancy[slot];
+/* The value a pass reads at the voxel of slot `slot`: 0 on known ROI (axis 0; NaN, unknown,
+ * fails the test), the previous pass's squared distance otherwise; FVP_EDT_FAR for none. */
+FVP_FN unsigned int fvp_edt_source(const fvp_edt_params* p, int slot, FVP_GLOBAL const float* roi,
+                                   FVP_GLOBAL const unsigned int* sq_in) {
+  if (p->axis == 0) return roi[slot] > 0.0f ? 0u : FVP_EDT_FAR;
+  return sq_in[slot];
+}
+
+/* ROI distance field, one separable pass over one line of a work brick: the 8 voxels along
+ * p->axis sharing the other two in-brick coordinates (exact squared Euclidean distance within
+ * the cap radius; Felzenszwalb-style min-plus over a window). Voxel j's value is the minimum
+ * over |k| <= radius of source(j + k) + k^2. Each source voxel of the line's window is read
+ * once, its brick's table entry once per brick, and relaxes every output it reaches: the
+ * same minimum as a voxel-by-voxel scan at a fraction of the reads. */
+FVP_FN void fvp_roi_distance_line(const fvp_edt_params* p, unsigned int item,
+                                  FVP_GLOBAL const int* brick_coords, FVP_GLOBAL const int* table,
+                                  FVP_GLOBAL const float* roi, FVP_GLOBAL const unsigned int* sq_in,
+                                  FVP_GLOBAL unsigned int* sq_out, FVP_GLOBAL float* distance_vox,
+                                  FVP_GLOBAL const unsigned int* work_bricks) {
+  unsigned int brick = work_bricks[item / 64u], line = item % 64u, best[FVP_BRICK_EDGE], v;
+  int c[3], first_local[3], stride, radius = p->radius_vox, axis = p->axis;
+  int reach = (radius + FVP_BRICK_EDGE - 1) / FVP_BRICK_EDGE, bricks_along, nb, t, j, k, entry;
+  int in_brick0, slot;
+  c[0] = brick_coords[3 * brick + 0];
+  c[1] = brick_coords[3 * brick + 1];
+  c[2] = brick_coords[3 * brick + 2];
+  /* The line's two fixed in-brick coordinates, in axis order without the pass's axis. */
+  first_local[0] = axis == 0 ? 0 : (int)(line & 7u);
+  first_local[1] = axis == 1 ? 0 : (axis == 0 ? (int)(line & 7u) : (int)(line >> 3));
+  first_local[2] = axis == 2 ? 0 : (int)(line >> 3);
+  stride = axis == 0 ? 1 : (axis == 1 ? FVP_BRICK_EDGE : FVP_BRICK_EDGE * FVP_BRICK_EDGE);
+  in_brick0 = fvp_local_of(first_local[0], first_local[1], first_local[2]);
+  bricks_along = axis == 0 ? p->map.bricks_x : (axis == 1 ? p->map.bricks_y : p->map.bricks_z);
+  for (j = 0; j < FVP_BRICK_EDGE; ++j) best[j] = FVP_EDT_FAR;
+  for (nb = -reach; nb <= reach; ++nb) {
+    int n[3];
+    n[0] = c[0];
+    n[1] = c[1];
+    n[2] = c[2];
+    n[axis] += nb;
+    if (n[axis] < 0 || n[axis] >= bricks_along) continue; /* outside the grid: none */
+    entry = table[n[0] + p->map.bricks_x * (n[1] + p->map.bricks_y * n[2])];
+    if (entry < 0) continue; /* unallocated: none */
+    for (t = 0; t < FVP_BRICK_EDGE; ++t) {
+      int s = nb * FVP_BRICK_EDGE + t; /* the source's offset from the line's first voxel */
+      if (s < -radius || s > FVP_BRICK_EDGE - 1 + radius) continue;
+      v = fvp_edt_source(p, fvp_slot_of_entry(entry, in_brick0 + t * stride), roi, sq_in);
+      if (v == FVP_EDT_FAR) continue;
+      for (j = 0; j < FVP_BRICK_EDGE; ++j) {
+        k = s - j;
+        if (k < -radius || k > radius) continue;
+        if (v + (unsigned int)(k * k) < best[j]) best[j] = v + (unsigned int)(k * k);
+      }
+    }
+  }
+  for (j = 0; j < FVP_BRICK_EDGE; ++j) {
+    slot = (int)brick * FVP_BRICK_VOXELS + in_brick0 + j * stride;
+    if (axis < 2)
+      sq_out[slot] = best[j];
+    else
+      distance_vox[slot] = fvp_edt_distance_vox(best[j], radius);
+  }
+}
+
+/* A neighbour's part in a frontier test: -1 outside the mapped region (ignored), 1 unknown,
+ * 0 known. A neighbour in the voxel's own brick reuses its table entry, and one in a brick
+ * flagged inside the region skips the sphere test (every voxel of such a brick passes it):
+ * the same answer as fvp_in_map and fvp_slot, with fewer reads. */
+FVP_FN int fvp_neighbour_unknown(const fvp_bricked_grid* m, FVP_GLOBAL const int* table,
+                                 FVP_GLOBAL const float* occupancy, int own_brick, int own_entry,
+                                 int nx, int ny, int nz) {
+  int brick, entry;
+  float occ;
+  if (nx < 0 || ny < 0 || nz < 0 || nx >= m->grid.dim_x || ny >= m->grid.dim_y ||
+      nz >= m->grid.dim_z)
+    return -1;
+  brick = fvp_brick_of(m, nx, ny, nz);
+  entry = brick == own_brick ? own_entry : table[brick];
+  if (m->use_region && !(entry >= 0 && (entry & FVP_BRICK_INSIDE)) &&
+      !fvp_region_contains(&m->region, nx, ny, nz))
+    return -1;
+  if (entry < 0) return 1;
+  occ = occupancy[fvp_slot_of_entry(entry, fvp_local_of(nx, ny, nz))];
+  return occ != occ;
 }
 
 /* Frontier classification of one voxel; returns FVP_FRONTIER_* flags and, for
@@ -248,35 +283,42 @@ FVP_FN unsigned int fvp_frontier_voxel(const fvp_frontier_params* p, int x, int 
                                        FVP_GLOBAL const int* table,
                                        FVP_GLOBAL const float* occupancy,
                                        FVP_GLOBAL const float* roi, int* normal) {
-  int slot, dx, dy, dz, face_unknown = 0;
+  int slot, a, dx, dy, dz, face_unknown = 0, own_brick, own_entry;
   unsigned int flags = 0;
   float occ;
   int is_roi, is_free;
   normal[0] = normal[1] = normal[2] = 0;
   if (!fvp_in_map(&p->map, x, y, z)) return 0;
-  slot = fvp_slot(&p->map, table, x, y, z);
-  if (slot < 0) return 0;
+  own_brick = fvp_brick_of(&p->map, x, y, z);
+  own_entry = table[own_brick];
+  if (own_entry < 0) return 0;
+  slot = fvp_slot_of_entry(own_entry, fvp_local_of(x, y, z));
   occ = occupancy[slot];
   if (occ != occ) return 0; /* unknown voxels are not frontiers */
   is_roi = roi[slot] > 0.0f;
   is_free = !(occ > p->occupied_logodds);
   if (!is_roi && !is_free) return 0;
+  /* A frontier needs an unknown face neighbour: most voxels have none, and are settled by
+   * their 6 faces before the 26 neighbours that make the normal are read. */
+  for (a = 0; a < 6 && !face_unknown; ++a) {
+    int step = (a & 1) ? 1 : -1;
+    face_unknown =
+        fvp_neighbour_unknown(&p->map, table, occupancy, own_brick, own_entry,
+                              x + ((a >> 1) == 0 ? step : 0), y + ((a >> 1) == 1 ? step : 0),
+                              z + ((a >> 1) == 2 ? step : 0)) == 1;
+  }
+  if (!face_unknown) return 0;
   for (dz = -1; dz <= 1; ++dz)
     for (dy = -1; dy <= 1; ++dy)
       for (dx = -1; dx <= 1; ++dx) {
-        int nx = x + dx, ny = y + dy, nz = z + dz;
-        int manhattan = (dx != 0) + (dy != 0) + (dz != 0);
-        if (manhattan == 0 || !fvp_in_map(&p->map, nx, ny, nz)) continue;
-        if (!fvp_voxel_unknown(&p->map, table, occupancy, nx, ny, nz)) continue;
-        if (manhattan == 1) face_unknown = 1;
+        if (dx == 0 && dy == 0 && dz == 0) continue;
+        if (fvp_neighbour_unknown(&p->map, table, occupancy, own_brick, own_entry, x + dx, y + dy,
+                                  z + dz) != 1)
+          continue;
         normal[0] -= dx;
         normal[1] -= dy;
         normal[2] -= dz;
       }
-  if (!face_unknown) {
-    normal[0] = normal[1] = normal[2] = 0;
-    return 0;
-  }
   if (is_roi) flags |= FVP_FRONTIER_ROI;
   if (is_free) flags |= FVP_FRONTIER_EXPLORE;
   return flags;
@@ -304,27 +346,6 @@ FVP_FN void fvp_frontier_append(const fvp_frontier_params* p, int x, int y, int 
   f.normal_z = normal[2];
   f.pad = 0;
   frontiers[index] = f;
-}
-
-/* Slot of work item i of a pass over a list of bricks (allocation indices). */
-FVP_FN unsigned int fvp_work_slot(FVP_GLOBAL const unsigned int* work_bricks, unsigned int i) {
-  return work_bricks[i / FVP_BRICK_VOXELS] * FVP_BRICK_VOXELS + i % FVP_BRICK_VOXELS;
-}
-
-/* One ROI distance pass (p->axis) for one slot: axes 0 and 1 write the squared distance
- * to sq_out, axis 2 the capped distance in voxels to distance_vox. */
-FVP_FN void fvp_roi_distance_slot(const fvp_edt_params* p, unsigned int slot,
-                                  FVP_GLOBAL const int* brick_coords, FVP_GLOBAL const int* table,
-                                  FVP_GLOBAL const float* roi, FVP_GLOBAL const unsigned int* sq_in,
-                                  FVP_GLOBAL unsigned int* sq_out, FVP_GLOBAL float* distance_vox) {
-  int x, y, z;
-  unsigned int best;
-  fvp_slot_voxel(brick_coords, slot, &x, &y, &z);
-  best = fvp_edt_pass_voxel(p, x, y, z, table, roi, sq_in);
-  if (p->axis < 2)
-    sq_out[slot] = best;
-  else
-    distance_vox[slot] = fvp_edt_distance_vox(best, p->radius_vox);
 }
 
 #endif /* FVP_MAP_KERNELS_H */

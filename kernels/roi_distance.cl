@@ -1,7 +1,7 @@
 // ROI distance field (paper Eq. 1's d_i): exact Euclidean distance in voxels from every
 // allocated voxel to the nearest known ROI voxel, capped at radius_vox. Three separable
 // passes (p.axis = 0, 1, 2) of a windowed min-plus transform over the bricks near ROI (one
-// work item per voxel of work_bricks); body in fvp_map_kernels.h.
+// work item per line of 8 voxels along the axis in work_bricks); body in fvp_map_kernels.h.
 #include "fvp_map_kernels.h"
 
 __kernel void fvp_roi_distance(const fvp_edt_params p, const uint item_count,
@@ -11,6 +11,6 @@ __kernel void fvp_roi_distance(const fvp_edt_params p, const uint item_count,
                                __global const uint* work_bricks) {
   const uint i = get_global_id(0);
   if (i >= item_count) return;
-  fvp_roi_distance_slot(&p, fvp_work_slot(work_bricks, i), brick_coords, brick_table, roi, sq_in,
-                        sq_out, distance_vox);
+  fvp_roi_distance_line(&p, i, brick_coords, brick_table, roi, sq_in, sq_out, distance_vox,
+                        work_bricks);
 }

@@ -148,78 +148,102 @@ void fvp_scan_update_item(FvpUpdateParams p, uint item) {
     defined(FVP_HAS_BRICK_COORDS) && defined(FVP_HAS_SQ_OUT) && defined(FVP_HAS_DISTANCE_VOX) && \
     !defined(FVP_EDT_GLSL)
 #define FVP_EDT_GLSL
-uint fvp_edt_term(FvpEdtParams p, int x, int y, int z, int k) {
-  ivec3 n = ivec3(x, y, z);
-  n[p.axis] += k;
-  if (n.x < 0 || n.y < 0 || n.z < 0 || n.x >= p.map.grid.dim_x || n.y >= p.map.grid.dim_y ||
-      n.z >= p.map.grid.dim_z)
-    return FVP_EDT_FAR;
-  int slot = fvp_slot(p.map, n.x, n.y, n.z);
-  if (slot < 0) return FVP_EDT_FAR;
-  uint v;
+// fvp_map_kernels.h's twin: one line of 8 voxels of a work brick along the pass's axis, each
+// source voxel of the window read once and relaxing every output it reaches.
+uint fvp_edt_source(FvpEdtParams p, int slot) {
   if (p.axis == 0) {
     float r = roi[slot];
-    if (fvp_is_nan(r) || !(r > 0.0)) return FVP_EDT_FAR;
-    v = 0u;
-  } else {
-    v = sq_in[slot];
-    if (v == FVP_EDT_FAR) return FVP_EDT_FAR;
+    return (fvp_is_nan(r) || !(r > 0.0)) ? FVP_EDT_FAR : 0u;
   }
-  return v + uint(k * k);
+  return sq_in[slot];
 }
 
-uint fvp_edt_pass_voxel(FvpEdtParams p, int x, int y, int z) {
-  uint best = fvp_edt_term(p, x, y, z, 0);
-  for (int d = 1; d <= p.radius_vox && uint(d * d) < best; ++d) {
-    best = min(best, fvp_edt_term(p, x, y, z, -d));
-    best = min(best, fvp_edt_term(p, x, y, z, d));
+void fvp_roi_distance_line(FvpEdtParams p, uint item) {
+  uint brick = work_bricks[item / 64u], line = item % 64u;
+  int axis = p.axis, radius = p.radius_vox;
+  int reach = (radius + FVP_BRICK_EDGE - 1) / FVP_BRICK_EDGE;
+  ivec3 c = ivec3(brick_coords[3 * brick + 0], brick_coords[3 * brick + 1],
+                  brick_coords[3 * brick + 2]);
+  ivec3 first_local = ivec3(axis == 0 ? 0 : int(line & 7u),
+                            axis == 1 ? 0 : (axis == 0 ? int(line & 7u) : int(line >> 3)),
+                            axis == 2 ? 0 : int(line >> 3));
+  int stride = axis == 0 ? 1 : (axis == 1 ? FVP_BRICK_EDGE : FVP_BRICK_EDGE * FVP_BRICK_EDGE);
+  int in_brick0 = fvp_local_of(first_local.x, first_local.y, first_local.z);
+  int bricks_along = axis == 0 ? p.map.bricks_x : (axis == 1 ? p.map.bricks_y : p.map.bricks_z);
+  uint best[FVP_BRICK_EDGE];
+  for (int j = 0; j < FVP_BRICK_EDGE; ++j) best[j] = FVP_EDT_FAR;
+  for (int nb = -reach; nb <= reach; ++nb) {
+    ivec3 n = c;
+    n[axis] += nb;
+    if (n[axis] < 0 || n[axis] >= bricks_along) continue;
+    int entry = brick_table[n.x + p.map.bricks_x * (n.y + p.map.bricks_y * n.z)];
+    if (entry < 0) continue;
+    for (int t = 0; t < FVP_BRICK_EDGE; ++t) {
+      int s = nb * FVP_BRICK_EDGE + t;
+      if (s < -radius || s > FVP_BRICK_EDGE - 1 + radius) continue;
+      uint v = fvp_edt_source(p, fvp_slot_of_entry(entry, in_brick0 + t * stride));
+      if (v == FVP_EDT_FAR) continue;
+      for (int j = 0; j < FVP_BRICK_EDGE; ++j) {
+        int k = s - j;
+        if (k < -radius || k > radius) continue;
+        best[j] = min(best[j], v + uint(k * k));
+      }
+    }
   }
-  return best;
-}
-
-void fvp_roi_distance_slot(FvpEdtParams p, uint slot) {
-  int x, y, z;
-  fvp_slot_voxel(slot, x, y, z);
-  uint best = fvp_edt_pass_voxel(p, x, y, z);
-  if (p.axis < 2) sq_out[slot] = best;
-  else distance_vox[slot] = fvp_edt_distance_vox(best, p.radius_vox);
+  for (int j = 0; j < FVP_BRICK_EDGE; ++j) {
+    int slot = int(brick) * FVP_BRICK_VOXELS + in_brick0 + j * stride;
+    if (axis < 2) sq_out[slot] = best[j];
+    else distance_vox[slot] = fvp_edt_distance_vox(best[j], radius);
+  }
 }
 #endif
 
 #if defined(FVP_HAS_BRICK_TABLE) && defined(FVP_HAS_OCCUPANCY) && defined(FVP_HAS_ROI) && \
     defined(FVP_HAS_FRONTIERS) && defined(FVP_HAS_COUNT) && !defined(FVP_FRONTIER_GLSL)
 #define FVP_FRONTIER_GLSL
-bool fvp_voxel_unknown(FvpBrickedGrid m, int x, int y, int z) {
-  int slot = fvp_slot(m, x, y, z);
-  if (slot < 0) return true;
-  return fvp_is_nan(occupancy[slot]);
+// fvp_map_kernels.h's twin: -1 outside the mapped region, 1 unknown, 0 known.
+int fvp_neighbour_unknown(FvpBrickedGrid m, int own_brick, int own_entry, int nx, int ny, int nz) {
+  if (nx < 0 || ny < 0 || nz < 0 || nx >= m.grid.dim_x || ny >= m.grid.dim_y ||
+      nz >= m.grid.dim_z)
+    return -1;
+  int brick = fvp_brick_of(m, nx, ny, nz);
+  int entry = brick == own_brick ? own_entry : brick_table[brick];
+  if (m.use_region != 0 && !(entry >= 0 && (entry & FVP_BRICK_INSIDE) != 0) &&
+      !fvp_region_contains(m.region, nx, ny, nz))
+    return -1;
+  if (entry < 0) return 1;
+  return fvp_is_nan(occupancy[fvp_slot_of_entry(entry, fvp_local_of(nx, ny, nz))]) ? 1 : 0;
 }
 
 uint fvp_frontier_voxel(FvpFrontierParams p, int x, int y, int z, out ivec3 normal) {
   normal = ivec3(0);
   if (!fvp_in_map(p.map, x, y, z)) return 0u;
-  int slot = fvp_slot(p.map, x, y, z);
-  if (slot < 0) return 0u;
+  int own_brick = fvp_brick_of(p.map, x, y, z);
+  int own_entry = brick_table[own_brick];
+  if (own_entry < 0) return 0u;
+  int slot = fvp_slot_of_entry(own_entry, fvp_local_of(x, y, z));
   float occ = occupancy[slot];
   if (fvp_is_nan(occ)) return 0u;  // unknown voxels are not frontiers
   float roi_value = roi[slot];
   bool is_roi = !fvp_is_nan(roi_value) && roi_value > 0.0;
   bool is_free = !(occ > p.occupied_logodds);
   if (!is_roi && !is_free) return 0u;
+  // fvp_map_kernels.h's order: the 6 faces settle most voxels, then the 26 make the normal.
   bool face_unknown = false;
+  for (int a = 0; a < 6 && !face_unknown; ++a) {
+    ivec3 n = ivec3(x, y, z);
+    n[a >> 1] += (a & 1) != 0 ? 1 : -1;
+    face_unknown = fvp_neighbour_unknown(p.map, own_brick, own_entry, n.x, n.y, n.z) == 1;
+  }
+  if (!face_unknown) return 0u;
   for (int dz = -1; dz <= 1; ++dz)
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
-        int manhattan = int(dx != 0) + int(dy != 0) + int(dz != 0);
-        if (manhattan == 0 || !fvp_in_map(p.map, x + dx, y + dy, z + dz)) continue;
-        if (!fvp_voxel_unknown(p.map, x + dx, y + dy, z + dz)) continue;
-        if (manhattan == 1) face_unknown = true;
+        if ((dx == 0 && dy == 0 && dz == 0) ||
+            fvp_neighbour_unknown(p.map, own_brick, own_entry, x + dx, y + dy, z + dz) != 1)
+          continue;
         normal -= ivec3(dx, dy, dz);
       }
-  if (!face_unknown) {
-    normal = ivec3(0);
-    return 0u;
-  }
   return (is_roi ? FVP_FRONTIER_ROI : 0u) | (is_free ? FVP_FRONTIER_EXPLORE : 0u);
 }
 

@@ -27,7 +27,5 @@ layout(std430, set = 0, binding = 6) readonly buffer WorkBricks { uint work_bric
 void main() {
   uint i = FVP_ITEM_INDEX;
   if (i >= FVP_ITEM_COUNT) return;
-  uint slot = work_bricks[i / uint(FVP_BRICK_VOXELS)] * uint(FVP_BRICK_VOXELS) +
-              i % uint(FVP_BRICK_VOXELS);
-  fvp_roi_distance_slot(fvp_params.p, slot);
+  fvp_roi_distance_line(fvp_params.p, i);
 }

@@ -314,10 +314,13 @@ TEST_P(GridEngineBackends, RoiDistanceFieldEqualsBruteForce) {
   const std::vector<float> roi = randomRoi(g, {0, 0, 0}, g.dims, 12, rng, &roi_voxels);
   OccupancyLayer grid(*backend_, g, true, std::nullopt, BrickAllocation::kUpFront);
   grid.assignDense(std::vector<float>(roi.size(), -0.4f), roi);
-  const int radius = 9;
   RoiDistanceField field(grid);
-  field.compute(radius);
-  expectDistancesEqualBruteForce(field, g, roi_voxels, radius);
+  // Windows inside one brick, reaching into the next and spanning three bricks each way.
+  for (const int radius : {1, 9, 20}) {
+    SCOPED_TRACE("radius " + std::to_string(radius));
+    field.compute(radius);
+    expectDistancesEqualBruteForce(field, g, roi_voxels, radius);
+  }
 }
 
 // The passes run only over bricks within the radius of ROI bricks; the rest must read the

@@ -11,6 +11,9 @@ namespace {
 
 using detail::paramsOf;
 
+// One work item per line of a brick along the pass's axis (fvp_roi_distance_line).
+constexpr std::uint32_t kLinesPerBrick = kBrickVoxels / kBrickEdge;
+
 const EdtParams& edt(const void* p) {
   return paramsOf<EdtParams>(p);
 }
@@ -41,8 +44,8 @@ void cpuLoop(const void* p, void* const* buffers, std::uint32_t count) {
   const auto* work_bricks = static_cast<const std::uint32_t*>(buffers[6]);
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < count; ++i)
-    fvp_roi_distance_slot(&params, fvp_work_slot(work_bricks, static_cast<unsigned>(i)), coords,
-                          table, roi, sq_in, sq_out, distance);
+    fvp_roi_distance_line(&params, static_cast<unsigned>(i), coords, table, roi, sq_in, sq_out,
+                          distance, work_bricks);
 }
 
 constexpr KernelBinding kBindings[] = {
@@ -66,7 +69,7 @@ const KernelDescriptor kDescriptor{
     "roi_distance",
     sizeof(EdtParams),
     kBindings,
-    [](const void* p) { return edt(p).work_brick_count * kBrickVoxels; },
+    [](const void* p) { return edt(p).work_brick_count * kLinesPerBrick; },
     validate,
     cpuLoop,
     FVP_OPENCL_CODE(roi_distance, "fvp_roi_distance"),

@@ -78,7 +78,8 @@ void RoiDistanceField::compute(int radius_vox) {
   // distance the cap, filled here. Most of a Cluster Region is far from every fruitlet.
   std::vector<std::uint32_t> work;
   for (std::size_t id = 0; id < near.size(); ++id)
-    if (near[id]) work.push_back(static_cast<std::uint32_t>(bricks.table()[id]));
+    if (near[id])
+      work.push_back(static_cast<std::uint32_t>(bricks.table()[id] & FVP_BRICK_INDEX_MASK));
   accel::Backend& backend = bricks.backend();
   const std::size_t slots = bricks.slotCount();
   backend.upload(distanceVox(), std::vector<float>(slots, float(radius_vox)).data(),

@@ -24,10 +24,11 @@ Kernel<ScanParams> scanMark();
 /// changed_bricks (slot_count / 512 uint: set to 1 for each brick with an updated voxel).
 Kernel<UpdateParams> scanUpdate();
 
-/// One pass (params.axis) of the ROI distance field (fvp_roi_distance_slot): one item per
-/// voxel of the work bricks. Bindings: brick_coords (3 int per brick), brick_table, roi
-/// (axis 0), sq_in (axes 1 and 2), sq_out (axes 0 and 1) as slot_count uint, distance_vox
-/// (axis 2, slot_count float), work_bricks (work_brick_count uint allocation indices).
+/// One pass (params.axis) of the ROI distance field (fvp_roi_distance_line): one item per
+/// line of 8 voxels along the axis in the work bricks (64 a brick). Bindings: brick_coords (3 int
+/// per brick), brick_table, roi (axis 0), sq_in (axes 1 and 2), sq_out (axes 0 and 1) as slot_count
+/// uint, distance_vox (axis 2, slot_count float), work_bricks (work_brick_count uint allocation
+/// indices).
 Kernel<EdtParams> roiDistance();
 
 /// Frontier extraction (fvp_frontier_append): one item per slot. Bindings: brick_coords,
