@@ -14,6 +14,7 @@
 #define FVP_BRICK_SHIFT 3
 #define FVP_BRICK_EDGE 8
 #define FVP_BRICK_VOXELS 512
+#define FVP_BRICK_LINES 64 /* lines of 8 voxels along one axis in a brick */
 #define FVP_NO_BRICK (-1)
 /* Brick table entries: the allocation index, plus this flag on bricks whose voxels all
  * lie inside the region (with a margin), so walks skip the per-voxel sphere test there. */

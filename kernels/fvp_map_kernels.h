@@ -209,7 +209,8 @@ FVP_FN void fvp_roi_distance_line(const fvp_edt_params* p, unsigned int item,
                                   FVP_GLOBAL const float* roi, FVP_GLOBAL const unsigned int* sq_in,
                                   FVP_GLOBAL unsigned int* sq_out, FVP_GLOBAL float* distance_vox,
                                   FVP_GLOBAL const unsigned int* work_bricks) {
-  unsigned int brick = work_bricks[item / 64u], line = item % 64u, best[FVP_BRICK_EDGE], v;
+  unsigned int brick = work_bricks[item / FVP_BRICK_LINES], line = item % FVP_BRICK_LINES,
+               best[FVP_BRICK_EDGE], v;
   int c[3], first_local[3], stride, radius = p->radius_vox, axis = p->axis;
   int reach = (radius + FVP_BRICK_EDGE - 1) / FVP_BRICK_EDGE, bricks_along, nb, t, j, k, entry;
   int in_brick0, slot;

@@ -7,6 +7,7 @@
 const int FVP_BRICK_SHIFT = 3;
 const int FVP_BRICK_EDGE = 8;
 const int FVP_BRICK_VOXELS = 512;
+const int FVP_BRICK_LINES = 64;
 const int FVP_BRICK_INSIDE = 0x40000000;
 const int FVP_BRICK_INDEX_MASK = 0x3fffffff;
 const int FVP_NO_BRICK = -1;

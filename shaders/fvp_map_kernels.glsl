@@ -159,7 +159,7 @@ uint fvp_edt_source(FvpEdtParams p, int slot) {
 }
 
 void fvp_roi_distance_line(FvpEdtParams p, uint item) {
-  uint brick = work_bricks[item / 64u], line = item % 64u;
+  uint brick = work_bricks[item / uint(FVP_BRICK_LINES)], line = item % uint(FVP_BRICK_LINES);
   int axis = p.axis, radius = p.radius_vox;
   int reach = (radius + FVP_BRICK_EDGE - 1) / FVP_BRICK_EDGE;
   ivec3 c = ivec3(brick_coords[3 * brick + 0], brick_coords[3 * brick + 1],

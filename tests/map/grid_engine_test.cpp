@@ -315,7 +315,7 @@ TEST_P(GridEngineBackends, RoiDistanceFieldEqualsBruteForce) {
   OccupancyLayer grid(*backend_, g, true, std::nullopt, BrickAllocation::kUpFront);
   grid.assignDense(std::vector<float>(roi.size(), -0.4f), roi);
   RoiDistanceField field(grid);
-  // Windows inside one brick, reaching into the next and spanning three bricks each way.
+  // Windows reaching one, two and three bricks each way.
   for (const int radius : {1, 9, 20}) {
     SCOPED_TRACE("radius " + std::to_string(radius));
     field.compute(radius);

@@ -12,7 +12,8 @@ namespace {
 using detail::paramsOf;
 
 // One work item per line of a brick along the pass's axis (fvp_roi_distance_line).
-constexpr std::uint32_t kLinesPerBrick = kBrickVoxels / kBrickEdge;
+constexpr std::uint32_t kLinesPerBrick = FVP_BRICK_LINES;
+static_assert(kLinesPerBrick * kBrickEdge == kBrickVoxels);
 
 const EdtParams& edt(const void* p) {
   return paramsOf<EdtParams>(p);
