@@ -10,7 +10,8 @@
 // match the world's fruitlets (one to one as the trials score them, each within 1 mm, its
 // centre inside it), and every backend ranks the same best view and gives the same sizes and
 // centres as the cpu backend, bit for bit (the determinism contract, docs/kernels.md).
-// Counters: each stage's milliseconds (of_which_stereo_ms is part of perception_ms,
+// BM_View/cpu/disparity_window: the cpu's with stereo's disparity window (its outcome checked
+// against the truth only). Counters: each stage's milliseconds (of_which_stereo_ms is part of perception_ms,
 // planning_<stage>_ms of planning_ms). Not in it: the arm's obstacle update and goal checks
 // (the arm's work, BM_MotionPlan), and later sampling rounds when round 0 ranks nothing
 // worth a move.
@@ -216,9 +217,13 @@ void reportStages(benchmark::State& state, const ViewOutcome& sum, std::size_t f
   state.counters["fruitlets_sized"] = double(fruitlets);
 }
 
-void BM_View(benchmark::State& state, accel::BackendKind kind) {
+// disparity_window: stereo's fine pass over the Cluster Region's disparities and nearer
+// (NbvSetupOptions::disparity_window): its own outcome, checked against the truth, since
+// its disparities are not the whole range's.
+void BM_View(benchmark::State& state, accel::BackendKind kind, bool disparity_window) {
   try {
-    const NbvSetupOptions options = optionsFor(kind);
+    NbvSetupOptions options = optionsFor(kind);
+    options.disparity_window = disparity_window;
     NbvSetup setup(options);  // an unavailable backend throws here: skipped with its reason
     const ViewOutcome& reference = cpuReference();
     if (const std::string wrong = checkAgainstTruth(reference); !wrong.empty())
@@ -228,7 +233,12 @@ void BM_View(benchmark::State& state, accel::BackendKind kind) {
     for (auto _ : state) {
       const ViewOutcome view = runView(setup, options);
       state.SetIterationTime(view.total_s());
-      same = same && sameOutcome(view, reference);
+      if (disparity_window) {
+        if (const std::string wrong = checkAgainstTruth(view); !wrong.empty())
+          throw std::runtime_error("with the disparity window: " + wrong);
+      } else {
+        same = same && sameOutcome(view, reference);
+      }
       sum.addTimes(view);
     }
     if (!same) throw std::runtime_error("the best view or the sizes differ from the cpu's");
@@ -242,11 +252,16 @@ void registerAll() {
   for (accel::BackendKind kind :
        {accel::BackendKind::kCpu, accel::BackendKind::kOpenCl, accel::BackendKind::kVulkan}) {
     const std::string name = "BM_View/" + std::string(accel::toString(kind));
-    benchmark::RegisterBenchmark(name.c_str(), BM_View, kind)
+    benchmark::RegisterBenchmark(name.c_str(), BM_View, kind, false)
         ->Iterations(5)
         ->UseManualTime()
         ->Unit(benchmark::kMillisecond);
   }
+  benchmark::RegisterBenchmark("BM_View/cpu/disparity_window", BM_View, accel::BackendKind::kCpu,
+                               true)
+      ->Iterations(5)
+      ->UseManualTime()
+      ->Unit(benchmark::kMillisecond);
 }
 
 const bool kRegistered = (registerAll(), true);

@@ -190,6 +190,85 @@ TEST(StereoMatcher, BandAndCoarsePassesMatchTheFullPass) {
             << band.stats.sgbm_s * 1e3 << " ms\n";
 }
 
+// The fine pass searched over a window of disparities (a Cluster Region's depth span): inside
+// the window the same disparities as the whole range, and what lies outside it (a leaf in
+// front, the background behind) keeps the coarse pass's value instead of a wrong fine one.
+TEST(StereoMatcher, WindowedBandMatchesTheFullRangeAndKeepsWhatLiesOutside) {
+  const StereoIntrinsics K = smallCamera();
+  const cv::Rect band(480, 30, 300, 180);
+  const cv::Rect fruit(500, 40, 220, 150), leaf(700, 60, 70, 100);
+  // The leaf is listed with the larger disparity, so it covers the fruit where they overlap.
+  const auto pair = test::makeStereoPair(K, 90.0, {{fruit, 183.3}, {leaf, 262.0}}, 2.0, 29);
+  const DisparityResult full = StereoMatcher().compute(pair.left, pair.right, band);
+  const DisparityWindow window{170, 200};
+  const DisparityResult windowed =
+      StereoMatcher().compute(pair.left, pair.right, band, window);
+  EXPECT_EQ(windowed.stats.fine_samples, band.area());
+  EXPECT_GT(windowed.stats.window_from_coarse, 0);
+
+  // The fruit away from its edges and from where the leaf hides it in the right image (left
+  // columns 438 + 183 .. 508 + 183): the same as the whole range.
+  const cv::Rect fruit_inner(fruit.x + 6, fruit.y + 6, 110, fruit.height - 12);
+  const cv::Mat a = full.disparity_px(fruit_inner), b = windowed.disparity_px(fruit_inner);
+  const long both = cv::countNonZero((a > 0) & (b > 0));
+  EXPECT_GT(both, fruit_inner.area() * 0.95);
+  EXPECT_GT(cv::countNonZero((a > 0) & (b > 0) & (cv::abs(a - b) <= 0.25)), both * 0.97);
+
+  // Outside the window: the leaf (in front) and the background (behind) inside the band are
+  // within the coarse pass's precision of the truth, and nothing of them lands in the window.
+  for (const cv::Rect& outside : {cv::Rect(leaf.x + 6, leaf.y + 6, leaf.width - 12, 88),
+                                  cv::Rect(band.x + 4, fruit.br().y + 4, band.width - 8, 12)}) {
+    const cv::Mat d = windowed.disparity_px(outside);
+    const cv::Mat truth = pair.disparity_px(outside);
+    const long valid = cv::countNonZero(d > 0);
+    const long close = cv::countNonZero((d > 0) & (cv::abs(d - truth) <= 2.0));
+    const long in_window = cv::countNonZero((d >= window.min_px) & (d <= window.max_px));
+    std::cout << "[ measured ] outside the window at " << truth.at<float>(0, 0) << " px: "
+              << valid << " of " << outside.area() << " valid, " << close << " within 2 px, "
+              << in_window << " in the window\n";
+    EXPECT_GT(valid, outside.area() * 0.8);
+    EXPECT_GT(close, valid * 0.95);
+    EXPECT_EQ(in_window, 0);
+  }
+  std::cout << "[ measured ] band " << band.width << "x" << band.height << ": whole range "
+            << full.stats.sgbm_s * 1e3 << " ms, window of " << window.max_px - window.min_px + 1
+            << " px " << windowed.stats.sgbm_s * 1e3 << " ms (both with the coarse pass)\n";
+}
+
+// A window as wide as the range, or one on an image with no coarse pass, searches the whole
+// range: the result is the plain band's, bit for bit.
+TEST(StereoMatcher, WindowAsWideAsTheRangeChangesNothing) {
+  const StereoIntrinsics K = smallCamera();
+  const cv::Rect band(520, 40, 220, 150);
+  const auto pair = test::makeStereoPair(K, 90.0, {{band, 183.3}}, 2.0, 31);
+  const cv::Mat plain = StereoMatcher().compute(pair.left, pair.right, band).disparity_px;
+  const cv::Mat wide =
+      StereoMatcher().compute(pair.left, pair.right, band, DisparityWindow{-5, 400}).disparity_px;
+  EXPECT_EQ(cv::countNonZero(plain != wide), 0);
+  StereoMatcherConfig one_pass;
+  one_pass.coarse_scale = 1;
+  const cv::Mat a = StereoMatcher(one_pass).compute(pair.left, pair.right, {}).disparity_px;
+  const cv::Mat b = StereoMatcher(one_pass)
+                        .compute(pair.left, pair.right, {}, DisparityWindow{170, 200})
+                        .disparity_px;
+  EXPECT_EQ(cv::countNonZero(a != b), 0);
+}
+
+// A band near the image's left edge: the right image cannot be shifted by the whole window
+// start. The window's search reaches columns from 170 - 8 + 32 on (the whole range's only
+// from 320): there, where the coarse pass is blind, the fine values stand.
+TEST(StereoMatcher, WindowedBandNearTheLeftEdge) {
+  const StereoIntrinsics K = smallCamera();
+  const cv::Rect band(150, 40, 250, 150);
+  const auto pair = test::makeStereoPair(K, 90.0, {{band, 183.3}}, 2.0, 37);
+  const DisparityResult r =
+      StereoMatcher().compute(pair.left, pair.right, band, DisparityWindow{170, 200});
+  const cv::Mat matched = r.disparity_px(cv::Rect(210, 50, 180, 130));
+  EXPECT_GT(cv::countNonZero(cv::abs(matched - 183.3) <= 0.5), matched.total() * 0.95);
+  EXPECT_EQ(cv::countNonZero(r.disparity_px(cv::Rect(150, 40, 40, 150))), 0);
+  EXPECT_GT(r.stats.blind_band, 0);
+}
+
 // A trial must be reproducible on any machine: the disparities may not depend on how many
 // cores split the work.
 TEST(StereoMatcher, DisparityIsTheSameForEveryThreadCount) {

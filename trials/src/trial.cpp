@@ -398,6 +398,7 @@ host::nbv::NbvSetupOptions setupOptions(const TrialOptions& o) {
   s.stop.completion.confirm_detections = o.confirm_detections;
   s.stop.completion.seek_partly_seen = o.seek_partly_seen;
   s.stop.completion.release_left_out = o.release_left_out;
+  s.disparity_window = o.disparity_window;
   s.loop.view_overhead_s = o.view_overhead_s;
   return s;
 }

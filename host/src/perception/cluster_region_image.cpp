@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace fvp::host {
 
@@ -37,6 +38,19 @@ cv::Rect clusterRegionImageBounds(const ClusterRegion& region, const StereoIntri
   const int y0 = static_cast<int>(std::floor(px(ky0, K.fy_px, K.cy_px)));
   const int y1 = static_cast<int>(std::ceil(px(ky1, K.fy_px, K.cy_px))) + 1;
   return cv::Rect(cv::Point(x0, y0), cv::Point(x1, y1)) & image;
+}
+
+std::optional<DisparityWindow> clusterRegionDisparityWindow(const ClusterRegion& region,
+                                                            const StereoIntrinsics& K,
+                                                            const Eigen::Isometry3d& T_world_camera,
+                                                            double depth_margin_m, int pad_px) {
+  const double z = (T_world_camera.inverse() * region.center_m()).z();
+  const double farthest = z + region.radius_m() + depth_margin_m;
+  if (!(farthest > 0.0)) return std::nullopt;
+  DisparityWindow w;
+  w.min_px = static_cast<int>(std::floor(K.fx_px * K.baseline_m / farthest)) - pad_px;
+  w.max_px = std::numeric_limits<int>::max();
+  return w;
 }
 
 }  // namespace fvp::host

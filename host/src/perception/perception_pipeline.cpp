@@ -23,6 +23,8 @@ void PerceptionConfig::validate() const {
   region.validate();
   if (band_margin_px < 0)
     throw std::invalid_argument("perception config: band_margin_px: expected >= 0");
+  if (!(window_depth_margin_m >= 0.0))
+    throw std::invalid_argument("perception config: window_depth_margin_m: expected >= 0");
   if (!(projection.max_depth_m > projection.min_depth_m))
     throw std::invalid_argument(
         "perception config: projection: expected min_depth_m < max_depth_m");
@@ -87,8 +89,14 @@ PerceptionResult PerceptionPipeline::process(
   // Full resolution where the fine map and the TSDF need it: the Cluster Region's image
   // rectangle; without a region (no tag yet), around every segmented fruitlet pixel.
   cv::Rect fine;
+  std::optional<DisparityWindow> window;
   if (result.region) {
     fine = clusterRegionImageBounds(*result.region, K, frame.T_world_camera);
+    // The window's low edge is rejected as saturated: pad past it.
+    if (config_.disparity_window)
+      window = clusterRegionDisparityWindow(*result.region, K, frame.T_world_camera,
+                                            config_.window_depth_margin_m,
+                                            config_.stereo.sgbm.saturation_margin_px + 1);
   } else {
     fine = cv::boundingRect(result.fruitlet_mask);
   }
@@ -106,7 +114,7 @@ PerceptionResult PerceptionPipeline::process(
     result.disparity.coarse_scale = 1;
     result.disparity.stats.fine_samples = static_cast<std::int64_t>(frame.disparity_px.total());
   } else {
-    result.disparity = matcher_.compute(frame.left_bgr, frame.right_bgr, fine);
+    result.disparity = matcher_.compute(frame.left_bgr, frame.right_bgr, fine, window);
   }
   grid.full_res_rect = result.disparity.fine_rect;
   grid.coarse_step = result.disparity.coarse_scale;
@@ -121,6 +129,8 @@ PerceptionResult PerceptionPipeline::process(
   st.saturated = ds.saturated;
   st.blind_band = ds.blind_band;
   st.no_signal = ds.no_signal;
+  st.outside_window = ds.outside_window;
+  st.window_from_coarse = ds.window_from_coarse;
   st.sgbm_s = ds.sgbm_s;
   st.segmentation_s = timing.segmentation_s;
   st.tag_s = timing.tag_s;

@@ -22,9 +22,15 @@ void fail(const std::string& where, const std::string& field, const std::string&
   throw std::invalid_argument(where + ": " + field + ": expected " + expected);
 }
 
-// Raw SGBM (CV_16S fixed point) of a (sub)image pair -> classified CV_32F codes. `x0` is the
-// column of the pair in the full image of this resolution (only x < blind width is blind).
-cv::Mat sgbmCodes(const cv::Mat& left, const cv::Mat& right, const SgbmConfig& c, int x0) {
+constexpr float kCodeOutsideWindow = -5.0f;
+
+// Raw SGBM (CV_16S fixed point) of a (sub)image pair -> classified CV_32F codes. The right
+// image starts `shift_px` columns left of the left one, so a found disparity is SGBM's plus
+// shift_px. `x0` is the column of the pair in the full image of this resolution, less the
+// shift (only x < blind width is blind). cut_below / cut_above: that end of the search is a
+// window's, not the range's, so a disparity at it is an object outside the window.
+cv::Mat sgbmCodes(const cv::Mat& left, const cv::Mat& right, const SgbmConfig& c, int x0,
+                  int shift_px = 0, bool cut_below = false, bool cut_above = false) {
   auto sgbm = cv::StereoSGBM::create(c.min_disparity, c.num_disparities, c.block_size, c.p1, c.p2,
                                      c.disp12_max_diff, c.pre_filter_cap, c.uniqueness_ratio,
                                      c.speckle_window_size, c.speckle_range, c.mode);
@@ -48,6 +54,8 @@ cv::Mat sgbmCodes(const cv::Mat& left, const cv::Mat& right, const SgbmConfig& c
   const int invalid_below = c.min_disparity * 16;
   const float saturated_from =
       static_cast<float>(c.min_disparity + c.num_disparities - c.saturation_margin_px);
+  const float below_window = static_cast<float>(c.min_disparity + c.saturation_margin_px);
+  const float top_code = cut_above ? kCodeOutsideWindow : kCodeSaturated;
   const int blind_cols = c.min_disparity + c.num_disparities;
   for (int v = 0; v < raw.rows; ++v) {
     const auto* r = raw.ptr<short>(v);
@@ -62,11 +70,61 @@ cv::Mat sgbmCodes(const cv::Mat& left, const cv::Mat& right, const SgbmConfig& c
         out[u] = kCodeInvalid;
       } else {
         const float d = r[u] / 16.0f;
-        out[u] = d >= saturated_from ? kCodeSaturated : d;
+        if (d >= saturated_from)
+          out[u] = top_code;
+        else if (cut_below && d < below_window)
+          out[u] = kCodeOutsideWindow;
+        else
+          out[u] = d + static_cast<float>(shift_px);
       }
     }
   }
   return codes;
+}
+
+// The fine pass's search: the configured range, or a window of it reached through a
+// right image shifted by `shift_px`; its strips span columns [x0, x1) of both images.
+struct FineSearch {
+  SgbmConfig sgbm;
+  bool windowed = false;
+  bool cut_below = false, cut_above = false;  ///< the window ends inside the range
+  int lo_px = 0, hi_px = 0;                   ///< the searched full disparities (windowed only)
+  int shift_px = 0;
+  int x0 = 0, x1 = 0;
+};
+
+FineSearch planFineSearch(const SgbmConfig& range, std::optional<DisparityWindow> window,
+                          cv::Rect fine_rect, int image_width) {
+  FineSearch f;
+  f.sgbm = range;
+  // Left of the band, the columns its search reaches; right of it too: the left-right check
+  // compares each pixel with left pixels up to the search's width to its right, and a
+  // right-to-left path aggregates from there.
+  const int margin = range.block_size + 2;
+  const int range_hi = range.min_disparity + range.num_disparities - 1;
+  const int reach = range.min_disparity + range.num_disparities;
+  if (window && window->max_px >= window->min_px) {
+    int lo = std::max(window->min_px, range.min_disparity);
+    const int hi = std::min(window->max_px, range_hi);
+    const int num = (hi - lo + 1 + 15) / 16 * 16;
+    if (hi >= lo && num < range.num_disparities) {
+      lo = std::clamp(lo - (num - (hi - lo + 1)) / 2, range.min_disparity, range_hi + 1 - num);
+      f.windowed = true;
+      f.lo_px = lo;
+      f.hi_px = lo + num - 1;
+      f.cut_below = lo > range.min_disparity;
+      f.cut_above = f.hi_px < range_hi;
+      f.x0 = std::max(0, fine_rect.x - num - margin);
+      f.shift_px = std::min(lo, f.x0);  // the right image's columns start at x0 - shift
+      f.sgbm.min_disparity = lo - f.shift_px;
+      f.sgbm.num_disparities = num;
+      f.x1 = std::min(image_width, fine_rect.br().x + num + margin);
+      return f;
+    }
+  }
+  f.x0 = std::max(0, fine_rect.x - reach - margin);
+  f.x1 = std::min(image_width, fine_rect.br().x + reach + margin);
+  return f;
 }
 
 // Row strips [begin, end) of n roughly equal parts.
@@ -100,7 +158,67 @@ inline float classify(float code, float scale, PerceptionStats& s) {
     ++s.no_signal;
     return 0.0f;
   }
+  if (code == kCodeOutsideWindow) {
+    ++s.outside_window;
+    return 0.0f;
+  }
   return code * scale;
+}
+
+// A windowed fine sample checked against the coarse pass, which searched the whole range.
+// It stands where a valid coarse sample within one coarse pixel agrees with it (to within
+// the coarse pass's precision: one coarse pixel, plus one), or where the coarse pass has
+// nothing to say; where the coarse pass places the pixel outside the window, the coarse
+// value replaces it: SGBM forced such a pixel into the window.
+float checkedWindowSample(float fine_code, const cv::Mat& coarse_codes, int cu, int cv, int s,
+                          const FineSearch& window, PerceptionStats& st) {
+  const float d = classify(fine_code, 1.0f, st);
+  const float tol = static_cast<float>(s + 1);
+  for (int y = std::max(0, cv - 1); d > 0.0f && y <= std::min(coarse_codes.rows - 1, cv + 1); ++y)
+    for (int x = std::max(0, cu - 1); x <= std::min(coarse_codes.cols - 1, cu + 1); ++x) {
+      const float c = coarse_codes.at<float>(y, x);
+      if (c > 0.0f && std::abs(c * static_cast<float>(s) - d) <= tol) return d;
+    }
+  const float coarse = coarse_codes.at<float>(cv, cu) * static_cast<float>(s);
+  if (coarse > 0.0f && (coarse < window.lo_px - tol || coarse > window.hi_px + tol)) {
+    ++st.window_from_coarse;
+    return coarse;
+  }
+  return d;
+}
+
+// The full-size map from both passes (result's fine_rect and coarse_scale set), every kept
+// sample counted once. window: the fine pass's search when it was windowed, else null.
+void assemble(const cv::Mat& fine_codes, const FineSearch* window, const cv::Mat& coarse_codes,
+              cv::Size size, DisparityResult& result) {
+  const cv::Rect fine_rect = result.fine_rect;
+  const int s = result.coarse_scale;
+  const bool coarse = !coarse_codes.empty();
+  PerceptionStats& st = result.stats;
+  result.disparity_px = cv::Mat::zeros(size, CV_32F);
+  for (int v = 0; v < size.height; ++v) {
+    auto* out = result.disparity_px.ptr<float>(v);
+    const bool fine_row = v >= fine_rect.y && v < fine_rect.br().y;
+    const float* fine_codes_row = fine_row ? fine_codes.ptr<float>(v - fine_rect.y) : nullptr;
+    const float* coarse_row = coarse ? coarse_codes.ptr<float>(v / s) : nullptr;
+    const bool coarse_sample_row = coarse && v % s == 0;
+    for (int u = 0; u < size.width; ++u) {
+      if (fine_row && u >= fine_rect.x && u < fine_rect.br().x) {
+        ++st.fine_samples;
+        const float code = fine_codes_row[u - fine_rect.x];
+        out[u] = window ? checkedWindowSample(code, coarse_codes, u / s, v / s, s, *window, st)
+                        : classify(code, 1.0f, st);
+      } else if (coarse) {
+        const float code = coarse_row[u / s];
+        if (coarse_sample_row && u % s == 0) {
+          out[u] = classify(code, static_cast<float>(s), st);
+          ++st.coarse_samples;
+        } else {
+          out[u] = code > 0.0f ? code * static_cast<float>(s) : 0.0f;  // replicated, not counted
+        }
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -162,7 +280,8 @@ cv::Mat StereoMatcher::runSgbm(const cv::Mat& left, const cv::Mat& right, const 
 }
 
 DisparityResult StereoMatcher::compute(const cv::Mat& left, const cv::Mat& right,
-                                       cv::Rect fine_rect) const {
+                                       cv::Rect fine_rect,
+                                       std::optional<DisparityWindow> fine_window) const {
   if (left.empty() || left.size() != right.size() || left.type() != right.type() ||
       left.depth() != CV_8U)
     throw std::invalid_argument(
@@ -170,7 +289,6 @@ DisparityResult StereoMatcher::compute(const cv::Mat& left, const cv::Mat& right
   const auto t0 = std::chrono::steady_clock::now();
   const int W = left.cols, H = left.rows;
   const cv::Rect image(0, 0, W, H);
-  const SgbmConfig& fine_cfg = config_.sgbm;
   int s = config_.coarse_scale;
   bool coarse = config_.coarse_pass && s > 1;
   if (s == 1) fine_rect = image;  // everything at full resolution
@@ -182,24 +300,23 @@ DisparityResult StereoMatcher::compute(const cv::Mat& left, const cv::Mat& right
   std::vector<std::function<void()>> tasks;
   const int threads = detail::resolveThreads(config_.threads);
 
-  // Fine pass: columns from fine.x - (minD + numDisp) so the band has its full search range.
+  // Fine pass over the band's rows, in strips; windowed, the right image's columns start
+  // shift_px left of the left image's.
   cv::Mat fine_codes;
+  const FineSearch fine = planFineSearch(config_.sgbm, coarse ? fine_window : std::nullopt,
+                                         fine_rect, W);
   if (!fine_rect.empty()) {
-    const int margin = fine_cfg.block_size + 2;
-    const int x0 =
-        std::max(0, fine_rect.x - fine_cfg.min_disparity - fine_cfg.num_disparities - margin);
-    // Right of the band too: the left-right check compares each pixel with left pixels up to
-    // minD + numDisp columns to its right, and a right-to-left path aggregates from there.
-    const int x1 =
-        std::min(W, fine_rect.br().x + fine_cfg.min_disparity + fine_cfg.num_disparities + margin);
     fine_codes.create(fine_rect.size(), CV_32F);
     for (const cv::Range& r : strips(fine_rect.y, fine_rect.br().y, kSgbmStrips)) {
-      tasks.emplace_back([&, r, x0, x1] {
+      tasks.emplace_back([&, r] {
         const int y0 = std::max(0, r.start - config_.strip_overlap_px);
         const int y1 = std::min(H, r.end + config_.strip_overlap_px);
-        const cv::Rect roi(x0, y0, x1 - x0, y1 - y0);
-        cv::Mat codes = sgbmCodes(left(roi), right(roi), fine_cfg, x0);
-        codes(cv::Rect(fine_rect.x - x0, r.start - y0, fine_rect.width, r.size()))
+        const cv::Rect roi(fine.x0, y0, fine.x1 - fine.x0, y1 - y0);
+        const cv::Rect right_roi = roi - cv::Point(fine.shift_px, 0);
+        cv::Mat codes = sgbmCodes(left(roi), right(right_roi), fine.sgbm,
+                                  fine.x0 - fine.shift_px, fine.shift_px, fine.cut_below,
+                                  fine.cut_above);
+        codes(cv::Rect(fine_rect.x - fine.x0, r.start - y0, fine_rect.width, r.size()))
             .copyTo(fine_codes(cv::Rect(0, r.start - fine_rect.y, fine_rect.width, r.size())));
       });
     }
@@ -208,7 +325,7 @@ DisparityResult StereoMatcher::compute(const cv::Mat& left, const cv::Mat& right
   // Coarse pass on images padded to a multiple of s and reduced by area averaging.
   cv::Mat coarse_codes;
   cv::Mat left_small, right_small;
-  const SgbmConfig coarse_cfg = fine_cfg.scaled(s);
+  const SgbmConfig coarse_cfg = config_.sgbm.scaled(s);
   if (coarse) {
     const int Wp = (W + s - 1) / s * s, Hp = (H + s - 1) / s * s;
     auto reduce = [&](const cv::Mat& in, cv::Mat& out) {
@@ -232,32 +349,9 @@ DisparityResult StereoMatcher::compute(const cv::Mat& left, const cv::Mat& right
   }
   // Largest first: the fine strips were queued first.
   detail::runTasks(tasks, threads);
-
-  // Assemble the full-size map and count every kept sample once.
-  PerceptionStats& st = result.stats;
-  result.disparity_px = cv::Mat::zeros(H, W, CV_32F);
-  for (int v = 0; v < H; ++v) {
-    auto* out = result.disparity_px.ptr<float>(v);
-    const bool fine_row = v >= fine_rect.y && v < fine_rect.br().y;
-    const float* fine_codes_row = fine_row ? fine_codes.ptr<float>(v - fine_rect.y) : nullptr;
-    const float* coarse_row = coarse ? coarse_codes.ptr<float>(v / s) : nullptr;
-    const bool coarse_sample_row = coarse && v % s == 0;
-    for (int u = 0; u < W; ++u) {
-      if (fine_row && u >= fine_rect.x && u < fine_rect.br().x) {
-        out[u] = classify(fine_codes_row[u - fine_rect.x], 1.0f, st);
-        ++st.fine_samples;
-      } else if (coarse) {
-        const float code = coarse_row[u / s];
-        if (coarse_sample_row && u % s == 0) {
-          out[u] = classify(code, static_cast<float>(s), st);
-          ++st.coarse_samples;
-        } else {
-          out[u] = code > 0.0f ? code * static_cast<float>(s) : 0.0f;  // replicated, not counted
-        }
-      }
-    }
-  }
-  st.sgbm_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  assemble(fine_codes, fine.windowed ? &fine : nullptr, coarse_codes, left.size(), result);
+  result.stats.sgbm_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;
 }
 

@@ -74,6 +74,9 @@ struct TrialOptions {
   /// With stop auto: a fruitlet the planner looked for twice in vain no longer holds the stop
   /// (host::nbv::ClusterCompletionConfig::release_left_out).
   bool release_left_out = true;
+  /// Stereo's full-resolution pass over only the disparities of the Cluster Region and nearer
+  /// (host::PerceptionConfig::disparity_window).
+  bool disparity_window = false;
   /// Seconds a view costs besides the arm's move: views that pass the goal check are tried
   /// by information per second (host::nbv::NbvLoopOptions::view_overhead_s); 0: the
   /// planner's order.

@@ -56,6 +56,7 @@ void visitTrialFields(Options& o, Visitor&& visit) {
   visit(f::kSeekPartlySeen, o.seek_partly_seen);
   visit(f::kReleaseLeftOut, o.release_left_out);
   visit(f::kRegisterViews, o.register_views);
+  visit(f::kDisparityWindow, o.disparity_window);
   visit(f::kViewOverhead, o.view_overhead_s);
   visit(f::kSizeHistory, o.record_size_history);
   visit(t::kClock, o.clock);

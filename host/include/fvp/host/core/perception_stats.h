@@ -10,7 +10,7 @@ namespace fvp::host {
 struct PerceptionStats {
   // Disparity stage (StereoMatcher): one count per disparity sample (full-resolution pixel
   // inside the fine band, coarse pixel elsewhere). The matcher writes 0 for every rejected
-  // sample, so these four are a breakdown of `nonpositive` below, not additional drops.
+  // sample, so these five are a breakdown of `nonpositive` below, not additional drops.
   std::int64_t fine_samples = 0;    ///< samples computed at full resolution
   std::int64_t coarse_samples = 0;  ///< samples of the coarse (reduced resolution) pass
   std::int64_t sgbm_invalid = 0;    ///< SGBM marked invalid (uniqueness, L-R check, speckle)
@@ -19,6 +19,12 @@ struct PerceptionStats {
   /// The left image's matching window is dark: nothing the flash lit, only sensor noise,
   /// so any disparity SGBM put there is a guess (it fills black sky from its neighbours).
   std::int64_t no_signal = 0;
+  /// Fine samples at an edge of the disparity window (the object is nearer or farther than
+  /// the window) that the coarse pass could not place: rejected.
+  std::int64_t outside_window = 0;
+  /// Fine samples the coarse pass placed wholly outside the window: they keep the coarse
+  /// value (not a drop; counted in fine_samples too).
+  std::int64_t window_from_coarse = 0;
 
   // Projection stage (CloudProjector): one count per sample considered.
   std::int64_t nonfinite = 0;     ///< NaN / inf disparities

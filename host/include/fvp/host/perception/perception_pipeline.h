@@ -19,6 +19,10 @@
 namespace fvp::host {
 
 inline constexpr int kDefaultBandMarginPx = 16;
+/// Depth added behind the Cluster Region for the fine pass's disparity window:
+/// several times the field preset's errors of the region's placement (tag, hand-eye and arm,
+/// a few millimetres together; docs/simulation.md) and of the baseline (0.5 %).
+inline constexpr double kDefaultWindowDepthMarginM = 0.01;
 
 struct PerceptionConfig {
   SegmentationConfig segmentation;
@@ -27,6 +31,12 @@ struct PerceptionConfig {
   ClusterRegionConfig region;
   ProjectionConfig projection;
   int band_margin_px = kDefaultBandMarginPx;  ///< added around the fine rectangle
+  /// Search the fine band only over disparities of the Cluster Region and nearer
+  /// (StereoMatcher's fine_window); false: the whole range, as without a region. Off by
+  /// default: ~40 % less stereo time and the same accuracy, but its effect on a cluster's
+  /// time is not settled (docs/results.md, "The stereo window").
+  bool disparity_window = false;
+  double window_depth_margin_m = kDefaultWindowDepthMarginM;
   void validate() const;
   /// The user-facing keys (docs/capture-format.md "Perception configuration"): the tag
   /// (family, id, size), the Cluster Region (offset from the tag and radius, or an explicit

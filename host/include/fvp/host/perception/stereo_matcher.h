@@ -5,11 +5,13 @@
 // single-threaded; a fixed count keeps the result the same on every machine). Pitfalls handled
 // (docs/design.md §10): saturated disparities at the top of the search range (objects nearer
 // than ~0.17 m) are rejected, and the left band where SGBM has no match is marked invalid; both
-// are counted.
+// are counted. Given a disparity window (the Cluster Region's depth span), the fine pass searches
+// only that window; what the coarse pass places wholly outside it keeps the coarse value.
 #pragma once
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
+#include <optional>
 
 #include "fvp/host/core/perception_stats.h"
 
@@ -67,6 +69,12 @@ struct StereoMatcherConfig {
   void validate() const;
 };
 
+/// Full-resolution disparities [min_px, max_px] the fine pass searches (both inclusive).
+struct DisparityWindow {
+  int min_px = 0;
+  int max_px = 0;
+};
+
 /// A full-size disparity map assembled from the fine and the coarse pass.
 struct DisparityResult {
   /// CV_32F, pixels of the full-resolution left image; 0 = no valid disparity.
@@ -88,7 +96,16 @@ class StereoMatcher {
   /// left/right: rectified CV_8UC3 (or CV_8UC1) images of equal size. fine_rect: the region
   /// wanted at full resolution (clipped to the image; empty: none). With coarse_scale 1 the
   /// whole image is computed at full resolution.
-  DisparityResult compute(const cv::Mat& left, const cv::Mat& right, cv::Rect fine_rect) const;
+  ///
+  /// fine_window: search the fine pass only over these disparities (clipped to the
+  /// configured range; nullopt, or no coarse pass: the whole range). The right image is
+  /// shifted by the window's start, so the fine strips need only the window's width of
+  /// columns on either side. A fine sample at a window edge inside the range is rejected
+  /// (outside_window). One that no valid coarse sample within one coarse pixel confirms,
+  /// where the coarse pass places the pixel outside the window, takes the coarse value
+  /// (window_from_coarse): what lies beyond the window stays in the map, not forced into it.
+  DisparityResult compute(const cv::Mat& left, const cv::Mat& right, cv::Rect fine_rect,
+                          std::optional<DisparityWindow> fine_window = std::nullopt) const;
 
   /// One plain SGBM call on a (sub)image pair: CV_32F pixels, 0 where invalid, saturated
   /// or blind (the counts are added to stats when given).
