@@ -10,11 +10,11 @@
 // match the world's fruitlets (one to one as the trials score them, each within 1 mm, its
 // centre inside it), and every backend ranks the same best view and gives the same sizes and
 // centres as the cpu backend, bit for bit (the determinism contract, docs/kernels.md).
-// BM_View/cpu/disparity_window: the cpu's with stereo's disparity window (its outcome checked
-// against the truth only). Counters: each stage's milliseconds (of_which_stereo_ms is part of perception_ms,
-// planning_<stage>_ms of planning_ms). Not in it: the arm's obstacle update and goal checks
-// (the arm's work, BM_MotionPlan), and later sampling rounds when round 0 ranks nothing
-// worth a move.
+// BM_View/cpu/disparity_window: the cpu's with stereo's disparity window (its outcome
+// checked against the truth only). Counters: each stage's milliseconds (of_which_stereo_ms
+// is part of perception_ms, planning_<stage>_ms of planning_ms). Not in it: the arm's
+// obstacle update and goal checks (the arm's work, BM_MotionPlan), and later sampling rounds
+// when round 0 ranks nothing worth a move.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>

@@ -228,9 +228,8 @@ TEST(PerceptionSim, DisparityWindowKeepsFruitletDepthAndWhatLiesOutside) {
     ASSERT_TRUE(window.has_value());
     const double fb = K.fx_px * K.baseline_m;
     for (Tally* t : {&full, &windowed}) {
-      const DisparityResult r =
-          StereoMatcher().compute(frame.left_bgr, frame.right_bgr, band,
-                                  t == &windowed ? window : std::nullopt);
+      const DisparityResult r = StereoMatcher().compute(frame.left_bgr, frame.right_bgr, band,
+                                                        t == &windowed ? window : std::nullopt);
       t->sgbm_s += r.stats.sgbm_s;
       for (int v = band.y; v < band.br().y; ++v)
         for (int u = band.x; u < band.br().x; ++u) {

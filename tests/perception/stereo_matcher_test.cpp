@@ -201,8 +201,7 @@ TEST(StereoMatcher, WindowedBandMatchesTheFullRangeAndKeepsWhatLiesOutside) {
   const auto pair = test::makeStereoPair(K, 90.0, {{fruit, 183.3}, {leaf, 262.0}}, 2.0, 29);
   const DisparityResult full = StereoMatcher().compute(pair.left, pair.right, band);
   const DisparityWindow window{170, 200};
-  const DisparityResult windowed =
-      StereoMatcher().compute(pair.left, pair.right, band, window);
+  const DisparityResult windowed = StereoMatcher().compute(pair.left, pair.right, band, window);
   EXPECT_EQ(windowed.stats.fine_samples, band.area());
   EXPECT_GT(windowed.stats.window_from_coarse, 0);
 
@@ -223,9 +222,9 @@ TEST(StereoMatcher, WindowedBandMatchesTheFullRangeAndKeepsWhatLiesOutside) {
     const long valid = cv::countNonZero(d > 0);
     const long close = cv::countNonZero((d > 0) & (cv::abs(d - truth) <= 2.0));
     const long in_window = cv::countNonZero((d >= window.min_px) & (d <= window.max_px));
-    std::cout << "[ measured ] outside the window at " << truth.at<float>(0, 0) << " px: "
-              << valid << " of " << outside.area() << " valid, " << close << " within 2 px, "
-              << in_window << " in the window\n";
+    std::cout << "[ measured ] outside the window at " << truth.at<float>(0, 0) << " px: " << valid
+              << " of " << outside.area() << " valid, " << close << " within 2 px, " << in_window
+              << " in the window\n";
     EXPECT_GT(valid, outside.area() * 0.8);
     EXPECT_GT(close, valid * 0.95);
     EXPECT_EQ(in_window, 0);

@@ -8,9 +8,9 @@ std::ostream& operator<<(std::ostream& os, const PerceptionStats& s) {
   os << "disparity samples  " << s.fine_samples << " full-res + " << s.coarse_samples << " coarse\n"
      << "dropped            " << s.droppedDisparities() << " (SGBM invalid " << s.sgbm_invalid
      << ", saturated/too near " << s.saturated << ", blind left band " << s.blind_band
-     << ", dark (no signal) " << s.no_signal << ", outside the fine window "
-     << s.outside_window << "; non-finite " << s.nonfinite << ", zero/negative "
-     << s.nonpositive << ", out of depth range " << s.out_of_range << ")\n"
+     << ", dark (no signal) " << s.no_signal << ", outside the fine window " << s.outside_window
+     << "; non-finite " << s.nonfinite << ", zero/negative " << s.nonpositive
+     << ", out of depth range " << s.out_of_range << ")\n"
      << "from coarse        " << s.window_from_coarse << " full-res samples outside the window\n"
      << "points             " << s.roi_points << " ROI, " << s.other_points << " other\n"
      << "times              segmentation " << s.segmentation_s * 1e3 << " ms, tag " << s.tag_s * 1e3

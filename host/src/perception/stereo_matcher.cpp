@@ -303,8 +303,8 @@ DisparityResult StereoMatcher::compute(const cv::Mat& left, const cv::Mat& right
   // Fine pass over the band's rows, in strips; windowed, the right image's columns start
   // shift_px left of the left image's.
   cv::Mat fine_codes;
-  const FineSearch fine = planFineSearch(config_.sgbm, coarse ? fine_window : std::nullopt,
-                                         fine_rect, W);
+  const FineSearch fine =
+      planFineSearch(config_.sgbm, coarse ? fine_window : std::nullopt, fine_rect, W);
   if (!fine_rect.empty()) {
     fine_codes.create(fine_rect.size(), CV_32F);
     for (const cv::Range& r : strips(fine_rect.y, fine_rect.br().y, kSgbmStrips)) {
@@ -313,9 +313,8 @@ DisparityResult StereoMatcher::compute(const cv::Mat& left, const cv::Mat& right
         const int y1 = std::min(H, r.end + config_.strip_overlap_px);
         const cv::Rect roi(fine.x0, y0, fine.x1 - fine.x0, y1 - y0);
         const cv::Rect right_roi = roi - cv::Point(fine.shift_px, 0);
-        cv::Mat codes = sgbmCodes(left(roi), right(right_roi), fine.sgbm,
-                                  fine.x0 - fine.shift_px, fine.shift_px, fine.cut_below,
-                                  fine.cut_above);
+        cv::Mat codes = sgbmCodes(left(roi), right(right_roi), fine.sgbm, fine.x0 - fine.shift_px,
+                                  fine.shift_px, fine.cut_below, fine.cut_above);
         codes(cv::Rect(fine_rect.x - fine.x0, r.start - y0, fine_rect.width, r.size()))
             .copyTo(fine_codes(cv::Rect(0, r.start - fine_rect.y, fine_rect.width, r.size())));
       });
