@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "fvp/accel/backend.h"
+#include "fvp/host/nbv/nbv_setup.h"
 #include "seed2_orbit_frames.h"
 
 namespace fvp::host::nbv {
@@ -267,6 +268,20 @@ TEST(StopCondition, RefusesNonsenseAndReportsTheFirstThatHolds) {
   EXPECT_FALSE(both.check({1, 0, 1.0, 0}));
   EXPECT_EQ(both.check({2, 0, 9.0, 0}), "max_views");
   EXPECT_EQ(both.check({1, 0, 9.0, 0}), "budget");
+}
+
+// The setup's disparity_window decides every cluster's perception, over the perception
+// config's own (a config read from a file does not carry it).
+TEST(NbvSetup, DisparityWindowReachesEveryClustersPerception) {
+  for (const bool window : {false, true}) {
+    NbvSetupOptions options;
+    options.backend = accel::BackendChoice::kCpu;
+    options.disparity_window = window;
+    options.perception.disparity_window = !window;
+    NbvSetup setup(options);
+    for (std::size_t k = 0; k < 2; ++k)
+      EXPECT_EQ(setup.makeWork({}, k)->session->perception().config().disparity_window, window);
+  }
 }
 
 }  // namespace

@@ -203,7 +203,7 @@ TEST(PerceptionSim, DisparityDepthErrorOnFruitletsAtPointThreeMetres) {
 }
 
 // The fine pass searched only over disparities of the Cluster Region and nearer (the
-// pipeline's default) against the whole range, on full start views of worlds with leaves:
+// pipeline's disparity_window) against the whole range, on full start views of worlds with leaves:
 // fruitlet depth as good, the band's other pixels as well placed, and what lies behind the
 // region kept from the coarse pass rather than matched wrongly into the window.
 TEST(PerceptionSim, DisparityWindowKeepsFruitletDepthAndWhatLiesOutside) {
@@ -223,8 +223,9 @@ TEST(PerceptionSim, DisparityWindowKeepsFruitletDepthAndWhatLiesOutside) {
     const StereoIntrinsics& K = frame.intrinsics;
     const ClusterRegion region(world.clusterCenter_m(), kDefaultClusterRadiusM);
     const cv::Rect band = clusterRegionImageBounds(region, K, frame.T_world_camera);
-    const auto window = clusterRegionDisparityWindow(region, K, frame.T_world_camera,
-                                                     kDefaultWindowDepthMarginM, 3);
+    const auto window =
+        clusterRegionDisparityWindow(region, K, frame.T_world_camera, kDefaultWindowDepthMarginM,
+                                     SgbmConfig{}.saturation_margin_px + 1);
     ASSERT_TRUE(window.has_value());
     const double fb = K.fx_px * K.baseline_m;
     for (Tally* t : {&full, &windowed}) {

@@ -204,6 +204,8 @@ TEST(StereoMatcher, WindowedBandMatchesTheFullRangeAndKeepsWhatLiesOutside) {
   const DisparityResult windowed = StereoMatcher().compute(pair.left, pair.right, band, window);
   EXPECT_EQ(windowed.stats.fine_samples, band.area());
   EXPECT_GT(windowed.stats.window_from_coarse, 0);
+  EXPECT_GT(windowed.stats.outside_window, 0);  // both ends of the window cut the range
+  EXPECT_EQ(full.stats.outside_window + full.stats.window_from_coarse, 0);
 
   // The fruit away from its edges and from where the leaf hides it in the right image (left
   // columns 438 + 183 .. 508 + 183): the same as the whole range.
@@ -254,8 +256,8 @@ TEST(StereoMatcher, WindowAsWideAsTheRangeChangesNothing) {
 }
 
 // A band near the image's left edge: the right image cannot be shifted by the whole window
-// start. The window's search reaches columns from 170 - 8 + 32 on (the whole range's only
-// from 320): there, where the coarse pass is blind, the fine values stand.
+// start. The window's search (170..201) reaches columns from 170 + 32 on (the whole range's
+// only from 320): there, where the coarse pass is blind, the fine values stand.
 TEST(StereoMatcher, WindowedBandNearTheLeftEdge) {
   const StereoIntrinsics K = smallCamera();
   const cv::Rect band(150, 40, 250, 150);

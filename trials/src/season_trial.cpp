@@ -54,6 +54,14 @@ fs::path rememberedDay(const nlohmann::json& result) {
   return day.has_filename() ? day.filename() : day.parent_path().filename();
 }
 
+/// The first key of `now` whose value `old` does not hold; a switch added after `old` was
+/// written (absent there) is the same when it is off (empty: the same settings).
+std::string firstSettingDifference(const nlohmann::json& old, const nlohmann::json& now) {
+  for (const auto& [key, value] : now.items())
+    if (old.contains(key) ? old.at(key) != value : value != false) return key;
+  return {};
+}
+
 /// A visit's result.json already in its directory (a season cut short), when it is this
 /// visit's: the same settings, seed and day; another is an error naming the file.
 std::optional<nlohmann::json> finishedVisit(const TrialOptions& visit) {
@@ -64,7 +72,9 @@ std::optional<nlohmann::json> finishedVisit(const TrialOptions& visit) {
   TrialOptions resolved = visit;
   resolved.register_views = registerViewsOf(visit);
   if (result.is_discarded() || !result.is_object() ||
-      result.value("settings", nlohmann::json()) != nlohmann::json(trialSettingsJson(resolved)) ||
+      !result.value("settings", nlohmann::json()).is_object() ||
+      !firstSettingDifference(result.at("settings"),
+                              nlohmann::json(trialSettingsJson(resolved))).empty() ||
       rememberedDay(result) != visit.remembered_visit.filename())
     throw std::runtime_error(file.string() +
                              ": not this visit's result (another seed, day, settings or "
@@ -259,10 +269,7 @@ namespace {
 std::string seasonDifference(const nlohmann::json& line, const nlohmann::json& settings,
                              const std::vector<double>& days) {
   if (line.value("days", nlohmann::json()) != nlohmann::json(days)) return "days";
-  const nlohmann::json old = line.value("settings", nlohmann::json::object());
-  for (const auto& [key, value] : settings.items())
-    if (!old.contains(key) || old.at(key) != value) return key;
-  return {};
+  return firstSettingDifference(line.value("settings", nlohmann::json::object()), settings);
 }
 
 }  // namespace

@@ -11,7 +11,8 @@ std::ostream& operator<<(std::ostream& os, const PerceptionStats& s) {
      << ", dark (no signal) " << s.no_signal << ", outside the fine window " << s.outside_window
      << "; non-finite " << s.nonfinite << ", zero/negative " << s.nonpositive
      << ", out of depth range " << s.out_of_range << ")\n"
-     << "from coarse        " << s.window_from_coarse << " full-res samples outside the window\n"
+     << "from coarse        " << s.window_from_coarse
+     << " full-res samples outside the disparity window (0 without one)\n"
      << "points             " << s.roi_points << " ROI, " << s.other_points << " other\n"
      << "times              segmentation " << s.segmentation_s * 1e3 << " ms, tag " << s.tag_s * 1e3
      << " ms, SGBM " << s.sgbm_s * 1e3 << " ms, projection " << s.projection_s * 1e3 << " ms\n";

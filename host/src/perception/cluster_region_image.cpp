@@ -48,7 +48,10 @@ std::optional<DisparityWindow> clusterRegionDisparityWindow(const ClusterRegion&
   const double farthest = z + region.radius_m() + depth_margin_m;
   if (!(farthest > 0.0)) return std::nullopt;
   DisparityWindow w;
-  w.min_px = static_cast<int>(std::floor(K.fx_px * K.baseline_m / farthest)) - pad_px;
+  // A far side at the camera plane has no bounded disparity: then no window.
+  const double far_side_px = std::floor(K.fx_px * K.baseline_m / farthest);
+  if (!(far_side_px < 1e6)) return std::nullopt;
+  w.min_px = static_cast<int>(far_side_px) - pad_px;
   w.max_px = std::numeric_limits<int>::max();
   return w;
 }

@@ -92,7 +92,7 @@ PerceptionResult PerceptionPipeline::process(
   std::optional<DisparityWindow> window;
   if (result.region) {
     fine = clusterRegionImageBounds(*result.region, K, frame.T_world_camera);
-    // The window's low edge is rejected as saturated: pad past it.
+    // The window's low edge is rejected (outside_window): pad past it.
     if (config_.disparity_window)
       window = clusterRegionDisparityWindow(*result.region, K, frame.T_world_camera,
                                             config_.window_depth_margin_m,

@@ -17,12 +17,11 @@ constexpr float kCodeInvalid = -1.0f;
 constexpr float kCodeSaturated = -2.0f;
 constexpr float kCodeBlind = -3.0f;
 constexpr float kCodeNoSignal = -4.0f;
+constexpr float kCodeOutsideWindow = -5.0f;  ///< at an end of a window inside the range
 
 void fail(const std::string& where, const std::string& field, const std::string& expected) {
   throw std::invalid_argument(where + ": " + field + ": expected " + expected);
 }
-
-constexpr float kCodeOutsideWindow = -5.0f;
 
 // Raw SGBM (CV_16S fixed point) of a (sub)image pair -> classified CV_32F codes. The right
 // image starts `shift_px` columns left of the left one, so a found disparity is SGBM's plus
@@ -106,7 +105,9 @@ FineSearch planFineSearch(const SgbmConfig& range, std::optional<DisparityWindow
   if (window && window->max_px >= window->min_px) {
     int lo = std::max(window->min_px, range.min_disparity);
     const int hi = std::min(window->max_px, range_hi);
-    const int num = (hi - lo + 1 + 15) / 16 * 16;
+    // Both of a window's edges reject saturation_margin_px: at least 16 disparities between.
+    const int least = (2 * range.saturation_margin_px + 16 + 15) / 16 * 16;
+    const int num = std::max((hi - lo + 1 + 15) / 16 * 16, least);
     if (hi >= lo && num < range.num_disparities) {
       lo = std::clamp(lo - (num - (hi - lo + 1)) / 2, range.min_disparity, range_hi + 1 - num);
       f.windowed = true;
@@ -115,7 +116,7 @@ FineSearch planFineSearch(const SgbmConfig& range, std::optional<DisparityWindow
       f.cut_below = lo > range.min_disparity;
       f.cut_above = f.hi_px < range_hi;
       f.x0 = std::max(0, fine_rect.x - num - margin);
-      f.shift_px = std::min(lo, f.x0);  // the right image's columns start at x0 - shift
+      f.shift_px = std::clamp(lo, 0, f.x0);  // the right image's columns start at x0 - shift
       f.sgbm.min_disparity = lo - f.shift_px;
       f.sgbm.num_disparities = num;
       f.x1 = std::min(image_width, fine_rect.br().x + num + margin);
@@ -168,22 +169,32 @@ inline float classify(float code, float scale, PerceptionStats& s) {
 // A windowed fine sample checked against the coarse pass, which searched the whole range.
 // It stands where a valid coarse sample within one coarse pixel agrees with it (to within
 // the coarse pass's precision: one coarse pixel, plus one), or where the coarse pass has
-// nothing to say; where the coarse pass places the pixel outside the window, the coarse
-// value replaces it: SGBM forced such a pixel into the window.
-float checkedWindowSample(float fine_code, const cv::Mat& coarse_codes, int cu, int cv, int s,
-                          const FineSearch& window, PerceptionStats& st) {
-  const float d = classify(fine_code, 1.0f, st);
+// nothing to say. Any other sample, where the coarse pass places the pixel outside the
+// window, takes the coarse value instead: SGBM forced it into the window or could not place
+// it there. (Dark and blind pixels are dark and blind in the coarse pass too.)
+float checkedWindowSample(float fine_code, const cv::Mat& coarse_codes, int coarse_u, int coarse_v,
+                          int s, const FineSearch& window, PerceptionStats& st) {
+  PerceptionStats fine_counts;  // merged unless the coarse value replaces the sample
+  const float d = classify(fine_code, 1.0f, fine_counts);
   const float tol = static_cast<float>(s + 1);
-  for (int y = std::max(0, cv - 1); d > 0.0f && y <= std::min(coarse_codes.rows - 1, cv + 1); ++y)
-    for (int x = std::max(0, cu - 1); x <= std::min(coarse_codes.cols - 1, cu + 1); ++x) {
+  const int v0 = std::max(0, coarse_v - 1), v1 = std::min(coarse_codes.rows - 1, coarse_v + 1);
+  const int u0 = std::max(0, coarse_u - 1), u1 = std::min(coarse_codes.cols - 1, coarse_u + 1);
+  bool confirmed = false;
+  for (int y = v0; d > 0.0f && !confirmed && y <= v1; ++y)
+    for (int x = u0; !confirmed && x <= u1; ++x) {
       const float c = coarse_codes.at<float>(y, x);
-      if (c > 0.0f && std::abs(c * static_cast<float>(s) - d) <= tol) return d;
+      confirmed = c > 0.0f && std::abs(c * static_cast<float>(s) - d) <= tol;
     }
-  const float coarse = coarse_codes.at<float>(cv, cu) * static_cast<float>(s);
-  if (coarse > 0.0f && (coarse < window.lo_px - tol || coarse > window.hi_px + tol)) {
+  const float coarse = coarse_codes.at<float>(coarse_v, coarse_u) * static_cast<float>(s);
+  if (!confirmed && coarse > 0.0f && (coarse < window.lo_px - tol || coarse > window.hi_px + tol)) {
     ++st.window_from_coarse;
     return coarse;
   }
+  st.sgbm_invalid += fine_counts.sgbm_invalid;
+  st.saturated += fine_counts.saturated;
+  st.blind_band += fine_counts.blind_band;
+  st.no_signal += fine_counts.no_signal;
+  st.outside_window += fine_counts.outside_window;
   return d;
 }
 

@@ -20,7 +20,8 @@ cv::Rect clusterRegionImageBounds(const ClusterRegion& region, const StereoIntri
 /// The fine pass's search window: every disparity from the far side of the sphere grown by
 /// depth_margin_m (less pad_px) up, so everything nearer than the region's far side (the
 /// region and what hides it) is matched at full resolution, and what lies behind it is left
-/// to the coarse pass. nullopt when the grown sphere is wholly behind the camera.
+/// to the coarse pass. nullopt when the grown sphere is wholly behind the camera or its far
+/// side at the camera plane.
 std::optional<DisparityWindow> clusterRegionDisparityWindow(const ClusterRegion& region,
                                                             const StereoIntrinsics& intrinsics,
                                                             const Eigen::Isometry3d& T_world_camera,

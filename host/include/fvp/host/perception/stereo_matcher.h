@@ -69,7 +69,9 @@ struct StereoMatcherConfig {
   void validate() const;
 };
 
-/// Full-resolution disparities [min_px, max_px] the fine pass searches (both inclusive).
+/// Full-resolution disparities [min_px, max_px] the fine pass searches (both inclusive),
+/// widened to a multiple of 16 (at least 2 * saturation_margin_px + 16) around its centre;
+/// max_px < min_px: the whole range.
 struct DisparityWindow {
   int min_px = 0;
   int max_px = 0;
