@@ -73,8 +73,8 @@ std::optional<nlohmann::json> finishedVisit(const TrialOptions& visit) {
   resolved.register_views = registerViewsOf(visit);
   if (result.is_discarded() || !result.is_object() ||
       !result.value("settings", nlohmann::json()).is_object() ||
-      !firstSettingDifference(result.at("settings"),
-                              nlohmann::json(trialSettingsJson(resolved))).empty() ||
+      !firstSettingDifference(result.at("settings"), nlohmann::json(trialSettingsJson(resolved)))
+           .empty() ||
       rememberedDay(result) != visit.remembered_visit.filename())
     throw std::runtime_error(file.string() +
                              ": not this visit's result (another seed, day, settings or "
