@@ -174,8 +174,7 @@ inline float classify(float code, float scale, PerceptionStats& s) {
 // it there. (Dark and blind pixels are dark and blind in the coarse pass too.)
 float checkedWindowSample(float fine_code, const cv::Mat& coarse_codes, int coarse_u, int coarse_v,
                           int s, const FineSearch& window, PerceptionStats& st) {
-  PerceptionStats fine_counts;  // merged unless the coarse value replaces the sample
-  const float d = classify(fine_code, 1.0f, fine_counts);
+  const float d = fine_code > 0.0f ? fine_code : 0.0f;  // classify's value, not yet counted
   const float tol = static_cast<float>(s + 1);
   const int v0 = std::max(0, coarse_v - 1), v1 = std::min(coarse_codes.rows - 1, coarse_v + 1);
   const int u0 = std::max(0, coarse_u - 1), u1 = std::min(coarse_codes.cols - 1, coarse_u + 1);
@@ -187,15 +186,10 @@ float checkedWindowSample(float fine_code, const cv::Mat& coarse_codes, int coar
     }
   const float coarse = coarse_codes.at<float>(coarse_v, coarse_u) * static_cast<float>(s);
   if (!confirmed && coarse > 0.0f && (coarse < window.lo_px - tol || coarse > window.hi_px + tol)) {
-    ++st.window_from_coarse;
+    ++st.window_from_coarse;  // replaced: the fine sample's rejection is not counted
     return coarse;
   }
-  st.sgbm_invalid += fine_counts.sgbm_invalid;
-  st.saturated += fine_counts.saturated;
-  st.blind_band += fine_counts.blind_band;
-  st.no_signal += fine_counts.no_signal;
-  st.outside_window += fine_counts.outside_window;
-  return d;
+  return classify(fine_code, 1.0f, st);
 }
 
 // The full-size map from both passes (result's fine_rect and coarse_scale set), every kept
