@@ -19,15 +19,21 @@ constexpr float kCodeBlind = -3.0f;
 constexpr float kCodeNoSignal = -4.0f;
 constexpr float kCodeOutsideWindow = -5.0f;  ///< at an end of a window inside the range
 
+// SGBM searches a multiple of 16 disparities.
+int roundUpTo16(int disparities) {
+  return (disparities + 15) / 16 * 16;
+}
+
 void fail(const std::string& where, const std::string& field, const std::string& expected) {
   throw std::invalid_argument(where + ": " + field + ": expected " + expected);
 }
 
 // Raw SGBM (CV_16S fixed point) of a (sub)image pair -> classified CV_32F codes. The right
 // image starts `shift_px` columns left of the left one, so a found disparity is SGBM's plus
-// shift_px. `x0` is the column of the pair in the full image of this resolution, less the
-// shift (only x < blind width is blind). cut_below / cut_above: that end of the search is a
-// window's, not the range's, so a disparity at it is an object outside the window.
+// shift_px. `x0` is the column of the left image's pair in the full image of this
+// resolution (only a column below the search's blind width, shift included, is blind). cut_below /
+// cut_above: that end of the search is a window's, not the range's, so a disparity at it is an
+// object outside the window.
 cv::Mat sgbmCodes(const cv::Mat& left, const cv::Mat& right, const SgbmConfig& c, int x0,
                   int shift_px = 0, bool cut_below = false, bool cut_above = false) {
   auto sgbm = cv::StereoSGBM::create(c.min_disparity, c.num_disparities, c.block_size, c.p1, c.p2,
@@ -61,7 +67,7 @@ cv::Mat sgbmCodes(const cv::Mat& left, const cv::Mat& right, const SgbmConfig& c
     const std::uint8_t* lit = brightest.empty() ? nullptr : brightest.ptr<std::uint8_t>(v);
     auto* out = codes.ptr<float>(v);
     for (int u = 0; u < raw.cols; ++u) {
-      if (x0 + u < blind_cols && r[u] < invalid_below) {
+      if (x0 - shift_px + u < blind_cols && r[u] < invalid_below) {
         out[u] = kCodeBlind;
       } else if (lit && lit[u] <= c.min_signal) {
         out[u] = kCodeNoSignal;
@@ -102,12 +108,12 @@ FineSearch planFineSearch(const SgbmConfig& range, std::optional<DisparityWindow
   const int margin = range.block_size + 2;
   const int range_hi = range.min_disparity + range.num_disparities - 1;
   const int reach = range.min_disparity + range.num_disparities;
-  if (window && window->max_px >= window->min_px) {
+  if (window) {
     int lo = std::max(window->min_px, range.min_disparity);
     const int hi = std::min(window->max_px, range_hi);
     // Both of a window's edges reject saturation_margin_px: at least 16 disparities between.
-    const int least = (2 * range.saturation_margin_px + 16 + 15) / 16 * 16;
-    const int num = std::max((hi - lo + 1 + 15) / 16 * 16, least);
+    const int least = roundUpTo16(2 * range.saturation_margin_px + 16);
+    const int num = std::max(roundUpTo16(hi - lo + 1), least);
     if (hi >= lo && num < range.num_disparities) {
       lo = std::clamp(lo - (num - (hi - lo + 1)) / 2, range.min_disparity, range_hi + 1 - num);
       f.windowed = true;
@@ -232,7 +238,7 @@ SgbmConfig SgbmConfig::scaled(int scale) const {
   if (scale <= 1) return *this;
   SgbmConfig c = *this;
   c.min_disparity = min_disparity / scale;
-  c.num_disparities = ((num_disparities / scale + 15) / 16) * 16;
+  c.num_disparities = roundUpTo16(num_disparities / scale);
   c.speckle_window_size = speckle_window_size / (scale * scale);
   c.speckle_range = std::max(1, speckle_range / scale);
   return c;
@@ -318,8 +324,8 @@ DisparityResult StereoMatcher::compute(const cv::Mat& left, const cv::Mat& right
         const int y1 = std::min(H, r.end + config_.strip_overlap_px);
         const cv::Rect roi(fine.x0, y0, fine.x1 - fine.x0, y1 - y0);
         const cv::Rect right_roi = roi - cv::Point(fine.shift_px, 0);
-        cv::Mat codes = sgbmCodes(left(roi), right(right_roi), fine.sgbm, fine.x0 - fine.shift_px,
-                                  fine.shift_px, fine.cut_below, fine.cut_above);
+        cv::Mat codes = sgbmCodes(left(roi), right(right_roi), fine.sgbm, fine.x0, fine.shift_px,
+                                  fine.cut_below, fine.cut_above);
         codes(cv::Rect(fine_rect.x - fine.x0, r.start - y0, fine_rect.width, r.size()))
             .copyTo(fine_codes(cv::Rect(0, r.start - fine_rect.y, fine_rect.width, r.size())));
       });
