@@ -154,8 +154,8 @@ def test_the_setups_keywords_are_the_trials():
 
 def test_the_view_ordering_is_a_setting_that_reaches_the_trial():
     # Views tried by information per second of move plus the overhead (0: planner's order).
-    assert float(keyword_defaults(fvp.sim.Trial)["view_overhead_s"]) == pytest.approx(0.9)
-    assert float(keyword_defaults(fvp.NbvSetup)["view_overhead_s"]) == pytest.approx(0.9)
+    assert float(keyword_defaults(fvp.sim.Trial)["view_overhead_s"]) == pytest.approx(1.3)
+    assert float(keyword_defaults(fvp.NbvSetup)["view_overhead_s"]) == pytest.approx(1.3)
     result = fvp.sim.run_trial(seed=2, clock="fixed", max_views=1, view_overhead_s=0.0)
     assert result["settings"]["view_overhead_s"] == 0.0
     with pytest.raises(ValueError, match="setting 'view_overhead_s': expected a finite number"):

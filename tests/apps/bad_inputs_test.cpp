@@ -26,6 +26,8 @@
 #include <vector>
 
 #include "fvp/host/core/subprocess.h"
+#include "fvp/host/planner/view_overhead.h"
+#include "fvp/trials/experiment_directory.h"
 
 namespace fs = std::filesystem;
 
@@ -78,8 +80,9 @@ void writeExperiment(const fs::path& dir, const std::string& error_scale,
                               {"register_views", false},
                               {"confirm_detections", false},
                               {"release_left_out", false},
-                              {"view_overhead_s", 0.9},
+                              {"view_overhead_s", fvp::host::planner::kDefaultViewOverheadS},
                               {"error_scale", error_scale},
+                              {"clock_charges", fvp::trials::ExperimentManifest::kClockCharges},
                               {"world_config", {{"path", ""}, {"fnv1a64", ""}}},
                               {"planner_config", {{"path", ""}, {"fnv1a64", ""}}},
                               {"arm_config", {{"path", ""}, {"fnv1a64", ""}}},

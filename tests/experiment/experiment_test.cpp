@@ -189,10 +189,10 @@ TEST(Experiment, TheGrowersFiguresAndTheTimeSplitByHand) {
                   first ? nlohmann::json{{"success", 3}, {"no_collision_free_ik", 2}}
                         : nlohmann::json{{"success", 3}}}};
     if (!first) r["tour"]["transit_motion_sim_s"] = 11.0;
-    r["sim_time_by_stage_s"] = {{"motion_s", 40.0 * k},    {"capture_s", 4.0 * k},
-                                {"mapping_s", 4.0 * k},    {"tsdf_s", 2.0 * k},
-                                {"sizing_s", 2.0 * k},     {"planning_s", 2.0 * k},
-                                {"goal_check_s", 2.0 * k}, {"motion_planning_s", 2.0 * k}};
+    r["sim_time_by_stage_s"] = {
+        {"motion_s", 40.0 * k},    {"capture_s", 4.0 * k},         {"mapping_s", 4.0 * k},
+        {"tsdf_s", 2.0 * k},       {"sizing_s", 2.0 * k},          {"planning_s", 2.0 * k},
+        {"goal_check_s", 2.0 * k}, {"motion_planning_s", 2.0 * k}, {"perception_s", 1.0 * k}};
     return r;
   };
   runExperiment(options(out, 2), tree, nullptr);
@@ -204,16 +204,18 @@ TEST(Experiment, TheGrowersFiguresAndTheTimeSplitByHand) {
   EXPECT_DOUBLE_EQ(fvp["views_per_cluster"].get<double>(), 6.0);
   EXPECT_DOUBLE_EQ(fvp["failed_moves_per_cluster"].get<double>(), 1.5);
   EXPECT_DOUBLE_EQ(fvp["transit_s_per_tree"].get<double>(), 10.0);
-  // 180 s in all: 120 s of motion of which 19 s transit, 12 s capture, 6 s in no stage.
+  // 180 s in all: 120 s of motion of which 19 s transit, 12 s capture, 3 s perception, 3 s in
+  // no stage.
   const nlohmann::json& split = fvp["sim_time_percent"];
   EXPECT_NEAR(split["motion_between_views"].get<double>(), 100.0 * 101 / 180, 1e-9);
   EXPECT_NEAR(split["transit"].get<double>(), 100.0 * 19 / 180, 1e-9);
   EXPECT_NEAR(split["capture"].get<double>(), 100.0 * 12 / 180, 1e-9);
-  EXPECT_NEAR(split["other"].get<double>(), 100.0 * 6 / 180, 1e-9);
+  EXPECT_NEAR(split["perception"].get<double>(), 100.0 * 3 / 180, 1e-9);
+  EXPECT_NEAR(split["other"].get<double>(), 100.0 * 3 / 180, 1e-9);
   const std::string table = slurp(out / "table1.md");
   EXPECT_NE(table.find("| FVP (ours) | 4 | 35.0 | 50.0 | 6.0 | 1.50 | 10.0 |"), std::string::npos)
       << table;
-  EXPECT_NE(table.find("| FVP (ours) | 56.1 | 10.6 | 6.7 | 6.7 | 3.3 |"), std::string::npos)
+  EXPECT_NE(table.find("| FVP (ours) | 56.1 | 10.6 | 6.7 | 1.7 | 6.7 | 3.3 |"), std::string::npos)
       << table;
   EXPECT_EQ(table.find("paper's sizing estimator | 4 |"), std::string::npos);  // same trials
   EXPECT_EQ(slurp(out / "time_split.png").substr(1, 3), "PNG");
@@ -877,6 +879,32 @@ TEST(Experiment, TheManifestRecordsEveryTrialSettingButThePerTrialOnes) {
   ASSERT_TRUE(resumeDifference(read, other).has_value());
   EXPECT_EQ(resumeDifference(read, other)->setting, "engine");
   EXPECT_EQ(resumeDifference(read, other)->old_value, "(each planner's own)");
+}
+
+TEST(Experiment, TrialsTimedByAnotherClockAreNeverPooled) {
+  // A manifest without clock_charges was made before the clock charged perception: its
+  // trials' times are not this build's, so neither resume nor merge pools them.
+  ExperimentManifest m;
+  m.planners = {"fvp"};
+  m.trials = 1;
+  nlohmann::ordered_json j = m.toJson();
+  EXPECT_EQ(j["clock_charges"], ExperimentManifest::kClockCharges);
+  j.erase("clock_charges");
+  const fs::path dir = freshDir("manifest_clock");
+  fs::create_directories(dir);
+  writeText(dir / "manifest.json", j.dump(2));
+  const ExperimentManifest old = readManifest(dir / "manifest.json");
+  EXPECT_EQ(old.clock_charges, ExperimentManifest::kClockChargesBeforePerception);
+  for (const auto& d : {resumeDifference(old, m), mergeDifference(old, m)}) {
+    ASSERT_TRUE(d.has_value());
+    EXPECT_EQ(d->setting, "clock_charges");
+  }
+  writeText(dir / "manifest.json", m.toJson().dump(2));
+  EXPECT_FALSE(resumeDifference(readManifest(dir / "manifest.json"), m).has_value());
+  j["clock_charges"] = 7;
+  writeText(dir / "manifest.json", j.dump(2));
+  EXPECT_NE(errorOf([&] { readManifest(dir / "manifest.json"); }).find("field 'clock_charges'"),
+            std::string::npos);
 }
 
 TEST(Experiment, ABadTrialResultIsNotAppended) {

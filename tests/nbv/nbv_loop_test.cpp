@@ -26,9 +26,10 @@ class FakeClock : public LoopClock {
   void chargeCompute(LoopStage stage, double) override {
     ++compute_charges;
     if (stage == LoopStage::kGoalCheck) ++goal_check_charges;
+    if (stage == LoopStage::kPerception) ++perception_charges;
   }
   void advance(double s) { now_ += s; }
-  int compute_charges = 0, goal_check_charges = 0;
+  int compute_charges = 0, goal_check_charges = 0, perception_charges = 0;
 
  private:
   double now_ = 0.0;
@@ -164,6 +165,7 @@ TEST(NbvLoop, AViewTheGoalCheckTurnsDownIsNotMovedToAndEachBatchIsCharged) {
   EXPECT_EQ(rig.arm.moves, 2);
   EXPECT_EQ(r.events.iterations_without_move, 1u);
   EXPECT_EQ(rig.clock.goal_check_charges, 3);  // each batch a compute stage of its own
+  EXPECT_EQ(rig.clock.perception_charges, 3);  // each view's perception, once
 }
 
 TEST(NbvLoop, NoGoalChecksWhenTheArmHasNoneOrTheyAreOff) {
@@ -202,6 +204,7 @@ TEST(NbvLoop, DroppedFramesAreCountedAndCapturedAgain) {
   EXPECT_EQ(r.events.dropped_frames, 2u);
   EXPECT_EQ(rig.camera.captures, 4);
   EXPECT_EQ(rig.planner.calls, 1);
+  EXPECT_EQ(rig.clock.perception_charges, 2);  // a dropped frame has nothing to perceive
 }
 
 TEST(NbvLoop, ACameraThatNeverDeliversStopsTheLoop) {

@@ -50,6 +50,27 @@ TEST(SimClock, FixedModeChargesConstantsAndKeepsTheMeasuredTime) {
   EXPECT_THROW(clock.chargeMotion(-1.0), std::invalid_argument);
 }
 
+TEST(SimClock, PerceptionIsChargedLikeEveryComputeStage) {
+  // Fixed mode: perception's own constant (stereo matching dominates it), not the 0.1 s of
+  // the lighter stages; the measured time is kept beside it.
+  SimClock fixed(SimClock::Mode::kFixed, 0.2, 0.1, 0.4);
+  fixed.chargeCapture();
+  fixed.chargeCompute(ClockStage::kPerception, 0.37);
+  fixed.chargeCompute(ClockStage::kMapping, 0.05);
+  EXPECT_NEAR(fixed.now_s(), 0.2 + 0.4 + 0.1, 1e-12);
+  EXPECT_DOUBLE_EQ(fixed.iterations()[0].charged(ClockStage::kPerception), 0.4);
+  EXPECT_DOUBLE_EQ(fixed.iterations()[0].measured_s[static_cast<int>(ClockStage::kPerception)],
+                   0.37);
+  const auto row = nlohmann::json::parse(fixed.toJson())["iterations"][0];
+  EXPECT_DOUBLE_EQ(row["perception_s"].get<double>(), 0.4);
+  EXPECT_DOUBLE_EQ(row["measured_wall"]["perception_s"].get<double>(), 0.37);
+  // Wall mode: as measured.
+  SimClock wall(SimClock::Mode::kWall, 0.2, 0.1, 0.4);
+  wall.chargeCompute(ClockStage::kPerception, 0.25);
+  EXPECT_NEAR(wall.now_s(), 0.25, 1e-12);
+  EXPECT_THROW(SimClock(SimClock::Mode::kFixed, 0.2, 0.1, -0.4), std::invalid_argument);
+}
+
 TEST(SimClock, ModeFromString) {
   EXPECT_EQ(SimClock::modeFromString("fixed"), SimClock::Mode::kFixed);
   EXPECT_EQ(SimClock::modeFromString("wall"), SimClock::Mode::kWall);

@@ -88,6 +88,7 @@ nlohmann::json clockIterations(int views) {
   nlohmann::json it = nlohmann::json::array();
   for (int i = 0; i < views; ++i)
     it.push_back({{"capture_s", 0.2},
+                  {"perception_s", 0.4},
                   {"mapping_s", 0.1},
                   {"tsdf_s", 0.1},
                   {"planning_s", 0.1},
@@ -97,7 +98,7 @@ nlohmann::json clockIterations(int views) {
                   {"measured_wall", {{"mapping_s", 0.3}}},
                   {"rendering_wall_s", 1.6},
                   {"sgbm_wall_s", 1.1},
-                  {"total_s", 2.1}});
+                  {"total_s", 2.5}});
   return {{"mode", "fixed"}, {"iterations", it}};
 }
 
@@ -112,7 +113,7 @@ nlohmann::json trialResult() {
   r["status"] = "ok";
   r["stop_reason"] = "budget";
   r["views"] = kViews;
-  r["sim_time_s"] = 2.1 * kViews;
+  r["sim_time_s"] = 2.5 * kViews;
   r["budget_s"] = 180.0;
   r["wall_time_s"] = 82.4;
   r["wall_breakdown_s"] = {{"rendering", 25.3}, {"perception", 20.2}, {"planning", 12.9}};
@@ -214,10 +215,12 @@ TEST(TrialReport, KeepsWallAndSimulatedTimeInSeparateTables) {
   const std::string sim = section(md, "Where the simulated budget went");
   ASSERT_FALSE(sim.empty()) << md;
   EXPECT_TRUE(contains(row(sim, "motion"), "| 7.00 |")) << sim;
-  EXPECT_TRUE(contains(sim, "| **total of the iterations** | **10.50** |")) << sim;
+  EXPECT_TRUE(contains(sim, "| **total of the iterations** | **12.50** |")) << sim;
+  // Perception is charged, in the loop's order: right after the capture.
+  EXPECT_TRUE(contains(sim, "| capture | 1.00 |\n| perception | 2.00 |\n| mapping |")) << sim;
   EXPECT_FALSE(contains(sim, "wall")) << sim;
   EXPECT_FALSE(contains(sim, "sgbm")) << sim;
-  // The wall time: the total first, then the parts and the uncharged stereo matching.
+  // The wall time: the total first, then the parts and stereo matching's share of perception.
   const std::string wall = section(md, "Where the wall time went");
   ASSERT_FALSE(wall.empty()) << md;
   const std::size_t table = wall.find("|---|---|\n");

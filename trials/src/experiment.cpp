@@ -386,6 +386,7 @@ const std::vector<std::pair<std::string, std::string>>& timeSplitStages() {
       {"motion_between_views", "motion between views"},
       {"transit", "transit between clusters"},
       {"capture", "capture"},
+      {"perception", "perception"},
       {"mapping", "mapping"},
       {"tsdf", "TSDF"},
       {"sizing", "sizing"},
@@ -460,9 +461,11 @@ std::string timeSplitFigureScript(const nlohmann::json& summary,
     ++bars;
   }
   if (bars == 0) return "";
-  // Motion in blues, capture grey, compute in warm colours, planning in greens.
-  static const char* const colours[] = {"#1f77b4", "#aec7e8", "#7f7f7f", "#ff7f0e", "#ffbb78",
-                                        "#d62728", "#2ca02c", "#98df8a", "#17becf", "#e5e5e5"};
+  // Motion in blues, capture grey, perception purple, compute in warm colours, planning in
+  // greens.
+  static const char* const colours[] = {"#1f77b4", "#aec7e8", "#7f7f7f", "#9467bd",
+                                        "#ff7f0e", "#ffbb78", "#d62728", "#2ca02c",
+                                        "#98df8a", "#17becf", "#e5e5e5"};
   std::ostringstream gp;
   gp << "set terminal pngcairo size 900," << 220 + 60 * bars << " font 'DejaVu Sans,12'\n"
      << "set title 'Where the simulated time went'\n"

@@ -477,6 +477,7 @@ nlohmann::ordered_json ExperimentManifest::toJson() const {
       j[key] = settingJson(value);
   });
   j["error_scale"] = error_scale;
+  j["clock_charges"] = clock_charges;
   if (kind == "merged") {
     j["sources"] = sources;
     return j;
@@ -533,6 +534,8 @@ ExperimentManifest readManifest(const std::filesystem::path& path) {
     fieldError(where, "kind", "\"run\" or \"merged\"", &j["kind"]);
   readManifestSettings(j, where, m.kind == "merged", m);
   if (member(j, "error_scale")) m.error_scale = readErrorScale(j, where);
+  m.clock_charges = member(j, "clock_charges") ? readString(j, "clock_charges", where)
+                                               : ExperimentManifest::kClockChargesBeforePerception;
   if (m.kind == "merged") {
     const nlohmann::json& sources = required(j, "sources", where, "an array of directories");
     if (!sources.is_array()) fieldError(where, "sources", "an array of directories", &sources);
@@ -571,16 +574,27 @@ ExperimentManifest readManifest(const std::filesystem::path& path) {
   return m;
 }
 
+/// The clock's charges as a difference, if they differ.
+std::optional<ManifestDifference> clockDifference(const ExperimentManifest& a,
+                                                  const ExperimentManifest& b) {
+  if (a.clock_charges == b.clock_charges) return std::nullopt;
+  return ManifestDifference{"clock_charges", "\"" + a.clock_charges + "\"",
+                            "\"" + b.clock_charges + "\""};
+}
+
 std::optional<ManifestDifference> mergeDifference(const ExperimentManifest& a,
                                                   const ExperimentManifest& b) {
-  return settingsDifference(
-      a, b, [](std::string_view key) { return key != "engine" && key != "backend"; });
+  if (auto d = settingsDifference(
+          a, b, [](std::string_view key) { return key != "engine" && key != "backend"; }))
+    return d;
+  return clockDifference(a, b);
 }
 
 std::optional<ManifestDifference> resumeDifference(const ExperimentManifest& old,
                                                    const ExperimentManifest& now) {
   if (auto d = settingsDifference(old, now, [](std::string_view key) { return key != "backend"; }))
     return d;
+  if (auto d = clockDifference(old, now)) return d;
   if (old.planners != now.planners)
     return ManifestDifference{"planners", joined(old.planners), joined(now.planners)};
   if (old.trials != now.trials)

@@ -317,9 +317,9 @@ void appendSimulatedBudget(std::ostringstream& md, const nlohmann::json& result)
      << (field(result, "clock").is_object() ? result["clock"].value("mode", "?") : "?")
      << "` mode), summed over the loop's iterations.\n\n| stage | simulated s |\n|---|---|\n";
   // The loop's order first, any other stage after it.
-  const std::vector<std::string> order = {"capture_s",  "mapping_s",    "tsdf_s",
-                                          "planning_s", "goal_check_s", "motion_planning_s",
-                                          "motion_s",   "sizing_s"};
+  const std::vector<std::string> order = {
+      "capture_s",    "perception_s",      "mapping_s", "tsdf_s",  "planning_s",
+      "goal_check_s", "motion_planning_s", "motion_s",  "sizing_s"};
   const auto row = [&](const std::string& key, double s) {
     md << "| " << key.substr(0, key.size() - (key.size() > 2 && key.ends_with("_s") ? 2 : 0))
        << " | " << fmt(s, 2) << " |\n";
@@ -339,8 +339,8 @@ void appendSimulatedBudget(std::ostringstream& md, const nlohmann::json& result)
 /// machine, which the simulated clock does not count).
 void appendWallTime(std::ostringstream& md, const nlohmann::json& result) {
   md << "\n## Where the wall time went\n\nWall-clock seconds on this machine. The simulated "
-        "clock never charges rendering or stereo matching (a fixed capture charge stands in "
-        "for a camera), and charges the compute stages their measured time only in `wall` "
+        "clock never charges rendering (a fixed capture charge stands in for a camera), and "
+        "charges the compute stages, perception included, their measured time only in `wall` "
         "clock mode.\n\n| part | wall s |\n|---|---|\n"
      << "| **total wall time** | **" << fmtOrDash(field(result, "wall_time_s"), 2) << "** |\n";
   for (const auto& [part, s] : field(result, "wall_breakdown_s").items())

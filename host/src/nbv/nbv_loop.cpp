@@ -140,6 +140,7 @@ NbvResult NbvLoop::run(const StopCondition& stop, LoopObserver* observer) {
       out.wall_s.perception += view.perceive_s;
       out.wall_s.mapping += view.scan.seconds;
       out.wall_s.tsdf += view.tsdf_s;
+      clock_.chargeCompute(LoopStage::kPerception, view.perceive_s);
       clock_.chargeCompute(LoopStage::kMapping, view.scan.seconds);
       clock_.chargeCompute(LoopStage::kTsdf, view.tsdf_s);
       clock_.recordStereoMatching(view.perception.sgbm_s);

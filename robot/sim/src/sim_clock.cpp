@@ -23,6 +23,8 @@ const char* toString(ClockStage stage) {
       return "sizing";
     case ClockStage::kGoalCheck:
       return "goal_check";
+    case ClockStage::kPerception:
+      return "perception";
   }
   return "unknown";
 }
@@ -33,9 +35,13 @@ double IterationCharges::total_s() const {
   return sum;
 }
 
-SimClock::SimClock(Mode mode, double capture_time_s, double fixed_stage_time_s)
-    : mode_(mode), capture_time_s_(capture_time_s), fixed_stage_time_s_(fixed_stage_time_s) {
-  if (!(capture_time_s >= 0.0) || !(fixed_stage_time_s >= 0.0))
+SimClock::SimClock(Mode mode, double capture_time_s, double fixed_stage_time_s,
+                   double fixed_perception_time_s)
+    : mode_(mode),
+      capture_time_s_(capture_time_s),
+      fixed_stage_time_s_(fixed_stage_time_s),
+      fixed_perception_time_s_(fixed_perception_time_s) {
+  if (!(capture_time_s >= 0.0) || !(fixed_stage_time_s >= 0.0) || !(fixed_perception_time_s >= 0.0))
     throw std::invalid_argument("SimClock: capture and fixed stage times must be >= 0");
 }
 
@@ -62,7 +68,11 @@ void SimClock::chargeCompute(ClockStage stage, double measured_wall_s) {
   if (stage == ClockStage::kCapture || stage == ClockStage::kMotion)
     throw std::invalid_argument("SimClock::chargeCompute: not a compute stage");
   current().measured_s[static_cast<int>(stage)] += measured_wall_s;
-  charge(stage, mode_ == Mode::kFixed ? fixed_stage_time_s_ : measured_wall_s);
+  if (mode_ == Mode::kWall)
+    charge(stage, measured_wall_s);
+  else
+    charge(stage,
+           stage == ClockStage::kPerception ? fixed_perception_time_s_ : fixed_stage_time_s_);
 }
 
 void SimClock::chargeMotion(double duration_s) {

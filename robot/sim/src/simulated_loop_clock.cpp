@@ -19,6 +19,9 @@ void SimulatedLoopClock::chargeCompute(host::nbv::LoopStage stage, double wall_s
     case host::nbv::LoopStage::kGoalCheck:
       clock_.chargeCompute(ClockStage::kGoalCheck, wall_s);
       return;
+    case host::nbv::LoopStage::kPerception:
+      clock_.chargeCompute(ClockStage::kPerception, wall_s);
+      return;
   }
 }
 

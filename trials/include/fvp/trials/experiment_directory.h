@@ -93,6 +93,14 @@ struct ExperimentManifest {
   /// --error-scale GROUP=FACTOR, or empty; the world config's hash already tells runs apart,
   /// this names the sweep point (absent in a manifest: empty).
   std::string error_scale;
+  /// What the simulated clock charged the trials (robot/sim/sim_clock.h), so that resume and
+  /// merge never pool trials timed by different clocks: kClockCharges, or, in a manifest
+  /// without the key, kClockChargesBeforePerception.
+  std::string clock_charges = kClockCharges;
+  static constexpr const char* kClockCharges =
+      "capture, perception and every compute stage (fixed clock: 0.2 s, 0.4 s, 0.1 s each)";
+  static constexpr const char* kClockChargesBeforePerception =
+      "capture and the compute stages but not perception (an fvp before 2026-11-30)";
   // The run's own plan (kind "run" only). Resume refuses a difference; merge does not
   // compare them (shards differ in them by design).
   std::vector<std::string> planners;
@@ -115,14 +123,14 @@ struct ManifestDifference {
 };
 
 /// The first setting `now` changes against `old` that resume refuses: the row-defining
-/// settings, then engine, planners, trials, first_seed and shard (backend is recorded
-/// only: it picks the compute device, not what a trial measures).
+/// settings, then engine, what the clock charges, planners, trials, first_seed and shard
+/// (backend is recorded only: it picks the compute device, not what a trial measures).
 std::optional<ManifestDifference> resumeDifference(const ExperimentManifest& old,
                                                    const ExperimentManifest& now);
 
 /// The first row-defining setting in which two experiments differ (what merge refuses): every
 /// setting but the engine and the backend, in the settings list's order (configs by content
-/// hash).
+/// hash), then what the clock charges.
 std::optional<ManifestDifference> mergeDifference(const ExperimentManifest& a,
                                                   const ExperimentManifest& b);
 

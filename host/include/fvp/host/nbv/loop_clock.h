@@ -10,7 +10,8 @@ namespace fvp::host::nbv {
 /// The loop's own compute, which a simulated clock charges (measured or fixed).
 /// kSizing: sizing the cluster during the loop (the automatic stop's, cluster_completion.h).
 /// kGoalCheck: one batch of the arm's goal checks of ranked views (Arm::checkGoal).
-enum class LoopStage { kMapping, kTsdf, kPlanning, kSizing, kGoalCheck };
+/// kPerception: a captured frame's stereo matching, tag detection, segmentation and clouds.
+enum class LoopStage { kMapping, kTsdf, kPlanning, kSizing, kGoalCheck, kPerception };
 
 class LoopClock {
  public:
@@ -23,8 +24,8 @@ class LoopClock {
     (void)stage;
     (void)wall_s;
   }
-  /// Stereo matching's wall time, which a simulated clock does not charge (the capture
-  /// charge stands in for the camera's own depth pipeline).
+  /// Stereo matching's share of a view's perception (charged within kPerception), recorded
+  /// so the records say how much of perception it is.
   virtual void recordStereoMatching(double wall_s) { (void)wall_s; }
 };
 

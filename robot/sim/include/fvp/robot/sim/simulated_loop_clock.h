@@ -1,5 +1,5 @@
 // The simulated clock as the next-best-view loop's clock: the loop's compute charged as
-// measured (clock wall) or as a constant (clock fixed), stereo matching recorded, not charged.
+// measured (clock wall) or as a constant (clock fixed), perception included.
 #pragma once
 
 #include "fvp/host/nbv/loop_clock.h"
