@@ -397,6 +397,79 @@ TEST_P(GridEngineBackends, FrontiersFollowTheirDefinitions) {
   }
 }
 
+TEST_P(GridEngineBackends, FrontiersFromChangedBricksEqualAFullExtractionAfterEveryScan) {
+  // The engine's extractor classifies again only the bricks a scan changed and their
+  // neighbours; a fresh extractor on the same layer classifies every brick.
+  const std::uint64_t seed = fvp::testing::freshSeed();
+  SCOPED_TRACE(fvp::testing::replayHint(seed));
+  GridMapEngine map(smallConfig(), kRegion, *backend_);
+  const float occupied = map.config().model.occupiedLogOdds();
+  std::size_t partial = 0;
+  for (int view = 0; view < 6; ++view) {
+    map.integrate(viewOfCluster(seed + view, 120).clouds());
+    const std::vector<FrontierVoxel> got = map.frontiers();
+    FrontierExtractor fresh(map.fine());
+    const std::vector<FrontierVoxel> want = fresh.extract(occupied);
+    ASSERT_TRUE(fresh.lastStats().full);
+    ASSERT_EQ(got.size(), want.size()) << "view " << view;
+    for (std::size_t i = 0; i < want.size(); ++i) {
+      ASSERT_EQ(got[i].index, want[i].index) << "view " << view << ", frontier " << i;
+      ASSERT_EQ(got[i].normal, want[i].normal) << "view " << view << ", frontier " << i;
+      ASSERT_EQ(got[i].roi_frontier, want[i].roi_frontier);
+      ASSERT_EQ(got[i].exploration_frontier, want[i].exploration_frontier);
+    }
+    EXPECT_FALSE(want.empty());
+    partial += map.frontierStats().classified_bricks < map.frontierStats().allocated_bricks;
+  }
+  EXPECT_GE(partial, 4u) << "later views change part of the map: not every brick again";
+  // No scan since: nothing to classify, the same list.
+  const std::size_t before = map.frontiers().size();
+  EXPECT_EQ(map.frontierStats().classified_bricks, 0u);
+  EXPECT_FALSE(map.frontierStats().full);
+  EXPECT_EQ(map.frontiers().size(), before);
+}
+
+TEST_P(GridEngineBackends, FrontiersFromChangedBricksReachEveryNeighbourBrick) {
+  // 4^3 bricks of known free space with unknown voxels at two corners of brick (1, 1, 1),
+  // each with a frontier voxel diagonally across in another brick whose normal it enters
+  // (that voxel stays a frontier through an unknown face neighbour of its own). Making a
+  // corner known changes frontiers in the bricks across each of its faces and the normal
+  // in the brick across its corner: one changed brick, neighbours in every direction.
+  GridGeometry g;
+  g.voxel_size_m = 0.001;
+  g.first_voxel = {0, 0, 0};
+  g.dims = {32, 32, 32};
+  const auto at = [](int x, int y, int z) { return std::size_t(x + 32 * (y + 32 * z)); };
+  const float unknown = std::nanf("");
+  std::vector<float> occupancy(std::size_t(g.voxelCount()), -0.4f);
+  occupancy[at(8, 8, 8)] = occupancy[at(6, 7, 7)] = unknown;        // the low corner
+  occupancy[at(15, 15, 15)] = occupancy[at(17, 16, 16)] = unknown;  // the high corner
+  OccupancyLayer grid(*backend_, g, true, std::nullopt, BrickAllocation::kUpFront);
+  grid.assignDense(occupancy, std::vector<float>(occupancy.size(), unknown));
+  FrontierExtractor extractor(grid);
+  extractor.extract(0.0f);
+  BrickLayer& bricks = grid.bricks();
+  for (const std::array<int, 3> corner : {std::array{8, 8, 8}, std::array{15, 15, 15}}) {
+    SCOPED_TRACE("corner " + std::to_string(corner[0]));
+    // Known now: written as a scan writes it, its brick marked changed.
+    std::vector<float> slots(bricks.slotCount());
+    backend_->download(grid.occupancy(), slots.data(), slots.size() * sizeof(float));
+    slots[std::size_t(bricks.slotOf(corner))] = -0.4f;
+    backend_->upload(grid.occupancy(), slots.data(), slots.size() * sizeof(float));
+    const int entry = bricks.table()[std::size_t(bricks.brickIndex(1, 1, 1))];
+    bricks.markChanged({std::uint32_t(entry & FVP_BRICK_INDEX_MASK)});
+    const std::vector<FrontierVoxel> got = extractor.extract(0.0f);
+    EXPECT_FALSE(extractor.lastStats().full);
+    EXPECT_EQ(extractor.lastStats().classified_bricks, 27u);
+    const std::vector<FrontierVoxel> want = FrontierExtractor(grid).extract(0.0f);
+    ASSERT_EQ(got.size(), want.size());
+    for (std::size_t i = 0; i < want.size(); ++i) {
+      EXPECT_EQ(got[i].index, want[i].index) << i;
+      EXPECT_EQ(got[i].normal, want[i].normal) << i;
+    }
+  }
+}
+
 TEST_P(GridEngineBackends, ChangedBricksAreExactlyTheBricksWhoseVoxelsChanged) {
   // Readers (host mirror, Embree scenes, the coarse OcTree) refresh only the bricks a scan
   // reports changed: compare the report with a full before/after comparison.

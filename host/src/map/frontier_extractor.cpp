@@ -1,25 +1,66 @@
 #include "fvp/host/map/frontier_extractor.h"
 
 #include <algorithm>
+#include <cstring>
+#include <iterator>
 #include <stdexcept>
 #include <tuple>
 
 #include "fvp/accel/kernels.h"
 
 namespace fvp::host::map {
+namespace {
+
+bool byGridIndex(const FrontierVoxel& a, const FrontierVoxel& b) {
+  return std::tie(a.index[2], a.index[1], a.index[0]) <
+         std::tie(b.index[2], b.index[1], b.index[0]);
+}
+
+bool sameBits(float a, float b) {
+  return std::memcmp(&a, &b, sizeof(float)) == 0;
+}
+
+}  // namespace
 
 FrontierExtractor::FrontierExtractor(OccupancyLayer& layer) : layer_(layer) {
   if (!layer.hasRoi()) throw std::logic_error("FrontierExtractor needs a map with ROI");
   counter_ = layer.bricks().backend().createBuffer(sizeof(std::uint32_t));
 }
 
-std::vector<FrontierVoxel> FrontierExtractor::extract(float occupied_logodds) {
+std::vector<std::uint32_t> FrontierExtractor::bricksToReclassify(
+    std::vector<char>& reclassified) const {
+  const BrickLayer& bricks = layer_.bricks();
+  const accel::BrickedGridParams& grid = bricks.params();
+  const std::vector<int>& coords = bricks.brickCoords();
+  const std::vector<std::uint64_t>& stamps = bricks.brickChangeStamps();
+  reclassified.assign(bricks.gridBricks(), 0);
+  std::vector<std::uint32_t> out;
+  for (std::size_t b = 0; b < stamps.size(); ++b) {
+    if (stamps[b] <= last_change_count_) continue;
+    const int* c = &coords[3 * b];
+    for (int z = std::max(0, c[2] - 1); z <= std::min(grid.bricks_z - 1, c[2] + 1); ++z)
+      for (int y = std::max(0, c[1] - 1); y <= std::min(grid.bricks_y - 1, c[1] + 1); ++y)
+        for (int x = std::max(0, c[0] - 1); x <= std::min(grid.bricks_x - 1, c[0] + 1); ++x) {
+          const int id = bricks.brickIndex(x, y, z);
+          if (reclassified[id]) continue;
+          reclassified[id] = 1;
+          // An unallocated brick is unknown space: it holds no frontier.
+          const int entry = bricks.table()[id];
+          if (entry != accel::kNoBrick) out.push_back(entry & FVP_BRICK_INDEX_MASK);
+        }
+  }
+  return out;
+}
+
+std::vector<FrontierVoxel> FrontierExtractor::classify(accel::DeviceBuffer& coords,
+                                                       std::size_t brick_count,
+                                                       float occupied_logodds) {
   BrickLayer& bricks = layer_.bricks();
   accel::Backend& backend = bricks.backend();
   accel::FrontierParams params{};
   params.map = bricks.params();
   params.occupied_logodds = occupied_logodds;
-  params.slot_count = static_cast<std::uint32_t>(bricks.slotCount());
+  params.slot_count = static_cast<std::uint32_t>(brick_count * accel::kBrickVoxels);
   std::vector<accel::Frontier> raw;
   for (;;) {
     params.capacity = capacity_;
@@ -27,8 +68,8 @@ std::vector<FrontierVoxel> FrontierExtractor::extract(float occupied_logodds) {
     const std::uint32_t zero = 0;
     backend.upload(*counter_, &zero, sizeof(zero));
     backend.run(accel::kernels::frontier(), params,
-                {&bricks.coordsBuffer(), &bricks.tableBuffer(), &layer_.occupancy(), &layer_.roi(),
-                 out.get(), counter_.get()});
+                {&coords, &bricks.tableBuffer(), &layer_.occupancy(), &layer_.roi(), out.get(),
+                 counter_.get()});
     std::uint32_t found = 0;
     backend.download(*counter_, &found, sizeof(found));
     if (found <= capacity_) {
@@ -38,10 +79,6 @@ std::vector<FrontierVoxel> FrontierExtractor::extract(float occupied_logodds) {
     }
     capacity_ = found;  // too small: run again with room for all
   }
-  // Kernels append in any order: sort by grid index for a deterministic result.
-  std::sort(raw.begin(), raw.end(), [](const accel::Frontier& a, const accel::Frontier& b) {
-    return std::tie(a.z, a.y, a.x) < std::tie(b.z, b.y, b.x);
-  });
   std::vector<FrontierVoxel> frontiers;
   frontiers.reserve(raw.size());
   for (const auto& f : raw) {
@@ -54,7 +91,63 @@ std::vector<FrontierVoxel> FrontierExtractor::extract(float occupied_logodds) {
     if (n.squaredNorm() > 0) v.normal = n.normalized();
     frontiers.push_back(v);
   }
+  // Kernels append in any order: sort by grid index for a deterministic result.
+  std::sort(frontiers.begin(), frontiers.end(), byGridIndex);
   return frontiers;
+}
+
+std::vector<FrontierVoxel> FrontierExtractor::extract(float occupied_logodds) {
+  BrickLayer& bricks = layer_.bricks();
+  stats_ = {};
+  stats_.allocated_bricks = bricks.allocatedBricks();
+  std::vector<char> reclassified;
+  std::vector<std::uint32_t> changed;
+  // A new threshold changes every voxel's class; so many changes are cheaper whole.
+  bool incremental = have_last_ && sameBits(occupied_logodds, last_occupied_logodds_);
+  if (incremental) {
+    changed = bricksToReclassify(reclassified);
+    incremental = changed.size() < stats_.allocated_bricks;
+  }
+  if (!incremental) {
+    last_ = classify(bricks.coordsBuffer(), stats_.allocated_bricks, occupied_logodds);
+    stats_.classified_bricks = stats_.allocated_bricks;
+  } else {
+    stats_.full = false;
+    stats_.classified_bricks = changed.size();
+    std::vector<FrontierVoxel> fresh;
+    if (!changed.empty()) {
+      std::vector<int> coords;
+      coords.reserve(3 * changed.size());
+      for (std::uint32_t b : changed)
+        coords.insert(coords.end(), &bricks.brickCoords()[3 * b], &bricks.brickCoords()[3 * b + 3]);
+      accel::Backend& backend = bricks.backend();
+      if (changed.size() > changed_coords_capacity_) {
+        changed_coords_capacity_ = std::max(changed.size(), 2 * changed_coords_capacity_);
+        changed_coords_ = backend.createBuffer(changed_coords_capacity_ * 3 * sizeof(int));
+      }
+      backend.upload(*changed_coords_, coords.data(), coords.size() * sizeof(int));
+      fresh = classify(*changed_coords_, changed.size(), occupied_logodds);
+    }
+    // The kept frontiers lie in bricks not classified again; both lists are sorted.
+    const auto brick_of = [&](const FrontierVoxel& v) {
+      return bricks.brickIndex(v.index[0] >> 3, v.index[1] >> 3, v.index[2] >> 3);
+    };
+    std::vector<FrontierVoxel> merged;
+    merged.reserve(last_.size() + fresh.size());
+    auto kept = last_.begin();
+    for (const FrontierVoxel& f : fresh) {
+      for (; kept != last_.end() && byGridIndex(*kept, f); ++kept)
+        if (!reclassified[brick_of(*kept)]) merged.push_back(*kept);
+      merged.push_back(f);
+    }
+    for (; kept != last_.end(); ++kept)
+      if (!reclassified[brick_of(*kept)]) merged.push_back(*kept);
+    last_ = std::move(merged);
+  }
+  have_last_ = true;
+  last_change_count_ = bricks.changeCount();
+  last_occupied_logodds_ = occupied_logodds;
+  return last_;
 }
 
 }  // namespace fvp::host::map

@@ -44,6 +44,8 @@ class GridMapEngine final : public MapEngine {
   void updateRoiDistance(double max_d_m) override;
   double roiDistance_m(const std::array<int, 3>& fine_index) const override;
   std::vector<FrontierVoxel> frontiers() override;
+  /// What the last frontiers() classified again (the bricks changed since the call before).
+  const FrontierExtractionStats& frontierStats() const { return fine_->frontiers.lastStats(); }
   const octomap::OcTree& coarseOcTree() override;
 
  protected:
