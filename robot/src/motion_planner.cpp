@@ -327,13 +327,19 @@ MotionPlanner::MotionPlanner(const ArmCollisionChecker& checker) : checker_(chec
 MotionPlan MotionPlanner::moveToPose(const JointVector& current,
                                      const Eigen::Isometry3d& T_world_camera) const {
   const auto start = Clock::now();
+  const std::uint64_t checks_before = checker_.checks();
   MotionPlan plan;
+  // Every check of the query: the goals' and both planning attempts'.
+  const auto finish = [&](MotionPlan& done) -> MotionPlan& {
+    done.validity_checks = checker_.checks() - checks_before;
+    done.planning_wall_s = secondsSince(start);
+    return done;
+  };
   const std::vector<JointVector> solutions = checker_.arm().inverse(T_world_camera, current);
   plan.ik_solutions = static_cast<int>(solutions.size());
   if (solutions.empty()) {
     plan.status = MotionStatus::kNoIk;
-    plan.planning_wall_s = secondsSince(start);
-    return plan;
+    return finish(plan);
   }
   // Valid solutions, nearest first, keeping only ones distinct from those already kept
   // (the slider samples give many near-copies of each IK branch).
@@ -347,8 +353,7 @@ MotionPlan MotionPlanner::moveToPose(const JointVector& current,
   }
   if (goals.empty()) {
     plan.status = MotionStatus::kNoCollisionFreeIk;
-    plan.planning_wall_s = secondsSince(start);
-    return plan;
+    return finish(plan);
   }
   // The soonest solution first, in the local box, for a share of the time: most plans take a
   // few tens of ms. A goal in a pocket of the map cannot be reached at all, so then every
@@ -359,8 +364,7 @@ MotionPlan MotionPlanner::moveToPose(const JointVector& current,
     plan = plan_(current, goals, 1.0 - kNearestShare, /*local=*/false);
   }
   plan.ik_solutions = static_cast<int>(solutions.size());
-  plan.planning_wall_s = secondsSince(start);
-  return plan;
+  return finish(plan);
 }
 
 MotionStatus MotionPlanner::goalStatus(const JointVector& current,

@@ -430,11 +430,12 @@ TEST_P(GridEngineBackends, FrontiersFromChangedBricksEqualAFullExtractionAfterEv
 }
 
 TEST_P(GridEngineBackends, FrontiersFromChangedBricksReachEveryNeighbourBrick) {
-  // 4^3 bricks of known free space with unknown voxels at two corners of brick (1, 1, 1),
-  // each with a frontier voxel diagonally across in another brick whose normal it enters
-  // (that voxel stays a frontier through an unknown face neighbour of its own). Making a
-  // corner known changes frontiers in the bricks across each of its faces and the normal
-  // in the brick across its corner: one changed brick, neighbours in every direction.
+  // 4^3 bricks of known free space with unknown voxels at two corners and on one edge of
+  // brick (1, 1, 1), each with a frontier voxel diagonally across in another brick whose
+  // normal it enters (that voxel stays a frontier through an unknown face neighbour of its
+  // own). Making such a voxel known changes frontiers in the bricks across its faces and the
+  // normal in the brick across its corner or edge: one changed brick, its face, edge and
+  // corner neighbours.
   GridGeometry g;
   g.voxel_size_m = 0.001;
   g.first_voxel = {0, 0, 0};
@@ -444,13 +445,16 @@ TEST_P(GridEngineBackends, FrontiersFromChangedBricksReachEveryNeighbourBrick) {
   std::vector<float> occupancy(std::size_t(g.voxelCount()), -0.4f);
   occupancy[at(8, 8, 8)] = occupancy[at(6, 7, 7)] = unknown;        // the low corner
   occupancy[at(15, 15, 15)] = occupancy[at(17, 16, 16)] = unknown;  // the high corner
+  occupancy[at(8, 8, 12)] = occupancy[at(6, 7, 12)] = unknown;      // an edge: (0, 0, 1) across
   OccupancyLayer grid(*backend_, g, true, std::nullopt, BrickAllocation::kUpFront);
   grid.assignDense(occupancy, std::vector<float>(occupancy.size(), unknown));
   FrontierExtractor extractor(grid);
   extractor.extract(0.0f);
   BrickLayer& bricks = grid.bricks();
-  for (const std::array<int, 3> corner : {std::array{8, 8, 8}, std::array{15, 15, 15}}) {
-    SCOPED_TRACE("corner " + std::to_string(corner[0]));
+  for (const std::array<int, 3> corner :
+       {std::array{8, 8, 8}, std::array{15, 15, 15}, std::array{8, 8, 12}}) {
+    SCOPED_TRACE("voxel " + std::to_string(corner[0]) + "," + std::to_string(corner[1]) + "," +
+                 std::to_string(corner[2]));
     // Known now: written as a scan writes it, its brick marked changed.
     std::vector<float> slots(bricks.slotCount());
     backend_->download(grid.occupancy(), slots.data(), slots.size() * sizeof(float));

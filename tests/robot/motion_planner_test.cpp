@@ -62,13 +62,20 @@ TEST(MotionPlanner, ReportsStatusesWithoutThrowing) {
   checker.setMap(tree);
   JointVector elsewhere = home;
   elsewhere[0] = 0.4;
-  EXPECT_EQ(planner.moveToPose(elsewhere, goal).status, MotionStatus::kNoCollisionFreeIk);
+  // Every check of a query is its work (what the fixed clock charges): the goals' too.
+  std::uint64_t before = checker.checks();
+  const MotionPlan blocked = planner.moveToPose(elsewhere, goal);
+  EXPECT_EQ(blocked.status, MotionStatus::kNoCollisionFreeIk);
+  EXPECT_GT(blocked.validity_checks, 0u);
+  EXPECT_EQ(blocked.validity_checks, checker.checks() - before);
   EXPECT_EQ(planner.moveToPose(home, arm.T_world_camera(elsewhere)).status,
             MotionStatus::kStartInvalid);
   // Free space: success, and the trajectory ends at the goal.
   checker.clearMap();
+  before = checker.checks();
   const MotionPlan plan = planner.moveToPose(elsewhere, goal);
   ASSERT_EQ(plan.status, MotionStatus::kSuccess);
+  EXPECT_EQ(plan.validity_checks, checker.checks() - before);
   // Nothing in the way: the straight motion, as fast as the joints allow.
   EXPECT_TRUE(plan.straight);
   EXPECT_EQ(plan.trajectory.waypoints().size(), 2u);

@@ -355,21 +355,48 @@ TEST(PlannedArm, StatusNamesAndSampleTimes) {
   EXPECT_THROW(sampleTimes_s(trajectory, 0.0), std::invalid_argument);
 }
 
+// A simulated arm on the fixed clock, planning reproducibly.
+struct FixedClockArm {
+  explicit FixedClockArm(const ArmConfig& config)
+      : model(config), reachability(model), arm(model, reachability, clock, home()) {
+    arm.setReproducibleMotionPlanning(5);
+  }
+  JointVector home() const { return model.homeConfiguration(); }
+  /// One move from home along the slider, turned at wrist 2: a free straight move.
+  PlannedMove moveOnce() {
+    JointVector target = home();
+    target[0] = 0.2;
+    target[4] = 0.5;
+    clock.beginIteration();
+    return arm.planned().moveToPose(model.T_world_camera(target));
+  }
+  const ArmModel model;
+  const IkReachability reachability;
+  sim::SimClock clock{sim::SimClock::Mode::kFixed, 0.2, 0.1};
+  sim::SimulatedArm arm;
+};
+
 TEST(SimulatedArm, ChargesPlanningThenMotionAndMovesTheJoints) {
-  const ArmModel model{ArmConfig{}};
-  const IkReachability reachability(model);
-  sim::SimClock clock(sim::SimClock::Mode::kFixed, 0.2, 0.1);
-  sim::SimulatedArm arm(model, reachability, clock, model.homeConfiguration());
-  arm.setReproducibleMotionPlanning(5);
-  JointVector target = model.homeConfiguration();
-  target[0] = 0.2;
-  target[4] = 0.5;
-  clock.beginIteration();
-  const PlannedMove move = arm.planned().moveToPose(model.T_world_camera(target));
+  FixedClockArm fixed{ArmConfig{}};
+  const PlannedMove move = fixed.moveOnce();
   ASSERT_EQ(move.status, MoveStatus::kSuccess);
   EXPECT_TRUE(move.execution.done());
-  EXPECT_EQ(clock.now_s(), 0.1 + move.plan.trajectory.duration_s());
-  EXPECT_EQ(arm.joints(), move.plan.trajectory.waypoints().back());
+  EXPECT_EQ(fixed.clock.now_s(), 0.1 + move.plan.trajectory.duration_s());
+  EXPECT_EQ(fixed.arm.joints(), move.plan.trajectory.waypoints().back());
+}
+
+TEST(SimulatedArm, TheFixedClockChargesAPlanItsValidityChecks) {
+  // A reference computer of 10 checks a second (the budget over planning_time_s): every
+  // check of the query counts, at that rate, above the stage's constant.
+  ArmConfig config;
+  config.planning_time_s = 100.0;
+  config.reproducible_planning_checks = 1000;
+  FixedClockArm fixed{config};
+  const PlannedMove move = fixed.moveOnce();
+  ASSERT_EQ(move.status, MoveStatus::kSuccess);
+  ASSERT_GT(move.plan.validity_checks, 10u);
+  EXPECT_DOUBLE_EQ(fixed.clock.iterations()[0].charged(sim::ClockStage::kMotionPlanning),
+                   static_cast<double>(move.plan.validity_checks) / 10.0);
 }
 
 }  // namespace

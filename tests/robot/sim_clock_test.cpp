@@ -1,6 +1,8 @@
 // The simulated clock: charges add up, fixed mode is deterministic, records per iteration.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <nlohmann/json.hpp>
 
 #include "fvp/robot/sim/sim_clock.h"
@@ -17,7 +19,7 @@ TEST(SimClock, AddsUpToTheSumOfItsCharges) {
     clock.chargeCompute(ClockStage::kMapping, 0.011 * i);
     clock.chargeCompute(ClockStage::kTsdf, 0.003);
     clock.chargeCompute(ClockStage::kPlanning, 0.05);
-    clock.chargeCompute(ClockStage::kMotionPlanning, 0.02);
+    clock.chargeMotionPlanning(0.02, 0.5);  // wall mode: the measured time
     clock.chargeMotion(1.5 + i);
     clock.recordUncharged(0.7, 0.4);  // not charged
     expected += 0.2 + 0.011 * i + 0.003 + 0.05 + 0.02 + 1.5 + i;
@@ -69,6 +71,26 @@ TEST(SimClock, PerceptionIsChargedLikeEveryComputeStage) {
   wall.chargeCompute(ClockStage::kPerception, 0.25);
   EXPECT_NEAR(wall.now_s(), 0.25, 1e-12);
   EXPECT_THROW(SimClock(SimClock::Mode::kFixed, 0.2, 0.1, -0.4), std::invalid_argument);
+}
+
+TEST(SimClock, AMotionPlanIsChargedAtLeastItsWorkOnTheFixedClock) {
+  // Fixed mode: the stage's constant for a plan lighter than it, the plan's work on the
+  // reference computer beyond (a timed-out plan spends its whole budget).
+  SimClock fixed(SimClock::Mode::kFixed, 0.2, 0.1);
+  fixed.chargeMotionPlanning(0.004, 0.03);
+  EXPECT_NEAR(fixed.now_s(), 0.1, 1e-12);
+  fixed.chargeMotionPlanning(3.5, 1.1);
+  EXPECT_NEAR(fixed.now_s(), 0.1 + 1.1, 1e-12);
+  EXPECT_DOUBLE_EQ(fixed.iterations()[0].charged(ClockStage::kMotionPlanning), 1.2);
+  EXPECT_DOUBLE_EQ(fixed.iterations()[0].measured_s[static_cast<int>(ClockStage::kMotionPlanning)],
+                   3.504);
+  EXPECT_THROW(fixed.chargeMotionPlanning(0.1, -1.0), std::invalid_argument);
+  EXPECT_THROW(fixed.chargeMotionPlanning(0.1, std::nan("")), std::invalid_argument);
+  EXPECT_THROW(fixed.chargeCompute(ClockStage::kMotionPlanning, 0.1), std::invalid_argument);
+  // Wall mode: as measured, whatever the work.
+  SimClock wall(SimClock::Mode::kWall, 0.2, 0.1);
+  wall.chargeMotionPlanning(0.3, 5.0);
+  EXPECT_NEAR(wall.now_s(), 0.3, 1e-12);
 }
 
 TEST(SimClock, ModeFromString) {

@@ -14,6 +14,7 @@
 #include "fvp/host/season/season_visit.h"
 #include "fvp/robot/sim/world.h"
 #include "fvp/robot/sim/world_config.h"
+#include "fvp/trials/experiment_directory.h"
 #include "fvp/trials/trial_fields.h"
 
 namespace fvp::trials {
@@ -75,10 +76,11 @@ std::optional<nlohmann::json> finishedVisit(const TrialOptions& visit) {
       !result.value("settings", nlohmann::json()).is_object() ||
       !firstSettingDifference(result.at("settings"), nlohmann::json(trialSettingsJson(resolved)))
            .empty() ||
-      rememberedDay(result) != visit.remembered_visit.filename())
+      rememberedDay(result) != visit.remembered_visit.filename() ||
+      result.value("clock_charges", "") != ExperimentManifest::kClockCharges)
     throw std::runtime_error(file.string() +
-                             ": not this visit's result (another seed, day, settings or "
-                             "remembered visit); another --out");
+                             ": not this visit's result (another seed, day, settings, "
+                             "remembered visit or clock); another --out");
   return result;
 }
 
@@ -102,14 +104,16 @@ void checkSeasonDays(const std::vector<double>& days) {
 
 namespace {
 
-/// What must be the same for seasons to pool: the visits' settings but the seed and day, and
-/// the caliper baseline's error.
+/// What must be the same for seasons to pool: the visits' settings but the seed and day, the
+/// caliper baseline's error and what the clock charged (a season finished before the clock
+/// charged motion plans their work holds no "clock_charges" and is not pooled).
 nlohmann::json seasonSettings(const SeasonTrialOptions& o) {
   nlohmann::json settings = trialSettingsJson(o.visit);
   settings.erase("seed");
   settings.erase("season_day");
   settings["caliper_sigma_mm"] = o.caliper_sigma_mm;
   settings["remember_visits"] = o.remember_visits;
+  settings["clock_charges"] = ExperimentManifest::kClockCharges;
   return settings;
 }
 

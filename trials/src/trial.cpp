@@ -40,6 +40,7 @@
 #include "fvp/robot/sim/stereo_renderer.h"
 #include "fvp/robot/sim/world.h"
 #include "fvp/robot/workspace_tree.h"
+#include "fvp/trials/experiment_directory.h"
 #include "fvp/trials/simulated_robot.h"
 #include "fvp/trials/trial_fields.h"
 #include "trial_parts.h"
@@ -613,6 +614,8 @@ nlohmann::json Trial::Impl::stopJson() const {
 void Trial::Impl::describeRun(nlohmann::json& result, const TrialLog& log,
                               const std::vector<Eigen::Vector3d>& camera_path) const {
   result["clock"] = nlohmann::json::parse(robot->clock().toJson());
+  // What the clock charges: a season resumes only visits timed by this build's clock.
+  result["clock_charges"] = ExperimentManifest::kClockCharges;
   if (!options.remembered_visit.empty())
     result["remembered_visit"] = options.remembered_visit.string();
   // The clock's record stays in result.json only; its sums by stage go everywhere the trial

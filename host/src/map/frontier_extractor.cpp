@@ -60,6 +60,8 @@ std::vector<FrontierVoxel> FrontierExtractor::classify(accel::DeviceBuffer& coor
   accel::FrontierParams params{};
   params.map = bricks.params();
   params.occupied_logodds = occupied_logodds;
+  // The items are the listed bricks' voxels; each reads the channels of any allocated brick
+  // through the table (the bindings' sizes are minimums, the channels hold every slot).
   params.slot_count = static_cast<std::uint32_t>(brick_count * accel::kBrickVoxels);
   std::vector<accel::Frontier> raw;
   for (;;) {
@@ -118,8 +120,10 @@ std::vector<FrontierVoxel> FrontierExtractor::extract(float occupied_logodds) {
     if (!changed.empty()) {
       std::vector<int> coords;
       coords.reserve(3 * changed.size());
-      for (std::uint32_t b : changed)
-        coords.insert(coords.end(), &bricks.brickCoords()[3 * b], &bricks.brickCoords()[3 * b + 3]);
+      for (std::uint32_t b : changed) {
+        const int* c = bricks.brickCoords().data() + 3 * std::size_t{b};
+        coords.insert(coords.end(), c, c + 3);
+      }
       accel::Backend& backend = bricks.backend();
       if (changed.size() > changed_coords_capacity_) {
         changed_coords_capacity_ = std::max(changed.size(), 2 * changed_coords_capacity_);

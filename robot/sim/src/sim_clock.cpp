@@ -1,5 +1,6 @@
 #include "fvp/robot/sim/sim_clock.h"
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
@@ -67,12 +68,22 @@ void SimClock::chargeCapture() {
 void SimClock::chargeCompute(ClockStage stage, double measured_wall_s) {
   if (stage == ClockStage::kCapture || stage == ClockStage::kMotion)
     throw std::invalid_argument("SimClock::chargeCompute: not a compute stage");
+  if (stage == ClockStage::kMotionPlanning)
+    throw std::invalid_argument("SimClock::chargeCompute: a motion plan is chargeMotionPlanning's");
   current().measured_s[static_cast<int>(stage)] += measured_wall_s;
   if (mode_ == Mode::kWall)
     charge(stage, measured_wall_s);
   else
     charge(stage,
            stage == ClockStage::kPerception ? fixed_perception_time_s_ : fixed_stage_time_s_);
+}
+
+void SimClock::chargeMotionPlanning(double measured_wall_s, double reference_work_s) {
+  if (!(reference_work_s >= 0.0))
+    throw std::invalid_argument("SimClock::chargeMotionPlanning: negative or NaN work");
+  current().measured_s[static_cast<int>(ClockStage::kMotionPlanning)] += measured_wall_s;
+  charge(ClockStage::kMotionPlanning,
+         mode_ == Mode::kWall ? measured_wall_s : std::max(fixed_stage_time_s_, reference_work_s));
 }
 
 void SimClock::chargeMotion(double duration_s) {

@@ -37,6 +37,8 @@ struct MotionPlan {
   double planning_wall_s = 0.0;            ///< IK + planning + simplification + timing
   int ik_solutions = 0;                    ///< within limits, before collision checks
   bool straight = false;  ///< the straight joint-space motion, without a sampling planner
+  /// Every state and motion check of the query (moveToPose: the goals' and every planning
+  /// attempt's): the work a fixed clock charges (SimClock::chargeMotionPlanning).
   std::uint64_t validity_checks = 0;
   bool ok() const { return status == MotionStatus::kSuccess; }
 };

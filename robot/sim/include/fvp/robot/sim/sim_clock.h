@@ -3,8 +3,9 @@
 // and both images' transfer), the measured wall time of perception (stereo matching, tag,
 // segmentation, clouds), mapping, TSDF integration, planning and motion planning, and the
 // trajectory's duration. Mode `fixed` charges a constant per compute stage instead of the
-// measured time, for deterministic tests. Every charge is kept per iteration; the wall time of
-// rendering is recorded, not charged (a simulator cost).
+// measured time (a motion plan at least its validity checks' time), for deterministic runs.
+// Every charge is kept per iteration; the wall time of rendering is recorded, not charged (a
+// simulator cost).
 #pragma once
 
 #include <stdexcept>
@@ -66,9 +67,15 @@ class SimClock {
   /// Opens the next iteration's record (charges before the first call open one).
   void beginIteration();
   void chargeCapture();
-  /// A compute stage (perception, mapping, TSDF, planning, motion planning, sizing for an
-  /// automatic stop, a batch of goal checks) that took measured_wall_s.
+  /// A compute stage (perception, mapping, TSDF, planning, sizing for an automatic stop, a
+  /// batch of goal checks) that took measured_wall_s; motion plans: chargeMotionPlanning.
   void chargeCompute(ClockStage stage, double measured_wall_s);
+  /// A motion plan that took measured_wall_s and whose work on the reference computer takes
+  /// reference_work_s (its validity checks at the rate that sets the reproducible check
+  /// budgets, MotionPlanner::setReproducible). Mode fixed charges the larger of that and the
+  /// stage's constant: a plan that spends its whole budget costs what a robot's time-limited
+  /// planner (planning_time_s) would spend, not the constant.
+  void chargeMotionPlanning(double measured_wall_s, double reference_work_s);
   void chargeMotion(double duration_s);
   /// Records what is not charged apart: the renderer's wall time (a simulator cost) and
   /// stereo matching's share of the perception already charged.

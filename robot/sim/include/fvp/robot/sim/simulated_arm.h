@@ -18,6 +18,9 @@ class SimulatedArm : public host::nbv::Arm {
   /// `arm`, `reachability` and `clock` must outlive the simulated arm; it starts at `start`.
   SimulatedArm(const ArmModel& arm, const Reachability& reachability, SimClock& clock,
                const JointVector& start);
+  // The planned arm refers to this object's joint state, executor and planning flag.
+  SimulatedArm(const SimulatedArm&) = delete;
+  SimulatedArm& operator=(const SimulatedArm&) = delete;
 
   /// The start configuration for a world's start view: its IK solution nearest the arm's
   /// home configuration that is free of self and static collision; none when unreachable.
@@ -47,8 +50,11 @@ class SimulatedArm : public host::nbv::Arm {
 
   /// Motion planning as MotionPlanner::setReproducible (fvp run --clock fixed): the same
   /// moves on any machine and under any load.
+  /// The fixed clock then charges each plan its validity checks' time (SimClock::
+  /// chargeMotionPlanning), which only reproducible planning makes the same on any machine.
   void setReproducibleMotionPlanning(std::uint64_t seed) {
     arm_.setReproducibleMotionPlanning(seed);
+    reproducible_planning_ = true;
   }
   JointVector joints() const { return joint_state_.jointPositions(); }
   /// A motion the arm's driver was sent from outside the loop (the ROS bridge's joint
@@ -61,6 +67,7 @@ class SimulatedArm : public host::nbv::Arm {
   SimulatedJointState joint_state_;
   SimulatedTrajectoryExecutor executor_;
   PlannedArm arm_;
+  bool reproducible_planning_ = false;
 };
 
 }  // namespace fvp::robot::sim
