@@ -136,17 +136,13 @@ std::vector<FrontierVoxel> FrontierExtractor::extract(float occupied_logodds) {
     const auto brick_of = [&](const FrontierVoxel& v) {
       return bricks.brickIndex(v.index[0] >> 3, v.index[1] >> 3, v.index[2] >> 3);
     };
-    std::vector<FrontierVoxel> merged;
-    merged.reserve(last_.size() + fresh.size());
-    auto kept = last_.begin();
-    for (const FrontierVoxel& f : fresh) {
-      for (; kept != last_.end() && byGridIndex(*kept, f); ++kept)
-        if (!reclassified[brick_of(*kept)]) merged.push_back(*kept);
-      merged.push_back(f);
-    }
-    for (; kept != last_.end(); ++kept)
-      if (!reclassified[brick_of(*kept)]) merged.push_back(*kept);
-    last_ = std::move(merged);
+    std::vector<FrontierVoxel> kept;
+    kept.reserve(last_.size());
+    std::copy_if(last_.begin(), last_.end(), std::back_inserter(kept),
+                 [&](const FrontierVoxel& v) { return !reclassified[brick_of(v)]; });
+    last_.clear();
+    std::merge(kept.begin(), kept.end(), fresh.begin(), fresh.end(), std::back_inserter(last_),
+               byGridIndex);
   }
   have_last_ = true;
   last_change_count_ = bricks.changeCount();
