@@ -11,7 +11,9 @@
 // centre inside it), and every backend ranks the same best view and gives the same sizes and
 // centres as the cpu backend, bit for bit (the determinism contract, docs/kernels.md).
 // BM_View/cpu/disparity_window: the cpu's with stereo's disparity window (its outcome
-// checked against the truth only). Counters: each stage's milliseconds (of_which_stereo_ms
+// checked against the truth only). BM_View/<backend>/guided_stereo: stereo's fine pass by
+// the guided kernels on that backend (the cpu's checked against the truth, the others
+// against the cpu's bit for bit). Counters: each stage's milliseconds (of_which_stereo_ms
 // is part of perception_ms, planning_<stage>_ms of planning_ms). Not in it: the arm's
 // obstacle update and goal checks (the arm's work, BM_MotionPlan), and later sampling rounds
 // when round 0 ranks nothing worth a move.
@@ -187,13 +189,28 @@ std::string checkAgainstTruth(const ViewOutcome& cpu) {
 }
 
 /// The cpu backend's outcome, the reference every backend must repeat.
-const ViewOutcome& cpuReference() {
-  static const ViewOutcome reference = [] {
-    const NbvSetupOptions options = optionsFor(accel::BackendKind::kCpu);
+/// How stereo's full-resolution pass runs in a BM_View variant.
+enum class FinePass { kSgbm, kSgbmWindow, kGuided };
+
+NbvSetupOptions optionsFor(accel::BackendKind kind, FinePass fine) {
+  NbvSetupOptions options = optionsFor(kind);
+  options.disparity_window = fine == FinePass::kSgbmWindow;
+  options.guided_stereo = fine == FinePass::kGuided;
+  return options;
+}
+
+/// The cpu backend's outcome with SGBM's fine pass, or with the guided kernels'.
+const ViewOutcome& cpuReference(bool guided) {
+  static const auto run = [](bool g) {
+    const NbvSetupOptions options =
+        optionsFor(accel::BackendKind::kCpu, g ? FinePass::kGuided : FinePass::kSgbm);
     NbvSetup setup(options);
     return runView(setup, options);
-  }();
-  return reference;
+  };
+  static const ViewOutcome sgbm = run(false);
+  if (!guided) return sgbm;
+  static const ViewOutcome guided_outcome = run(true);
+  return guided_outcome;
 }
 
 bool sameOutcome(const ViewOutcome& a, const ViewOutcome& b) {
@@ -217,17 +234,19 @@ void reportStages(benchmark::State& state, const ViewOutcome& sum, std::size_t f
   state.counters["fruitlets_sized"] = double(fruitlets);
 }
 
-// disparity_window: stereo's fine pass over the Cluster Region's disparities and nearer
+// kSgbmWindow: stereo's fine pass over the Cluster Region's disparities and nearer
 // (NbvSetupOptions::disparity_window): its own outcome, checked against the truth, since
-// its disparities are not the whole range's.
-void BM_View(benchmark::State& state, accel::BackendKind kind, bool disparity_window) {
+// its disparities are not the whole range's. kGuided: the guided kernels' fine pass
+// (NbvSetupOptions::guided_stereo), checked against the truth on the cpu and bit for bit
+// against the cpu's on the other backends.
+void BM_View(benchmark::State& state, accel::BackendKind kind, FinePass fine) {
   try {
-    NbvSetupOptions options = optionsFor(kind);
-    options.disparity_window = disparity_window;
+    const NbvSetupOptions options = optionsFor(kind, fine);
     NbvSetup setup(options);  // an unavailable backend throws here: skipped with its reason
-    const ViewOutcome& reference = cpuReference();
+    const ViewOutcome& reference = cpuReference(fine == FinePass::kGuided);
     if (const std::string wrong = checkAgainstTruth(reference); !wrong.empty())
       throw std::runtime_error("cpu reference: " + wrong);
+    const bool disparity_window = fine == FinePass::kSgbmWindow;
     ViewOutcome sum;
     bool same = true;
     for (auto _ : state) {
@@ -248,20 +267,21 @@ void BM_View(benchmark::State& state, accel::BackendKind kind, bool disparity_wi
   }
 }
 
+void registerView(const std::string& name, accel::BackendKind kind, FinePass fine) {
+  benchmark::RegisterBenchmark(name.c_str(), BM_View, kind, fine)
+      ->Iterations(5)
+      ->UseManualTime()
+      ->Unit(benchmark::kMillisecond);
+}
+
 void registerAll() {
   for (accel::BackendKind kind :
        {accel::BackendKind::kCpu, accel::BackendKind::kOpenCl, accel::BackendKind::kVulkan}) {
     const std::string name = "BM_View/" + std::string(accel::toString(kind));
-    benchmark::RegisterBenchmark(name.c_str(), BM_View, kind, false)
-        ->Iterations(5)
-        ->UseManualTime()
-        ->Unit(benchmark::kMillisecond);
+    registerView(name, kind, FinePass::kSgbm);
+    registerView(name + "/guided_stereo", kind, FinePass::kGuided);
   }
-  benchmark::RegisterBenchmark("BM_View/cpu/disparity_window", BM_View, accel::BackendKind::kCpu,
-                               true)
-      ->Iterations(5)
-      ->UseManualTime()
-      ->Unit(benchmark::kMillisecond);
+  registerView("BM_View/cpu/disparity_window", accel::BackendKind::kCpu, FinePass::kSgbmWindow);
 }
 
 const bool kRegistered = (registerAll(), true);

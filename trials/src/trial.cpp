@@ -400,6 +400,7 @@ host::nbv::NbvSetupOptions setupOptions(const TrialOptions& o) {
   s.stop.completion.seek_partly_seen = o.seek_partly_seen;
   s.stop.completion.release_left_out = o.release_left_out;
   s.disparity_window = o.disparity_window;
+  s.guided_stereo = o.guided_stereo;
   s.loop.view_overhead_s = o.view_overhead_s;
   return s;
 }

@@ -145,6 +145,7 @@ std::unique_ptr<ClusterWork> NbvSetup::makeWork(const ClusterTarget& target, std
   if (target.tag_id) perception.tag.tag_id = *target.tag_id;
   if (target.region_center_m) perception.region.center_m = target.region_center_m;
   perception.disparity_window = options_.disparity_window;
+  perception.stereo.guided_fine = options_.guided_stereo;
   auto work = std::make_unique<ClusterWork>();
   work->map_config = planner::plannerMapConfig(options_.planner, engine_);
   work->session =

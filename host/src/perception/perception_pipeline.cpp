@@ -30,10 +30,10 @@ void PerceptionConfig::validate() const {
         "perception config: projection: expected min_depth_m < max_depth_m");
 }
 
-PerceptionPipeline::PerceptionPipeline(PerceptionConfig config)
+PerceptionPipeline::PerceptionPipeline(PerceptionConfig config, accel::Backend* backend)
     : config_((config.validate(), std::move(config))),
       segmenter_(config_.segmentation),
-      matcher_(config_.stereo),
+      matcher_(config_.stereo, backend),
       tag_detector_(config_.tag),
       projector_(config_.projection) {}
 

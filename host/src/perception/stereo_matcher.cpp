@@ -3,10 +3,14 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <string>
 
+#include "fvp/accel/backend.h"
+#include "fvp/accel/kernels.h"
+#include "fvp/host/perception/guided_stereo.h"
 #include "task_runner.h"
 
 namespace fvp::host {
@@ -34,13 +38,8 @@ void fail(const std::string& where, const std::string& field, const std::string&
 // resolution (only a column below the search's blind width, shift included, is blind). cut_below /
 // cut_above: that end of the search is a window's, not the range's, so a disparity at it is an
 // object outside the window.
-cv::Mat sgbmCodes(const cv::Mat& left, const cv::Mat& right, const SgbmConfig& c, int x0,
-                  int shift_px = 0, bool cut_below = false, bool cut_above = false) {
-  auto sgbm = cv::StereoSGBM::create(c.min_disparity, c.num_disparities, c.block_size, c.p1, c.p2,
-                                     c.disp12_max_diff, c.pre_filter_cap, c.uniqueness_ratio,
-                                     c.speckle_window_size, c.speckle_range, c.mode);
-  cv::Mat raw;
-  sgbm->compute(left, right, raw);
+cv::Mat codesOf(const cv::Mat& raw, const cv::Mat& left, const SgbmConfig& c, int x0,
+                int shift_px = 0, bool cut_below = false, bool cut_above = false) {
   // The brightest value in each pixel's matching window, over the channels.
   cv::Mat brightest;
   if (c.min_signal > 0) {
@@ -83,6 +82,57 @@ cv::Mat sgbmCodes(const cv::Mat& left, const cv::Mat& right, const SgbmConfig& c
           out[u] = d + static_cast<float>(shift_px);
       }
     }
+  }
+  return codes;
+}
+
+cv::Mat sgbmCodes(const cv::Mat& left, const cv::Mat& right, const SgbmConfig& c, int x0,
+                  int shift_px = 0, bool cut_below = false, bool cut_above = false) {
+  auto sgbm = cv::StereoSGBM::create(c.min_disparity, c.num_disparities, c.block_size, c.p1, c.p2,
+                                     c.disp12_max_diff, c.pre_filter_cap, c.uniqueness_ratio,
+                                     c.speckle_window_size, c.speckle_range, c.mode);
+  cv::Mat raw;
+  sgbm->compute(left, right, raw);
+  return codesOf(raw, left, c, x0, shift_px, cut_below, cut_above);
+}
+
+cv::Mat grey(const cv::Mat& image) {
+  if (image.channels() == 1) return image;
+  cv::Mat out;
+  cv::cvtColor(image, out, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
+  return out;
+}
+
+// The guided kernels' fine pass over fine_rect (guide: the coarse pass's codes), as codes:
+// SGBM's fixed point where the kernels found a disparity, their rejections as SGBM's
+// (invalid) or outside the window (the match lies outside the windows the guide gave).
+cv::Mat guidedCodes(accel::Backend& backend, const StereoMatcherConfig& config, const cv::Mat& left,
+                    const cv::Mat& right, cv::Rect fine_rect, const cv::Mat& coarse_codes) {
+  const SgbmConfig& c = config.sgbm;
+  GuidedBandRules rules;
+  rules.min_disparity_px = c.min_disparity;
+  rules.max_disparity_px = c.min_disparity + c.num_disparities - 1;
+  rules.uniqueness_ratio = c.uniqueness_ratio;
+  rules.disp12_max_diff = c.disp12_max_diff;
+  rules.speckle_window_size = c.speckle_window_size;
+  rules.speckle_range = c.speckle_range;
+  const cv::Mat found =
+      GuidedStereo(backend, config.guided)
+          .compute(grey(left), grey(right), fine_rect, coarse_codes, config.coarse_scale, rules);
+  cv::Mat raw(found.size(), CV_16S);
+  const short invalid = static_cast<short>((c.min_disparity - 1) * 16);
+  for (int v = 0; v < found.rows; ++v) {
+    const int* in = found.ptr<int>(v);
+    short* out = raw.ptr<short>(v);
+    for (int u = 0; u < found.cols; ++u) out[u] = in[u] >= 0 ? static_cast<short>(in[u]) : invalid;
+  }
+  cv::Mat codes = codesOf(raw, left(fine_rect), c, fine_rect.x);
+  for (int v = 0; v < found.rows; ++v) {
+    const int* in = found.ptr<int>(v);
+    float* out = codes.ptr<float>(v);
+    for (int u = 0; u < found.cols; ++u)
+      if (out[u] == kCodeInvalid && (in[u] == FVP_STEREO_OUTSIDE || in[u] == FVP_STEREO_UNGUIDED))
+        out[u] = kCodeOutsideWindow;
   }
   return codes;
 }
@@ -270,10 +320,19 @@ void StereoMatcherConfig::validate() const {
   sgbm.scaled(coarse_scale).validate();
   if (strip_overlap_px < 0) fail("stereo config", "strip_overlap_px", ">= 0");
   if (threads < 0) fail("stereo config", "threads", ">= 0 (0: all cores)");
+  if (guided_fine && (!coarse_pass || coarse_scale < 2))
+    fail("stereo config", "guided_fine",
+         "a coarse pass (coarse_pass, coarse_scale >= 2) to guide it");
+  guided.validate();
 }
 
-StereoMatcher::StereoMatcher(StereoMatcherConfig config) : config_(config) {
+StereoMatcher::StereoMatcher(StereoMatcherConfig config, accel::Backend* backend)
+    : config_(config), backend_(backend) {
   config_.validate();
+  if (config_.guided_fine && !backend_) {
+    own_backend_ = accel::createBackend(accel::BackendKind::kCpu);
+    backend_ = own_backend_.get();
+  }
 }
 
 cv::Mat StereoMatcher::runSgbm(const cv::Mat& left, const cv::Mat& right, const SgbmConfig& config,
@@ -314,9 +373,10 @@ DisparityResult StereoMatcher::compute(const cv::Mat& left, const cv::Mat& right
   // Fine pass over the band's rows, in strips; windowed, the right image's columns start
   // shift_px left of the left image's.
   cv::Mat fine_codes;
+  const bool guided = config_.guided_fine && coarse;
   const FineSearch fine =
-      planFineSearch(config_.sgbm, coarse ? fine_window : std::nullopt, fine_rect, W);
-  if (!fine_rect.empty()) {
+      planFineSearch(config_.sgbm, coarse && !guided ? fine_window : std::nullopt, fine_rect, W);
+  if (!fine_rect.empty() && !guided) {
     fine_codes.create(fine_rect.size(), CV_32F);
     for (const cv::Range& r : strips(fine_rect.y, fine_rect.br().y, kSgbmStrips)) {
       tasks.emplace_back([&, r] {
@@ -359,6 +419,8 @@ DisparityResult StereoMatcher::compute(const cv::Mat& left, const cv::Mat& right
   }
   // Largest first: the fine strips were queued first.
   detail::runTasks(tasks, threads);
+  if (guided && !fine_rect.empty())
+    fine_codes = guidedCodes(*backend_, config_, left, right, fine_rect, coarse_codes);
   assemble(fine_codes, fine.windowed ? &fine : nullptr, coarse_codes, left.size(), result);
   result.stats.sgbm_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -8,7 +8,7 @@ namespace fvp::host {
 
 MappingSession::MappingSession(PerceptionConfig perception, std::string engine,
                                map::MapConfig map_config, accel::Backend* backend)
-    : perception_(std::move(perception)),
+    : perception_(std::move(perception), backend),
       engine_(std::move(engine)),
       map_config_(std::move(map_config)),
       backend_(backend) {

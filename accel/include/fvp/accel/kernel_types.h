@@ -13,6 +13,7 @@ extern "C" {
 #include "fvp_dda.h"
 #include "fvp_info_gain.h"
 #include "fvp_map_kernels.h"
+#include "fvp_stereo.h"
 #include "fvp_tsdf.h"
 }
 
@@ -40,6 +41,9 @@ using GainResultRaw = fvp_gain_result;
 // Projective TSDF integration (kernels/fvp_tsdf.h).
 using TsdfParams = fvp_tsdf_params;
 
+// Coarse-guided semi-global matching (kernels/fvp_stereo.h).
+using StereoParams = fvp_stereo_params;
+
 inline constexpr int kBrickEdge = FVP_BRICK_EDGE;
 inline constexpr int kBrickVoxels = FVP_BRICK_VOXELS;
 inline constexpr int kNoBrick = FVP_NO_BRICK;
@@ -55,6 +59,7 @@ static_assert(sizeof(GainParams) == 68, "must match FvpGainParams");
 static_assert(sizeof(GainSegment) == 48, "must match FvpGainSegment (three vec4)");
 static_assert(sizeof(GainResultRaw) == 16, "must match FvpGainResult");
 static_assert(sizeof(TsdfParams) == 92, "must match FvpTsdfParams");
+static_assert(sizeof(StereoParams) == 68, "must match FvpStereoParams");
 static_assert(sizeof(GridParams) == 32, "must match FvpGridParams in shaders/fvp_dda.glsl");
 static_assert(sizeof(Ray) == 32, "must match FvpRay (two vec4)");
 static_assert(sizeof(RayResult) == 16, "must match FvpRayResult");

@@ -48,4 +48,22 @@ Kernel<GainParams> infoGain();
 /// distance and weight (512 float per allocated brick, read and written).
 Kernel<TsdfParams> tsdfIntegrate();
 
+/// Coarse-guided semi-global matching of a stereo pair's band (kernels/fvp_stereo.h), four
+/// dispatches in order. stereo_census: one item per census pixel (the band in the left
+/// image, then the right image's columns the band may match, fvp_stereo_right_x0 to the
+/// band's end). Bindings: grey (both whole images, left first, four 8-bit pixels a uint),
+/// census (two uint a census pixel).
+Kernel<StereoParams> stereoCensus();
+/// stereo_cost: one item per band pixel. Bindings: census, coarse_disparity (the guide:
+/// coarse_width_px * coarse_height_px int, disparity * 16, <= 0 none), windows (one uint a
+/// band pixel), costs (4 uint a band pixel).
+Kernel<StereoParams> stereoCost();
+/// stereo_aggregate: one item per line of params.path_family (run families 0..3 in turn,
+/// first_family = 1 for the first). Bindings: windows, costs, sums (8 uint a band pixel).
+Kernel<StereoParams> stereoAggregate();
+/// stereo_select: one item per band row. Bindings: windows, sums, right_best (scratch:
+/// band_height_px * (band_width_px + max_disparity_px) uint), disparity (one int a band
+/// pixel: disparity * 16, or FVP_STEREO_INVALID / _OUTSIDE / _UNGUIDED).
+Kernel<StereoParams> stereoSelect();
+
 }  // namespace fvp::accel::kernels

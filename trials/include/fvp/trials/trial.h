@@ -77,6 +77,9 @@ struct TrialOptions {
   /// Stereo's full-resolution pass over only the disparities of the Cluster Region and nearer
   /// (host::PerceptionConfig::disparity_window).
   bool disparity_window = false;
+  /// Stereo's full-resolution pass by the guided kernels on the trial's backend
+  /// (host::StereoMatcherConfig::guided_fine).
+  bool guided_stereo = false;
   /// Seconds a view costs besides the arm's move: views that pass the goal check are tried
   /// by information per second (host::nbv::NbvLoopOptions::view_overhead_s); 0: the
   /// planner's order.

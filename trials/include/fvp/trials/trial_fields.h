@@ -57,6 +57,7 @@ void visitTrialFields(Options& o, Visitor&& visit) {
   visit(f::kReleaseLeftOut, o.release_left_out);
   visit(f::kRegisterViews, o.register_views);
   visit(f::kDisparityWindow, o.disparity_window);
+  visit(f::kGuidedStereo, o.guided_stereo);
   visit(f::kViewOverhead, o.view_overhead_s);
   visit(f::kSizeHistory, o.record_size_history);
   visit(t::kClock, o.clock);

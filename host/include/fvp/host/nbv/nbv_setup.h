@@ -84,12 +84,15 @@ struct NbvSetupOptions {
   /// Stereo's full-resolution pass over only the disparities of the Cluster Region and
   /// nearer (PerceptionConfig::disparity_window, which this sets for every cluster).
   bool disparity_window = false;
+  /// Stereo's full-resolution pass by the guided kernels on the setup's backend
+  /// (StereoMatcherConfig::guided_fine, which this sets for every cluster).
+  bool guided_stereo = false;
   /// The farthest a remembered fruitlet's centre may stand from where an earlier visit saw it
   /// and still be that fruitlet (season::AssociationConfig::max_center_shift_m's reason:
   /// stems droop a few millimetres as fruitlets grow, plus each visit's registration error).
   double remembered_max_shift_m = 0.008;
   /// Perception for every cluster; the target's tag id and region replace the tag's and
-  /// region's, disparity_window above its own.
+  /// region's, disparity_window and guided_stereo above its own.
   PerceptionConfig perception;
   sizing::SizingConfig sizing;
   StopSpec stop;

@@ -87,6 +87,11 @@ inline constexpr RunField kDisparityWindow{
     "full-resolution stereo over only the disparities of the Cluster Region and nearer, what "
     "lies behind from the half-resolution pass: ~40 % less stereo time, off until it is "
     "measured on more worlds (docs/design.md section 8)"};
+inline constexpr RunField kGuidedStereo{
+    "guided_stereo", "--guided-stereo",
+    "full-resolution stereo by the guided semi-global matching kernels on the run's backend, "
+    "each pixel searching near what the half-resolution pass found, instead of OpenCV's SGBM "
+    "over the whole range (docs/stereo.md)"};
 inline constexpr RunField kViewOverhead{
     "view_overhead_s",
     "--view-overhead-s",
@@ -151,6 +156,7 @@ void visitSetupFields(Options& o, Visitor&& visit) {
   visit(f::kReleaseLeftOut, o.stop.completion.release_left_out);
   visit(f::kRegisterViews, o.register_views);
   visit(f::kDisparityWindow, o.disparity_window);
+  visit(f::kGuidedStereo, o.guided_stereo);
   visit(f::kViewOverhead, o.loop.view_overhead_s);
   visit(f::kMaxDroppedFrames, o.loop.max_consecutive_dropped_frames);
 }

@@ -64,7 +64,8 @@ void checkStereoFrame(const StereoFrame& frame, const std::string& source);
 
 class PerceptionPipeline {
  public:
-  explicit PerceptionPipeline(PerceptionConfig config = {});
+  /// backend: where the stereo matcher's kernels run (StereoMatcher; not owned, may be null).
+  explicit PerceptionPipeline(PerceptionConfig config = {}, accel::Backend* backend = nullptr);
   const PerceptionConfig& config() const { return config_; }
 
   /// known_region: the Cluster Region from an earlier view (the tag is then still detected

@@ -9,9 +9,12 @@
 // only that window; what the coarse pass places wholly outside it keeps the coarse value.
 #pragma once
 
+#include <memory>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <optional>
+
+#include "fvp/host/perception/guided_stereo.h"
 
 #include "fvp/host/core/perception_stats.h"
 
@@ -66,6 +69,11 @@ struct StereoMatcherConfig {
   bool coarse_pass = true;                 ///< false: no disparity outside the fine rect
   int strip_overlap_px = kDefaultStripOverlapPx;
   int threads = 0;  ///< 0: std::thread::hardware_concurrency()
+  /// The fine pass by the guided kernels (guided_stereo.h) on the matcher's backend, after
+  /// the coarse pass and guided by it, instead of SGBM (the disparity window is then not
+  /// used: the guide narrows each pixel's search). Needs the coarse pass.
+  bool guided_fine = false;
+  GuidedStereoConfig guided;
   void validate() const;
 };
 
@@ -92,7 +100,9 @@ struct DisparityResult {
 
 class StereoMatcher {
  public:
-  explicit StereoMatcher(StereoMatcherConfig config = {});
+  /// backend: where guided_fine's kernels run (not owned; null: a cpu backend of the
+  /// matcher's own).
+  explicit StereoMatcher(StereoMatcherConfig config = {}, accel::Backend* backend = nullptr);
   const StereoMatcherConfig& config() const { return config_; }
 
   /// left/right: rectified CV_8UC3 (or CV_8UC1) images of equal size. fine_rect: the region
@@ -116,6 +126,8 @@ class StereoMatcher {
 
  private:
   StereoMatcherConfig config_;
+  std::shared_ptr<accel::Backend> own_backend_;  ///< when none was given
+  accel::Backend* backend_ = nullptr;
 };
 
 }  // namespace fvp::host

@@ -1,0 +1,125 @@
+#include "fvp/host/perception/guided_stereo.h"
+
+#include <cmath>
+#include <cstring>
+#include <opencv2/calib3d.hpp>
+#include <stdexcept>
+#include <vector>
+
+#include "fvp/accel/backend.h"
+#include "fvp/accel/kernels.h"
+
+namespace fvp::host {
+namespace {
+
+// Both grey images, left first, four 8-bit pixels a word.
+std::vector<std::uint32_t> packGrey(const cv::Mat& left, const cv::Mat& right) {
+  const std::size_t pixels = left.total();
+  std::vector<std::uint32_t> words((2 * pixels + 3) / 4, 0u);
+  auto* bytes = reinterpret_cast<unsigned char*>(words.data());
+  const cv::Mat l = left.isContinuous() ? left : left.clone();
+  const cv::Mat r = right.isContinuous() ? right : right.clone();
+  std::memcpy(bytes, l.data, pixels);
+  std::memcpy(bytes + pixels, r.data, pixels);
+  return words;
+}
+
+// The guide as the kernels read it: disparity * 16, rounded, 0 where none.
+std::vector<std::int32_t> packGuide(const cv::Mat& guide_px) {
+  std::vector<std::int32_t> out(guide_px.total(), 0);
+  for (int v = 0; v < guide_px.rows; ++v) {
+    const float* row = guide_px.ptr<float>(v);
+    for (int u = 0; u < guide_px.cols; ++u)
+      if (row[u] > 0.0f && std::isfinite(row[u]))
+        out[std::size_t(v) * guide_px.cols + u] = std::max(1, int(std::lround(row[u] * 16.0f)));
+  }
+  return out;
+}
+
+// OpenCV's speckle filter over the band, as SGBM runs it: regions of fewer than `window`
+// pixels whose disparities step by more than `range` from the rest become invalid. The
+// window codes (outside, unguided) stay what they are.
+void filterSpeckles(cv::Mat& disparity, const GuidedBandRules& rules) {
+  if (rules.speckle_window_size <= 0) return;
+  const short invalid = static_cast<short>((rules.min_disparity_px - 1) * 16);
+  cv::Mat fixed(disparity.size(), CV_16S);
+  for (int v = 0; v < disparity.rows; ++v) {
+    const int* in = disparity.ptr<int>(v);
+    short* out = fixed.ptr<short>(v);
+    for (int u = 0; u < disparity.cols; ++u) out[u] = in[u] >= 0 ? short(in[u]) : invalid;
+  }
+  cv::filterSpeckles(fixed, invalid, rules.speckle_window_size, 16 * rules.speckle_range);
+  for (int v = 0; v < disparity.rows; ++v) {
+    int* out = disparity.ptr<int>(v);
+    const short* in = fixed.ptr<short>(v);
+    for (int u = 0; u < disparity.cols; ++u)
+      if (out[u] >= 0 && in[u] == invalid) out[u] = FVP_STEREO_INVALID;
+  }
+}
+
+}  // namespace
+
+void GuidedStereoConfig::validate() const {
+  if (p1 < 0 || p2 <= p1 || p2 > 8000)
+    throw std::invalid_argument("guided stereo config: p1/p2: expected 0 <= p1 < p2 <= 8000");
+}
+
+GuidedStereo::GuidedStereo(accel::Backend& backend, GuidedStereoConfig config)
+    : backend_(backend), config_(config) {
+  config_.validate();
+}
+
+cv::Mat GuidedStereo::compute(const cv::Mat& left_grey, const cv::Mat& right_grey, cv::Rect band,
+                              const cv::Mat& guide_px, int guide_scale,
+                              const GuidedBandRules& rules) {
+  if (left_grey.type() != CV_8UC1 || right_grey.type() != CV_8UC1 ||
+      left_grey.size() != right_grey.size() || guide_px.type() != CV_32F || guide_px.empty())
+    throw std::invalid_argument(
+        "GuidedStereo::compute: expected two CV_8UC1 images of equal size and a CV_32F guide");
+  accel::StereoParams p{};
+  p.image_width_px = left_grey.cols;
+  p.image_height_px = left_grey.rows;
+  p.band_x_px = band.x;
+  p.band_y_px = band.y;
+  p.band_width_px = band.width;
+  p.band_height_px = band.height;
+  p.coarse_width_px = guide_px.cols;
+  p.coarse_height_px = guide_px.rows;
+  p.coarse_scale = guide_scale;
+  p.min_disparity_px = rules.min_disparity_px;
+  p.max_disparity_px = rules.max_disparity_px;
+  p.p1 = config_.p1;
+  p.p2 = config_.p2;
+  p.uniqueness_ratio = rules.uniqueness_ratio;
+  p.disp12_max_diff = rules.disp12_max_diff;
+
+  const std::size_t pixels = band.area();
+  auto grey = backend_.createBufferFrom(packGrey(left_grey, right_grey));
+  auto guide = backend_.createBufferFrom(packGuide(guide_px));
+  const int right_width = band.br().x - std::max(0, band.x - rules.max_disparity_px);
+  auto census = backend_.createBuffer(2 * std::size_t(band.height) * (band.width + right_width) *
+                                      sizeof(std::uint32_t));
+  auto windows = backend_.createBuffer(pixels * sizeof(std::uint32_t));
+  auto costs = backend_.createBuffer(pixels * 4 * sizeof(std::uint32_t));
+  auto sums = backend_.createBuffer(pixels * 8 * sizeof(std::uint32_t));
+  auto right_best = backend_.createBuffer(
+      std::size_t(band.height) * (band.width + rules.max_disparity_px) * sizeof(std::uint32_t));
+  auto disparity = backend_.createBuffer(pixels * sizeof(std::int32_t));
+
+  backend_.run(accel::kernels::stereoCensus(), p, {grey.get(), census.get()});
+  backend_.run(accel::kernels::stereoCost(), p,
+               {census.get(), guide.get(), windows.get(), costs.get()});
+  for (int family = 0; family < 4; ++family) {
+    p.path_family = family;
+    p.first_family = family == 0 ? 1 : 0;
+    backend_.run(accel::kernels::stereoAggregate(), p, {windows.get(), costs.get(), sums.get()});
+  }
+  backend_.run(accel::kernels::stereoSelect(), p,
+               {windows.get(), sums.get(), right_best.get(), disparity.get()});
+  cv::Mat out(band.size(), CV_32S);
+  backend_.download(*disparity, out.data, pixels * sizeof(std::int32_t));
+  filterSpeckles(out, rules);
+  return out;
+}
+
+}  // namespace fvp::host
