@@ -27,7 +27,8 @@
 #define FVP_STEREO_CANDIDATES 16 /* two windows */
 #define FVP_STEREO_CENSUS_RADIUS 2
 #define FVP_STEREO_BT_CAP 15
-#define FVP_STEREO_MAX_COST (25 + FVP_STEREO_BT_CAP) /* also the cost of a match off the image */
+/* Above any real match's cost (24 census bits + the grey cap): a match off the image. */
+#define FVP_STEREO_MAX_COST (25 + FVP_STEREO_BT_CAP)
 /* Disparities from the guide's value a window reaches below it (and 8 - 1 - this above):
  * the reduced pass is within one of its pixels (s = 2 full pixels), and the subpixel
  * fit needs one more on each side. */
@@ -398,6 +399,9 @@ FVP_FN int fvp_stereo_winner(const fvp_stereo_params* p, FVP_GLOBAL const unsign
     if (s < best_sum) best = i, best_sum = s;
   }
   const int d = fvp_stereo_candidate(w, best);
+  /* A match off the right image (its cost is FVP_STEREO_MAX_COST) is no match: the host
+   * counts it in the blind band, as SGBM's. */
+  if (p->band_x_px + (int)(pixel % (unsigned int)p->band_width_px) < d) return FVP_STEREO_INVALID;
   for (int i = 0; i < FVP_STEREO_CANDIDATES; ++i) {
     const int di = fvp_stereo_candidate(w, i);
     if ((di > d + 1 || di < d - 1) &&
@@ -433,7 +437,8 @@ FVP_FN void fvp_stereo_select_row(const fvp_stereo_params* p,
   const unsigned int scratch_width = (unsigned int)(p->band_width_px + p->max_disparity_px);
   FVP_GLOBAL unsigned int* best = right_best + item * scratch_width;
   for (unsigned int q = 0u; q < scratch_width; ++q) best[q] = 0xffffffffu;
-  for (int x = 0; x < p->band_width_px; ++x) {
+  /* Right to left, as SGBM: of equal sums landing on one right pixel, the rightmost keeps it. */
+  for (int x = p->band_width_px - 1; x >= 0; --x) {
     int d, s;
     disparity[row + (unsigned int)x] =
         fvp_stereo_winner(p, windows, sums, row + (unsigned int)x, &d, &s);

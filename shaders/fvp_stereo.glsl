@@ -332,6 +332,7 @@ int fvp_stereo_winner(FvpStereoParams p, uint pixel, out int integer_disparity,
     }
   }
   int d = fvp_stereo_candidate(w, best);
+  if (p.band_x_px + int(pixel % uint(p.band_width_px)) < d) return FVP_STEREO_INVALID;
   for (int i = 0; i < FVP_STEREO_CANDIDATES; ++i) {
     int di = fvp_stereo_candidate(w, i);
     if ((di > d + 1 || di < d - 1) &&
@@ -359,7 +360,7 @@ void fvp_stereo_select_row(FvpStereoParams p, uint item) {
   uint scratch_width = uint(p.band_width_px + p.max_disparity_px);
   uint base = item * scratch_width;
   for (uint q = 0u; q < scratch_width; ++q) right_best[base + q] = 0xffffffffu;
-  for (int x = 0; x < p.band_width_px; ++x) {
+  for (int x = p.band_width_px - 1; x >= 0; --x) {
     int d, s;
     disparity[row + uint(x)] = fvp_stereo_winner(p, row + uint(x), d, s);
     if (d < 0) continue;

@@ -73,7 +73,7 @@ GuidedBandRules rules() {
 const cv::Rect kBand(120, 10, 260, 100);
 
 // Pixels of the band the right camera sees (not occluded by the near plane), and of them
-// how many come out within half a pixel of the truth (the subpixel parabola is not exact), and how
+// how many come out within half a pixel of the truth (the subpixel fit is not exact), and how
 // many wrong by more than 1.
 struct Score {
   int visible = 0, matched = 0, close = 0, wrong = 0;

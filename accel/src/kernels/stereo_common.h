@@ -59,8 +59,10 @@ inline void validate(const void* params, const char* what) {
       p.band_x_px + p.band_width_px > p.image_width_px ||
       p.band_y_px + p.band_height_px > p.image_height_px)
     fail("band", "a non-empty rectangle inside the image");
-  if (p.coarse_scale < 1 || p.coarse_width_px <= 0 || p.coarse_height_px <= 0)
-    fail("guide", "a scale >= 1 and a non-empty image");
+  // The guide's values are disparities * 16 / scale: bounded scales keep their products in
+  // 32 bits.
+  if (p.coarse_scale < 1 || p.coarse_scale > 8 || p.coarse_width_px <= 0 || p.coarse_height_px <= 0)
+    fail("guide", "a scale in [1, 8] and a non-empty image");
   if (p.min_disparity_px < 0 || p.max_disparity_px >= 16384 ||
       p.max_disparity_px - p.min_disparity_px + 1 < FVP_STEREO_CANDIDATES)
     fail("disparity range", "0 <= min, max < 16384, at least 16 disparities");

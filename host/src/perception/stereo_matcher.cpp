@@ -320,9 +320,13 @@ void StereoMatcherConfig::validate() const {
   sgbm.scaled(coarse_scale).validate();
   if (strip_overlap_px < 0) fail("stereo config", "strip_overlap_px", ">= 0");
   if (threads < 0) fail("stereo config", "threads", ">= 0 (0: all cores)");
-  if (guided_fine && (!coarse_pass || coarse_scale < 2))
-    fail("stereo config", "guided_fine",
-         "a coarse pass (coarse_pass, coarse_scale >= 2) to guide it");
+  // The guided windows reach 3 disparities below the guide and 4 above: one half-resolution
+  // pixel and the subpixel fit's neighbour (docs/stereo.md).
+  if (guided_fine && (!coarse_pass || coarse_scale != 2))
+    fail("stereo config", "guided_fine", "the half-resolution pass (coarse_pass, coarse_scale 2)");
+  if (guided_fine && (sgbm.min_disparity < 0 || sgbm.min_disparity + sgbm.num_disparities > 16384))
+    fail("stereo config", "sgbm.min_disparity/num_disparities",
+         "disparities in [0, 16384) for guided_fine");
   guided.validate();
 }
 
