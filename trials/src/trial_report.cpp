@@ -349,7 +349,7 @@ void appendWallTime(std::ostringstream& md, const nlohmann::json& result) {
   for (const auto& it : field(field(result, "clock"), "iterations"))
     if (it.contains("sgbm_wall_s") && it["sgbm_wall_s"].is_number())
       sgbm += it["sgbm_wall_s"].get<double>();
-  if (sgbm > 0.0) md << "| stereo matching (SGBM), within perception | " << fmt(sgbm, 2) << " |\n";
+  if (sgbm > 0.0) md << "| stereo matching, within perception | " << fmt(sgbm, 2) << " |\n";
 }
 
 /// The size and centre a detection was scored with (the trial's estimator's).
