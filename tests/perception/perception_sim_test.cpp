@@ -202,6 +202,23 @@ TEST(PerceptionSim, DisparityDepthErrorOnFruitletsAtPointThreeMetres) {
   EXPECT_LE(med_mm, 1.0);
 }
 
+// The start view of world `seed` (the default config, with leaves) rendered with its exact
+// depth, its Cluster Region and that region's image band.
+struct StartView {
+  RenderedView view;
+  ClusterRegion region;
+  cv::Rect band;
+};
+StartView startView(std::uint64_t seed) {
+  const World world = World::generate(WorldConfig{}, seed);
+  StartView out{StereoRenderer(world).renderWithGroundTruth(world.startCameraPose()),
+                ClusterRegion(world.clusterCenter_m(), kDefaultClusterRadiusM),
+                {}};
+  out.band = clusterRegionImageBounds(out.region, out.view.frame.intrinsics,
+                                      out.view.frame.T_world_camera);
+  return out;
+}
+
 // The fine pass searched only over disparities of the Cluster Region and nearer (the
 // pipeline's disparity_window) against the whole range, on full start views of worlds with leaves:
 // fruitlet depth as good, the band's other pixels as well placed, and what lies behind the
@@ -216,13 +233,12 @@ TEST(PerceptionSim, DisparityWindowKeepsFruitletDepthAndWhatLiesOutside) {
   Tally full, windowed;
   long outside_truth = 0;
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
-    const World world = World::generate(WorldConfig{}, seed);
-    const StereoRenderer renderer(world);
-    const RenderedView view = renderer.renderWithGroundTruth(world.startCameraPose());
+    const StartView start = startView(seed);
+    const RenderedView& view = start.view;
     const StereoFrame& frame = view.frame;
     const StereoIntrinsics& K = frame.intrinsics;
-    const ClusterRegion region(world.clusterCenter_m(), kDefaultClusterRadiusM);
-    const cv::Rect band = clusterRegionImageBounds(region, K, frame.T_world_camera);
+    const ClusterRegion& region = start.region;
+    const cv::Rect band = start.band;
     const auto window =
         clusterRegionDisparityWindow(region, K, frame.T_world_camera, kDefaultWindowDepthMarginM,
                                      SgbmConfig{}.saturation_margin_px + 1);
@@ -286,13 +302,12 @@ TEST(PerceptionSim, GuidedFinePassAgainstSgbmOnFruitlets) {
   guided_config.guided_fine = true;
   const StereoMatcher sgbm_matcher, guided_matcher(guided_config);
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
-    const World world = World::generate(WorldConfig{}, seed);
-    const StereoRenderer renderer(world);
-    const RenderedView view = renderer.renderWithGroundTruth(world.startCameraPose());
+    const StartView start = startView(seed);
+    const RenderedView& view = start.view;
     const StereoFrame& frame = view.frame;
     const StereoIntrinsics& K = frame.intrinsics;
-    const ClusterRegion region(world.clusterCenter_m(), kDefaultClusterRadiusM);
-    const cv::Rect band = clusterRegionImageBounds(region, K, frame.T_world_camera);
+    const ClusterRegion& region = start.region;
+    const cv::Rect band = start.band;
     const double fb = K.fx_px * K.baseline_m;
     for (Tally* t : {&sgbm, &guided}) {
       const StereoMatcher& matcher = t == &guided ? guided_matcher : sgbm_matcher;

@@ -42,12 +42,7 @@ std::vector<std::int32_t> packGuide(const cv::Mat& guide_px) {
 void filterSpeckles(cv::Mat& disparity, const GuidedBandRules& rules) {
   if (rules.speckle_window_size <= 0) return;
   const short invalid = static_cast<short>((rules.min_disparity_px - 1) * 16);
-  cv::Mat fixed(disparity.size(), CV_16S);
-  for (int v = 0; v < disparity.rows; ++v) {
-    const int* in = disparity.ptr<int>(v);
-    short* out = fixed.ptr<short>(v);
-    for (int u = 0; u < disparity.cols; ++u) out[u] = in[u] >= 0 ? short(in[u]) : invalid;
-  }
+  cv::Mat fixed = GuidedStereo::sgbmFixedPoint(disparity, rules.min_disparity_px);
   cv::filterSpeckles(fixed, invalid, rules.speckle_window_size, 16 * rules.speckle_range);
   for (int v = 0; v < disparity.rows; ++v) {
     int* out = disparity.ptr<int>(v);
@@ -62,6 +57,17 @@ void filterSpeckles(cv::Mat& disparity, const GuidedBandRules& rules) {
 void GuidedStereoConfig::validate() const {
   if (p1 < 0 || p2 <= p1 || p2 > 8000)
     throw std::invalid_argument("guided stereo config: p1/p2: expected 0 <= p1 < p2 <= 8000");
+}
+
+cv::Mat GuidedStereo::sgbmFixedPoint(const cv::Mat& found, int min_disparity_px) {
+  const short invalid = static_cast<short>((min_disparity_px - 1) * 16);
+  cv::Mat fixed(found.size(), CV_16S);
+  for (int v = 0; v < found.rows; ++v) {
+    const int* in = found.ptr<int>(v);
+    short* out = fixed.ptr<short>(v);
+    for (int u = 0; u < found.cols; ++u) out[u] = in[u] >= 0 ? short(in[u]) : invalid;
+  }
+  return fixed;
 }
 
 GuidedStereo::GuidedStereo(accel::Backend& backend, GuidedStereoConfig config)

@@ -119,14 +119,8 @@ cv::Mat guidedCodes(accel::Backend& backend, const StereoMatcherConfig& config, 
   const cv::Mat found =
       GuidedStereo(backend, config.guided)
           .compute(grey(left), grey(right), fine_rect, coarse_codes, config.coarse_scale, rules);
-  cv::Mat raw(found.size(), CV_16S);
-  const short invalid = static_cast<short>((c.min_disparity - 1) * 16);
-  for (int v = 0; v < found.rows; ++v) {
-    const int* in = found.ptr<int>(v);
-    short* out = raw.ptr<short>(v);
-    for (int u = 0; u < found.cols; ++u) out[u] = in[u] >= 0 ? static_cast<short>(in[u]) : invalid;
-  }
-  cv::Mat codes = codesOf(raw, left(fine_rect), c, fine_rect.x);
+  cv::Mat codes = codesOf(GuidedStereo::sgbmFixedPoint(found, c.min_disparity), left(fine_rect), c,
+                          fine_rect.x);
   for (int v = 0; v < found.rows; ++v) {
     const int* in = found.ptr<int>(v);
     float* out = codes.ptr<float>(v);

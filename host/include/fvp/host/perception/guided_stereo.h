@@ -48,6 +48,10 @@ class GuidedStereo {
   cv::Mat compute(const cv::Mat& left_grey, const cv::Mat& right_grey, cv::Rect band,
                   const cv::Mat& guide_px, int guide_scale, const GuidedBandRules& rules);
 
+  /// compute()'s output in SGBM's CV_16S fixed point: every code below 0 becomes SGBM's
+  /// invalid value, (min_disparity_px - 1) * 16.
+  static cv::Mat sgbmFixedPoint(const cv::Mat& found, int min_disparity_px);
+
  private:
   accel::Backend& backend_;
   GuidedStereoConfig config_;
