@@ -283,15 +283,18 @@ void BM_MapStep(benchmark::State& state, const std::string& engine, BackendKind 
   const Frame& f = frame();
   MapStepResult result;
   accel::TransferCounters moved{};
+  std::uint64_t waits = 0;
   for (auto _ : state) {
     state.PauseTiming();
     auto map = host::map::createMapEngine(engine, f.config, f.region, backend.get());
     mapStep(*map, f);
     if (backend) backend->resetTransfers();
+    const std::uint64_t waits_before = backend ? backend->deviceWaits() : 0;
     state.ResumeTiming();
     result = mapStep(*map, f);
     state.PauseTiming();
     if (backend) moved = backend->transfers();
+    if (backend) waits = backend->deviceWaits() - waits_before;
     map.reset();
     state.ResumeTiming();
   }
@@ -313,6 +316,7 @@ void BM_MapStep(benchmark::State& state, const std::string& engine, BackendKind 
   state.counters["upload_MB"] = moved.upload_bytes / 1e6;
   state.counters["download_MB"] = moved.download_bytes / 1e6;
   state.counters["transfers"] = static_cast<double>(moved.uploads + moved.downloads);
+  state.counters["device_waits"] = static_cast<double>(waits);
   state.SetLabel(backend ? backend->deviceName() : "OcTree + RoiOcTree + DynamicEDTOctomap");
 }
 

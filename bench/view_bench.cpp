@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "bench_common.h"
+#include "fvp/accel/backend.h"
 #include "fvp/accel/backend_choice.h"
 #include "fvp/host/eval/fruitlet_matching.h"
 #include "fvp/host/nbv/cluster_completion.h"
@@ -85,6 +86,7 @@ struct ViewOutcome {
   std::optional<Eigen::Isometry3d> best_view;
   std::vector<double> sizes_mm;
   std::vector<Eigen::Vector3d> centers_m;
+  std::uint64_t device_waits = 0;  ///< Backend::deviceWaits() over the view
   void addTimes(const ViewOutcome& o) {
     perception_s += o.perception_s;
     stereo_s += o.stereo_s;
@@ -94,6 +96,7 @@ struct ViewOutcome {
     sizing_s += o.sizing_s;
     guidance_s += o.guidance_s;
     planning_s += o.planning_s;
+    device_waits += o.device_waits;
     for (const auto& [name, seconds] : o.planning_stages_s) planning_stages_s[name] += seconds;
   }
   /// Stereo matching is part of perception, so it is not added again.
@@ -109,9 +112,10 @@ struct ViewLoop {
   host::nbv::SteadyLoopClock clock;
   std::optional<host::nbv::ClusterCompletion> completion;
   std::optional<host::nbv::SizingGuidance> guidance;
+  const accel::Backend* backend;
 
   ViewLoop(NbvSetup& setup, const NbvSetupOptions& options)
-      : work(setup.makeWork(workload().target)) {
+      : work(setup.makeWork(workload().target)), backend(setup.backend()) {
     completion.emplace(*work->session, clock, options.sizing, options.stop.completion);
     guidance.emplace(*completion, *work->planner, options.sizing.well_seen_fraction);
   }
@@ -121,6 +125,7 @@ struct ViewLoop {
   ViewOutcome take(int index) {
     const host::StereoFrame& frame = workload().frames[static_cast<std::size_t>(index)];
     ViewOutcome out;
+    const std::uint64_t waits_before = backend ? backend->deviceWaits() : 0;
     const auto t_view = Clock::now();
     const host::ViewResult view = work->session->addView(frame);
     const double add_view_s = secondsSince(t_view);
@@ -147,6 +152,7 @@ struct ViewLoop {
     for (const auto& [name, seconds] : step.timings_s) out.planning_stages_s[name] += seconds;
     if (ranking && !ranking->order.empty())
       out.best_view = ranking->candidates[ranking->order.front()].T_world_camera;
+    if (backend) out.device_waits = backend->deviceWaits() - waits_before;
     for (const host::nbv::FruitletSnapshot& f : completion->history().back().fruitlets) {
       out.sizes_mm.push_back(f.size_mm);
       out.centers_m.push_back(f.center_m);
@@ -232,6 +238,9 @@ void reportStages(benchmark::State& state, const ViewOutcome& sum, std::size_t f
   for (const auto& [name, seconds] : sum.planning_stages_s)
     state.counters["planning_" + name + "_ms"] = seconds * ms_per_view;
   state.counters["fruitlets_sized"] = double(fruitlets);
+  // Host waits for the device (fvp/accel/backend.h): a submission and its wait cost
+  // ~0.3-0.5 ms on an H100, so this times that is the view's share of them there.
+  state.counters["device_waits"] = double(sum.device_waits) / double(state.iterations());
 }
 
 // kSgbmWindow: stereo's fine pass over the Cluster Region's disparities and nearer

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "backends.h"
+#include "fvp/accel/sequence.h"
 
 namespace fvp::accel {
 
@@ -121,8 +122,9 @@ void Backend::resetTransfers() {
   upload_bytes_ = download_bytes_ = uploads_ = downloads_ = 0;
 }
 
-void Backend::dispatch(const KernelDescriptor& kernel, const void* params, std::size_t params_bytes,
-                       std::span<DeviceBuffer* const> buffers) {
+std::uint32_t Backend::checkDispatch(const KernelDescriptor& kernel, const void* params,
+                                     std::size_t params_bytes,
+                                     std::span<DeviceBuffer* const> buffers) {
   const std::string name(kernel.name);
   if (params_bytes != kernel.params_bytes)
     throw std::invalid_argument(name + ": parameter block of " + std::to_string(params_bytes) +
@@ -144,8 +146,87 @@ void Backend::dispatch(const KernelDescriptor& kernel, const void* params, std::
     }
     checkRange(*buffers[i], needed * binding.element_bytes, 0, what.c_str());
   }
-  const std::uint32_t items = kernel.item_count(params);
+  return kernel.item_count(params);
+}
+
+void Backend::dispatch(const KernelDescriptor& kernel, const void* params, std::size_t params_bytes,
+                       std::span<DeviceBuffer* const> buffers) {
+  const std::uint32_t items = checkDispatch(kernel, params, params_bytes, buffers);
   if (items) dispatchKernel(kernel, params, buffers, items);
+}
+
+void Backend::evaluate(std::span<const SequenceOp> ops) {
+  if (ops.empty()) return;
+  runSequence(ops);
+  for (const SequenceOp& op : ops) {
+    if (op.kind == SequenceOp::Kind::kUpload) upload_bytes_ += op.size_bytes, ++uploads_;
+    if (op.kind == SequenceOp::Kind::kDownload) download_bytes_ += op.size_bytes, ++downloads_;
+  }
+}
+
+void Backend::runSequence(std::span<const SequenceOp> ops) {
+  for (const SequenceOp& op : ops) switch (op.kind) {
+      case SequenceOp::Kind::kUpload:
+        uploadBytes(*op.buffer, op.bytes.data(), op.size_bytes, op.offset_bytes);
+        break;
+      case SequenceOp::Kind::kDispatch:
+        dispatchKernel(*op.kernel, op.bytes.data(), op.buffers, op.item_count);
+        break;
+      case SequenceOp::Kind::kDownload:
+        downloadBytes(*op.buffer, op.dst, op.size_bytes, op.offset_bytes);
+        break;
+    }
+}
+
+Sequence& Sequence::dispatch(const KernelDescriptor& kernel, const void* params,
+                             std::size_t params_bytes, std::span<DeviceBuffer* const> buffers) {
+  const std::uint32_t items = backend_.checkDispatch(kernel, params, params_bytes, buffers);
+  if (!items) return *this;
+  SequenceOp op;
+  op.kind = SequenceOp::Kind::kDispatch;
+  op.kernel = &kernel;
+  op.buffers.assign(buffers.begin(), buffers.end());
+  op.item_count = items;
+  const auto* bytes = static_cast<const std::byte*>(params);
+  op.bytes.assign(bytes, bytes + params_bytes);
+  ops_.push_back(std::move(op));
+  return *this;
+}
+
+Sequence& Sequence::upload(DeviceBuffer& buf, const void* src, std::size_t size_bytes,
+                           std::size_t offset_bytes) {
+  checkRange(buf, size_bytes, offset_bytes, "Sequence::upload");
+  if (!size_bytes) return *this;
+  SequenceOp op;
+  op.kind = SequenceOp::Kind::kUpload;
+  op.buffer = &buf;
+  op.offset_bytes = offset_bytes;
+  op.size_bytes = size_bytes;
+  const auto* bytes = static_cast<const std::byte*>(src);
+  op.bytes.assign(bytes, bytes + size_bytes);
+  ops_.push_back(std::move(op));
+  return *this;
+}
+
+Sequence& Sequence::download(const DeviceBuffer& buf, void* dst, std::size_t size_bytes,
+                             std::size_t offset_bytes) {
+  checkRange(buf, size_bytes, offset_bytes, "Sequence::download");
+  if (!size_bytes) return *this;
+  SequenceOp op;
+  op.kind = SequenceOp::Kind::kDownload;
+  // Downloads only read the buffer; the op's one buffer field is not const for uploads.
+  op.buffer = const_cast<DeviceBuffer*>(&buf);
+  op.offset_bytes = offset_bytes;
+  op.size_bytes = size_bytes;
+  op.dst = dst;
+  ops_.push_back(std::move(op));
+  return *this;
+}
+
+void Sequence::eval() {
+  std::vector<SequenceOp> ops;
+  ops.swap(ops_);  // empty afterwards, also when a backend throws
+  backend_.evaluate(ops);
 }
 
 std::unique_ptr<Backend> createBackend(BackendKind kind) {

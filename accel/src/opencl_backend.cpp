@@ -158,10 +158,12 @@ class OpenClBackend final : public Backend {
  protected:
   void uploadBytes(DeviceBuffer& buf, const void* src, std::size_t size_bytes,
                    std::size_t offset_bytes) override {
+    countDeviceWait();
     FVP_CL(queue_.enqueueWriteBuffer(clBuf(buf), CL_TRUE, offset_bytes, size_bytes, src));
   }
   void downloadBytes(const DeviceBuffer& buf, void* dst, std::size_t size_bytes,
                      std::size_t offset_bytes) override {
+    countDeviceWait();
     FVP_CL(queue_.enqueueReadBuffer(clBuf(buf), CL_TRUE, offset_bytes, size_bytes, dst));
   }
   // Non-blocking writes on the in-order queue and one wait: the host image stays alive
@@ -177,11 +179,46 @@ class OpenClBackend final : public Backend {
       queue_.finish();  // writes already queued read the caller's image: wait before it goes
       throw;
     }
+    countDeviceWait();
     FVP_CL(queue_.finish());
   }
 
   void dispatchKernel(const KernelDescriptor& kernel, const void* params,
                       std::span<DeviceBuffer* const> buffers, std::uint32_t item_count) override {
+    enqueueKernel(kernel, params, buffers, item_count);
+    countDeviceWait();
+    FVP_CL(queue_.finish());
+  }
+
+  // The in-order queue runs the commands in order, each after the last has finished (its
+  // writes visible to the next); the host waits once. Kernel arguments are captured when a
+  // command is enqueued, so one cl::Kernel serves several of them.
+  void runSequence(std::span<const SequenceOp> ops) override {
+    try {
+      for (const SequenceOp& op : ops) switch (op.kind) {
+          case SequenceOp::Kind::kUpload:
+            FVP_CL(queue_.enqueueWriteBuffer(clBuf(*op.buffer), CL_FALSE, op.offset_bytes,
+                                             op.size_bytes, op.bytes.data()));
+            break;
+          case SequenceOp::Kind::kDispatch:
+            enqueueKernel(*op.kernel, op.bytes.data(), op.buffers, op.item_count);
+            break;
+          case SequenceOp::Kind::kDownload:
+            FVP_CL(queue_.enqueueReadBuffer(clBuf(*op.buffer), CL_FALSE, op.offset_bytes,
+                                            op.size_bytes, op.dst));
+            break;
+        }
+    } catch (...) {
+      queue_.finish();  // queued commands read the ops' bytes and write the callers' memory
+      throw;
+    }
+    countDeviceWait();
+    FVP_CL(queue_.finish());
+  }
+
+ private:
+  void enqueueKernel(const KernelDescriptor& kernel, const void* params,
+                     std::span<DeviceBuffer* const> buffers, std::uint32_t item_count) {
     Kernel& k = kernels_.at(&kernel);
     FVP_CL(k.kernel.setArg(0, kernel.params_bytes, params));
     FVP_CL(k.kernel.setArg(1, cl_uint{item_count}));
@@ -191,10 +228,8 @@ class OpenClBackend final : public Backend {
     const std::size_t global = (std::size_t{item_count} + k.local - 1) / k.local * k.local;
     FVP_CL(queue_.enqueueNDRangeKernel(k.kernel, cl::NullRange, cl::NDRange(global),
                                        cl::NDRange(k.local)));
-    FVP_CL(queue_.finish());
   }
 
- private:
   struct Kernel {
     cl::Kernel kernel;
     std::size_t local = 1;

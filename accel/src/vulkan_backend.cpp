@@ -1,7 +1,8 @@
 // Vulkan backend: GLSL compute shaders from shaders/, compiled to SPIR-V at build time and
 // embedded. Prefers a discrete or integrated GPU; falls back to a CPU implementation
 // (Mesa lavapipe here). Every dispatch is recorded into a command buffer, submitted and
-// waited for with a fence, so results are ready when the call returns.
+// waited for with a fence, so results are ready when the call returns; a Sequence records
+// all its operations into one command buffer, with a barrier between each two.
 #include <dlfcn.h>
 #include <link.h>
 #include <vulkan/vulkan_raii.hpp>
@@ -37,6 +38,12 @@ auto vkChecked(F&& f, const char* call, const char* file, int line) -> decltype(
 constexpr uint32_t kPreferredWorkGroupSize = 64;
 // The dispatch header every shader's parameter block starts with (shaders/fvp_kernel.glsl).
 constexpr uint32_t kDispatchHeaderBytes = 2 * sizeof(uint32_t);
+// Dispatches one submission holds at most: each holds up to two descriptor sets from the
+// pool until its fence; a longer sequence is submitted in parts of this many.
+constexpr uint32_t kDispatchesPerSubmission = 32;
+// Storage-buffer descriptors the pool holds: enough for that many dispatches of kernels
+// binding up to 15 buffers each.
+constexpr uint32_t kPoolDescriptors = kDispatchesPerSubmission * 16;
 
 std::set<std::string> loadedObjects() {
   std::set<std::string> names;
@@ -218,15 +225,30 @@ class VulkanBackend final : public Backend {
 
   void dispatchKernel(const KernelDescriptor& kernel, const void* params,
                       std::span<DeviceBuffer* const> buffers, std::uint32_t item_count) override {
-    const ComputePipeline& p = pipelines_.at(&kernel);
-    std::vector<const DeviceBuffer*> bound;
-    for (DeviceBuffer* b : buffers) bound.push_back(b ? b : unused_.get());
     std::unique_ptr<DeviceBuffer> params_buffer;
-    if (p.params_in_buffer) {
+    if (pipelines_.at(&kernel).params_in_buffer) {
       params_buffer = createBuffer(kernel.params_bytes);
       upload(*params_buffer, params, kernel.params_bytes);
     }
-    dispatch1D(p, bound, params_buffer.get(), params, kernel.params_bytes, item_count);
+    BoundDispatch bound = bindDispatch(kernel, params, buffers, item_count, params_buffer.get());
+    submit([&](const vk::raii::CommandBuffer& cmd) { recordDispatch(cmd, bound); });
+  }
+
+  // Parts of at most kDispatchesPerSubmission dispatches, each one submission: uploads and
+  // parameter blocks packed into the upload staging buffer and copied by the command
+  // buffer, downloads copied into the download staging buffer and read after the fence.
+  void runSequence(std::span<const SequenceOp> ops) override {
+    std::size_t first = 0;
+    while (first < ops.size()) {
+      std::size_t end = first;
+      for (uint32_t dispatches = 0; end < ops.size(); ++end) {
+        if (ops[end].kind == SequenceOp::Kind::kDispatch &&
+            dispatches++ == kDispatchesPerSubmission)
+          break;
+      }
+      runSequencePart(ops.subspan(first, end - first));
+      first = end;
+    }
   }
 
  private:
@@ -370,11 +392,11 @@ class VulkanBackend final : public Backend {
         vk::CommandBufferAllocateInfo(*command_pool_, vk::CommandBufferLevel::ePrimary, 1)));
     command_buffer_ = std::move(buffers.front());
     fence_ = FVP_VK(vk::raii::Fence(device_, vk::FenceCreateInfo()));
-    // One dispatch at a time: its buffers' set and the parameter buffer's set.
-    vk::DescriptorPoolSize pool_size(vk::DescriptorType::eStorageBuffer, 32);
+    // A submission's dispatches: each its buffers' set and its parameter buffer's set.
+    vk::DescriptorPoolSize pool_size(vk::DescriptorType::eStorageBuffer, kPoolDescriptors);
     descriptor_pool_ = FVP_VK(vk::raii::DescriptorPool(
         device_, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet,
-                                              4, pool_size)));
+                                              2 * kDispatchesPerSubmission, pool_size)));
     work_group_size_ = std::min({kPreferredWorkGroupSize, limits_.maxComputeWorkGroupSize[0],
                                  limits_.maxComputeWorkGroupInvocations});
   }
@@ -401,6 +423,10 @@ class VulkanBackend final : public Backend {
     if (!code.words)
       throw BackendError("vulkan: kernel " + std::string(kernel.name) +
                          " has no SPIR-V in this build");
+    if (kernel.bindings.size() >= kPoolDescriptors / kDispatchesPerSubmission)
+      throw BackendError("vulkan: kernel " + std::string(kernel.name) + " binds " +
+                         std::to_string(kernel.bindings.size()) +
+                         " buffers; the descriptor pool allows 15 a dispatch");
     std::vector<vk::DescriptorSetLayoutBinding> bindings;
     for (uint32_t b = 0; b < kernel.bindings.size(); ++b)
       bindings.emplace_back(b, vk::DescriptorType::eStorageBuffer, 1,
@@ -455,6 +481,7 @@ class VulkanBackend final : public Backend {
         vk::PipelineStageFlagBits::eHost, {}, to_host, {}, {});
     FVP_VK(cmd.end());
     vk::CommandBuffer handle = *cmd;
+    countDeviceWait();
     FVP_VK(queue_.submit(vk::SubmitInfo({}, {}, handle), *fence_));
     const vk::Result waited = FVP_VK(device_.waitForFences(*fence_, VK_TRUE, UINT64_MAX));
     if (waited != vk::Result::eSuccess)
@@ -470,45 +497,126 @@ class VulkanBackend final : public Backend {
     return vk::DescriptorBufferInfo(vkBuf(b).get(), 0, VK_WHOLE_SIZE);
   }
 
-  // Records one pipeline over `items` work items, chunked so that no dispatch exceeds the
-  // device's work-group count limit; the push constants carry each chunk's first item.
-  void dispatch1D(const ComputePipeline& p, const std::vector<const DeviceBuffer*>& buffers,
-                  const DeviceBuffer* params_buffer, const void* params, std::size_t params_bytes,
-                  uint32_t items) {
+  // A dispatch ready to record: its pipeline, descriptor sets (held until the fence) and
+  // push constants ({first_item, item_count} then, when they fit, the parameters).
+  struct BoundDispatch {
+    const ComputePipeline* pipeline = nullptr;
+    vk::raii::DescriptorSets sets{nullptr};
+    std::vector<vk::DescriptorSet> set_handles;
+    std::vector<std::byte> push;
+    uint32_t items = 0;
+  };
+
+  BoundDispatch bindDispatch(const KernelDescriptor& kernel, const void* params,
+                             std::span<DeviceBuffer* const> buffers, uint32_t items,
+                             const DeviceBuffer* params_buffer) {
+    BoundDispatch d;
+    const ComputePipeline& p = pipelines_.at(&kernel);
+    d.pipeline = &p;
+    d.items = items;
     std::vector<vk::DescriptorSetLayout> layouts{*p.set_layout};
     if (p.params_in_buffer) layouts.push_back(*p.params_set_layout);
-    vk::raii::DescriptorSets sets = FVP_VK(vk::raii::DescriptorSets(
+    d.sets = FVP_VK(vk::raii::DescriptorSets(
         device_, vk::DescriptorSetAllocateInfo(*descriptor_pool_, layouts)));
     std::vector<vk::DescriptorBufferInfo> infos;
-    for (const DeviceBuffer* b : buffers) infos.push_back(bufferInfo(*b));
-    if (params_buffer) infos.push_back(bufferInfo(*params_buffer));
+    for (const DeviceBuffer* b : buffers) infos.push_back(bufferInfo(b ? *b : *unused_));
+    if (p.params_in_buffer) infos.push_back(bufferInfo(*params_buffer));
     std::vector<vk::WriteDescriptorSet> writes;
     for (uint32_t i = 0; i < buffers.size(); ++i)
-      writes.emplace_back(*sets[0], i, 0, 1, vk::DescriptorType::eStorageBuffer, nullptr,
+      writes.emplace_back(*d.sets[0], i, 0, 1, vk::DescriptorType::eStorageBuffer, nullptr,
                           &infos[i]);
-    if (params_buffer)
-      writes.emplace_back(*sets[1], 0, 0, 1, vk::DescriptorType::eStorageBuffer, nullptr,
+    if (p.params_in_buffer)
+      writes.emplace_back(*d.sets[1], 0, 0, 1, vk::DescriptorType::eStorageBuffer, nullptr,
                           &infos.back());
     device_.updateDescriptorSets(writes, {});
-    std::vector<vk::DescriptorSet> bound_sets;
-    for (const auto& set : sets) bound_sets.push_back(*set);
+    for (const auto& set : d.sets) d.set_handles.push_back(*set);
+    d.push.resize(kDispatchHeaderBytes + (p.params_in_buffer ? 0 : kernel.params_bytes));
+    std::memcpy(d.push.data() + sizeof(uint32_t), &items, sizeof(uint32_t));
+    if (!p.params_in_buffer)
+      std::memcpy(d.push.data() + kDispatchHeaderBytes, params, kernel.params_bytes);
+    return d;
+  }
 
-    // Push constants: {first_item, item_count} then, when they fit, the parameters.
-    std::vector<std::byte> push(kDispatchHeaderBytes + (p.params_in_buffer ? 0 : params_bytes));
-    std::memcpy(push.data() + sizeof(uint32_t), &items, sizeof(uint32_t));
-    if (!p.params_in_buffer) std::memcpy(push.data() + kDispatchHeaderBytes, params, params_bytes);
+  // Records one pipeline over its work items, chunked so that no dispatch exceeds the
+  // device's work-group count limit; the push constants carry each chunk's first item.
+  void recordDispatch(const vk::raii::CommandBuffer& cmd, BoundDispatch& d) {
+    const ComputePipeline& p = *d.pipeline;
     const uint64_t chunk = uint64_t{limits_.maxComputeWorkGroupCount[0]} * work_group_size_;
+    cmd.bindPipeline(vk::PipelineBindPoint::eCompute, *p.pipeline);
+    cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *p.layout, 0, d.set_handles, {});
+    for (uint64_t start = 0; start < d.items; start += chunk) {
+      const uint64_t n = std::min<uint64_t>(chunk, d.items - start);
+      const auto first = static_cast<uint32_t>(start);
+      std::memcpy(d.push.data(), &first, sizeof(uint32_t));
+      cmd.pushConstants<std::byte>(*p.layout, vk::ShaderStageFlagBits::eCompute, 0, d.push);
+      cmd.dispatch(static_cast<uint32_t>((n + work_group_size_ - 1) / work_group_size_), 1, 1);
+    }
+  }
+
+  // Every operation's earlier device writes visible to the next one's reads and writes.
+  static void recordOrderBarrier(const vk::raii::CommandBuffer& cmd) {
+    const auto access = vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite |
+                        vk::AccessFlagBits::eTransferRead | vk::AccessFlagBits::eTransferWrite;
+    const auto stages =
+        vk::PipelineStageFlagBits::eComputeShader | vk::PipelineStageFlagBits::eTransfer;
+    cmd.pipelineBarrier(stages, stages, {}, vk::MemoryBarrier(access, access), {}, {});
+  }
+
+  void runSequencePart(std::span<const SequenceOp> ops) {
+    std::size_t up_bytes = 0, down_bytes = 0;
+    for (const SequenceOp& op : ops) {
+      if (op.kind == SequenceOp::Kind::kUpload) up_bytes += op.size_bytes;
+      if (op.kind == SequenceOp::Kind::kDownload) down_bytes += op.size_bytes;
+      if (op.kind == SequenceOp::Kind::kDispatch && pipelines_.at(op.kernel).params_in_buffer)
+        up_bytes += op.kernel->params_bytes;
+    }
+    const VkBuffer* up =
+        up_bytes ? &stagingBuffer(staging_upload_, up_bytes, Placement::kStagingUpload) : nullptr;
+    const VkBuffer* down =
+        down_bytes ? &stagingBuffer(staging_download_, down_bytes, Placement::kStagingDownload)
+                   : nullptr;
+    std::vector<std::unique_ptr<DeviceBuffer>> params_buffers;
+    std::vector<BoundDispatch> bound;
+    bound.reserve(ops.size());
+    std::vector<std::pair<std::size_t, const SequenceOp*>> downloads;  // staging offset, op
     submit([&](const vk::raii::CommandBuffer& cmd) {
-      cmd.bindPipeline(vk::PipelineBindPoint::eCompute, *p.pipeline);
-      cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *p.layout, 0, bound_sets, {});
-      for (uint64_t start = 0; start < items; start += chunk) {
-        const uint64_t n = std::min<uint64_t>(chunk, items - start);
-        const auto first = static_cast<uint32_t>(start);
-        std::memcpy(push.data(), &first, sizeof(uint32_t));
-        cmd.pushConstants<std::byte>(*p.layout, vk::ShaderStageFlagBits::eCompute, 0, push);
-        cmd.dispatch(static_cast<uint32_t>((n + work_group_size_ - 1) / work_group_size_), 1, 1);
+      std::size_t up_at = 0, down_at = 0;
+      auto stage_upload = [&](const VkBuffer& dst, const void* src, std::size_t n, std::size_t at) {
+        std::memcpy(up->mapped() + up_at, src, n);
+        cmd.copyBuffer(up->get(), dst.get(), vk::BufferCopy(up_at, at, n));
+        up_at += n;
+      };
+      for (std::size_t i = 0; i < ops.size(); ++i) {
+        const SequenceOp& op = ops[i];
+        if (i > 0) recordOrderBarrier(cmd);
+        switch (op.kind) {
+          case SequenceOp::Kind::kUpload:
+            stage_upload(vkBuf(*op.buffer), op.bytes.data(), op.size_bytes, op.offset_bytes);
+            break;
+          case SequenceOp::Kind::kDispatch: {
+            const DeviceBuffer* params_buffer = nullptr;
+            if (pipelines_.at(op.kernel).params_in_buffer) {
+              params_buffers.push_back(createBuffer(op.kernel->params_bytes));
+              params_buffer = params_buffers.back().get();
+              stage_upload(vkBuf(*params_buffer), op.bytes.data(), op.bytes.size(), 0);
+              recordOrderBarrier(cmd);
+            }
+            bound.push_back(bindDispatch(*op.kernel, op.bytes.data(), op.buffers, op.item_count,
+                                         params_buffer));
+            recordDispatch(cmd, bound.back());
+            break;
+          }
+          case SequenceOp::Kind::kDownload:
+            cmd.copyBuffer(vkBuf(*op.buffer).get(), down->get(),
+                           vk::BufferCopy(op.offset_bytes, down_at, op.size_bytes));
+            downloads.emplace_back(down_at, &op);
+            down_at += op.size_bytes;
+            break;
+        }
       }
     });
+    for (const auto& [at, op] : downloads)
+      std::memcpy(op->dst, down->mapped() + at, op->size_bytes);
   }
 
   vk::raii::Context context_;

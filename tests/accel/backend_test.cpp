@@ -12,6 +12,7 @@
 #include "fvp/accel/backend.h"
 #include "fvp/accel/kernels.h"
 #include "fvp/accel/ray_workload.h"
+#include "fvp/accel/sequence.h"
 
 namespace fvp::accel {
 namespace {
@@ -111,6 +112,118 @@ TEST_P(BackendTest, DispatchChecksTheBindings) {
   EXPECT_THROW(backend_->run(kernels::rayTraverse(), params,
                              {rays.get(), occupancy.get(), nullptr, results.get()}),
                std::invalid_argument);
+}
+
+// The ray walk of `rays` over `grid` on the cpu reference.
+std::vector<RayResult> cpuTraverse(const DenseGrid& grid, const std::vector<Ray>& rays) {
+  auto cpu = createBackend(BackendKind::kCpu);
+  return traverseOnBackend(*cpu, grid, rays);
+}
+
+void expectSameWalks(const std::vector<RayResult>& got, const std::vector<RayResult>& want,
+                     const std::string& context) {
+  ASSERT_EQ(got.size(), want.size()) << context;
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    ASSERT_EQ(got[i].status, want[i].status) << context << ", ray " << i;
+    ASSERT_EQ(got[i].steps, want[i].steps) << context << ", ray " << i;
+    ASSERT_EQ(got[i].stop_voxel, want[i].stop_voxel) << context << ", ray " << i;
+    ASSERT_NEAR(got[i].field_sum, want[i].field_sum,
+                kFieldSumRelativeTolerance * std::max(1.0f, std::abs(want[i].field_sum)))
+        << context << ", ray " << i;
+  }
+}
+
+// Two grids walked in one sequence: the second grid's uploads overwrite buffers the first
+// dispatch read, and the second dispatch overwrites the results the first download read;
+// each download sees the buffer as the operations before it left it. One wait in all.
+TEST_P(BackendTest, SequenceRunsItsOperationsInOrderWithOneWait) {
+  const DenseGrid a = makeCanopyGrid(32, 0.004f, 11), b = makeCanopyGrid(32, 0.004f, 12);
+  const std::vector<Ray> rays = makeRandomRays(a.params, {3000, 0.5f}, 13);
+  auto occupancy = backend_->createBuffer(a.occupancy.size() * sizeof(float));
+  auto field = backend_->createBuffer(a.field.size() * sizeof(float));
+  auto ray_buffer = backend_->createBufferFrom(rays);
+  auto results = backend_->createBuffer(rays.size() * sizeof(RayResult));
+  std::vector<RayResult> got_a(rays.size()), got_b(rays.size());
+  Sequence seq(*backend_);
+  for (const auto& [grid, got] : {std::pair{&a, &got_a}, std::pair{&b, &got_b}}) {
+    const TraverseParams params{grid->params, kDefaultOccupiedThreshold, unsigned(rays.size())};
+    seq.upload(*occupancy, grid->occupancy.data(), grid->occupancy.size() * sizeof(float))
+        .upload(*field, grid->field.data(), grid->field.size() * sizeof(float))
+        .run(kernels::rayTraverse(), params,
+             {ray_buffer.get(), occupancy.get(), field.get(), results.get()})
+        .download(*results, got->data(), got->size() * sizeof(RayResult));
+  }
+  EXPECT_EQ(seq.size(), 8u);
+  backend_->resetTransfers();
+  const std::uint64_t waits_before = backend_->deviceWaits();
+  seq.eval();
+  EXPECT_EQ(seq.size(), 0u);
+  EXPECT_EQ(backend_->deviceWaits() - waits_before, GetParam() == BackendKind::kCpu ? 0u : 1u);
+  EXPECT_EQ(backend_->transfers().uploads, 4u);
+  EXPECT_EQ(backend_->transfers().downloads, 2u);
+  expectSameWalks(got_a, cpuTraverse(a, rays), "grid a");
+  expectSameWalks(got_b, cpuTraverse(b, rays), "grid b");
+}
+
+// More dispatches than one Vulkan submission holds (32): parts run in order, each
+// download reading its own dispatch's results.
+TEST_P(BackendTest, SequenceLongerThanOneSubmission) {
+  const DenseGrid grid = makeCanopyGrid(32, 0.004f, 21);
+  const std::vector<Ray> rays = makeRandomRays(grid.params, {400, 0.5f}, 22);
+  auto occupancy = backend_->createBufferFrom(grid.occupancy);
+  auto field = backend_->createBufferFrom(grid.field);
+  auto ray_buffer = backend_->createBuffer(rays.size() * sizeof(Ray));
+  auto results = backend_->createBuffer(rays.size() * sizeof(RayResult));
+  constexpr int kDispatches = 40;
+  std::vector<std::vector<RayResult>> got(kDispatches);
+  Sequence seq(*backend_);
+  for (int i = 0; i < kDispatches; ++i) {
+    const std::size_t first = std::size_t(i) * 7 % 300, count = 1 + std::size_t(i) * 13 % 100;
+    got[i].resize(count);
+    const TraverseParams params{grid.params, kDefaultOccupiedThreshold, unsigned(count)};
+    seq.upload(*ray_buffer, rays.data() + first, count * sizeof(Ray))
+        .run(kernels::rayTraverse(), params,
+             {ray_buffer.get(), occupancy.get(), field.get(), results.get()})
+        .download(*results, got[i].data(), count * sizeof(RayResult));
+  }
+  const std::uint64_t waits_before = backend_->deviceWaits();
+  seq.eval();
+  const std::uint64_t waits = backend_->deviceWaits() - waits_before;
+  EXPECT_EQ(waits,
+            GetParam() == BackendKind::kVulkan ? 2u : (GetParam() == BackendKind::kCpu ? 0u : 1u));
+  const std::vector<RayResult> want = cpuTraverse(grid, rays);
+  for (int i = 0; i < kDispatches; ++i) {
+    const std::size_t first = std::size_t(i) * 7 % 300;
+    expectSameWalks(
+        got[i], std::vector<RayResult>(want.begin() + first, want.begin() + first + got[i].size()),
+        "dispatch " + std::to_string(i));
+  }
+}
+
+// Recording checks what run(), upload() and download() check, and records nothing on error.
+TEST_P(BackendTest, SequenceChecksWhenRecording) {
+  const DenseGrid grid = makeCanopyGrid(16, 0.01f, 1);
+  auto occupancy = backend_->createBufferFrom(grid.occupancy);
+  auto rays = backend_->createBuffer(sizeof(Ray));
+  auto results = backend_->createBuffer(sizeof(RayResult));
+  const TraverseParams params{grid.params, kDefaultOccupiedThreshold, 1};
+  Sequence seq(*backend_);
+  float four[4] = {};
+  seq.upload(*rays, four, sizeof(four));
+  EXPECT_THROW(
+      seq.run(kernels::rayTraverse(), params, {rays.get(), occupancy.get(), results.get()}),
+      std::invalid_argument);
+  EXPECT_THROW(seq.upload(*results, four, sizeof(four), sizeof(RayResult)), std::out_of_range);
+  EXPECT_THROW(seq.download(*results, four, sizeof(RayResult) + 1), std::out_of_range);
+  EXPECT_EQ(seq.size(), 1u);
+  const TraverseParams none{grid.params, kDefaultOccupiedThreshold, 0};
+  seq.run(kernels::rayTraverse(), none,
+          {rays.get(), occupancy.get(), occupancy.get(), results.get()});
+  EXPECT_EQ(seq.size(), 1u);  // no work items: nothing recorded
+  seq.eval();
+  float back[4] = {1, 1, 1, 1};
+  backend_->download(*rays, back, sizeof(back));
+  EXPECT_EQ(back[0], 0.0f);
 }
 
 TEST(KernelDescriptors, EveryKernelHasItsCodeAndDistinctBindingNames) {

@@ -7,6 +7,7 @@
 #include <tuple>
 
 #include "fvp/accel/kernels.h"
+#include "fvp/accel/sequence.h"
 
 namespace fvp::host::map {
 namespace {
@@ -68,12 +69,14 @@ std::vector<FrontierVoxel> FrontierExtractor::classify(accel::DeviceBuffer& coor
     params.capacity = capacity_;
     auto out = backend.createBuffer(std::size_t{capacity_} * sizeof(accel::Frontier));
     const std::uint32_t zero = 0;
-    backend.upload(*counter_, &zero, sizeof(zero));
-    backend.run(accel::kernels::frontier(), params,
-                {&coords, &bricks.tableBuffer(), &layer_.occupancy(), &layer_.roi(), out.get(),
-                 counter_.get()});
     std::uint32_t found = 0;
-    backend.download(*counter_, &found, sizeof(found));
+    accel::Sequence(backend)
+        .upload(*counter_, &zero, sizeof(zero))
+        .run(accel::kernels::frontier(), params,
+             {&coords, &bricks.tableBuffer(), &layer_.occupancy(), &layer_.roi(), out.get(),
+              counter_.get()})
+        .download(*counter_, &found, sizeof(found))
+        .eval();
     if (found <= capacity_) {
       raw.resize(found);
       if (found) backend.download(*out, raw.data(), found * sizeof(accel::Frontier));

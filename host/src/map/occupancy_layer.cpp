@@ -3,6 +3,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "fvp/accel/sequence.h"
+
 namespace fvp::host::map {
 namespace {
 
@@ -41,7 +43,8 @@ void OccupancyLayer::refreshMirror() const {
   if (with_roi_) mirror_roi_.resize(slots, kUnknown);
   const auto& stamps = bricks_.brickChangeStamps();
   auto& backend = bricks_.backend();
-  // Download runs of consecutive changed bricks, one transfer per run.
+  // Download runs of consecutive changed bricks, one transfer per run, all in one submission.
+  accel::Sequence seq(backend);
   std::size_t b = 0;
   while (b < stamps.size()) {
     if (stamps[b] <= since) {
@@ -51,13 +54,14 @@ void OccupancyLayer::refreshMirror() const {
     std::size_t end = b + 1;
     while (end < stamps.size() && stamps[end] > since) ++end;
     const std::size_t first = b * accel::kBrickVoxels, count = (end - b) * accel::kBrickVoxels;
-    backend.download(bricks_.channel(occupancy_), mirror_occupancy_.data() + first,
-                     count * sizeof(float), first * sizeof(float));
+    seq.download(bricks_.channel(occupancy_), mirror_occupancy_.data() + first,
+                 count * sizeof(float), first * sizeof(float));
     if (with_roi_)
-      backend.download(bricks_.channel(*roi_), mirror_roi_.data() + first, count * sizeof(float),
-                       first * sizeof(float));
+      seq.download(bricks_.channel(*roi_), mirror_roi_.data() + first, count * sizeof(float),
+                   first * sizeof(float));
     b = end;
   }
+  seq.eval();
   mirror_slots_.store(slots, std::memory_order_release);
   mirror_change_count_.store(bricks_.changeCount(), std::memory_order_release);
 }

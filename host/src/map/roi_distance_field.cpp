@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "fvp/accel/kernels.h"
+#include "fvp/accel/sequence.h"
 
 namespace fvp::host::map {
 
@@ -82,8 +83,11 @@ void RoiDistanceField::compute(int radius_vox) {
       work.push_back(static_cast<std::uint32_t>(bricks.table()[id] & FVP_BRICK_INDEX_MASK));
   accel::Backend& backend = bricks.backend();
   const std::size_t slots = bricks.slotCount();
-  backend.upload(distanceVox(), std::vector<float>(slots, float(radius_vox)).data(),
-                 slots * sizeof(float));
+  // The fill and the three passes in one submission.
+  accel::Sequence seq(backend);
+  seq.upload(distanceVox(), std::vector<float>(slots, float(radius_vox)).data(),
+             slots * sizeof(float));
+  std::unique_ptr<accel::DeviceBuffer> sq_a, sq_b, work_bricks;  // alive until eval()
   if (!work.empty()) {
     accel::EdtParams edt{};
     edt.map = bricks.params();
@@ -91,23 +95,27 @@ void RoiDistanceField::compute(int radius_vox) {
     edt.slot_count = static_cast<std::uint32_t>(slots);
     edt.work_brick_count = static_cast<std::uint32_t>(work.size());
     const std::vector<std::uint32_t> far(slots, FVP_EDT_FAR);
-    auto sq_a = backend.createBufferFrom(far);
-    auto sq_b = backend.createBufferFrom(far);
-    auto work_bricks = backend.createBufferFrom(work);
+    sq_a = backend.createBuffer(slots * sizeof(std::uint32_t));
+    sq_b = backend.createBuffer(slots * sizeof(std::uint32_t));
+    work_bricks = backend.createBuffer(work.size() * sizeof(std::uint32_t));
+    seq.upload(*sq_a, far.data(), slots * sizeof(std::uint32_t))
+        .upload(*sq_b, far.data(), slots * sizeof(std::uint32_t))
+        .upload(*work_bricks, work.data(), work.size() * sizeof(std::uint32_t));
     // x pass: roi -> sq_a; y pass: sq_a -> sq_b; z pass: sq_b -> distance.
     const auto kernel = accel::kernels::roiDistance();
     auto* coords = &bricks.coordsBuffer();
     auto* table = &bricks.tableBuffer();
     edt.axis = 0;
-    backend.run(kernel, edt,
-                {coords, table, &layer_.roi(), nullptr, sq_a.get(), nullptr, work_bricks.get()});
+    seq.run(kernel, edt,
+            {coords, table, &layer_.roi(), nullptr, sq_a.get(), nullptr, work_bricks.get()});
     edt.axis = 1;
-    backend.run(kernel, edt,
-                {coords, table, nullptr, sq_a.get(), sq_b.get(), nullptr, work_bricks.get()});
+    seq.run(kernel, edt,
+            {coords, table, nullptr, sq_a.get(), sq_b.get(), nullptr, work_bricks.get()});
     edt.axis = 2;
-    backend.run(kernel, edt,
-                {coords, table, nullptr, sq_b.get(), nullptr, &distanceVox(), work_bricks.get()});
+    seq.run(kernel, edt,
+            {coords, table, nullptr, sq_b.get(), nullptr, &distanceVox(), work_bricks.get()});
   }
+  seq.eval();
   radius_vox_ = radius_vox;
   computed_slots_ = slots;
   computed_ = true;

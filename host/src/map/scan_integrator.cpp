@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "fvp/accel/kernels.h"
+#include "fvp/accel/sequence.h"
 
 namespace fvp::host::map {
 
@@ -30,13 +31,18 @@ std::size_t ScanIntegrator::integrate(accel::DeviceBuffer& points, std::uint32_t
   const auto grid_bricks = static_cast<std::uint32_t>(bricks.gridBricks());
   for (int attempt = 0;; ++attempt) {
     scan.slot_count = static_cast<std::uint32_t>(bricks.capacitySlots());
-    backend.run(accel::kernels::scanMark(), scan,
-                {&points, &bricks.tableBuffer(), &bricks.channel(marks_), missing_.get()});
-    if (bricks.allocation() == BrickAllocation::kUpFront) break;
+    // The marks and, where bricks are allocated on touch, the flag of missing ones read
+    // back in the same submission.
     std::uint32_t any_missing = 0;
-    backend.download(*missing_, &any_missing, sizeof(any_missing),
-                     grid_bricks * sizeof(std::uint32_t));
-    if (!any_missing) break;
+    accel::Sequence mark(backend);
+    mark.run(accel::kernels::scanMark(), scan,
+             {&points, &bricks.tableBuffer(), &bricks.channel(marks_), missing_.get()});
+    const bool on_touch = bricks.allocation() != BrickAllocation::kUpFront;
+    if (on_touch)
+      mark.download(*missing_, &any_missing, sizeof(any_missing),
+                    grid_bricks * sizeof(std::uint32_t));
+    mark.eval();
+    if (!on_touch || !any_missing) break;
     if (attempt > 0)
       throw std::logic_error("ScanIntegrator: bricks still missing after allocation");
     // Allocate every brick the rays reached, in ascending order (the same on every
@@ -57,18 +63,21 @@ std::size_t ScanIntegrator::integrate(accel::DeviceBuffer& points, std::uint32_t
   update.clamp_min_logodds = model.clampMinLogOdds();
   update.clamp_max_logodds = model.clampMaxLogOdds();
   update.has_roi = layer_.hasRoi();
+  // Reset, update and both read-backs in one submission.
   const std::uint32_t zero = 0;
-  backend.upload(*counter_, &zero, sizeof(zero));
-  auto changed = backend.createBufferFrom(
-      std::vector<std::uint32_t>(bricks.capacitySlots() / accel::kBrickVoxels, 0u));
-  backend.run(accel::kernels::scanUpdate(), update,
-              {&bricks.channel(marks_), &layer_.occupancy(),
-               layer_.hasRoi() ? &layer_.roi() : nullptr, counter_.get(), changed.get()});
+  const std::vector<std::uint32_t> no_change(bricks.capacitySlots() / accel::kBrickVoxels, 0u);
+  auto changed = backend.createBuffer(no_change.size() * sizeof(std::uint32_t));
   std::uint32_t updated = 0;
-  backend.download(*counter_, &updated, sizeof(updated));
   std::vector<std::uint32_t> flags(bricks.allocatedBricks());
-  if (!flags.empty())
-    backend.download(*changed, flags.data(), flags.size() * sizeof(std::uint32_t));
+  accel::Sequence(backend)
+      .upload(*counter_, &zero, sizeof(zero))
+      .upload(*changed, no_change.data(), no_change.size() * sizeof(std::uint32_t))
+      .run(accel::kernels::scanUpdate(), update,
+           {&bricks.channel(marks_), &layer_.occupancy(), layer_.hasRoi() ? &layer_.roi() : nullptr,
+            counter_.get(), changed.get()})
+      .download(*counter_, &updated, sizeof(updated))
+      .download(*changed, flags.data(), flags.size() * sizeof(std::uint32_t))
+      .eval();
   std::vector<std::uint32_t> changed_bricks;
   for (std::uint32_t b = 0; b < flags.size(); ++b)
     if (flags[b]) changed_bricks.push_back(b);

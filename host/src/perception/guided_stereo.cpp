@@ -8,6 +8,7 @@
 
 #include "fvp/accel/backend.h"
 #include "fvp/accel/kernels.h"
+#include "fvp/accel/sequence.h"
 
 namespace fvp::host {
 namespace {
@@ -100,8 +101,10 @@ cv::Mat GuidedStereo::compute(const cv::Mat& left_grey, const cv::Mat& right_gre
   p.disp12_max_diff = rules.disp12_max_diff;
 
   const std::size_t pixels = band.area();
-  auto grey = backend_.createBufferFrom(packGrey(left_grey, right_grey));
-  auto guide = backend_.createBufferFrom(packGuide(guide_px));
+  const std::vector<std::uint32_t> grey_words = packGrey(left_grey, right_grey);
+  const std::vector<std::int32_t> guide_words = packGuide(guide_px);
+  auto grey = backend_.createBuffer(grey_words.size() * sizeof(std::uint32_t));
+  auto guide = backend_.createBuffer(guide_words.size() * sizeof(std::int32_t));
   const int right_width = band.br().x - std::max(0, band.x - rules.max_disparity_px);
   auto census = backend_.createBuffer(2 * std::size_t(band.height) * (band.width + right_width) *
                                       sizeof(std::uint32_t));
@@ -112,18 +115,23 @@ cv::Mat GuidedStereo::compute(const cv::Mat& left_grey, const cv::Mat& right_gre
       std::size_t(band.height) * (band.width + rules.max_disparity_px) * sizeof(std::uint32_t));
   auto disparity = backend_.createBuffer(pixels * sizeof(std::int32_t));
 
-  backend_.run(accel::kernels::stereoCensus(), p, {grey.get(), census.get()});
-  backend_.run(accel::kernels::stereoCost(), p,
-               {census.get(), guide.get(), windows.get(), costs.get()});
+  // One submission: the kernels in order, each reading what the one before wrote.
+  accel::Sequence seq(backend_);
+  cv::Mat out(band.size(), CV_32S);
+  seq.upload(*grey, grey_words.data(), grey_words.size() * sizeof(std::uint32_t))
+      .upload(*guide, guide_words.data(), guide_words.size() * sizeof(std::int32_t))
+      .run(accel::kernels::stereoCensus(), p, {grey.get(), census.get()})
+      .run(accel::kernels::stereoCost(), p,
+           {census.get(), guide.get(), windows.get(), costs.get()});
   for (int family = 0; family < 4; ++family) {
     p.path_family = family;
     p.first_family = family == 0 ? 1 : 0;
-    backend_.run(accel::kernels::stereoAggregate(), p, {windows.get(), costs.get(), sums.get()});
+    seq.run(accel::kernels::stereoAggregate(), p, {windows.get(), costs.get(), sums.get()});
   }
-  backend_.run(accel::kernels::stereoSelect(), p,
-               {windows.get(), sums.get(), right_best.get(), disparity.get()});
-  cv::Mat out(band.size(), CV_32S);
-  backend_.download(*disparity, out.data, pixels * sizeof(std::int32_t));
+  seq.run(accel::kernels::stereoSelect(), p,
+          {windows.get(), sums.get(), right_best.get(), disparity.get()})
+      .download(*disparity, out.data, pixels * sizeof(std::int32_t))
+      .eval();
   filterSpeckles(out, rules);
   return out;
 }

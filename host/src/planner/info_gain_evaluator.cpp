@@ -8,6 +8,7 @@
 
 #include "fvp/accel/backend.h"
 #include "fvp/accel/kernels.h"
+#include "fvp/accel/sequence.h"
 #include "fvp/host/map/map_engine.h"
 #include "fvp/host/map/occupied_voxel_scene.h"
 
@@ -445,14 +446,17 @@ void InfoGainEvaluator::walk(std::span<const accel::GainSegment> segments,
       segment_device_ = backend_->createBuffer(batch * sizeof(accel::GainSegment));
       result_device_ = backend_->createBuffer(batch * sizeof(accel::GainResultRaw));
     }
+    // Each batch's upload, walk and download in one submission.
+    accel::Sequence seq(*backend_);
     for (std::size_t first = 0; first < segments.size(); first += kSegmentsPerDispatch) {
       const std::size_t n = std::min(kSegmentsPerDispatch, segments.size() - first);
       const accel::GainParams params{fine_.params(), coarse_.params(), std::uint32_t(n)};
-      backend_->upload(*segment_device_, segments.data() + first, n * sizeof(accel::GainSegment));
-      backend_->run(
-          accel::kernels::infoGain(), params,
-          {segment_device_.get(), fine_device_.get(), coarse_device_.get(), result_device_.get()});
-      backend_->download(*result_device_, results + first, n * sizeof(accel::GainResultRaw));
+      seq.upload(*segment_device_, segments.data() + first, n * sizeof(accel::GainSegment))
+          .run(accel::kernels::infoGain(), params,
+               {segment_device_.get(), fine_device_.get(), coarse_device_.get(),
+                result_device_.get()})
+          .download(*result_device_, results + first, n * sizeof(accel::GainResultRaw))
+          .eval();
     }
     return;
   }

@@ -9,6 +9,7 @@
 
 #include "fvp/accel/backend.h"
 #include "fvp/accel/kernels.h"
+#include "fvp/accel/sequence.h"
 #include "fvp/host/map/brick_layer.h"
 
 #include <opencv2/imgproc.hpp>
@@ -268,11 +269,15 @@ TsdfIntegrateStats TsdfVolume::integrate(const cv::Mat& depth_m, const cv::Mat& 
   params.height_px = box.height();
   params.update_bricks = static_cast<std::uint32_t>(update.size());
   params.allocated_bricks = static_cast<std::uint32_t>(layer_->allocatedBricks());
-  const auto update_buf = backend_->createBufferFrom(update);
-  const auto depth_buf = backend_->createBufferFrom(crop);
-  backend_->run(accel::kernels::tsdfIntegrate(), params,
-                {&layer_->coordsBuffer(), update_buf.get(), depth_buf.get(),
-                 &layer_->channel(distance_channel_), &layer_->channel(weight_channel_)});
+  const auto update_buf = backend_->createBuffer(update.size() * sizeof(update[0]));
+  const auto depth_buf = backend_->createBuffer(crop.size() * sizeof(crop[0]));
+  accel::Sequence(*backend_)
+      .upload(*update_buf, update.data(), update.size() * sizeof(update[0]))
+      .upload(*depth_buf, crop.data(), crop.size() * sizeof(crop[0]))
+      .run(accel::kernels::tsdfIntegrate(), params,
+           {&layer_->coordsBuffer(), update_buf.get(), depth_buf.get(),
+            &layer_->channel(distance_channel_), &layer_->channel(weight_channel_)})
+      .eval();
   layer_->markChanged(update);
   host_stale_ = true;
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -285,9 +290,10 @@ void TsdfVolume::syncHost() const {
   host_distance_.assign(n, 0.0f);
   host_weight_.assign(n, 0.0f);
   if (n) {
-    backend_->download(layer_->channel(distance_channel_), host_distance_.data(),
-                       n * sizeof(float));
-    backend_->download(layer_->channel(weight_channel_), host_weight_.data(), n * sizeof(float));
+    accel::Sequence(*backend_)
+        .download(layer_->channel(distance_channel_), host_distance_.data(), n * sizeof(float))
+        .download(layer_->channel(weight_channel_), host_weight_.data(), n * sizeof(float))
+        .eval();
   }
   host_stale_ = false;
 }

@@ -1,7 +1,8 @@
 // The compute-backend interface. Three implementations: cpu (plain multithreaded C++,
 // the reference and test oracle), opencl and vulkan. GPU work is explicit: the caller
 // creates device buffers, uploads, dispatches kernels on buffers and downloads; each
-// dispatch returns when its results are ready.
+// dispatch returns when its results are ready, and a Sequence (fvp/accel/sequence.h) runs
+// many operations as one submission.
 #pragma once
 
 #include <atomic>
@@ -19,6 +20,7 @@
 #include "fvp/accel/backend_choice.h"
 #include "fvp/accel/kernel.h"
 #include "fvp/accel/kernel_types.h"
+#include "fvp/accel/sequence_op.h"
 
 namespace fvp::accel {
 
@@ -70,6 +72,8 @@ struct TransferCounters {
   std::uint64_t uploads = 0, downloads = 0;
 };
 
+class Sequence;
+
 class Backend {
  public:
   virtual ~Backend() = default;
@@ -96,6 +100,10 @@ class Backend {
   /// creation from host data counts as an upload).
   TransferCounters transfers() const;
   void resetTransfers();
+  /// Times the host has waited for the device since construction: Vulkan queue submissions
+  /// (each waits on its fence), OpenCL blocking transfers and finishes; 0 on the cpu
+  /// backend. A Sequence waits once however many operations it holds.
+  std::uint64_t deviceWaits() const { return device_waits_.load(); }
 
   /// Runs a kernel (fvp/accel/kernels.h) over the work items its parameters define, with
   /// buffers in the kernel's binding order; returns when its results are ready. A buffer
@@ -130,7 +138,15 @@ class Backend {
   Backend() = default;
 
  private:
+  friend class Sequence;
+  /// Checks a dispatch's arguments (see run()); returns its work items.
+  std::uint32_t checkDispatch(const KernelDescriptor& kernel, const void* params,
+                              std::size_t params_bytes, std::span<DeviceBuffer* const> buffers);
+  /// Counts a sequence's transfers and runs it (runSequence).
+  void evaluate(std::span<const SequenceOp> ops);
+
   std::atomic<std::uint64_t> upload_bytes_{0}, download_bytes_{0}, uploads_{0}, downloads_{0};
+  std::atomic<std::uint64_t> device_waits_{0};
 
  protected:
   // Implementations: arguments are validated by the public twins above; size_bytes > 0.
@@ -145,6 +161,10 @@ class Backend {
   /// unused by this dispatch are null.
   virtual void dispatchKernel(const KernelDescriptor& kernel, const void* params,
                               std::span<DeviceBuffer* const> buffers, std::uint32_t item_count) = 0;
+  /// Runs a sequence's operations in order (checked, non-empty) and returns when all are
+  /// done. The default runs them one by one through the calls above.
+  virtual void runSequence(std::span<const SequenceOp> ops);
+  void countDeviceWait() { ++device_waits_; }
 };
 
 struct BackendInfo {
