@@ -167,7 +167,7 @@ void Backend::evaluate(std::span<const SequenceOp> ops) {
 void Backend::runSequence(std::span<const SequenceOp> ops) {
   for (const SequenceOp& op : ops) switch (op.kind) {
       case SequenceOp::Kind::kUpload:
-        uploadBytes(*op.buffer, op.bytes.data(), op.size_bytes, op.offset_bytes);
+        uploadBytes(*op.buffer, op.src, op.size_bytes, op.offset_bytes);
         break;
       case SequenceOp::Kind::kDispatch:
         dispatchKernel(*op.kernel, op.bytes.data(), op.buffers, op.item_count);
@@ -202,8 +202,7 @@ Sequence& Sequence::upload(DeviceBuffer& buf, const void* src, std::size_t size_
   op.buffer = &buf;
   op.offset_bytes = offset_bytes;
   op.size_bytes = size_bytes;
-  const auto* bytes = static_cast<const std::byte*>(src);
-  op.bytes.assign(bytes, bytes + size_bytes);
+  op.src = src;
   ops_.push_back(std::move(op));
   return *this;
 }

@@ -198,7 +198,7 @@ class OpenClBackend final : public Backend {
       for (const SequenceOp& op : ops) switch (op.kind) {
           case SequenceOp::Kind::kUpload:
             FVP_CL(queue_.enqueueWriteBuffer(clBuf(*op.buffer), CL_FALSE, op.offset_bytes,
-                                             op.size_bytes, op.bytes.data()));
+                                             op.size_bytes, op.src));
             break;
           case SequenceOp::Kind::kDispatch:
             enqueueKernel(*op.kernel, op.bytes.data(), op.buffers, op.item_count);
@@ -209,7 +209,7 @@ class OpenClBackend final : public Backend {
             break;
         }
     } catch (...) {
-      queue_.finish();  // queued commands read the ops' bytes and write the callers' memory
+      queue_.finish();  // queued commands read and write the callers' memory
       throw;
     }
     countDeviceWait();

@@ -17,6 +17,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "backends.h"
@@ -562,11 +563,44 @@ class VulkanBackend final : public Backend {
     cmd.pipelineBarrier(stages, stages, {}, vk::MemoryBarrier(access, access), {}, {});
   }
 
+  static bool references(const SequenceOp& op, const DeviceBuffer* buf) {
+    return op.buffer == buf ||
+           std::find(op.buffers.begin(), op.buffers.end(), buf) != op.buffers.end();
+  }
+  static bool writes(const SequenceOp& op, const DeviceBuffer* buf) {
+    if (op.kind == SequenceOp::Kind::kUpload) return op.buffer == buf;
+    if (op.kind != SequenceOp::Kind::kDispatch) return false;
+    for (std::size_t b = 0; b < op.buffers.size(); ++b)
+      if (op.buffers[b] == buf && op.kernel->bindings[b].access != Access::kRead) return true;
+    return false;
+  }
+
+  // Which transfers of a part go straight through mapped memory (unified memory), skipping
+  // the staging copy: an upload to a buffer no earlier operation of the part touches (the
+  // host writes it before the submission), a download from a buffer no later operation
+  // writes (the host reads it after the fence).
+  std::vector<char> directTransfers(std::span<const SequenceOp> ops) const {
+    std::vector<char> direct(ops.size(), 0);
+    for (std::size_t i = 0; i < ops.size(); ++i) {
+      const SequenceOp& op = ops[i];
+      if (op.kind == SequenceOp::Kind::kDispatch || !vkBuf(*op.buffer).mapped()) continue;
+      if (op.kind == SequenceOp::Kind::kUpload)
+        direct[i] = std::none_of(ops.begin(), ops.begin() + i,
+                                 [&](const SequenceOp& o) { return references(o, op.buffer); });
+      else
+        direct[i] = std::none_of(ops.begin() + i + 1, ops.end(),
+                                 [&](const SequenceOp& o) { return writes(o, op.buffer); });
+    }
+    return direct;
+  }
+
   void runSequencePart(std::span<const SequenceOp> ops) {
+    const std::vector<char> direct = directTransfers(ops);
     std::size_t up_bytes = 0, down_bytes = 0;
-    for (const SequenceOp& op : ops) {
-      if (op.kind == SequenceOp::Kind::kUpload) up_bytes += op.size_bytes;
-      if (op.kind == SequenceOp::Kind::kDownload) down_bytes += op.size_bytes;
+    for (std::size_t i = 0; i < ops.size(); ++i) {
+      const SequenceOp& op = ops[i];
+      if (op.kind == SequenceOp::Kind::kUpload && !direct[i]) up_bytes += op.size_bytes;
+      if (op.kind == SequenceOp::Kind::kDownload && !direct[i]) down_bytes += op.size_bytes;
       if (op.kind == SequenceOp::Kind::kDispatch && pipelines_.at(op.kernel).params_in_buffer)
         up_bytes += op.kernel->params_bytes;
     }
@@ -578,7 +612,8 @@ class VulkanBackend final : public Backend {
     std::vector<std::unique_ptr<DeviceBuffer>> params_buffers;
     std::vector<BoundDispatch> bound;
     bound.reserve(ops.size());
-    std::vector<std::pair<std::size_t, const SequenceOp*>> downloads;  // staging offset, op
+    // Downloads read after the fence: their source (mapped buffer or staging) and offset.
+    std::vector<std::tuple<const std::byte*, const SequenceOp*>> downloads;
     submit([&](const vk::raii::CommandBuffer& cmd) {
       std::size_t up_at = 0, down_at = 0;
       auto stage_upload = [&](const VkBuffer& dst, const void* src, std::size_t n, std::size_t at) {
@@ -589,34 +624,32 @@ class VulkanBackend final : public Backend {
       for (std::size_t i = 0; i < ops.size(); ++i) {
         const SequenceOp& op = ops[i];
         if (i > 0) recordOrderBarrier(cmd);
-        switch (op.kind) {
-          case SequenceOp::Kind::kUpload:
-            stage_upload(vkBuf(*op.buffer), op.bytes.data(), op.size_bytes, op.offset_bytes);
-            break;
-          case SequenceOp::Kind::kDispatch: {
-            const DeviceBuffer* params_buffer = nullptr;
-            if (pipelines_.at(op.kernel).params_in_buffer) {
-              params_buffers.push_back(createBuffer(op.kernel->params_bytes));
-              params_buffer = params_buffers.back().get();
-              stage_upload(vkBuf(*params_buffer), op.bytes.data(), op.bytes.size(), 0);
-              recordOrderBarrier(cmd);
-            }
-            bound.push_back(bindDispatch(*op.kernel, op.bytes.data(), op.buffers, op.item_count,
-                                         params_buffer));
-            recordDispatch(cmd, bound.back());
-            break;
+        if (direct[i] && op.kind == SequenceOp::Kind::kUpload) {
+          std::memcpy(vkBuf(*op.buffer).mapped() + op.offset_bytes, op.src, op.size_bytes);
+        } else if (direct[i]) {
+          downloads.emplace_back(vkBuf(*op.buffer).mapped() + op.offset_bytes, &op);
+        } else if (op.kind == SequenceOp::Kind::kUpload) {
+          stage_upload(vkBuf(*op.buffer), op.src, op.size_bytes, op.offset_bytes);
+        } else if (op.kind == SequenceOp::Kind::kDownload) {
+          cmd.copyBuffer(vkBuf(*op.buffer).get(), down->get(),
+                         vk::BufferCopy(op.offset_bytes, down_at, op.size_bytes));
+          downloads.emplace_back(down->mapped() + down_at, &op);
+          down_at += op.size_bytes;
+        } else {
+          const DeviceBuffer* params_buffer = nullptr;
+          if (pipelines_.at(op.kernel).params_in_buffer) {
+            params_buffers.push_back(createBuffer(op.kernel->params_bytes));
+            params_buffer = params_buffers.back().get();
+            stage_upload(vkBuf(*params_buffer), op.bytes.data(), op.bytes.size(), 0);
+            recordOrderBarrier(cmd);
           }
-          case SequenceOp::Kind::kDownload:
-            cmd.copyBuffer(vkBuf(*op.buffer).get(), down->get(),
-                           vk::BufferCopy(op.offset_bytes, down_at, op.size_bytes));
-            downloads.emplace_back(down_at, &op);
-            down_at += op.size_bytes;
-            break;
+          bound.push_back(
+              bindDispatch(*op.kernel, op.bytes.data(), op.buffers, op.item_count, params_buffer));
+          recordDispatch(cmd, bound.back());
         }
       }
     });
-    for (const auto& [at, op] : downloads)
-      std::memcpy(op->dst, down->mapped() + at, op->size_bytes);
+    for (const auto& [from, op] : downloads) std::memcpy(op->dst, from, op->size_bytes);
   }
 
   vk::raii::Context context_;

@@ -85,16 +85,18 @@ void RoiDistanceField::compute(int radius_vox) {
   const std::size_t slots = bricks.slotCount();
   // The fill and the three passes in one submission.
   accel::Sequence seq(backend);
-  seq.upload(distanceVox(), std::vector<float>(slots, float(radius_vox)).data(),
-             slots * sizeof(float));
-  std::unique_ptr<accel::DeviceBuffer> sq_a, sq_b, work_bricks;  // alive until eval()
+  const std::vector<float> cap(slots, float(radius_vox));
+  seq.upload(distanceVox(), cap.data(), slots * sizeof(float));
+  // Read by eval(): alive until then.
+  std::unique_ptr<accel::DeviceBuffer> sq_a, sq_b, work_bricks;
+  std::vector<std::uint32_t> far;
   if (!work.empty()) {
     accel::EdtParams edt{};
     edt.map = bricks.params();
     edt.radius_vox = radius_vox;
     edt.slot_count = static_cast<std::uint32_t>(slots);
     edt.work_brick_count = static_cast<std::uint32_t>(work.size());
-    const std::vector<std::uint32_t> far(slots, FVP_EDT_FAR);
+    far.assign(slots, FVP_EDT_FAR);
     sq_a = backend.createBuffer(slots * sizeof(std::uint32_t));
     sq_b = backend.createBuffer(slots * sizeof(std::uint32_t));
     work_bricks = backend.createBuffer(work.size() * sizeof(std::uint32_t));

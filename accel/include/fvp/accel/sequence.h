@@ -31,8 +31,10 @@ class Sequence {
   }
   Sequence& dispatch(const KernelDescriptor& kernel, const void* params, std::size_t params_bytes,
                      std::span<DeviceBuffer* const> buffers);
-  /// Records a copy of size_bytes of src (copied now) into buf at offset_bytes. Throws
-  /// std::out_of_range if the range does not fit the buffer.
+  /// Records a copy of size_bytes of src into buf at offset_bytes. src is read when the
+  /// sequence runs (not copied: uploads are a view's largest transfers), so it must stay
+  /// valid and unchanged until eval() returns. Throws std::out_of_range if the range does
+  /// not fit the buffer.
   Sequence& upload(DeviceBuffer& buf, const void* src, std::size_t size_bytes,
                    std::size_t offset_bytes = 0);
   /// Records a copy of buf's range into dst, which must stay valid until eval() returns and

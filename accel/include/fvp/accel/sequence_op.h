@@ -19,8 +19,10 @@ struct SequenceOp {
   const KernelDescriptor* kernel = nullptr;
   std::vector<DeviceBuffer*> buffers;
   std::uint32_t item_count = 0;
-  /// kUpload: the data, copied when recorded; kDispatch: the parameter block.
+  /// kDispatch: the parameter block, copied when recorded.
   std::vector<std::byte> bytes;
+  /// kUpload: the caller's data, read when the sequence runs.
+  const void* src = nullptr;
   /// kUpload / kDownload: the device buffer and its byte range (size > 0, checked).
   DeviceBuffer* buffer = nullptr;
   std::size_t offset_bytes = 0, size_bytes = 0;
