@@ -14,6 +14,7 @@
 #include "fvp/host/perception/fruitlet_segmenter.h"
 #include "fvp/host/perception/perception_pipeline.h"
 #include "fvp/host/perception/stereo_matcher.h"
+#include "fvp/robot/sim/camera_views.h"
 #include "fvp/robot/sim/object_ids.h"
 #include "fvp/robot/sim/occlusion_statistic.h"
 #include "fvp/robot/sim/stereo_renderer.h"
@@ -377,6 +378,60 @@ TEST(PerceptionSim, AprilTagPoseAtPointThreeMetres) {
             << " deg\n";
   EXPECT_LE(max_mm, 2.0);
   EXPECT_LE(max_deg, 2.0);
+}
+
+// detectNear on full 1440x1080 views: in the window up to where the tag should appear it
+// finds what the whole image's search finds, bit for bit, with the expected pose exact or 2
+// degrees and 5 mm off; a tag far from where it was expected is not searched for.
+TEST(PerceptionSim, TagSearchedWhereItShouldAppearIsTheWholeImagesDetection) {
+  int windowed = 0;
+  double window_fraction = 0.0;
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    const World world = World::generate(WorldConfig{}, seed);
+    const StereoRenderer renderer(world);
+    AprilTagDetectorConfig config;
+    config.tag_size_m = world.tag().tag_size_m;
+    const AprilTagDetector detector(config);
+    const Eigen::Isometry3d& T_world_tag = world.tag().T_world_tag;
+    Eigen::Isometry3d off = T_world_tag;
+    off.translation() += Eigen::Vector3d(0.005, -0.003, 0.002);
+    off.linear() = Eigen::AngleAxisd(2.0 * M_PI / 180.0, Eigen::Vector3d(1, 1, 0).normalized()) *
+                   T_world_tag.linear();
+    for (const Eigen::Isometry3d& pose : robot::sim::orbitViews(world, 2, 60.0)) {
+      Eigen::Isometry3d far_off = T_world_tag;  // ~25 degrees to the camera's left at 0.3 m
+      far_off.translation() -= 0.15 * pose.linear().col(0);
+      const StereoFrame frame = renderer.render(pose);
+      const StereoIntrinsics& K = frame.intrinsics;
+      const auto whole = detector.detect(frame.left_bgr, K, pose);
+      if (!whole) continue;
+      const Eigen::Isometry3d expectations[] = {T_world_tag, off, far_off};
+      for (const Eigen::Isometry3d& expected : expectations) {
+        SCOPED_TRACE("seed " + std::to_string(seed));
+        const cv::Rect window = detector.searchWindow(K, pose, expected);
+        const auto near = detector.detectNear(frame.left_bgr, K, pose, expected);
+        if (&expected == &expectations[2]) {
+          EXPECT_FALSE(near.has_value());
+          EXPECT_FALSE(
+              window.contains(cv::Point(int(whole->center_px.x()), int(whole->center_px.y()))));
+          continue;
+        }
+        ASSERT_TRUE(near.has_value());
+        for (int k = 0; k < 4; ++k) EXPECT_EQ(near->corners_px[k], whole->corners_px[k]);
+        EXPECT_EQ(near->T_world_tag.matrix(), whole->T_world_tag.matrix());
+        ASSERT_FALSE(window.empty());
+        EXPECT_LT(window.area(), K.width_px * K.height_px);
+        window_fraction += double(window.area()) / (K.width_px * K.height_px);
+        for (int k = 0; k < 4; ++k)
+          EXPECT_TRUE(window.contains(
+              cv::Point(int(whole->corners_px[k].x()), int(whole->corners_px[k].y()))))
+              << "window " << window << ", corner " << whole->corners_px[k].transpose();
+        ++windowed;
+      }
+    }
+  }
+  EXPECT_GE(windowed, 6);  // the tag is in view from one of each world's two poses
+  std::cout << "[ measured ] the window holds " << 100.0 * window_fraction / windowed
+            << " % of the image on average\n";
 }
 
 // The whole chain on a full 1440x1080 start view: the tag places a Cluster Region that holds

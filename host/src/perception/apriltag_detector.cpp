@@ -1,5 +1,7 @@
 #include "fvp/host/perception/apriltag_detector.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
@@ -71,6 +73,8 @@ void AprilTagDetectorConfig::validate() const {
   if (tag_id < -1) fail("tag_id", "a tag id of the family or -1 (any)");
   if (!findFamily(family)) fail("family", "one of " + familyNames() + ", got '" + family + "'");
   if (threads < 0) fail("threads", ">= 0 (0: all cores)");
+  if (!(search_margin_deg >= 0.0 && search_margin_deg < 45.0))
+    fail("search_margin_deg", "[0, 45) degrees");
 }
 
 struct AprilTagDetector::Impl {
@@ -105,6 +109,12 @@ AprilTagDetector::~AprilTagDetector() = default;
 std::vector<TagDetection> AprilTagDetector::detectAll(
     const cv::Mat& image, const StereoIntrinsics& K,
     const Eigen::Isometry3d& T_world_camera) const {
+  return detectIn(image, cv::Rect(0, 0, image.cols, image.rows), K, T_world_camera);
+}
+
+std::vector<TagDetection> AprilTagDetector::detectIn(
+    const cv::Mat& image, cv::Rect window, const StereoIntrinsics& K,
+    const Eigen::Isometry3d& T_world_camera) const {
   // libapriltag asserts or crashes on images too small for its decimated quad search and on
   // a degenerate camera model (estimate_tag_pose); neither can hold a tag.
   checkIntrinsics(K, "AprilTagDetector: camera model");
@@ -112,9 +122,9 @@ std::vector<TagDetection> AprilTagDetector::detectAll(
     throw std::invalid_argument("AprilTagDetector: the image does not match the camera model");
   cv::Mat gray;
   if (image.type() == CV_8UC3) {
-    cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
+    cv::cvtColor(image(window), gray, cv::COLOR_BGR2GRAY);
   } else if (image.type() == CV_8UC1) {
-    gray = image.isContinuous() ? image : image.clone();
+    gray = image(window);  // libapriltag takes the row stride
   } else {
     throw std::invalid_argument("AprilTagDetector: expected a CV_8UC3 or CV_8UC1 image");
   }
@@ -139,17 +149,20 @@ std::vector<TagDetection> AprilTagDetector::detectAll(
     // at integers: corners are reported in ours, and the pose is estimated with the principal
     // point moved into libapriltag's, which is the same thing for a pinhole camera.
     constexpr double kLibapriltagPixelCentre = 0.5;
+    // In a window, pixels are the window's: corners move back by its corner, and the pose
+    // is estimated with the principal point moved into the window.
+    const Eigen::Vector2d offset(window.x - kLibapriltagPixelCentre,
+                                 window.y - kLibapriltagPixelCentre);
     for (int k = 0; k < 4; ++k)
-      d.corners_px[k] = {det->p[k][0] - kLibapriltagPixelCentre,
-                         det->p[k][1] - kLibapriltagPixelCentre};
-    d.center_px = {det->c[0] - kLibapriltagPixelCentre, det->c[1] - kLibapriltagPixelCentre};
+      d.corners_px[k] = Eigen::Vector2d(det->p[k][0], det->p[k][1]) + offset;
+    d.center_px = Eigen::Vector2d(det->c[0], det->c[1]) + offset;
 
     apriltag_detection_info_t info{det,
                                    config_.tag_size_m,
                                    K.fx_px,
                                    K.fy_px,
-                                   K.cx_px + kLibapriltagPixelCentre,
-                                   K.cy_px + kLibapriltagPixelCentre};
+                                   K.cx_px - window.x + kLibapriltagPixelCentre,
+                                   K.cy_px - window.y + kLibapriltagPixelCentre};
     apriltag_pose_t pose{nullptr, nullptr};
     d.object_space_error = estimate_tag_pose(&info, &pose);
     // A degenerate quad can leave no pose (NaN errors pick a missing second solution).
@@ -178,15 +191,71 @@ std::vector<TagDetection> AprilTagDetector::detectAll(
   return out;
 }
 
+std::optional<TagDetection> AprilTagDetector::best(
+    const std::vector<TagDetection>& detections) const {
+  std::optional<TagDetection> chosen;
+  for (const TagDetection& d : detections) {
+    if (config_.tag_id >= 0 && d.tag_id != config_.tag_id) continue;
+    if (!chosen || d.decision_margin > chosen->decision_margin) chosen = d;
+  }
+  return chosen;
+}
+
 std::optional<TagDetection> AprilTagDetector::detect(
     const cv::Mat& image, const StereoIntrinsics& intrinsics,
     const Eigen::Isometry3d& T_world_camera) const {
-  std::optional<TagDetection> best;
-  for (const TagDetection& d : detectAll(image, intrinsics, T_world_camera)) {
-    if (config_.tag_id >= 0 && d.tag_id != config_.tag_id) continue;
-    if (!best || d.decision_margin > best->decision_margin) best = d;
+  return best(detectAll(image, intrinsics, T_world_camera));
+}
+
+cv::Rect AprilTagDetector::searchWindow(const StereoIntrinsics& K,
+                                        const Eigen::Isometry3d& T_world_camera,
+                                        const Eigen::Isometry3d& T_world_tag_expected) const {
+  if (config_.search_margin_deg <= 0.0) return {};
+  const Eigen::Isometry3d T_camera_tag = T_world_camera.inverse() * T_world_tag_expected;
+  const double h = 0.5 * config_.tag_size_m;
+  const double margin_rad = config_.search_margin_deg * M_PI / 180.0;
+  // A normalised image coordinate turned by the margin about the camera's axis.
+  const auto turned = [&](double t, double sign) {
+    return std::tan(std::atan(t) + sign * margin_rad);
+  };
+  double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
+  for (const Eigen::Vector2d& c : {Eigen::Vector2d(-h, h), Eigen::Vector2d(h, h),
+                                   Eigen::Vector2d(h, -h), Eigen::Vector2d(-h, -h)}) {
+    const Eigen::Vector3d p = T_camera_tag * Eigen::Vector3d(c.x(), c.y(), 0.0);
+    if (!(p.z() > 1e-3)) return {};  // behind or at the camera: no window
+    const double x = p.x() / p.z(), y = p.y() / p.z();
+    // Near 90 degrees off the axis a turn of the margin leaves the image plane.
+    if (std::abs(std::atan(x)) + margin_rad > 1.5 || std::abs(std::atan(y)) + margin_rad > 1.5)
+      return {};
+    u0 = std::min(u0, K.cx_px + K.fx_px * turned(x, -1.0));
+    u1 = std::max(u1, K.cx_px + K.fx_px * turned(x, 1.0));
+    v0 = std::min(v0, K.cy_px + K.fy_px * turned(y, -1.0));
+    v1 = std::max(v1, K.cy_px + K.fy_px * turned(y, 1.0));
   }
-  return best;
+  // From the image's corner: libapriltag fits the quads in float from the window's pixel
+  // coordinates, so a window that starts elsewhere moves corners by up to ~5e-5 px (measured),
+  // enough to change a trial. Anchored at (0, 0) its detection is the whole image's, bit for
+  // bit, and it skips the image's rows below and columns right of the tag.
+  (void)u0, (void)v0;
+  const auto clamp = [](double t, int hi) { return int(std::clamp(t, 0.0, double(hi))); };
+  const int x0 = 0, y0 = 0;
+  const int x1 = clamp(std::ceil(u1) + 1.0, K.width_px);
+  const int y1 = clamp(std::ceil(v1) + 1.0, K.height_px);
+  // libapriltag needs room for its quad search: a window too small to hold a tag is none.
+  constexpr int kLeastSidePx = 32;
+  if (x1 < kLeastSidePx || y1 < kLeastSidePx || (u0 > x1 || v0 > y1)) return {};
+  return cv::Rect(x0, y0, x1 - x0, y1 - y0);
+}
+
+std::optional<TagDetection> AprilTagDetector::detectNear(
+    const cv::Mat& image, const StereoIntrinsics& intrinsics,
+    const Eigen::Isometry3d& T_world_camera, const Eigen::Isometry3d& T_world_tag_expected) const {
+  const cv::Rect window = searchWindow(intrinsics, T_world_camera, T_world_tag_expected);
+  // No second search of the whole image: a tag outside the window is more than the margin
+  // from where it should be, and where the window misses it the view mostly does not show it
+  // (hidden by leaves), which a whole-image search would only confirm at twice the cost.
+  if (!window.empty()) return best(detectIn(image, window, intrinsics, T_world_camera));
+  return detect(image, intrinsics, T_world_camera);
 }
 
 }  // namespace fvp::host

@@ -61,7 +61,8 @@ void checkStereoFrame(const StereoFrame& frame, const std::string& source) {
 }
 
 PerceptionResult PerceptionPipeline::process(
-    const StereoFrame& frame, const std::optional<ClusterRegion>& known_region) const {
+    const StereoFrame& frame, const std::optional<ClusterRegion>& known_region,
+    const std::optional<Eigen::Isometry3d>& expected_T_world_tag) const {
   checkStereoFrame(frame, "stereo frame");
   const StereoIntrinsics& K = frame.intrinsics;
   PerceptionResult result;
@@ -76,7 +77,10 @@ PerceptionResult PerceptionPipeline::process(
   timing.segmentation_s = secondsSince(t0);
 
   t0 = std::chrono::steady_clock::now();
-  result.tag = tag_detector_.detect(frame.left_bgr, K, frame.T_world_camera);
+  result.tag =
+      expected_T_world_tag
+          ? tag_detector_.detectNear(frame.left_bgr, K, frame.T_world_camera, *expected_T_world_tag)
+          : tag_detector_.detect(frame.left_bgr, K, frame.T_world_camera);
   timing.tag_s = secondsSince(t0);
   if (known_region) {
     result.region = known_region;

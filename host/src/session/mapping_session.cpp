@@ -34,7 +34,7 @@ ViewResult MappingSession::addView(const StereoFrame& frame, PerceptionResult* p
   view.index = views_.size();
   view.T_world_camera_told = frame.T_world_camera;
   const auto t0 = std::chrono::steady_clock::now();
-  PerceptionResult perceived = perception_.process(frame, region_);
+  PerceptionResult perceived = perception_.process(frame, region_, T_world_tag_);
   view.perceive_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   view.tag_detected = perceived.tag.has_value();
   view.tag = perceived.tag;
