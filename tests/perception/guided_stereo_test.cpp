@@ -149,6 +149,21 @@ TEST_P(GuidedStereoBackends, PixelsWithoutAGuideOrBeyondItAreNotMatched) {
   EXPECT_LE(matched_beyond, beyond / 10);
 }
 
+// One object over bands of different sizes (its buffers kept and grown between passes)
+// gives what a fresh object gives each time.
+TEST_P(GuidedStereoBackends, KeptBuffersGiveWhatFreshOnesGive) {
+  const Pair pair = texturedPair(13);
+  const cv::Mat guide = guideOf(pair.truth, 0.0f);
+  GuidedStereo kept(*backend_);
+  for (const cv::Rect band : {kBand, cv::Rect(60, 4, 330, 112), cv::Rect(200, 30, 80, 40), kBand}) {
+    const cv::Mat again = kept.compute(pair.left, pair.right, band, guide, 2, rules());
+    const cv::Mat fresh =
+        GuidedStereo(*backend_).compute(pair.left, pair.right, band, guide, 2, rules());
+    ASSERT_EQ(again.size(), band.size());
+    EXPECT_EQ(cv::countNonZero(again != fresh), 0) << "band " << band;
+  }
+}
+
 TEST(GuidedStereo, BadInputIsAnErrorNamingTheField) {
   auto cpu = accel::createBackend(accel::BackendKind::kCpu);
   const Pair pair = texturedPair(3);

@@ -76,6 +76,15 @@ GuidedStereo::GuidedStereo(accel::Backend& backend, GuidedStereoConfig config)
   config_.validate();
 }
 
+GuidedStereo::~GuidedStereo() = default;
+
+accel::DeviceBuffer& GuidedStereo::buffer(int slot, std::size_t size_bytes) {
+  std::unique_ptr<accel::DeviceBuffer>& b = buffers_[slot];
+  // A quarter more than asked: bands vary a little from view to view.
+  if (!b || b->sizeBytes() < size_bytes) b = backend_.createBuffer(size_bytes + size_bytes / 4);
+  return *b;
+}
+
 cv::Mat GuidedStereo::compute(const cv::Mat& left_grey, const cv::Mat& right_grey, cv::Rect band,
                               const cv::Mat& guide_px, int guide_scale,
                               const GuidedBandRules& rules) {
@@ -103,33 +112,31 @@ cv::Mat GuidedStereo::compute(const cv::Mat& left_grey, const cv::Mat& right_gre
   const std::size_t pixels = band.area();
   const std::vector<std::uint32_t> grey_words = packGrey(left_grey, right_grey);
   const std::vector<std::int32_t> guide_words = packGuide(guide_px);
-  auto grey = backend_.createBuffer(grey_words.size() * sizeof(std::uint32_t));
-  auto guide = backend_.createBuffer(guide_words.size() * sizeof(std::int32_t));
+  accel::DeviceBuffer* grey = &buffer(0, grey_words.size() * sizeof(std::uint32_t));
+  accel::DeviceBuffer* guide = &buffer(1, guide_words.size() * sizeof(std::int32_t));
   const int right_width = band.br().x - std::max(0, band.x - rules.max_disparity_px);
-  auto census = backend_.createBuffer(2 * std::size_t(band.height) * (band.width + right_width) *
-                                      sizeof(std::uint32_t));
-  auto windows = backend_.createBuffer(pixels * sizeof(std::uint32_t));
-  auto costs = backend_.createBuffer(pixels * 4 * sizeof(std::uint32_t));
-  auto sums = backend_.createBuffer(pixels * 8 * sizeof(std::uint32_t));
-  auto right_best = backend_.createBuffer(
-      std::size_t(band.height) * (band.width + rules.max_disparity_px) * sizeof(std::uint32_t));
-  auto disparity = backend_.createBuffer(pixels * sizeof(std::int32_t));
+  accel::DeviceBuffer* census =
+      &buffer(2, 2 * std::size_t(band.height) * (band.width + right_width) * sizeof(std::uint32_t));
+  accel::DeviceBuffer* windows = &buffer(3, pixels * sizeof(std::uint32_t));
+  accel::DeviceBuffer* costs = &buffer(4, pixels * 4 * sizeof(std::uint32_t));
+  accel::DeviceBuffer* sums = &buffer(5, pixels * 8 * sizeof(std::uint32_t));
+  accel::DeviceBuffer* right_best = &buffer(
+      6, std::size_t(band.height) * (band.width + rules.max_disparity_px) * sizeof(std::uint32_t));
+  accel::DeviceBuffer* disparity = &buffer(7, pixels * sizeof(std::int32_t));
 
   // One submission: the kernels in order, each reading what the one before wrote.
   accel::Sequence seq(backend_);
   cv::Mat out(band.size(), CV_32S);
   seq.upload(*grey, grey_words.data(), grey_words.size() * sizeof(std::uint32_t))
       .upload(*guide, guide_words.data(), guide_words.size() * sizeof(std::int32_t))
-      .run(accel::kernels::stereoCensus(), p, {grey.get(), census.get()})
-      .run(accel::kernels::stereoCost(), p,
-           {census.get(), guide.get(), windows.get(), costs.get()});
+      .run(accel::kernels::stereoCensus(), p, {grey, census})
+      .run(accel::kernels::stereoCost(), p, {census, guide, windows, costs});
   for (int family = 0; family < 4; ++family) {
     p.path_family = family;
     p.first_family = family == 0 ? 1 : 0;
-    seq.run(accel::kernels::stereoAggregate(), p, {windows.get(), costs.get(), sums.get()});
+    seq.run(accel::kernels::stereoAggregate(), p, {windows, costs, sums});
   }
-  seq.run(accel::kernels::stereoSelect(), p,
-          {windows.get(), sums.get(), right_best.get(), disparity.get()})
+  seq.run(accel::kernels::stereoSelect(), p, {windows, sums, right_best, disparity})
       .download(*disparity, out.data, pixels * sizeof(std::int32_t))
       .eval();
   filterSpeckles(out, rules);

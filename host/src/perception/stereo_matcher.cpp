@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <string>
@@ -106,7 +107,7 @@ cv::Mat grey(const cv::Mat& image) {
 // The guided kernels' fine pass over fine_rect (guide: the coarse pass's codes), as codes:
 // SGBM's fixed point where the kernels found a disparity, their rejections as SGBM's
 // (invalid) or outside the window (the match lies outside the windows the guide gave).
-cv::Mat guidedCodes(accel::Backend& backend, const StereoMatcherConfig& config, const cv::Mat& left,
+cv::Mat guidedCodes(GuidedStereo& guided, const StereoMatcherConfig& config, const cv::Mat& left,
                     const cv::Mat& right, cv::Rect fine_rect, const cv::Mat& coarse_codes) {
   const SgbmConfig& c = config.sgbm;
   GuidedBandRules rules;
@@ -117,8 +118,7 @@ cv::Mat guidedCodes(accel::Backend& backend, const StereoMatcherConfig& config, 
   rules.speckle_window_size = c.speckle_window_size;
   rules.speckle_range = c.speckle_range;
   const cv::Mat found =
-      GuidedStereo(backend, config.guided)
-          .compute(grey(left), grey(right), fine_rect, coarse_codes, config.coarse_scale, rules);
+      guided.compute(grey(left), grey(right), fine_rect, coarse_codes, config.coarse_scale, rules);
   cv::Mat codes = codesOf(GuidedStereo::sgbmFixedPoint(found, c.min_disparity), left(fine_rect), c,
                           fine_rect.x);
   for (int v = 0; v < found.rows; ++v) {
@@ -324,6 +324,12 @@ void StereoMatcherConfig::validate() const {
   guided.validate();
 }
 
+struct StereoMatcher::GuidedPass {
+  GuidedPass(accel::Backend& backend, const GuidedStereoConfig& config) : stereo(backend, config) {}
+  std::mutex mutex;
+  GuidedStereo stereo;
+};
+
 StereoMatcher::StereoMatcher(StereoMatcherConfig config, accel::Backend* backend)
     : config_(config), backend_(backend) {
   config_.validate();
@@ -331,6 +337,7 @@ StereoMatcher::StereoMatcher(StereoMatcherConfig config, accel::Backend* backend
     own_backend_ = accel::createBackend(accel::BackendKind::kCpu);
     backend_ = own_backend_.get();
   }
+  if (config_.guided_fine) guided_ = std::make_shared<GuidedPass>(*backend_, config_.guided);
 }
 
 cv::Mat StereoMatcher::runSgbm(const cv::Mat& left, const cv::Mat& right, const SgbmConfig& config,
@@ -417,8 +424,10 @@ DisparityResult StereoMatcher::compute(const cv::Mat& left, const cv::Mat& right
   }
   // Largest first: the fine strips were queued first.
   detail::runTasks(tasks, threads);
-  if (guided && !fine_rect.empty())
-    fine_codes = guidedCodes(*backend_, config_, left, right, fine_rect, coarse_codes);
+  if (guided && !fine_rect.empty()) {
+    std::lock_guard lock(guided_->mutex);
+    fine_codes = guidedCodes(guided_->stereo, config_, left, right, fine_rect, coarse_codes);
+  }
   assemble(fine_codes, fine.windowed ? &fine : nullptr, coarse_codes, left.size(), result);
   result.stats.sgbm_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -5,12 +5,14 @@
 // uniqueness, subpixel and left-right rules, then OpenCV's speckle filter on the host.
 #pragma once
 
+#include <memory>
 #include <opencv2/core.hpp>
 
 // C++17 consumers (the ROS nodes) include this: the backend stays a declaration here.
 namespace fvp::accel {
 class Backend;
-}
+class DeviceBuffer;
+}  // namespace fvp::accel
 
 namespace fvp::host {
 
@@ -35,9 +37,15 @@ struct GuidedBandRules {
   int speckle_range = 2;
 };
 
+/// Keeps its device buffers from one compute() to the next, grown as bands need (a GPU
+/// allocation costs ~0.8 ms, and a view's pass needs eight buffers of ~40 MB in all):
+/// one object per stream of views, not thread-safe.
 class GuidedStereo {
  public:
   GuidedStereo(accel::Backend& backend, GuidedStereoConfig config = {});
+  ~GuidedStereo();
+  GuidedStereo(const GuidedStereo&) = delete;
+  GuidedStereo& operator=(const GuidedStereo&) = delete;
 
   /// left_grey / right_grey: rectified CV_8UC1 images of equal size; band: the left
   /// pixels to match (inside the image); guide_px: CV_32F disparities of the pair reduced
@@ -53,8 +61,12 @@ class GuidedStereo {
   static cv::Mat sgbmFixedPoint(const cv::Mat& found, int min_disparity_px);
 
  private:
+  /// buffers_[slot], at least size_bytes (reallocated, contents lost, when smaller).
+  accel::DeviceBuffer& buffer(int slot, std::size_t size_bytes);
+
   accel::Backend& backend_;
   GuidedStereoConfig config_;
+  std::unique_ptr<accel::DeviceBuffer> buffers_[8];
 };
 
 }  // namespace fvp::host

@@ -125,9 +125,13 @@ class StereoMatcher {
                          PerceptionStats* stats = nullptr);
 
  private:
+  /// guided_fine's pass with its device buffers kept across views; one compute at a time.
+  struct GuidedPass;
+
   StereoMatcherConfig config_;
   std::shared_ptr<accel::Backend> own_backend_;  ///< when none was given
   accel::Backend* backend_ = nullptr;
+  std::shared_ptr<GuidedPass> guided_;  ///< guided_fine only; copies share it
 };
 
 }  // namespace fvp::host
