@@ -45,6 +45,9 @@ constexpr uint32_t kDispatchesPerSubmission = 32;
 // Storage-buffer descriptors the pool holds: enough for that many dispatches of kernels
 // binding up to 15 buffers each.
 constexpr uint32_t kPoolDescriptors = kDispatchesPerSubmission * 16;
+// Bytes one submission's transfers may stage: a part ends before a transfer that would pass
+// it (a single larger transfer gets a part of its own), so the staging buffers stay bounded.
+constexpr std::size_t kStagedBytesPerSubmission = std::size_t{64} << 20;
 
 std::set<std::string> loadedObjects() {
   std::set<std::string> names;
@@ -229,23 +232,29 @@ class VulkanBackend final : public Backend {
     std::unique_ptr<DeviceBuffer> params_buffer;
     if (pipelines_.at(&kernel).params_in_buffer) {
       params_buffer = createBuffer(kernel.params_bytes);
-      upload(*params_buffer, params, kernel.params_bytes);
+      // Not counted as the caller's upload: a sequence's parameter blocks are not either.
+      uploadBytes(*params_buffer, params, kernel.params_bytes, 0);
     }
     BoundDispatch bound = bindDispatch(kernel, params, buffers, item_count, params_buffer.get());
     submit([&](const vk::raii::CommandBuffer& cmd) { recordDispatch(cmd, bound); });
   }
 
-  // Parts of at most kDispatchesPerSubmission dispatches, each one submission: uploads and
-  // parameter blocks packed into the upload staging buffer and copied by the command
-  // buffer, downloads copied into the download staging buffer and read after the fence.
+  // Parts of at most kDispatchesPerSubmission dispatches and kStagedBytesPerSubmission
+  // transferred bytes, each one submission: uploads and parameter blocks packed into the
+  // upload staging buffer and copied by the command buffer, downloads copied into the
+  // download staging buffer and read after the fence.
   void runSequence(std::span<const SequenceOp> ops) override {
     std::size_t first = 0;
     while (first < ops.size()) {
-      std::size_t end = first;
+      std::size_t end = first, bytes = 0;
       for (uint32_t dispatches = 0; end < ops.size(); ++end) {
-        if (ops[end].kind == SequenceOp::Kind::kDispatch &&
-            dispatches++ == kDispatchesPerSubmission)
+        const SequenceOp& op = ops[end];
+        if (op.kind == SequenceOp::Kind::kDispatch && dispatches++ == kDispatchesPerSubmission)
           break;
+        if (op.kind != SequenceOp::Kind::kDispatch) {
+          if (end > first && bytes + op.size_bytes > kStagedBytesPerSubmission) break;
+          bytes += op.size_bytes;
+        }
       }
       runSequencePart(ops.subspan(first, end - first));
       first = end;
@@ -596,6 +605,19 @@ class VulkanBackend final : public Backend {
 
   void runSequencePart(std::span<const SequenceOp> ops) {
     const std::vector<char> direct = directTransfers(ops);
+    // Only mapped copies (unified memory): no command to submit, nothing to wait for.
+    if (std::all_of(ops.begin(), ops.end(), [&](const SequenceOp& op) {
+          return direct[std::size_t(&op - ops.data())] != 0;
+        })) {
+      for (const SequenceOp& op : ops) {
+        std::byte* mapped = vkBuf(*op.buffer).mapped() + op.offset_bytes;
+        if (op.kind == SequenceOp::Kind::kUpload)
+          std::memcpy(mapped, op.src, op.size_bytes);
+        else
+          std::memcpy(op.dst, mapped, op.size_bytes);
+      }
+      return;
+    }
     std::size_t up_bytes = 0, down_bytes = 0;
     for (std::size_t i = 0; i < ops.size(); ++i) {
       const SequenceOp& op = ops[i];

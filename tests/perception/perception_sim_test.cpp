@@ -382,7 +382,8 @@ TEST(PerceptionSim, AprilTagPoseAtPointThreeMetres) {
 
 // detectNear on full 1440x1080 views: in the window up to where the tag should appear it
 // finds what the whole image's search finds, bit for bit, with the expected pose exact or 2
-// degrees and 5 mm off; a tag far from where it was expected is not searched for.
+// degrees and 5 mm off; a tag far to the left of where it was expected (its window, anchored
+// at the top-left corner, ends before it) is not searched for.
 TEST(PerceptionSim, TagSearchedWhereItShouldAppearIsTheWholeImagesDetection) {
   int windowed = 0;
   double window_fraction = 0.0;

@@ -211,6 +211,7 @@ cv::Rect AprilTagDetector::searchWindow(const StereoIntrinsics& K,
                                         const Eigen::Isometry3d& T_world_camera,
                                         const Eigen::Isometry3d& T_world_tag_expected) const {
   if (config_.search_margin_deg <= 0.0) return {};
+  checkIntrinsics(K, "AprilTagDetector: camera model");
   const Eigen::Isometry3d T_camera_tag = T_world_camera.inverse() * T_world_tag_expected;
   const double h = 0.5 * config_.tag_size_m;
   const double margin_rad = config_.search_margin_deg * M_PI / 180.0;
@@ -236,7 +237,6 @@ cv::Rect AprilTagDetector::searchWindow(const StereoIntrinsics& K,
   // coordinates, so a window that starts elsewhere moves corners by up to ~5e-5 px (measured),
   // enough to change a trial. Anchored at (0, 0) its detection is the whole image's, bit for
   // bit, and it skips the image's rows below and columns right of the tag.
-  (void)u0, (void)v0;
   const auto clamp = [](double t, int hi) { return int(std::clamp(t, 0.0, double(hi))); };
   const int x0 = 0, y0 = 0;
   const int x1 = clamp(std::ceil(u1) + 1.0, K.width_px);

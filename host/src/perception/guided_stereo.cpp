@@ -80,8 +80,7 @@ GuidedStereo::~GuidedStereo() = default;
 
 accel::DeviceBuffer& GuidedStereo::buffer(int slot, std::size_t size_bytes) {
   std::unique_ptr<accel::DeviceBuffer>& b = buffers_[slot];
-  // A quarter more than asked: bands vary a little from view to view.
-  if (!b || b->sizeBytes() < size_bytes) b = backend_.createBuffer(size_bytes + size_bytes / 4);
+  if (!b || b->sizeBytes() < size_bytes) b = backend_.createBuffer(size_bytes);
   return *b;
 }
 

@@ -1,8 +1,9 @@
 // GPU work as explicit recorded operations, run as one submission (Kompute's Sequence):
 // uploads, kernel dispatches and downloads are recorded in order, then eval() runs them and
 // returns when every result is ready. On Vulkan that is one command buffer with a barrier
-// between operations and one fence wait; on OpenCL, non-blocking commands on the in-order
-// queue and one finish; on the cpu backend, the operations one after another. A submission
+// between operations and one fence wait (per 32 dispatches or 64 MB of transfers); on
+// OpenCL, non-blocking commands on the in-order queue and one finish; on the cpu backend,
+// the operations one after another. A submission
 // and its wait cost ~0.3-0.5 ms on an H100, so a view's dozens of operations pay it once
 // per sequence instead of once per operation.
 #pragma once
@@ -45,7 +46,8 @@ class Sequence {
   /// Operations recorded and not yet run.
   std::size_t size() const { return ops_.size(); }
   /// Runs the recorded operations in order and returns when all are done; the sequence is
-  /// then empty and may record again. Buffers must outlive the call.
+  /// then empty and may record again. Buffers must outlive the call. If it throws, the
+  /// buffers' contents are unspecified (operations before the failure may have run).
   void eval();
 
  private:

@@ -37,9 +37,9 @@ struct GuidedBandRules {
   int speckle_range = 2;
 };
 
-/// Keeps its device buffers from one compute() to the next, grown as bands need (a GPU
-/// allocation costs ~0.8 ms, and a view's pass needs eight buffers of ~40 MB in all):
-/// one object per stream of views, not thread-safe.
+/// Keeps its device buffers from one compute() to the next, reallocated when a band needs
+/// more (a GPU allocation costs ~0.8 ms, and a view's pass needs eight buffers of ~40 MB in
+/// all): one object per stream of views, not thread-safe.
 class GuidedStereo {
  public:
   GuidedStereo(accel::Backend& backend, GuidedStereoConfig config = {});

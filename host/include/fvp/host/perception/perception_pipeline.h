@@ -70,8 +70,8 @@ class PerceptionPipeline {
 
   /// known_region: the Cluster Region from an earlier view (the tag is then still detected
   /// and reported, but the given region is used). expected_T_world_tag: where earlier views
-  /// put the tag; it is then searched first where it should appear
-  /// (AprilTagDetector::detectNear), a tenth of the image.
+  /// put the tag; it is then searched for only in the part of the image up to where it
+  /// should appear (AprilTagDetector::detectNear; about a third of the image).
   PerceptionResult process(
       const StereoFrame& frame, const std::optional<ClusterRegion>& known_region = std::nullopt,
       const std::optional<Eigen::Isometry3d>& expected_T_world_tag = std::nullopt) const;

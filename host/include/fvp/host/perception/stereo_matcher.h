@@ -101,7 +101,8 @@ struct DisparityResult {
 class StereoMatcher {
  public:
   /// backend: where guided_fine's kernels run (not owned; null: a cpu backend of the
-  /// matcher's own).
+  /// matcher's own). The matcher keeps device buffers on it, so it must outlive the matcher
+  /// and its copies; copies share those buffers and match one at a time.
   explicit StereoMatcher(StereoMatcherConfig config = {}, accel::Backend* backend = nullptr);
   const StereoMatcherConfig& config() const { return config_; }
 
