@@ -21,21 +21,25 @@ namespace {
 // to the bit today; the tolerance allows a device that rounds float adds differently.
 constexpr float kFieldSumRelativeTolerance = 1e-5f;
 
+void expectSameWalks(const std::vector<RayResult>& got, const std::vector<RayResult>& want,
+                     const std::string& context) {
+  ASSERT_EQ(got.size(), want.size()) << context;
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    ASSERT_EQ(got[i].status, want[i].status) << context << ", ray " << i;
+    ASSERT_EQ(got[i].steps, want[i].steps) << context << ", ray " << i;
+    ASSERT_EQ(got[i].stop_voxel, want[i].stop_voxel) << context << ", ray " << i;
+    ASSERT_NEAR(got[i].field_sum, want[i].field_sum,
+                kFieldSumRelativeTolerance * std::max(1.0f, std::abs(want[i].field_sum)))
+        << context << ", ray " << i;
+  }
+}
+
 class BackendTest : public fvp::testing::BackendFixture {
  protected:
   void expectSameAsCpu(const DenseGrid& grid, const std::vector<Ray>& rays,
                        const std::string& context) {
-    const auto got = traverseOnBackend(*backend_, grid, rays);
-    const auto want = traverseOnBackend(*cpu_, grid, rays);
-    ASSERT_EQ(got.size(), want.size());
-    for (std::size_t i = 0; i < got.size(); ++i) {
-      ASSERT_EQ(got[i].status, want[i].status) << context << ", ray " << i;
-      ASSERT_EQ(got[i].steps, want[i].steps) << context << ", ray " << i;
-      ASSERT_EQ(got[i].stop_voxel, want[i].stop_voxel) << context << ", ray " << i;
-      ASSERT_NEAR(got[i].field_sum, want[i].field_sum,
-                  kFieldSumRelativeTolerance * std::max(1.0f, std::abs(want[i].field_sum)))
-          << context << ", ray " << i;
-    }
+    expectSameWalks(traverseOnBackend(*backend_, grid, rays), traverseOnBackend(*cpu_, grid, rays),
+                    context);
   }
 };
 
@@ -118,19 +122,6 @@ TEST_P(BackendTest, DispatchChecksTheBindings) {
 std::vector<RayResult> cpuTraverse(const DenseGrid& grid, const std::vector<Ray>& rays) {
   auto cpu = createBackend(BackendKind::kCpu);
   return traverseOnBackend(*cpu, grid, rays);
-}
-
-void expectSameWalks(const std::vector<RayResult>& got, const std::vector<RayResult>& want,
-                     const std::string& context) {
-  ASSERT_EQ(got.size(), want.size()) << context;
-  for (std::size_t i = 0; i < got.size(); ++i) {
-    ASSERT_EQ(got[i].status, want[i].status) << context << ", ray " << i;
-    ASSERT_EQ(got[i].steps, want[i].steps) << context << ", ray " << i;
-    ASSERT_EQ(got[i].stop_voxel, want[i].stop_voxel) << context << ", ray " << i;
-    ASSERT_NEAR(got[i].field_sum, want[i].field_sum,
-                kFieldSumRelativeTolerance * std::max(1.0f, std::abs(want[i].field_sum)))
-        << context << ", ray " << i;
-  }
 }
 
 // Two grids walked in one sequence: the second grid's uploads overwrite buffers the first
