@@ -1,7 +1,6 @@
 #include "fvp/host/perception/guided_stereo.h"
 
 #include <cmath>
-#include <cstring>
 #include <opencv2/calib3d.hpp>
 #include <stdexcept>
 #include <vector>
@@ -12,18 +11,6 @@
 
 namespace fvp::host {
 namespace {
-
-// Both grey images, left first, four 8-bit pixels a word.
-std::vector<std::uint32_t> packGrey(const cv::Mat& left, const cv::Mat& right) {
-  const std::size_t pixels = left.total();
-  std::vector<std::uint32_t> words((2 * pixels + 3) / 4, 0u);
-  auto* bytes = reinterpret_cast<unsigned char*>(words.data());
-  const cv::Mat l = left.isContinuous() ? left : left.clone();
-  const cv::Mat r = right.isContinuous() ? right : right.clone();
-  std::memcpy(bytes, l.data, pixels);
-  std::memcpy(bytes + pixels, r.data, pixels);
-  return words;
-}
 
 // The guide as the kernels read it: disparity * 16, rounded, 0 where none.
 std::vector<std::int32_t> packGuide(const cv::Mat& guide_px) {
@@ -109,9 +96,13 @@ cv::Mat GuidedStereo::compute(const cv::Mat& left_grey, const cv::Mat& right_gre
   p.disp12_max_diff = rules.disp12_max_diff;
 
   const std::size_t pixels = band.area();
-  const std::vector<std::uint32_t> grey_words = packGrey(left_grey, right_grey);
+  // Both grey images in one buffer, left first, four 8-bit pixels a word: uploaded straight
+  // from the images (rows contiguous) into their halves.
+  const cv::Mat left_rows = left_grey.isContinuous() ? left_grey : left_grey.clone();
+  const cv::Mat right_rows = right_grey.isContinuous() ? right_grey : right_grey.clone();
+  const std::size_t image_bytes = left_rows.total();
   const std::vector<std::int32_t> guide_words = packGuide(guide_px);
-  accel::DeviceBuffer* grey = &buffer(0, grey_words.size() * sizeof(std::uint32_t));
+  accel::DeviceBuffer* grey = &buffer(0, (2 * image_bytes + 3) / 4 * sizeof(std::uint32_t));
   accel::DeviceBuffer* guide = &buffer(1, guide_words.size() * sizeof(std::int32_t));
   const int right_width = band.br().x - std::max(0, band.x - rules.max_disparity_px);
   accel::DeviceBuffer* census =
@@ -126,7 +117,8 @@ cv::Mat GuidedStereo::compute(const cv::Mat& left_grey, const cv::Mat& right_gre
   // One submission: the kernels in order, each reading what the one before wrote.
   accel::Sequence seq(backend_);
   cv::Mat out(band.size(), CV_32S);
-  seq.upload(*grey, grey_words.data(), grey_words.size() * sizeof(std::uint32_t))
+  seq.upload(*grey, left_rows.data, image_bytes)
+      .upload(*grey, right_rows.data, image_bytes, image_bytes)
       .upload(*guide, guide_words.data(), guide_words.size() * sizeof(std::int32_t))
       .run(accel::kernels::stereoCensus(), p, {grey, census})
       .run(accel::kernels::stereoCost(), p, {census, guide, windows, costs});
