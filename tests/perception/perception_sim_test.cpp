@@ -307,7 +307,6 @@ TEST(PerceptionSim, GuidedFinePassAgainstSgbmOnFruitlets) {
     const RenderedView& view = start.view;
     const StereoFrame& frame = view.frame;
     const StereoIntrinsics& K = frame.intrinsics;
-    const ClusterRegion& region = start.region;
     const cv::Rect band = start.band;
     const double fb = K.fx_px * K.baseline_m;
     for (Tally* t : {&sgbm, &guided}) {
