@@ -191,6 +191,49 @@ TEST(ClusterSplit, SplitsThreeInARowAndLeavesSingleFruitletsWhole) {
     }
 }
 
+// A fused surface millimetres thick (views that disagree by ~2 mm: development world 9525
+// with the guided stereo pass, after 12 views): the large fruitlet's points fit a second
+// sphere, a shell 2 mm inside the first and centred inside it, with more inliers than the
+// small fruitlet beside it. The shell is set aside and the small fruitlet still split off;
+// before, the search stopped at the shell, and the small fruitlet's points became noise.
+TEST(ClusterSplit, AThickSurfacesInnerShellDoesNotHideTheNextFruitlet) {
+  std::mt19937_64 rng(13);
+  std::vector<Eigen::Vector3f> pts;
+  std::vector<int> truth;
+  const Eigen::Vector3f a(0.0f, 0.0f, 1.0f), b(0.0155f, 0.0f, 0.996f);
+  sampleNearSide(a, 0.0076f, 1.0f, 0.0001f, rng, pts, truth, 0);
+  sampleNearSide(a, 0.0056f, 1.0f, 0.0001f, rng, pts, truth, 1);  // the inner shell
+  sampleNearSide(b, 0.0038f, 1.0f, 0.0001f, rng, pts, truth, 2);
+  std::vector<int> labels(pts.size(), 0);
+  const SphereFit first = fitSphereRansac(pts);
+  std::vector<Eigen::Vector3f> beyond_first;
+  for (const auto& p : pts)
+    if (std::abs((p.cast<double>() - first.center_m).norm() - first.radius_m) > 0.0015)
+      beyond_first.push_back(p);
+  const SphereFit second = fitSphereRansac(beyond_first);
+  ASSERT_TRUE(second.found);
+  ASSERT_LT((second.center_m - a.cast<double>()).norm(), 0.001)
+      << "the test's premise: the second sphere found is the inner shell";
+
+  EXPECT_EQ(splitMergedClusters(pts, labels), 1u);
+  std::map<int, int> small_fruitlet_labels;
+  int small_fruitlet_points = 0;
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    if (truth[i] == 2) {
+      ++small_fruitlet_labels[labels[i]];
+      ++small_fruitlet_points;
+    }
+  const auto most = std::max_element(small_fruitlet_labels.begin(), small_fruitlet_labels.end(),
+                                     [](auto& x, auto& y) { return x.second < y.second; });
+  EXPECT_NE(most->first, kDbscanNoise);
+  EXPECT_NE(most->first, 0);
+  EXPECT_GT(most->second, small_fruitlet_points * 95 / 100);
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    if (truth[i] == 0) {
+      EXPECT_EQ(labels[i], 0) << i;
+    }
+}
+
 // A fruitlet more elongated than the world generator makes (e = 1.4): its ends lie farther
 // than the assignment distance from its best sphere, and fit spheres of their own, but
 // centred inside the first one. It stays one cluster.

@@ -134,9 +134,12 @@ namespace {
 // Splits the cluster `members` (indices into `points`) by sequential RANSAC: the sphere with
 // the most inliers, then the sphere with the most inliers among the points farther than
 // max_assignment_distance_m from it, and so on while each new sphere is a fruitlet of its
-// own. With two spheres or more, each point goes to the nearest sphere (the first keeps the
-// cluster's label, the others get labels from `next_label`), and points far from every
-// sphere (the stereo bridge between fruitlets) become noise. Returns the parts split off.
+// own. A sphere centred inside one found already is a shell of that fruitlet (a fused
+// surface millimetres thick, an elongated fruitlet's end): its points are set aside and the
+// search goes on, so that a fruitlet found later is not lost with them. With two spheres or
+// more, each point goes to the nearest sphere (the first keeps the cluster's label, the
+// others get labels from `next_label`), and points far from every sphere (the stereo bridge
+// between fruitlets) become noise. Returns the parts split off.
 std::size_t splitCluster(const std::vector<Eigen::Vector3f>& points,
                          const std::vector<std::size_t>& members, std::vector<int>& labels,
                          int& next_label, const ClusterSplitConfig& config) {
@@ -150,26 +153,34 @@ std::size_t splitCluster(const std::vector<Eigen::Vector3f>& points,
   for (std::size_t i = 0; i < cloud.size(); ++i) remaining[i] = i;
   const double min_part_points =
       std::max<double>(config.min_cluster_points, config.min_part_fraction * cloud.size());
-  while (int(spheres.size()) <= config.max_parts) {
+  const auto explainedBy = [&](const SphereFit& sphere) {
+    std::vector<std::size_t> unexplained;
+    for (std::size_t i : remaining)
+      if (offSphere(cloud[i], sphere) > config.max_assignment_distance_m) unexplained.push_back(i);
+    remaining = std::move(unexplained);
+  };
+  // Every round takes at least min_part_points away; shells are bounded like parts.
+  for (int shells = 0; int(spheres.size()) <= config.max_parts && shells <= config.max_parts;) {
     const std::vector<Eigen::Vector3f> rest = gather(cloud, remaining);
     SphereFit fit = fitSphereRansac(rest, config.ransac);
     if (!fit.found) break;
     if (!spheres.empty()) {
       // Another fruitlet: enough points (stray spheres through the bridge between fruitlets
       // are small), and no overlap with one found already (each centre outside the other's
-      // sphere: an elongated fruitlet's ends fit spheres centred inside its own).
+      // sphere).
       if (double(fit.inliers.size()) < min_part_points) break;
       const bool overlaps = std::any_of(spheres.begin(), spheres.end(), [&](const SphereFit& s) {
         return (s.center_m - fit.center_m).norm() < std::max(s.radius_m, fit.radius_m);
       });
-      if (overlaps) break;
+      if (overlaps) {
+        ++shells;
+        explainedBy(fit);
+        if (double(remaining.size()) < min_part_points) break;
+        continue;
+      }
     }
     spheres.push_back(std::move(fit));
-    std::vector<std::size_t> unexplained;
-    for (std::size_t i : remaining)
-      if (offSphere(cloud[i], spheres.back()) > config.max_assignment_distance_m)
-        unexplained.push_back(i);
-    remaining = std::move(unexplained);
+    explainedBy(spheres.back());
     // One sphere explaining nearly all of it: one fruitlet (an elongated one's ends lie
     // within max_assignment_distance_m of its best sphere).
     if (spheres.size() == 1 &&
