@@ -9,6 +9,8 @@
 #include "fvp/accel/backend.h"
 #include "fvp/host/core/output_directory.h"
 #include "fvp/host/map/map_engine_registry.h"
+#include "fvp/host/nbv/nbv_setup.h"
+#include "fvp/host/nbv/run_fields.h"
 #include "fvp/host/report/capture_set_report.h"
 #include "stereo_bag_files.h"
 
@@ -19,6 +21,7 @@ void addSizeCommand(CLI::App& app) {
     std::string captures, bag, bag_ns = "/stereo", world_frame = "world", out, sizing = "ours",
                                engine = "grid", config;
     accel::BackendChoice backend = accel::BackendChoice::kAuto;
+    bool guided_stereo = host::nbv::NbvSetupOptions{}.guided_stereo;  // as a trial sizes
   };
   auto opt = optionStorage<Options>();
   auto* cmd =
@@ -50,7 +53,11 @@ void addSizeCommand(CLI::App& app) {
   cmd->add_option("--engine", opt->engine, "map engine: grid | octomap")
       ->check(CLI::IsMember(mapEngineNames()))
       ->capture_default_str();
-  addBackendOption(cmd, opt->backend, "compute backend for the grid engine");
+  addBackendOption(cmd, opt->backend,
+                   "compute backend for the grid engine and the guided stereo pass");
+  cmd->add_flag("--guided-stereo,!--no-guided-stereo", opt->guided_stereo,
+                std::string(host::nbv::run_fields::kGuidedStereo.help) + " (default: " +
+                    (opt->guided_stereo ? "on" : "off") + ", as in fvp run)");
   cmd->add_option("--config", opt->config,
                   "perception config YAML: the tag (family, id, size), the Cluster Region "
                   "(offset and radius, or an explicit centre) and HSV thresholds "
@@ -60,8 +67,10 @@ void addSizeCommand(CLI::App& app) {
   FVP_ON_RUN(cmd, [opt] {
     host::PerceptionConfig perception;  // read first: a bad file fails before any work
     if (!opt->config.empty()) perception = host::PerceptionConfig::fromYamlFile(opt->config);
+    perception.stereo.guided_fine = opt->guided_stereo;
     std::unique_ptr<accel::Backend> backend;
-    if (host::map::mapEngineNeedsBackend(opt->engine)) backend = accel::createBackend(opt->backend);
+    if (host::map::mapEngineNeedsBackend(opt->engine) || opt->guided_stereo)
+      backend = accel::createBackend(opt->backend);
     if (opt->captures.empty() == opt->bag.empty())
       throw std::invalid_argument("expected --captures DIR or --bag FILE");
     std::string captures_dir = opt->captures;

@@ -56,8 +56,9 @@ void bindSim(py::module_& m) {
       "and the simulated clock, for the library's fvp.NbvSetup (as a real robot's would be).")
       .def(py::init([](std::uint64_t seed, const std::string& world_config,
                        const std::string& arm_config, const std::string& clock,
-                       std::optional<double> season_day) {
+                       std::optional<double> season_day, double fixed_perception_time_s) {
              trials::SimulatedRobotOptions o;
+             o.fixed_perception_time_s = fixed_perception_time_s;
              o.seed = seed;
              o.world_config = world_config;
              o.season_day = season_day;
@@ -67,7 +68,8 @@ void bindSim(py::module_& m) {
            }),
            py::kw_only(), py::arg("seed") = 1, py::arg("world_config") = "",
            py::arg("arm_config") = "", py::arg("clock") = "wall",
-           py::arg("season_day") = py::none())
+           py::arg("season_day") = py::none(),
+           py::arg("fixed_perception_time_s") = robot::sim::kDefaultFixedPerceptionTimeS)
       .def_property_readonly(
           "camera", [](trials::SimulatedRobot& r) -> host::nbv::Camera& { return r.camera(); },
           py::return_value_policy::reference_internal, "The simulated camera (fvp.Camera).")

@@ -259,5 +259,25 @@ TEST_F(TreeTrial, RepeatsExactlyWithAFixedClock) {
   EXPECT_EQ(a["tour"]["cluster_status"].value("sized", 0), 3);
 }
 
+// The fixed clock charges perception what the stereo pass the trial runs costs: the guided
+// kernels' 0.2 s a view, SGBM's whole-range pass (the default) 0.4 s.
+TEST_F(TreeTrial, TheFixedClockChargesPerceptionByTheStereoPass) {
+  TrialOptions o = options();
+  o.world_config.clear();  // one cluster
+  o.max_views = 1;
+  ASSERT_FALSE(o.guided_stereo) << "SGBM's pass is the default";
+  for (const bool guided : {true, false}) {
+    o.guided_stereo = guided;
+    const nlohmann::json r = runTrial(o);
+    const int views = r.at("views").get<int>();
+    ASSERT_GE(views, 1);
+    EXPECT_NEAR(r["sim_time_by_stage_s"].at("perception_s").get<double>(),
+                views * robot::sim::fixedPerceptionTimeS(guided), 1e-9)
+        << (guided ? "guided" : "SGBM");
+  }
+  EXPECT_DOUBLE_EQ(robot::sim::fixedPerceptionTimeS(true), 0.2);
+  EXPECT_DOUBLE_EQ(robot::sim::fixedPerceptionTimeS(false), 0.4);
+}
+
 }  // namespace
 }  // namespace fvp::trials

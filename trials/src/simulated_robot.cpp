@@ -63,7 +63,8 @@ struct SimulatedRobot::Impl {
         std::make_unique<WorkspaceTree>(loadWorkspaceTree(*arm, [&o](const std::string& text) {
           if (o.on_warning) o.on_warning(text);
         }));
-    clock = std::make_unique<SimClock>(o.clock);
+    clock = std::make_unique<SimClock>(o.clock, kDefaultCaptureTimeS, kDefaultFixedStageTimeS,
+                                       o.fixed_perception_time_s);
     loop_clock = std::make_unique<SimulatedLoopClock>(*clock);
     const auto start = SimulatedArm::startConfiguration(*arm, world.startCameraPose());
     if (!start)

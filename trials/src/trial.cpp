@@ -439,6 +439,7 @@ struct Trial::Impl {
     sim.season_day = options.season_day;
     sim.arm_config = options.arm_config;
     sim.clock = options.clock;
+    sim.fixed_perception_time_s = robot::sim::fixedPerceptionTimeS(options.guided_stereo);
     sim.on_warning = [this](const std::string& text) { warn(text); };
     robot = std::make_unique<SimulatedRobot>(sim);
     world = &robot->world();

@@ -98,8 +98,9 @@ struct ExperimentManifest {
   /// without the key, kClockChargesBeforePerception.
   std::string clock_charges = kClockCharges;
   static constexpr const char* kClockCharges =
-      "capture, perception and every compute stage (fixed clock: 0.2 s, 0.4 s, 0.1 s each; "
-      "a motion plan at least its validity checks at 660 000 a second)";
+      "capture, perception and every compute stage (fixed clock: 0.2 s; perception 0.2 s with "
+      "the guided stereo pass, 0.4 s with SGBM's; 0.1 s each; a motion plan at least its "
+      "validity checks at 660 000 a second)";
   static constexpr const char* kClockChargesBeforePerception =
       "capture and the compute stages but not perception (an fvp before 2026-11-30)";
   // The run's own plan (kind "run" only). Resume refuses a difference; merge does not

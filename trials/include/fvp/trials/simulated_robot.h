@@ -40,6 +40,9 @@ struct SimulatedRobotOptions {
   /// "wall": compute charged as measured; "fixed": as constants, and motion planning
   /// reproducible (the same run on any machine).
   robot::sim::SimClock::Mode clock = robot::sim::SimClock::Mode::kWall;
+  /// Perception's charge on the fixed clock: that of the setup's stereo pass
+  /// (robot::sim::fixedPerceptionTimeS(NbvSetupOptions::guided_stereo)).
+  double fixed_perception_time_s = robot::sim::kDefaultFixedPerceptionTimeS;
   /// Each warning (a rebuilt workspace cache), as it happens.
   std::function<void(const std::string&)> on_warning;
 };

@@ -5,11 +5,12 @@
 namespace fvp::host::planner {
 
 /// What a view costs the robot besides its move, for ranking views by time
-/// (planAndMove, view_planner.h): the fixed clock's charges per view (capture 0.2 s, perception
-/// 0.4 s, mapping 0.2 s, TSDF, sizing, planning, motion planning and a batch of goal checks
-/// 0.1 s each; a motion plan more when its validity checks take longer). A robot on two cores
-/// measured 0.64 s of compute a view (perception 0.39 s of it) plus its capture (issue 41);
-/// the fixed charges round each stage up.
+/// (planAndMove, view_planner.h): the fixed clock's charges per view with the default stereo
+/// pass (capture 0.2 s, perception 0.4 s, mapping 0.2 s, TSDF, sizing, planning, motion
+/// planning and a batch of goal checks 0.1 s each; a motion plan more when its validity
+/// checks take longer). With the guided stereo pass perception is charged 0.2 s and a view
+/// 1.1 s (`--view-overhead-s 1.1`). The fixed charges round each stage's measured time on two
+/// cores up (robot/sim/sim_clock.h).
 inline constexpr double kDefaultViewOverheadS = 1.3;
 
 }  // namespace fvp::host::planner

@@ -44,10 +44,19 @@ struct IterationCharges {
 /// perception (before issue 41 this charge stood for a GPU stereo network as well).
 inline constexpr double kDefaultCaptureTimeS = 0.2;
 inline constexpr double kDefaultFixedStageTimeS = 0.1;  ///< per compute stage, mode fixed
-/// Perception's charge in mode fixed: BM_View's perception stage on the cpu backend, 2-core
-/// AMD EPYC, 368 ms (stereo 322 ms of it; docs/performance.md), rounded up to 0.1 s as the
-/// other stages' 0.1 s is above their measured times.
-inline constexpr double kDefaultFixedPerceptionTimeS = 0.4;
+/// Perception's charges in mode fixed, from BM_View's perception stage on the cpu backend,
+/// 2-core AMD EPYC (docs/performance.md), rounded up to 0.1 s as the other stages' 0.1 s is
+/// above their measured times. With the guided stereo kernels' full-resolution pass
+/// (NbvSetupOptions::guided_stereo): 155 ms (stereo 136 ms of it) at 0a8b737.
+inline constexpr double kGuidedFixedPerceptionTimeS = 0.2;
+/// With OpenCV SGBM's full-resolution pass (the default): set when it measured 368 ms (stereo
+/// 322 ms); 251 ms (stereo 233 ms) at 0a8b737, still below it.
+inline constexpr double kSgbmFixedPerceptionTimeS = 0.4;
+inline constexpr double kDefaultFixedPerceptionTimeS = kSgbmFixedPerceptionTimeS;
+/// The fixed perception charge of a run with or without the guided stereo pass.
+inline constexpr double fixedPerceptionTimeS(bool guided_stereo) {
+  return guided_stereo ? kGuidedFixedPerceptionTimeS : kSgbmFixedPerceptionTimeS;
+}
 
 class SimClock {
  public:
