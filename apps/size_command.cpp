@@ -56,8 +56,8 @@ void addSizeCommand(CLI::App& app) {
   addBackendOption(cmd, opt->backend,
                    "compute backend for the grid engine and the guided stereo pass");
   cmd->add_flag("--guided-stereo,!--no-guided-stereo", opt->guided_stereo,
-                std::string(host::nbv::run_fields::kGuidedStereo.help) + " (default: " +
-                    (opt->guided_stereo ? "on" : "off") + ", as in fvp run)");
+                std::string(host::nbv::run_fields::kGuidedStereo.help) +
+                    " (default: " + (opt->guided_stereo ? "on" : "off") + ", as in fvp run)");
   cmd->add_option("--config", opt->config,
                   "perception config YAML: the tag (family, id, size), the Cluster Region "
                   "(offset and radius, or an explicit centre) and HSV thresholds "
