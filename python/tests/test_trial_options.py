@@ -160,3 +160,13 @@ def test_the_view_ordering_is_a_setting_that_reaches_the_trial():
     assert result["settings"]["view_overhead_s"] == 0.0
     with pytest.raises(ValueError, match="setting 'view_overhead_s': expected a finite number"):
         fvp.sim.run_trial(view_overhead_s=-1.0)
+
+
+def test_the_simulated_robot_charges_perception_as_it_is_told():
+    # On the fixed clock perception costs what the setup's stereo pass costs: SGBM's 0.4 s by
+    # default; a Robot for NbvSetup(guided_stereo=True) is given the guided pass's 0.2 s.
+    with pytest.raises(ValueError, match="sim.Robot: fixed_perception_time_s: expected"):
+        fvp.sim.Robot(fixed_perception_time_s=-1.0)
+    with pytest.raises(ValueError, match="fixed_perception_time_s"):
+        fvp.sim.Robot(fixed_perception_time_s=float("nan"))
+    assert "0.2 s for NbvSetup(guided_stereo=True)" in fvp.sim.Robot.__doc__

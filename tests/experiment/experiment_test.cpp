@@ -901,6 +901,19 @@ TEST(Experiment, TrialsTimedByAnotherClockAreNeverPooled) {
   }
   writeText(dir / "manifest.json", m.toJson().dump(2));
   EXPECT_FALSE(resumeDifference(readManifest(dir / "manifest.json"), m).has_value());
+  // The guided stereo pass is charged its own perception since 2026-12-01: its runs charged
+  // SGBM's before are not pooled with those after; SGBM's runs keep their words.
+  EXPECT_STREQ(ExperimentManifest::clockChargesFor(false), ExperimentManifest::kClockCharges);
+  ExperimentManifest guided = m;
+  guided.settings.guided_stereo = true;
+  guided.clock_charges = ExperimentManifest::clockChargesFor(true);
+  ExperimentManifest guided_before = guided;
+  guided_before.clock_charges = ExperimentManifest::kClockCharges;
+  for (const auto& d :
+       {resumeDifference(guided_before, guided), mergeDifference(guided_before, guided)}) {
+    ASSERT_TRUE(d.has_value());
+    EXPECT_EQ(d->setting, "clock_charges");
+  }
   j["clock_charges"] = 7;
   writeText(dir / "manifest.json", j.dump(2));
   EXPECT_NE(errorOf([&] { readManifest(dir / "manifest.json"); }).find("field 'clock_charges'"),

@@ -195,7 +195,8 @@ TEST(ClusterSplit, SplitsThreeInARowAndLeavesSingleFruitletsWhole) {
 // with the guided stereo pass, after 12 views): the large fruitlet's points fit a second
 // sphere, a shell 2 mm inside the first and centred inside it, with more inliers than the
 // small fruitlet beside it. The shell is set aside and the small fruitlet still split off;
-// before, the search stopped at the shell, and the small fruitlet's points became noise.
+// before, the search stopped at the shell and the cluster stayed whole (the trial's case,
+// where two parts had been found before the shell, made the rest noise).
 TEST(ClusterSplit, AThickSurfacesInnerShellDoesNotHideTheNextFruitlet) {
   std::mt19937_64 rng(13);
   std::vector<Eigen::Vector3f> pts;

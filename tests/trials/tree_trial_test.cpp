@@ -14,6 +14,7 @@
 #include "fvp/host/nbv/arm.h"
 #include "fvp/host/nbv/camera.h"
 #include "fvp/robot/sim/world.h"
+#include "fvp/trials/experiment_directory.h"
 #include "fvp/trials/trial.h"
 
 namespace fvp::trials {
@@ -274,6 +275,7 @@ TEST_F(TreeTrial, TheFixedClockChargesPerceptionByTheStereoPass) {
     EXPECT_NEAR(r["sim_time_by_stage_s"].at("perception_s").get<double>(),
                 views * robot::sim::fixedPerceptionTimeS(guided), 1e-9)
         << (guided ? "guided" : "SGBM");
+    EXPECT_EQ(r.at("clock_charges"), ExperimentManifest::clockChargesFor(guided));
   }
   EXPECT_DOUBLE_EQ(robot::sim::fixedPerceptionTimeS(true), 0.2);
   EXPECT_DOUBLE_EQ(robot::sim::fixedPerceptionTimeS(false), 0.4);

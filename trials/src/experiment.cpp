@@ -102,6 +102,7 @@ ExperimentManifest manifestOf(const ExperimentOptions& o) {
   ExperimentManifest m;
   m.kind = "run";
   m.settings = o.trial;
+  m.clock_charges = ExperimentManifest::clockChargesFor(o.trial.guided_stereo);
   m.settings.register_views = registerViewsOf(o.trial);
   // Switches of the automatic stop: nothing under the budget stop, recorded as off there so
   // that budget experiments from before they existed still resume and merge.

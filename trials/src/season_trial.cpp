@@ -77,7 +77,7 @@ std::optional<nlohmann::json> finishedVisit(const TrialOptions& visit) {
       !firstSettingDifference(result.at("settings"), nlohmann::json(trialSettingsJson(resolved)))
            .empty() ||
       rememberedDay(result) != visit.remembered_visit.filename() ||
-      result.value("clock_charges", "") != ExperimentManifest::kClockCharges)
+      result.value("clock_charges", "") != ExperimentManifest::clockChargesFor(visit.guided_stereo))
     throw std::runtime_error(file.string() +
                              ": not this visit's result (another seed, day, settings, "
                              "remembered visit or clock); another --out");
@@ -113,7 +113,7 @@ nlohmann::json seasonSettings(const SeasonTrialOptions& o) {
   settings.erase("season_day");
   settings["caliper_sigma_mm"] = o.caliper_sigma_mm;
   settings["remember_visits"] = o.remember_visits;
-  settings["clock_charges"] = ExperimentManifest::kClockCharges;
+  settings["clock_charges"] = ExperimentManifest::clockChargesFor(o.visit.guided_stereo);
   return settings;
 }
 

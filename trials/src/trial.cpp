@@ -617,7 +617,7 @@ void Trial::Impl::describeRun(nlohmann::json& result, const TrialLog& log,
                               const std::vector<Eigen::Vector3d>& camera_path) const {
   result["clock"] = nlohmann::json::parse(robot->clock().toJson());
   // What the clock charges: a season resumes only visits timed by this build's clock.
-  result["clock_charges"] = ExperimentManifest::kClockCharges;
+  result["clock_charges"] = ExperimentManifest::clockChargesFor(options.guided_stereo);
   if (!options.remembered_visit.empty())
     result["remembered_visit"] = options.remembered_visit.string();
   // The clock's record stays in result.json only; its sums by stage go everywhere the trial

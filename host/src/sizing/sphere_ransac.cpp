@@ -160,7 +160,7 @@ std::size_t splitCluster(const std::vector<Eigen::Vector3f>& points,
     remaining = std::move(unexplained);
   };
   // Every round takes at least min_part_points away; shells are bounded like parts.
-  for (int shells = 0; int(spheres.size()) <= config.max_parts && shells <= config.max_parts;) {
+  for (int shells = 0; int(spheres.size()) <= config.max_parts && shells < config.max_parts;) {
     const std::vector<Eigen::Vector3f> rest = gather(cloud, remaining);
     SphereFit fit = fitSphereRansac(rest, config.ransac);
     if (!fit.found) break;

@@ -94,13 +94,22 @@ struct ExperimentManifest {
   /// this names the sweep point (absent in a manifest: empty).
   std::string error_scale;
   /// What the simulated clock charged the trials (robot/sim/sim_clock.h), so that resume and
-  /// merge never pool trials timed by different clocks: kClockCharges, or, in a manifest
-  /// without the key, kClockChargesBeforePerception.
+  /// merge never pool trials timed by different clocks: clockChargesFor(the run's stereo
+  /// pass), or, in a manifest without the key, kClockChargesBeforePerception.
   std::string clock_charges = kClockCharges;
+  /// With SGBM's stereo pass (the default; the same words since 2026-11-30's charges).
   static constexpr const char* kClockCharges =
-      "capture, perception and every compute stage (fixed clock: 0.2 s; perception 0.2 s with "
-      "the guided stereo pass, 0.4 s with SGBM's; 0.1 s each; a motion plan at least its "
+      "capture, perception and every compute stage (fixed clock: 0.2 s, 0.4 s, 0.1 s each; "
+      "a motion plan at least its validity checks at 660 000 a second)";
+  /// With the guided stereo pass: its perception charged 0.2 s (before 2026-12-01 it was
+  /// charged SGBM's 0.4 s under kClockCharges, and those runs are not pooled with these).
+  static constexpr const char* kClockChargesGuidedStereo =
+      "capture, perception and every compute stage (fixed clock: capture 0.2 s, perception "
+      "0.2 s for the guided stereo pass, each other stage 0.1 s; a motion plan at least its "
       "validity checks at 660 000 a second)";
+  static const char* clockChargesFor(bool guided_stereo) {
+    return guided_stereo ? kClockChargesGuidedStereo : kClockCharges;
+  }
   static constexpr const char* kClockChargesBeforePerception =
       "capture and the compute stages but not perception (an fvp before 2026-11-30)";
   // The run's own plan (kind "run" only). Resume refuses a difference; merge does not
