@@ -9,7 +9,6 @@
 #include "fvp/accel/backend.h"
 #include "fvp/host/core/output_directory.h"
 #include "fvp/host/map/map_engine_registry.h"
-#include "fvp/host/nbv/nbv_setup.h"
 #include "fvp/host/nbv/run_fields.h"
 #include "fvp/host/report/capture_set_report.h"
 #include "stereo_bag_files.h"
@@ -21,7 +20,7 @@ void addSizeCommand(CLI::App& app) {
     std::string captures, bag, bag_ns = "/stereo", world_frame = "world", out, sizing = "ours",
                                engine = "grid", config;
     accel::BackendChoice backend = accel::BackendChoice::kAuto;
-    bool guided_stereo = host::nbv::NbvSetupOptions{}.guided_stereo;  // as a trial sizes
+    bool guided_stereo = host::nbv::run_fields::kDefaultGuidedStereo;  // as a trial sizes
   };
   auto opt = optionStorage<Options>();
   auto* cmd =

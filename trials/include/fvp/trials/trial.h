@@ -14,6 +14,7 @@
 #include <string>
 
 #include "fvp/accel/backend_choice.h"
+#include "fvp/host/nbv/run_fields.h"
 #include "fvp/host/nbv/stop_rule.h"
 #include "fvp/host/planner/view_overhead.h"
 #include "fvp/robot/sim/sim_clock.h"
@@ -79,7 +80,7 @@ struct TrialOptions {
   bool disparity_window = false;
   /// Stereo's full-resolution pass by the guided kernels on the trial's backend
   /// (host::StereoMatcherConfig::guided_fine).
-  bool guided_stereo = false;
+  bool guided_stereo = host::nbv::run_fields::kDefaultGuidedStereo;
   /// Seconds a view costs besides the arm's move: views that pass the goal check are tried
   /// by information per second (host::nbv::NbvLoopOptions::view_overhead_s); 0: the
   /// planner's order.

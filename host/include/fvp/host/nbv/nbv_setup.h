@@ -24,6 +24,7 @@
 #include "fvp/host/nbv/cluster_completion.h"
 #include "fvp/host/nbv/loop_clock.h"
 #include "fvp/host/nbv/nbv_loop.h"
+#include "fvp/host/nbv/run_fields.h"
 #include "fvp/host/nbv/stop_rule.h"
 #include "fvp/host/nbv/visit_memory.h"
 #include "fvp/host/perception/perception_pipeline.h"
@@ -86,7 +87,7 @@ struct NbvSetupOptions {
   bool disparity_window = false;
   /// Stereo's full-resolution pass by the guided kernels on the setup's backend
   /// (StereoMatcherConfig::guided_fine, which this sets for every cluster).
-  bool guided_stereo = false;
+  bool guided_stereo = run_fields::kDefaultGuidedStereo;
   /// The farthest a remembered fruitlet's centre may stand from where an earlier visit saw it
   /// and still be that fruitlet (season::AssociationConfig::max_center_shift_m's reason:
   /// stems droop a few millimetres as fruitlets grow, plus each visit's registration error).

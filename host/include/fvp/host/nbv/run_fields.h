@@ -87,6 +87,9 @@ inline constexpr RunField kDisparityWindow{
     "full-resolution stereo over only the disparities of the Cluster Region and nearer, what "
     "lies behind from the half-resolution pass: ~40 % less stereo time, off until it is "
     "measured on more worlds (docs/design.md section 8)"};
+/// The guided stereo pass is off by default (docs/stereo.md): NbvSetupOptions', the trial's
+/// and fvp size's default.
+inline constexpr bool kDefaultGuidedStereo = false;
 inline constexpr RunField kGuidedStereo{
     "guided_stereo", "--guided-stereo",
     "full-resolution stereo by the guided semi-global matching kernels on the run's backend, "
