@@ -191,7 +191,7 @@ TEST(ClusterSplit, SplitsThreeInARowAndLeavesSingleFruitletsWhole) {
     }
 }
 
-// A fused surface millimetres thick (views that disagree by ~2 mm: development world 9525
+// A fused surface millimetres thick (views that disagree by ~2 mm: held-out world 9525
 // with the guided stereo pass, after 12 views): the large fruitlet's points fit a second
 // sphere, a shell 2 mm inside the first and centred inside it, with more inliers than the
 // small fruitlet beside it. The shell is set aside and the small fruitlet still split off;
