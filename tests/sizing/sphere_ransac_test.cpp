@@ -206,17 +206,19 @@ TEST(ClusterSplit, AThickSurfacesInnerShellDoesNotHideTheNextFruitlet) {
   sampleNearSide(a, 0.0056f, 1.0f, 0.0001f, rng, pts, truth, 1);  // the inner shell
   sampleNearSide(b, 0.0038f, 1.0f, 0.0001f, rng, pts, truth, 2);
   std::vector<int> labels(pts.size(), 0);
-  const SphereFit first = fitSphereRansac(pts);
+  const ClusterSplitConfig config;
+  const SphereFit first = fitSphereRansac(pts, config.ransac);
   std::vector<Eigen::Vector3f> beyond_first;
   for (const auto& p : pts)
-    if (std::abs((p.cast<double>() - first.center_m).norm() - first.radius_m) > 0.0015)
+    if (std::abs((p.cast<double>() - first.center_m).norm() - first.radius_m) >
+        config.max_assignment_distance_m)
       beyond_first.push_back(p);
-  const SphereFit second = fitSphereRansac(beyond_first);
+  const SphereFit second = fitSphereRansac(beyond_first, config.ransac);
   ASSERT_TRUE(second.found);
   ASSERT_LT((second.center_m - a.cast<double>()).norm(), 0.001)
       << "the test's premise: the second sphere found is the inner shell";
 
-  EXPECT_EQ(splitMergedClusters(pts, labels), 1u);
+  EXPECT_EQ(splitMergedClusters(pts, labels, config), 1u);
   std::map<int, int> small_fruitlet_labels;
   int small_fruitlet_points = 0;
   for (std::size_t i = 0; i < pts.size(); ++i)
