@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <set>
@@ -233,6 +234,34 @@ TEST(Sizing, Eq4OnAnIdealSphereViewPaperShortOursClose) {
   EXPECT_NEAR(f.size_ours_mm, 10.0, 0.15);
   EXPECT_LT((f.sphere_center_m - c).norm(), 1e-4);
   EXPECT_EQ(f.per_image.size(), 2u);
+}
+
+// A session keeps each view's segments (segmentsOf) and passes them in: the sizes, centres
+// and per-image measurements must be those of segmenting every view on the call, and a view
+// left without given segments (past the end of the list) is segmented on the call.
+TEST(Sizing, GivenSegmentsSizeAsSegmentingOnTheCall) {
+  const Eigen::Vector3d c(0.0, 0.0, 0.3);
+  const double r = 0.005;
+  const SphereView v = renderSphere(c, r);
+  tsdf::TsdfVolume volume({}, Eigen::AlignedBox3d(c.array() - 0.03, c.array() + 0.03));
+  volume.integrate(v.depth, v.mask, v.in, Eigen::Isometry3d::Identity());
+  const std::vector<Eigen::Vector3f> pts = volume.extractSurfacePoints();
+  const sizing::SizingView view{v.mask, v.disparity, v.in, Eigen::Isometry3d::Identity(), {}};
+  const sizing::SizingConfig config;
+  const auto segmented = sizing::sizeFruitlets({view, view}, pts, nullptr, config);
+  ASSERT_EQ(segmented.fruitlets.size(), 1u);
+  const auto segments = std::make_shared<const sizing::ViewSegments>(sizing::segmentsOf(view));
+  EXPECT_EQ(cv::countNonZero(segments->labels), cv::countNonZero(v.mask));
+  for (const auto& given : {std::vector{segments, segments}, std::vector{segments}}) {
+    const auto result = sizing::sizeFruitlets({view, view}, given, pts, nullptr, config);
+    ASSERT_EQ(result.fruitlets.size(), 1u);
+    const auto& a = result.fruitlets[0];
+    const auto& b = segmented.fruitlets[0];
+    EXPECT_EQ(a.size_ours_mm, b.size_ours_mm);
+    EXPECT_EQ(a.size_paper_mm, b.size_paper_mm);
+    EXPECT_EQ(a.sphere_center_m, b.sphere_center_m);
+    ASSERT_EQ(a.per_image.size(), b.per_image.size());
+  }
 }
 
 // The support rule (docs/sizing.md): a fragment split off a fruitlet's surface (here a

@@ -249,7 +249,17 @@ sizing::SizingResult MappingSession::sizeFruitletsInMapFrame(
   sizing::SizingConfig own = config;
   own.surface_voxel_size_m = tsdf_config_->voxel_size_m;
   own.registered_views = pose_graph_.has_value();
-  return sizing::sizeFruitlets(sizing_views_, surfacePoints(), in_roi_voxel, own);
+  return sizing::sizeFruitlets(sizing_views_, viewSegments(), surfacePoints(), in_roi_voxel, own);
+}
+
+std::vector<std::shared_ptr<const sizing::ViewSegments>> MappingSession::viewSegments() const {
+  // A view's segments do not change (its mask and instances are kept as perceived): each is
+  // computed once, by the first sizing that reads it, and charged to that sizing.
+  std::lock_guard<std::mutex> lock(segments_mutex_);
+  while (view_segments_.size() < sizing_views_.size())
+    view_segments_.push_back(std::make_shared<const sizing::ViewSegments>(
+        sizing::segmentsOf(sizing_views_[view_segments_.size()])));
+  return view_segments_;
 }
 
 sizing::SizingResult MappingSession::sizeFruitlets(const sizing::SizingConfig& config) const {

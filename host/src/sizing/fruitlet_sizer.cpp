@@ -25,12 +25,9 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-/// Connected fruitlet segments of one image (8-connected), computed once per image.
-struct Segments {
-  cv::Mat labels;  ///< CV_32S, 0 = background
-  cv::Mat stats, centroids;
-};
+using Segments = ViewSegments;
 
+/// Connected fruitlet segments of one image (8-connected).
 Segments segment(const cv::Mat& mask) {
   Segments s;
   cv::Mat binary = mask != 0;
@@ -287,13 +284,17 @@ std::map<int, std::vector<Eigen::Vector3f>> clusterSurfacePoints(
 // detections, each time sizing the kept ones again.
 class DetectionSizer {
  public:
-  DetectionSizer(const std::vector<SizingView>& views, const SizingConfig& config,
-                 std::map<int, std::vector<Eigen::Vector3f>> clusters, SizingResult& result)
+  DetectionSizer(const std::vector<SizingView>& views,
+                 const std::vector<std::shared_ptr<const ViewSegments>>& given_segments,
+                 const SizingConfig& config, std::map<int, std::vector<Eigen::Vector3f>> clusters,
+                 SizingResult& result)
       : views_(views), config_(config), clusters_(std::move(clusters)), result_(result) {
-    segments_.reserve(views.size());
-    for (const auto& v : views)
-      segments_.push_back(v.fruitlet_instances.empty() ? segment(v.fruitlet_mask)
-                                                       : segmentInstances(v.fruitlet_instances));
+    own_segments_.reserve(views.size());  // segments_ points into it: never reallocated
+    for (std::size_t i = 0; i < views.size(); ++i) {
+      const ViewSegments* given = i < given_segments.size() ? given_segments[i].get() : nullptr;
+      if (!given) own_segments_.push_back(segmentsOf(views[i]));
+      segments_.push_back(given ? given : &own_segments_.back());
+    }
     for (auto& [label, pts] : clusters_) {
       if (int(pts.size()) < config.min_cluster_points) {
         ++result.events.small_clusters;
@@ -423,7 +424,8 @@ class DetectionSizer {
   const SizingConfig& config_;
   std::map<int, std::vector<Eigen::Vector3f>> clusters_;
   SizingResult& result_;
-  std::vector<Segments> segments_;
+  std::vector<Segments> own_segments_;  ///< of the views that came without theirs
+  std::vector<const Segments*> segments_;
   std::vector<std::pair<int, std::vector<Eigen::Vector3f>*>> sized_;  // label, its points
   std::vector<std::vector<Fall>> falls_;                              // per cluster, per view
   // Each cluster's own measurements, once: its centroid and sphere, and Eq. 4 in every image
@@ -440,7 +442,7 @@ class DetectionSizer {
 void DetectionSizer::computeFalls(std::size_t ci) {
   for (std::size_t vi = 0; vi < views_.size(); ++vi) {
     const Eigen::Isometry3d T_camera_world = views_[vi].T_world_camera.inverse();
-    const cv::Mat& labels = segments_[vi].labels;
+    const cv::Mat& labels = segments_[vi]->labels;
     std::map<int, int> votes;
     int in_image = 0;
     for (const auto& p : *sized_[ci].second) {
@@ -468,7 +470,7 @@ void DetectionSizer::measure(std::size_t ci, SizingEvents& events) {
   f.centroid_m /= double(pts.size());
   for (std::size_t vi = 0; vi < views_.size(); ++vi) {
     if (!falls_[ci][vi].in_image) continue;
-    if (auto s = measureImage(views_[vi], segments_[vi], falls_[ci][vi].segment,
+    if (auto s = measureImage(views_[vi], *segments_[vi], falls_[ci][vi].segment,
                               falls_[ci][vi].visible, config_, events)) {
       s->view = int(vi);
       f.per_image.push_back(*s);
@@ -563,6 +565,11 @@ void DetectionSizer::applyRules() {
 
 }  // namespace
 
+ViewSegments segmentsOf(const SizingView& view) {
+  return view.fruitlet_instances.empty() ? segment(view.fruitlet_mask)
+                                         : segmentInstances(view.fruitlet_instances);
+}
+
 const char* toString(SizingEstimator estimator) {
   return estimator == SizingEstimator::kOurs ? "ours" : "paper";
 }
@@ -639,9 +646,17 @@ SizingResult sizeFruitlets(const std::vector<SizingView>& views,
                            const std::vector<Eigen::Vector3f>& surface_points_m,
                            const std::function<bool(const Eigen::Vector3f&)>& in_roi_voxel,
                            const SizingConfig& config) {
+  return sizeFruitlets(views, {}, surface_points_m, in_roi_voxel, config);
+}
+
+SizingResult sizeFruitlets(const std::vector<SizingView>& views,
+                           const std::vector<std::shared_ptr<const ViewSegments>>& segments,
+                           const std::vector<Eigen::Vector3f>& surface_points_m,
+                           const std::function<bool(const Eigen::Vector3f&)>& in_roi_voxel,
+                           const SizingConfig& config) {
   config.validate();
   SizingResult result;
-  DetectionSizer sizer(views, config,
+  DetectionSizer sizer(views, segments, config,
                        clusterSurfacePoints(views, surface_points_m, in_roi_voxel, config, result),
                        result);
   sizer.measureAll();

@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <utility>
@@ -168,6 +169,10 @@ class MappingSession {
   std::optional<ClusterPoseGraph> pose_graph_;
   std::unique_ptr<tsdf::TsdfVolume> tsdf_;
   std::vector<sizing::SizingView> sizing_views_;
+  /// The segments of sizing_views_, each computed by the first sizing that reads it.
+  std::vector<std::shared_ptr<const sizing::ViewSegments>> viewSegments() const;
+  mutable std::mutex segments_mutex_;
+  mutable std::vector<std::shared_ptr<const sizing::ViewSegments>> view_segments_;
   std::size_t tsdf_refusions_ = 0;
 };
 

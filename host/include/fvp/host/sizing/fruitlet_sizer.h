@@ -20,6 +20,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <string>
 #include <string_view>
@@ -201,6 +202,15 @@ struct SizingResult {
 /// The whole chain. in_roi_voxel: whether a point lies in an ROI-occupied fine voxel (null:
 /// keep every point).
 SizingResult sizeFruitlets(const std::vector<SizingView>& views,
+                           const std::vector<Eigen::Vector3f>& surface_points_m,
+                           const std::function<bool(const Eigen::Vector3f&)>& in_roi_voxel,
+                           const SizingConfig& config);
+
+/// The same, with the views' segments from a caller that keeps them (a session computes each
+/// view's once, segmentsOf): segments[i] those of views[i]; a view past the end of segments,
+/// or with a null entry, is segmented here.
+SizingResult sizeFruitlets(const std::vector<SizingView>& views,
+                           const std::vector<std::shared_ptr<const ViewSegments>>& segments,
                            const std::vector<Eigen::Vector3f>& surface_points_m,
                            const std::function<bool(const Eigen::Vector3f&)>& in_roi_voxel,
                            const SizingConfig& config);

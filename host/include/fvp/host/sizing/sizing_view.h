@@ -8,6 +8,13 @@
 
 namespace fvp::host::sizing {
 
+/// A view's fruitlet segments as the sizer reads them: the connected components of the mask
+/// (8-connected), or one segment per instance id where the view has instance ids.
+struct ViewSegments {
+  cv::Mat labels;            ///< CV_32S, 0 = background
+  cv::Mat stats, centroids;  ///< as cv::connectedComponentsWithStats gives them
+};
+
 struct SizingView {
   cv::Mat fruitlet_mask;  ///< CV_8U, nonzero = fruitlet
   cv::Mat disparity_px;   ///< CV_32F, 0 = invalid
@@ -17,5 +24,8 @@ struct SizingView {
   /// fruitlets are told apart by the mask's connected components.
   cv::Mat fruitlet_instances;
 };
+
+/// The segments of a view's mask, or of its instance ids where it has them.
+ViewSegments segmentsOf(const SizingView& view);
 
 }  // namespace fvp::host::sizing
