@@ -261,6 +261,15 @@ TEST(Sizing, GivenSegmentsSizeAsSegmentingOnTheCall) {
     EXPECT_EQ(a.size_paper_mm, b.size_paper_mm);
     EXPECT_EQ(a.sphere_center_m, b.sphere_center_m);
     ASSERT_EQ(a.per_image.size(), b.per_image.size());
+    for (std::size_t i = 0; i < a.per_image.size(); ++i) {
+      const sizing::ImageSize &pa = a.per_image[i], &pb = b.per_image[i];
+      EXPECT_EQ(pa.view, pb.view);
+      EXPECT_EQ(pa.size_ours_mm, pb.size_ours_mm);
+      EXPECT_EQ(pa.minor_axis_px, pb.minor_axis_px);
+      EXPECT_EQ(pa.visible_fraction, pb.visible_fraction);
+      EXPECT_EQ(pa.ellipse_center_px, pb.ellipse_center_px);
+      EXPECT_EQ(pa.ellipse_axes_px, pb.ellipse_axes_px);
+    }
   }
 }
 

@@ -60,7 +60,9 @@ class MappingSession {
 
   /// Perceives one view and integrates it (and any views kept from before the region was
   /// known) into the map. perceived (optional) receives the view's perception result (the
-  /// mask and disparity that TSDF integration and sizing use), its clouds moved out.
+  /// mask and disparity that TSDF integration and sizing use), its clouds moved out. Those
+  /// images (and a frame's instance mask) are the session's own from then on: read them, do
+  /// not change their pixels.
   ViewResult addView(const StereoFrame& frame, PerceptionResult* perceived = nullptr);
 
   /// Null / empty until a view's tag was detected.
@@ -169,7 +171,8 @@ class MappingSession {
   std::optional<ClusterPoseGraph> pose_graph_;
   std::unique_ptr<tsdf::TsdfVolume> tsdf_;
   std::vector<sizing::SizingView> sizing_views_;
-  /// The segments of sizing_views_, each computed by the first sizing that reads it.
+  /// The segments of sizing_views_, each computed by the first sizing that reads it (the
+  /// masks do not change: addView).
   std::vector<std::shared_ptr<const sizing::ViewSegments>> viewSegments() const;
   mutable std::mutex segments_mutex_;
   mutable std::vector<std::shared_ptr<const sizing::ViewSegments>> view_segments_;
