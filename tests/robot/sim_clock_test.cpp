@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
@@ -71,6 +72,21 @@ TEST(SimClock, PerceptionIsChargedLikeEveryComputeStage) {
   wall.chargeCompute(ClockStage::kPerception, 0.25);
   EXPECT_NEAR(wall.now_s(), 0.25, 1e-12);
   EXPECT_THROW(SimClock(SimClock::Mode::kFixed, 0.2, 0.1, -0.4), std::invalid_argument);
+}
+
+TEST(SimClock, ABadChargeNamesItsField) {
+  const auto messageOf = [](double capture_s, double stage_s, double perception_s) {
+    try {
+      SimClock(SimClock::Mode::kFixed, capture_s, stage_s, perception_s);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(messageOf(-1.0, 0.1, 0.4).find("capture_time_s"), std::string::npos);
+  EXPECT_NE(messageOf(0.2, NAN, 0.4).find("fixed_stage_time_s"), std::string::npos);
+  EXPECT_NE(messageOf(0.2, 0.1, -0.4).find("fixed_perception_time_s"), std::string::npos);
+  EXPECT_EQ(messageOf(0.2, 0.1, 0.4), "no error");
 }
 
 TEST(SimClock, AMotionPlanIsChargedAtLeastItsWorkOnTheFixedClock) {

@@ -236,16 +236,32 @@ TEST(Sizing, Eq4OnAnIdealSphereViewPaperShortOursClose) {
   EXPECT_EQ(f.per_image.size(), 2u);
 }
 
+// A 10 mm sphere 0.3 m in front of the camera, its one view fused into a TSDF, and the
+// volume's surface points: what a session would size after one view.
+struct FusedSphere {
+  Eigen::Vector3d center_m{0.0, 0.0, 0.3};
+  double radius_m = 0.005;
+  SphereView view;
+  std::vector<Eigen::Vector3f> surface;
+};
+
+FusedSphere fuseOneSphereView() {
+  FusedSphere s;
+  s.view = renderSphere(s.center_m, s.radius_m);
+  tsdf::TsdfVolume volume(
+      {}, Eigen::AlignedBox3d(s.center_m.array() - 0.03, s.center_m.array() + 0.03));
+  volume.integrate(s.view.depth, s.view.mask, s.view.in, Eigen::Isometry3d::Identity());
+  s.surface = volume.extractSurfacePoints();
+  return s;
+}
+
 // A session keeps each view's segments (segmentsOf) and passes them in: the sizes, centres
 // and per-image measurements must be those of segmenting every view on the call, and a view
 // left without given segments (past the end of the list) is segmented on the call.
 TEST(Sizing, GivenSegmentsSizeAsSegmentingOnTheCall) {
-  const Eigen::Vector3d c(0.0, 0.0, 0.3);
-  const double r = 0.005;
-  const SphereView v = renderSphere(c, r);
-  tsdf::TsdfVolume volume({}, Eigen::AlignedBox3d(c.array() - 0.03, c.array() + 0.03));
-  volume.integrate(v.depth, v.mask, v.in, Eigen::Isometry3d::Identity());
-  const std::vector<Eigen::Vector3f> pts = volume.extractSurfacePoints();
+  const FusedSphere sphere = fuseOneSphereView();
+  const SphereView& v = sphere.view;
+  const std::vector<Eigen::Vector3f>& pts = sphere.surface;
   const sizing::SizingView view{v.mask, v.disparity, v.in, Eigen::Isometry3d::Identity(), {}};
   const sizing::SizingConfig config;
   const auto segmented = sizing::sizeFruitlets({view, view}, pts, nullptr, config);
@@ -279,12 +295,10 @@ TEST(Sizing, GivenSegmentsSizeAsSegmentingOnTheCall) {
 // size implies; the fruitlet's own TSDF surface, from a single view, more than the quarter
 // asked.
 TEST(Sizing, SupportRuleDropsAFragmentAndKeepsTheFruitlet) {
-  const Eigen::Vector3d c(0.0, 0.0, 0.3);
-  const double r = 0.005;
-  const SphereView v = renderSphere(c, r);
-  tsdf::TsdfVolume volume({}, Eigen::AlignedBox3d(c.array() - 0.03, c.array() + 0.03));
-  volume.integrate(v.depth, v.mask, v.in, Eigen::Isometry3d::Identity());
-  std::vector<Eigen::Vector3f> pts = volume.extractSurfacePoints();
+  const FusedSphere sphere = fuseOneSphereView();
+  const Eigen::Vector3d& c = sphere.center_m;
+  const SphereView& v = sphere.view;
+  std::vector<Eigen::Vector3f> pts = sphere.surface;
   const std::size_t sphere_points = pts.size();
   // 81 points on a 2.4 mm square 15 mm behind the centre, on the optical axis: DBSCAN's
   // 2 mm cannot join it to the sphere.

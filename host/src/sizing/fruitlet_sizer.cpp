@@ -25,11 +25,9 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-using Segments = ViewSegments;
-
 /// Connected fruitlet segments of one image (8-connected).
-Segments segment(const cv::Mat& mask) {
-  Segments s;
+ViewSegments segment(const cv::Mat& mask) {
+  ViewSegments s;
   cv::Mat binary = mask != 0;
   cv::connectedComponentsWithStats(binary, s.labels, s.stats, s.centroids, 8, CV_32S);
   return s;
@@ -37,8 +35,8 @@ Segments segment(const cv::Mat& mask) {
 
 /// An instance segmentation's segments: one per instance id (its pixels need not be
 /// connected: a stem may cross a fruitlet), numbered 1.. in order of first pixel.
-Segments segmentInstances(const cv::Mat& instances) {
-  Segments s;
+ViewSegments segmentInstances(const cv::Mat& instances) {
+  ViewSegments s;
   s.labels = cv::Mat(instances.size(), CV_32S, cv::Scalar(0));
   std::map<int, int> label_of;
   struct Extent {
@@ -88,8 +86,8 @@ double windowMaxDisparity(const cv::Mat& disparity, int u, int v, int h) {
 /// Eq. 4 in one image on the segment a cluster falls on (view and shared flag left to the
 /// caller); nothing when the cluster is not visible there or the disparity window is
 /// invalid or saturated (counted).
-std::optional<ImageSize> measureImage(const SizingView& view, const Segments& segments, int best,
-                                      double visible, const SizingConfig& config,
+std::optional<ImageSize> measureImage(const SizingView& view, const ViewSegments& segments,
+                                      int best, double visible, const SizingConfig& config,
                                       SizingEvents& events) {
   const StereoIntrinsics& in = view.intrinsics;
   const cv::Mat& labels = segments.labels;
@@ -424,8 +422,8 @@ class DetectionSizer {
   const SizingConfig& config_;
   std::map<int, std::vector<Eigen::Vector3f>> clusters_;
   SizingResult& result_;
-  std::vector<Segments> own_segments_;  ///< of the views that came without theirs
-  std::vector<const Segments*> segments_;
+  std::vector<ViewSegments> own_segments_;  ///< of the views that came without theirs
+  std::vector<const ViewSegments*> segments_;
   std::vector<std::pair<int, std::vector<Eigen::Vector3f>*>> sized_;  // label, its points
   std::vector<std::vector<Fall>> falls_;                              // per cluster, per view
   // Each cluster's own measurements, once: its centroid and sphere, and Eq. 4 in every image

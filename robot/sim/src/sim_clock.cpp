@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
+#include <string>
 
 namespace fvp::robot::sim {
 
@@ -42,8 +43,14 @@ SimClock::SimClock(Mode mode, double capture_time_s, double fixed_stage_time_s,
       capture_time_s_(capture_time_s),
       fixed_stage_time_s_(fixed_stage_time_s),
       fixed_perception_time_s_(fixed_perception_time_s) {
-  if (!(capture_time_s >= 0.0) || !(fixed_stage_time_s >= 0.0) || !(fixed_perception_time_s >= 0.0))
-    throw std::invalid_argument("SimClock: capture and fixed stage times must be >= 0");
+  const auto require = [](const char* field, double seconds) {
+    if (!(seconds >= 0.0))
+      throw std::invalid_argument(std::string("SimClock: ") + field +
+                                  ": expected seconds >= 0, got " + std::to_string(seconds));
+  };
+  require("capture_time_s", capture_time_s);
+  require("fixed_stage_time_s", fixed_stage_time_s);
+  require("fixed_perception_time_s", fixed_perception_time_s);
 }
 
 void SimClock::beginIteration() {
