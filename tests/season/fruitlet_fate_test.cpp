@@ -51,6 +51,17 @@ TEST(FruitletFate, TheRatesUncertaintyMakesTheFateAProbability) {
   EXPECT_GT(p.fruit_set_standard_error_percent, 0.0);
 }
 
+TEST(FruitletFate, AResidualRatesFateFollowsStudentsT) {
+  // Fruitlet 2 is 2 standard errors below the threshold 0.5, as above, but its standard error
+  // comes from the residuals of three sizes (one degree of freedom): Cauchy, 1/2 - atan(2)/pi
+  // = 0.148 to persist, not the normal's 0.023.
+  GrowthRate residual = rateOf(0.3, 0.1);
+  residual.degrees_of_freedom = 1.0;
+  const FruitSetPrediction p = predictFruitSet({rateOf(1.0, 0.1), rateOf(0.5, 0.2), residual});
+  EXPECT_EQ(p.fates[2].fate, Fate::kAbscises);
+  EXPECT_NEAR(p.fates[2].persist_probability, 0.5 - std::atan(2.0) / M_PI, 1e-12);
+}
+
 TEST(FruitletFate, WithoutARateOrAGrowingSampleTheFateIsUnknown) {
   const FruitSetPrediction some = predictFruitSet({rateOf(0.8), rateOf(NAN)});
   EXPECT_EQ(some.fates[1].fate, Fate::kUnknown);

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <stdexcept>
 
@@ -68,11 +69,53 @@ TEST(GrowthRate, TheStandardErrorCoversTheTruthAtItsStatedLevel) {
       sizes.push_back({day, 6.0 + rate * day + sigma * unit(rng), sigma});
     }
     const GrowthRate r = fitGrowthRate(sizes);
-    covered += std::abs(r.mm_per_day - rate) <= 1.96 * r.standard_error_mm_per_day;
+    EXPECT_TRUE(std::isinf(r.degrees_of_freedom));
+    covered += std::abs(r.mm_per_day - rate) <=
+               rateIntervalHalfWidth(0.95, r.degrees_of_freedom) * r.standard_error_mm_per_day;
   }
   const double share = double(covered) / fruitlets;
   EXPECT_GT(share, 0.935);
   EXPECT_LT(share, 0.965);
+}
+
+// Without the sizes' own errors the residuals estimate the standard error: with three sizes
+// from one degree of freedom, so (estimate - truth) / standard error follows Student's t with
+// one degree, whose 95 % interval is 12.71 standard errors each side. Read as normal (1.96)
+// the interval holds the truth for about 70 % of fruitlets.
+TEST(GrowthRate, AResidualStandardErrorCoversTheTruthThroughStudentsT) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> rate_of(0.0, 1.2);
+  std::normal_distribution<double> unit;
+  const int fruitlets = 4000;
+  int covered_t = 0, covered_normal = 0;
+  for (int i = 0; i < fruitlets; ++i) {
+    const double rate = rate_of(rng);
+    std::vector<SizeOnDay> sizes;
+    for (const double day : {0.0, 4.0, 7.0})
+      sizes.push_back({day, 6.0 + rate * day + 0.35 * unit(rng)});  // errors not stated
+    const GrowthRate r = fitGrowthRate(sizes);
+    ASSERT_EQ(r.degrees_of_freedom, 1.0);
+    const double error = std::abs(r.mm_per_day - rate);
+    covered_t +=
+        error <= rateIntervalHalfWidth(0.95, r.degrees_of_freedom) * r.standard_error_mm_per_day;
+    covered_normal += error <= 1.96 * r.standard_error_mm_per_day;
+  }
+  EXPECT_GT(double(covered_t) / fruitlets, 0.935);
+  EXPECT_LT(double(covered_t) / fruitlets, 0.965);
+  EXPECT_LT(double(covered_normal) / fruitlets, 0.8);
+}
+
+TEST(GrowthRate, TheRateErrorsDistributionByHand) {
+  EXPECT_NEAR(rateIntervalHalfWidth(0.95, std::numeric_limits<double>::infinity()), 1.959964, 1e-6);
+  EXPECT_NEAR(rateIntervalHalfWidth(0.95, 1.0), 12.706205, 1e-5);
+  EXPECT_NEAR(rateIntervalHalfWidth(0.95, 2.0), 4.302653, 1e-5);
+  EXPECT_NEAR(rateErrorCdf(0.0, 1.0), 0.5, 1e-12);
+  EXPECT_NEAR(rateErrorCdf(1.0, 1.0), 0.75, 1e-12);  // Cauchy: 1/2 + atan(1)/pi
+  EXPECT_NEAR(rateErrorCdf(1.959964, std::numeric_limits<double>::infinity()), 0.975, 1e-6);
+  EXPECT_THROW(rateErrorCdf(0.0, 0.0), std::invalid_argument);
+  EXPECT_THROW(rateErrorCdf(0.0, std::nan("")), std::invalid_argument);
+  EXPECT_THROW(rateIntervalHalfWidth(1.0, 3.0), std::invalid_argument);
+  EXPECT_THROW(rateIntervalHalfWidth(0.95, -1.0), std::invalid_argument);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // fates and fruit set by hand (tests/season/data: a tree of two clusters on days 0 and 4).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -161,7 +162,17 @@ TEST(SeasonAnalysis, OneSightingBetweenTheFirstAndLastVisitIsUnconfirmedNotGone)
   EXPECT_EQ(s.fruit_set.unconfirmed, 1u);
   EXPECT_EQ(s.fruit_set.gone, 1u);
   EXPECT_EQ(s.fruit_set.persisting, 1u);
-  EXPECT_NEAR(s.fruit_set.percent, 50.0, 1e-6);  // A stays, C dropped; B not counted
+  // A stays, C dropped; B not counted. A's rate rests on three sizes with no standard error
+  // (residuals, one degree of freedom), so it stays with Student's t probability, not 1.
+  const auto a = std::find_if(s.tracks.begin(), s.tracks.end(),
+                              [](const FruitletTrack& t) { return !t.gone && !t.unconfirmed; });
+  ASSERT_NE(a, s.tracks.end());
+  ASSERT_EQ(a->rate.degrees_of_freedom, 1.0);
+  const double a_stays = rateErrorCdf(
+      (a->rate.mm_per_day - s.threshold_mm_per_day) / a->rate.standard_error_mm_per_day, 1.0);
+  EXPECT_GT(a_stays, 0.9);
+  EXPECT_LT(a_stays, 0.99);
+  EXPECT_NEAR(s.fruit_set.percent, 100.0 * a_stays / 2.0, 1e-9);
 }
 
 }  // namespace

@@ -22,8 +22,6 @@ using robot::sim::World;
 
 // The result's truth centres are the world's, through JSON's round trip.
 constexpr double kSameCentreM = 1e-9;
-// The two-sided 95 % quantile of the normal: how often the stated uncertainty covers the truth.
-constexpr double kZ95 = 1.959963984540054;
 
 /// A result's clusters as the season's reader takes them: (tag id, the cluster's object).
 std::vector<std::pair<int, const nlohmann::json*>> clusterEntries(const nlohmann::json& result) {
@@ -187,7 +185,9 @@ nlohmann::json growthScore(const Scoring& s) {
     worst = std::max(worst, std::abs(error));
     if (std::isfinite(t.rate.standard_error_mm_per_day)) {
       ++with_error;
-      covered += std::abs(error) <= kZ95 * t.rate.standard_error_mm_per_day;
+      covered +=
+          std::abs(error) <= host::season::rateIntervalHalfWidth(0.95, t.rate.degrees_of_freedom) *
+                                 t.rate.standard_error_mm_per_day;
     }
   }
   return {{"tracks_scored", scored},

@@ -56,7 +56,7 @@ FruitSetPrediction predictFruitSet(const std::vector<GrowthRate>& rates, const F
     f.fate = margin >= 0.0 ? Fate::kPersists : Fate::kAbscises;
     const double se = r.standard_error_mm_per_day;
     f.persist_probability = std::isfinite(se) && se > 0.0
-                                ? 0.5 * std::erfc(-margin / (se * std::sqrt(2.0)))
+                                ? rateErrorCdf(margin / se, r.degrees_of_freedom)
                                 : (margin >= 0.0 ? 1.0 : 0.0);
     ++(f.fate == Fate::kPersists ? out.persisting : out.abscising);
     expected += f.persist_probability;

@@ -1,5 +1,7 @@
 #include "fvp/host/season/growth_rate.h"
 
+#include <boost/math/distributions/normal.hpp>
+#include <boost/math/distributions/students_t.hpp>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -53,8 +55,35 @@ GrowthRate fitGrowthRate(const std::vector<SizeOnDay>& sizes) {
       residuals += r * r;
     }
     rate.standard_error_mm_per_day = std::sqrt(residuals / double(sizes.size() - 2) / s_dd);
+    rate.degrees_of_freedom = double(sizes.size() - 2);
   }
   return rate;
+}
+
+namespace {
+
+void checkDegreesOfFreedom(double degrees_of_freedom, const char* where) {
+  if (!(degrees_of_freedom > 0.0))
+    throw std::invalid_argument(std::string(where) + ": degrees_of_freedom must be > 0, got " +
+                                std::to_string(degrees_of_freedom));
+}
+
+}  // namespace
+
+double rateErrorCdf(double t, double degrees_of_freedom) {
+  checkDegreesOfFreedom(degrees_of_freedom, "rateErrorCdf");
+  if (std::isinf(degrees_of_freedom)) return boost::math::cdf(boost::math::normal(), t);
+  return boost::math::cdf(boost::math::students_t(degrees_of_freedom), t);
+}
+
+double rateIntervalHalfWidth(double level, double degrees_of_freedom) {
+  checkDegreesOfFreedom(degrees_of_freedom, "rateIntervalHalfWidth");
+  if (!(level > 0.0 && level < 1.0))
+    throw std::invalid_argument("rateIntervalHalfWidth: level must lie in (0, 1), got " +
+                                std::to_string(level));
+  const double upper = 0.5 + 0.5 * level;
+  if (std::isinf(degrees_of_freedom)) return boost::math::quantile(boost::math::normal(), upper);
+  return boost::math::quantile(boost::math::students_t(degrees_of_freedom), upper);
 }
 
 }  // namespace fvp::host::season

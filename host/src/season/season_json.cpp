@@ -38,6 +38,7 @@ json trackJson(const FruitletTrack& t, std::size_t id) {
           {"sizes", sizes},
           {"growth_rate_mm_per_day", numberOrNull(t.rate.mm_per_day)},
           {"growth_rate_standard_error_mm_per_day", numberOrNull(t.rate.standard_error_mm_per_day)},
+          {"growth_rate_degrees_of_freedom", numberOrNull(t.rate.degrees_of_freedom)},
           {"gone", t.gone},
           {"unconfirmed", t.unconfirmed},
           {"fate", t.unconfirmed ? "unconfirmed"

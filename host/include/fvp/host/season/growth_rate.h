@@ -20,6 +20,11 @@ struct GrowthRate {
   double mm_per_day = std::numeric_limits<double>::quiet_NaN();  ///< NaN: fewer than two days
   /// NaN where neither the sizes' standard errors nor three or more sizes give one.
   double standard_error_mm_per_day = std::numeric_limits<double>::quiet_NaN();
+  /// (estimate - true rate) / standard error follows Student's t with these degrees of
+  /// freedom: infinite (the normal) where the sizes' own standard errors give it, sizes - 2
+  /// where the residuals estimate it (with three sizes one degree: a 95 % interval is 12.7
+  /// standard errors wide each side, not 1.96).
+  double degrees_of_freedom = std::numeric_limits<double>::infinity();
   std::size_t sizes = 0;  ///< the sizes the rate rests on
 };
 
@@ -33,5 +38,14 @@ inline constexpr double kMinStandardErrorMm = 1e-6;
 /// only has no rate (NaN), an expected outcome; a non-finite day or size, or a standard error
 /// below kMinStandardErrorMm, is std::invalid_argument.
 GrowthRate fitGrowthRate(const std::vector<SizeOnDay>& sizes);
+
+/// P(T <= t) for the rate's error in standard errors (GrowthRate::degrees_of_freedom:
+/// infinite is the normal). Throws std::invalid_argument for degrees of freedom <= 0 or NaN.
+double rateErrorCdf(double t, double degrees_of_freedom);
+
+/// The half-width, in standard errors, of the two-sided interval that holds the true rate
+/// with probability `level` (0.95: 1.96 for the normal, 12.71 for one degree of freedom).
+/// Throws std::invalid_argument for a level outside (0, 1) or bad degrees of freedom.
+double rateIntervalHalfWidth(double level, double degrees_of_freedom);
 
 }  // namespace fvp::host::season
