@@ -86,6 +86,8 @@ TEST(SimClock, ABadChargeNamesItsField) {
   EXPECT_NE(messageOf(-1.0, 0.1, 0.4).find("capture_time_s"), std::string::npos);
   EXPECT_NE(messageOf(0.2, NAN, 0.4).find("fixed_stage_time_s"), std::string::npos);
   EXPECT_NE(messageOf(0.2, 0.1, -0.4).find("fixed_perception_time_s"), std::string::npos);
+  EXPECT_NE(messageOf(-1e-9, 0.1, 0.4).find("got -1e-09"), std::string::npos);
+  EXPECT_NE(messageOf(0.2, 0.1, INFINITY).find("fixed_perception_time_s"), std::string::npos);
   EXPECT_EQ(messageOf(0.2, 0.1, 0.4), "no error");
 }
 

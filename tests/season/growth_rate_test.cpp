@@ -59,7 +59,7 @@ TEST(GrowthRate, TheStandardErrorCoversTheTruthAtItsStatedLevel) {
   std::mt19937_64 rng(42);
   std::uniform_real_distribution<double> rate_of(0.0, 1.2), sigma_of(0.2, 0.5);
   std::normal_distribution<double> unit;
-  int covered = 0;
+  int covered = 0, normal = 0;
   const int fruitlets = 4000;
   for (int i = 0; i < fruitlets; ++i) {
     const double rate = rate_of(rng);
@@ -69,10 +69,11 @@ TEST(GrowthRate, TheStandardErrorCoversTheTruthAtItsStatedLevel) {
       sizes.push_back({day, 6.0 + rate * day + sigma * unit(rng), sigma});
     }
     const GrowthRate r = fitGrowthRate(sizes);
-    EXPECT_TRUE(std::isinf(r.degrees_of_freedom));
+    normal += std::isinf(r.degrees_of_freedom);
     covered += std::abs(r.mm_per_day - rate) <=
                rateIntervalHalfWidth(0.95, r.degrees_of_freedom) * r.standard_error_mm_per_day;
   }
+  EXPECT_EQ(normal, fruitlets);  // sizes with their own errors: the normal
   const double share = double(covered) / fruitlets;
   EXPECT_GT(share, 0.935);
   EXPECT_LT(share, 0.965);
@@ -94,7 +95,7 @@ TEST(GrowthRate, AResidualStandardErrorCoversTheTruthThroughStudentsT) {
     for (const double day : {0.0, 4.0, 7.0})
       sizes.push_back({day, 6.0 + rate * day + 0.35 * unit(rng)});  // errors not stated
     const GrowthRate r = fitGrowthRate(sizes);
-    ASSERT_EQ(r.degrees_of_freedom, 1.0);
+    ASSERT_EQ(r.degrees_of_freedom, 1.0) << "fruitlet " << i;
     const double error = std::abs(r.mm_per_day - rate);
     covered_t +=
         error <= rateIntervalHalfWidth(0.95, r.degrees_of_freedom) * r.standard_error_mm_per_day;
@@ -116,6 +117,13 @@ TEST(GrowthRate, TheRateErrorsDistributionByHand) {
   EXPECT_THROW(rateErrorCdf(0.0, std::nan("")), std::invalid_argument);
   EXPECT_THROW(rateIntervalHalfWidth(1.0, 3.0), std::invalid_argument);
   EXPECT_THROW(rateIntervalHalfWidth(0.95, -1.0), std::invalid_argument);
+  EXPECT_THROW(rateErrorCdf(NAN, 1.0), std::invalid_argument);
+  EXPECT_EQ(rateErrorCdf(INFINITY, 1.0), 1.0);
+  EXPECT_EQ(rateErrorCdf(-INFINITY, std::numeric_limits<double>::infinity()), 0.0);
+  // A level whose upper quantile 0.5 + level / 2 would round to 1.
+  EXPECT_GT(
+      rateIntervalHalfWidth(std::nextafter(1.0, 0.0), std::numeric_limits<double>::infinity()),
+      8.0);
 }
 
 }  // namespace

@@ -114,6 +114,10 @@ TEST(SeasonAnalysis, TwoVisitsOfATreeByHand) {
   EXPECT_EQ(j["format"], 1);
   EXPECT_EQ(j["clusters"][1]["fruitlets"][1]["fate"], "gone");
   EXPECT_EQ(j["clusters"][0]["fruitlets"][2]["fate"], "abscises");
+  // A rate weighted by the sizes' own errors: a standard error, normal (no degrees of freedom).
+  EXPECT_TRUE(
+      j["clusters"][0]["fruitlets"][2]["growth_rate_standard_error_mm_per_day"].is_number());
+  EXPECT_TRUE(j["clusters"][0]["fruitlets"][2]["growth_rate_degrees_of_freedom"].is_null());
   EXPECT_EQ(j["clusters"][0]["fruitlets"][0]["sizes"].size(), 2u);
   EXPECT_TRUE(j["clusters"][0]["fruitlets"][0]["sizes"][0]["association_confidence"].is_null());
 }
@@ -173,6 +177,11 @@ TEST(SeasonAnalysis, OneSightingBetweenTheFirstAndLastVisitIsUnconfirmedNotGone)
   EXPECT_GT(a_stays, 0.9);
   EXPECT_LT(a_stays, 0.99);
   EXPECT_NEAR(s.fruit_set.percent, 100.0 * a_stays / 2.0, 1e-9);
+  int residual_rates = 0;
+  const nlohmann::json j = seasonJson(s, {});
+  for (const auto& f : j["clusters"][0]["fruitlets"])
+    residual_rates += f["growth_rate_degrees_of_freedom"] == 1.0;
+  EXPECT_EQ(residual_rates, 1);
 }
 
 }  // namespace

@@ -16,6 +16,7 @@ namespace {
 
 using season::Fate;
 using season::FruitletTrack;
+using season::rateIntervalHalfWidth;
 
 /// What a track's fate reads as in the report: gone first (its fate is known).
 const char* fateWord(const FruitletTrack& t) {
@@ -73,16 +74,18 @@ std::string seasonMarkdown(const season::SeasonAnalysis& s, const std::string& f
   for (const season::ClusterSeason& c : s.clusters) {
     md << "\n## Tag " << c.tag_id << "\n\nPredicted fruit set " << fruitSetText(c.fruit_set)
        << "; visits with the tag seen " << c.visits_with_tag << ", without " << c.visits_without_tag
-       << ".\n\n| fruitlet | sizes (day: mm) | growth mm/day | fate | "
+       << ".\n\n| fruitlet | sizes (day: mm) | growth mm/day (+- 95 %) | fate | "
        << "P(persists) |\n|---|---|---|---|---|\n";
     for (std::size_t k = 0; k < c.tracks.size(); ++k) {
       const FruitletTrack& t = s.tracks[c.tracks[k]];
       md << "| " << k + 1 << " | ";
       for (std::size_t i = 0; i < t.sizes.size(); ++i)
         md << (i ? ", " : "") << t.sizes[i].day << ": " << fixed(t.sizes[i].sized.at.size_mm, 2);
-      md << " | " << fixed(t.rate.mm_per_day, 3) << " +- "
-         << fixed(t.rate.standard_error_mm_per_day, 3) << " | " << fateWord(t) << " | "
-         << fixed(t.fate.persist_probability, 2) << " |\n";
+      const double se = t.rate.standard_error_mm_per_day;
+      const double half_width_95 =
+          std::isfinite(se) ? rateIntervalHalfWidth(0.95, t.rate.degrees_of_freedom) * se : se;
+      md << " | " << fixed(t.rate.mm_per_day, 3) << " +- " << fixed(half_width_95, 3) << " | "
+         << fateWord(t) << " | " << fixed(t.fate.persist_probability, 2) << " |\n";
     }
   }
   return md.str();

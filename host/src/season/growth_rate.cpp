@@ -62,9 +62,11 @@ GrowthRate fitGrowthRate(const std::vector<SizeOnDay>& sizes) {
 
 namespace {
 
+// A residual fit has at least one degree of freedom (three sizes); below it Student's t has
+// no finite quantiles worth stating.
 void checkDegreesOfFreedom(double degrees_of_freedom, const char* where) {
-  if (!(degrees_of_freedom > 0.0))
-    throw std::invalid_argument(std::string(where) + ": degrees_of_freedom must be > 0, got " +
+  if (!(degrees_of_freedom >= 1.0))
+    throw std::invalid_argument(std::string(where) + ": degrees_of_freedom must be >= 1, got " +
                                 std::to_string(degrees_of_freedom));
 }
 
@@ -72,6 +74,8 @@ void checkDegreesOfFreedom(double degrees_of_freedom, const char* where) {
 
 double rateErrorCdf(double t, double degrees_of_freedom) {
   checkDegreesOfFreedom(degrees_of_freedom, "rateErrorCdf");
+  if (std::isnan(t)) throw std::invalid_argument("rateErrorCdf: t is NaN");
+  if (std::isinf(t)) return t > 0.0 ? 1.0 : 0.0;
   if (std::isinf(degrees_of_freedom)) return boost::math::cdf(boost::math::normal(), t);
   return boost::math::cdf(boost::math::students_t(degrees_of_freedom), t);
 }
@@ -81,9 +85,12 @@ double rateIntervalHalfWidth(double level, double degrees_of_freedom) {
   if (!(level > 0.0 && level < 1.0))
     throw std::invalid_argument("rateIntervalHalfWidth: level must lie in (0, 1), got " +
                                 std::to_string(level));
-  const double upper = 0.5 + 0.5 * level;
-  if (std::isinf(degrees_of_freedom)) return boost::math::quantile(boost::math::normal(), upper);
-  return boost::math::quantile(boost::math::students_t(degrees_of_freedom), upper);
+  // The upper tail's probability, not 0.5 + level / 2, which rounds to 1 for a level near 1.
+  const double tail = 0.5 * (1.0 - level);
+  if (std::isinf(degrees_of_freedom))
+    return boost::math::quantile(boost::math::complement(boost::math::normal(), tail));
+  return boost::math::quantile(
+      boost::math::complement(boost::math::students_t(degrees_of_freedom), tail));
 }
 
 }  // namespace fvp::host::season

@@ -1,7 +1,9 @@
 #include "fvp/robot/sim/sim_clock.h"
 
 #include <algorithm>
+#include <cmath>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -44,9 +46,11 @@ SimClock::SimClock(Mode mode, double capture_time_s, double fixed_stage_time_s,
       fixed_stage_time_s_(fixed_stage_time_s),
       fixed_perception_time_s_(fixed_perception_time_s) {
   const auto require = [](const char* field, double seconds) {
-    if (!(seconds >= 0.0))
-      throw std::invalid_argument(std::string("SimClock: ") + field +
-                                  ": expected seconds >= 0, got " + std::to_string(seconds));
+    if (!(seconds >= 0.0 && std::isfinite(seconds))) {
+      std::ostringstream message;
+      message << "SimClock: " << field << ": expected finite seconds >= 0, got " << seconds;
+      throw std::invalid_argument(message.str());
+    }
   };
   require("capture_time_s", capture_time_s);
   require("fixed_stage_time_s", fixed_stage_time_s);

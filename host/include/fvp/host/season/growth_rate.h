@@ -23,7 +23,8 @@ struct GrowthRate {
   /// (estimate - true rate) / standard error follows Student's t with these degrees of
   /// freedom: infinite (the normal) where the sizes' own standard errors give it, sizes - 2
   /// where the residuals estimate it (with three sizes one degree: a 95 % interval is 12.7
-  /// standard errors wide each side, not 1.96).
+  /// standard errors wide each side, not 1.96). Infinite by default: a rate given with a
+  /// standard error and nothing more is read as normal.
   double degrees_of_freedom = std::numeric_limits<double>::infinity();
   std::size_t sizes = 0;  ///< the sizes the rate rests on
 };
@@ -40,7 +41,8 @@ inline constexpr double kMinStandardErrorMm = 1e-6;
 GrowthRate fitGrowthRate(const std::vector<SizeOnDay>& sizes);
 
 /// P(T <= t) for the rate's error in standard errors (GrowthRate::degrees_of_freedom:
-/// infinite is the normal). Throws std::invalid_argument for degrees of freedom <= 0 or NaN.
+/// infinite is the normal). Throws std::invalid_argument for degrees of freedom below 1 or
+/// NaN, or a NaN t.
 double rateErrorCdf(double t, double degrees_of_freedom);
 
 /// The half-width, in standard errors, of the two-sided interval that holds the true rate
