@@ -74,12 +74,14 @@ def test_automatic_stop_switches_default_as_the_cli(fvp_exe):
     assert defaults["confirm_detections"] == "true"
     assert defaults["release_left_out"] == "true"
     assert defaults["seek_partly_seen"] == "true"
+    assert defaults["known_fruitlets"] == "true"
     help_text = subprocess.run([fvp_exe, "run", "--help"], check=True, capture_output=True,
                                text=True).stdout
     # The CLI's flags are on unless negated (TrialOptions' defaults).
     assert "--confirm-detections,--no-confirm-detections" in help_text
     assert "--release-left-out,--no-release-left-out" in help_text
     assert "--seek-partly-seen,--no-seek-partly-seen" in help_text
+    assert "--known-fruitlets,--no-known-fruitlets" in help_text
 
 
 @pytest.mark.parametrize("confirm,release,seek", [(False, True, True), (True, False, False)])
@@ -98,6 +100,7 @@ def test_automatic_stop_switches_default_on():
     assert result["stop"]["confirm_detections"] is True
     assert result["stop"]["release_left_out"] is True
     assert result["stop"]["seek_partly_seen"] is True
+    assert result["stop"]["known_fruitlets"] is True
 
 
 def test_the_field_preset_runs_with_view_registration_unless_told_otherwise():

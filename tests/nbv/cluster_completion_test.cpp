@@ -248,6 +248,26 @@ TEST(ClusterCompletion, ViewsThatSizedNothingDoNotSettleTheCluster) {
   EXPECT_FALSE(sizesSettled(h, config));
 }
 
+// Memory accounts for the fruitlets (a later visit): the evidence and one agreeing view stop,
+// from any directions; a size still moving or a fruitlet short of the evidence does not.
+TEST(ClusterCompletion, KnownFruitletsNeedTheEvidenceAndOneAgreeingView) {
+  const ClusterCompletionConfig config;
+  const ClusterCompletionConfig known = knownFruitletsRule(config);
+  EXPECT_EQ(known.stable_views, 1);
+  EXPECT_EQ(known.min_stable_span_deg, 0.0);
+  const auto two = history(2, 0.02, 2.0);  // two views 2 degrees apart
+  EXPECT_FALSE(sizesSettled(two, config));
+  EXPECT_TRUE(sizesSettled(two, known));
+  EXPECT_FALSE(sizesSettled(history(1), known)) << "one sizing agrees with nothing";
+  EXPECT_FALSE(sizesSettled(history(2, 0.2), known)) << "a size moved by 0.2 mm";
+  auto short_of_evidence = two;
+  short_of_evidence.back().fruitlets[1].view_span_deg = 10.0;
+  EXPECT_FALSE(sizesSettled(short_of_evidence, known));
+  auto one_lost = two;
+  one_lost.back().fruitlets.pop_back();
+  EXPECT_FALSE(sizesSettled(one_lost, known));
+}
+
 TEST(ClusterCompletion, AnEmptyClusterIsNeverDone) {
   std::vector<SizingSnapshot> empty(8);
   EXPECT_FALSE(sizesSettled(empty, {}));
@@ -281,6 +301,9 @@ TEST(ClusterCompletion, BadConfigIsRefusedNamingTheField) {
   c = {};
   c.min_stable_span_deg = -1.0;
   refused(c, "min_stable_span_deg");
+  c = {};
+  c.known_stable_views = 0;
+  refused(c, "known_stable_views");
 }
 
 class CountingClock : public LoopClock {
@@ -327,6 +350,19 @@ TEST(ClusterCompletion, SizesTheSessionAfterEveryMappedViewAndChargesTheClock) {
   // Three views cannot show three quiet ones after the first sizing.
   EXPECT_FALSE(completion.done());
   EXPECT_EQ(completion.stopCondition().check({}), std::nullopt);
+  // The rule memory's knowing the fruitlets switches to, and only while it knows them.
+  EXPECT_EQ(completion.ruleNow().stable_views, 3);
+  bool known = true;
+  completion.knownWhen([&known] { return known; });
+  EXPECT_EQ(completion.ruleNow().stable_views, 1);
+  EXPECT_EQ(completion.ruleNow().min_stable_span_deg, 0.0);
+  known = false;
+  EXPECT_EQ(completion.ruleNow().stable_views, 3);
+  ClusterCompletionConfig off;
+  off.known_fruitlets = false;
+  ClusterCompletion without(session, clock, {}, off);
+  without.knownWhen([] { return true; });
+  EXPECT_EQ(without.ruleNow().stable_views, 3);
 }
 
 }  // namespace

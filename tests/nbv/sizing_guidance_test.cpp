@@ -276,6 +276,8 @@ TEST(SizingGuidance, APartlySeenDetectionDoesNotFindARememberedFruitlet) {
   history.back().unconfirmed = {u};
   guidance.onView({.index = 1});
   EXPECT_EQ(guidance.expectedFound(), 1u);
+  EXPECT_FALSE(guidance.fruitletsKnown())
+      << "found only as an unconfirmed detection, and a kept fruitlet no one remembers";
 }
 
 TEST(SizingGuidance, ARememberedFruitletNotFoundIsSoughtThenGone) {
@@ -303,6 +305,7 @@ TEST(SizingGuidance, ARememberedFruitletNotFoundIsSoughtThenGone) {
   EXPECT_TRUE(planner.targets_[0].seen_from.empty()) << "any direction may show it";
   EXPECT_TRUE(guidance.waitingOnExpected());
   EXPECT_EQ(guidance.expectedFound(), 1u);
+  EXPECT_FALSE(guidance.fruitletsKnown()) << "one still sought";
   // Remembered views do not count: they showed the cluster as it was.
   planner::PlanStep remembered = aimedAt(-1);
   remembered.candidates[0].kind = planner::CandidateKind::kRemembered;
@@ -323,10 +326,15 @@ TEST(SizingGuidance, ARememberedFruitletNotFoundIsSoughtThenGone) {
   EXPECT_TRUE(planner.targets_.empty());
   EXPECT_EQ(guidance.expectedGone(), 1u);
   EXPECT_EQ(guidance.expectedFound(), 1u);
+  EXPECT_TRUE(guidance.fruitletsKnown()) << "one found, one gone";
+  // A fruitlet the earlier visit did not size: memory no longer accounts for the cluster.
+  sized({fruitlet(0.0, 4, 60.0), fruitlet(0.06, 4, 60.0)});
+  EXPECT_FALSE(guidance.fruitletsKnown());
   // Found after all, 5 mm from where it was (a drooping stem): no longer gone.
   sized({fruitlet(0.0, 4, 60.0), fruitlet(0.025, 4, 60.0)});
   EXPECT_EQ(guidance.expectedFound(), 2u);
   EXPECT_EQ(guidance.expectedGone(), 0u);
+  EXPECT_TRUE(guidance.fruitletsKnown());
 }
 
 TEST(SizingGuidance, OneFruitletIsNotTwoRememberedOnes) {

@@ -110,6 +110,7 @@ ExperimentManifest manifestOf(const ExperimentOptions& o) {
   m.settings.confirm_detections = automatic && o.trial.confirm_detections;
   m.settings.seek_partly_seen = automatic && o.trial.seek_partly_seen;
   m.settings.release_left_out = automatic && o.trial.release_left_out;
+  m.settings.known_fruitlets = automatic && o.trial.known_fruitlets;
   m.error_scale = o.error_scale;
   m.configs = {{"world_config", stampOf(o.trial.world_config, "world config")},
                {"planner_config", stampOf(o.trial.planner_config, "planner config")},

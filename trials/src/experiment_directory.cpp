@@ -168,7 +168,7 @@ bool mayBeAbsent(std::string_view key, bool merged) {
   for (const std::string_view k :
        {"stop", "register_views", "confirm_detections", "seek_partly_seen", "release_left_out",
         "arm_config", "size_history", "view_overhead_s", "season_day", "disparity_window",
-        "guided_stereo"})
+        "guided_stereo", "known_fruitlets"})
     if (key == k) return true;
   return merged && (key == "engine" || key == "backend");
 }

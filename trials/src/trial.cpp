@@ -399,6 +399,7 @@ host::nbv::NbvSetupOptions setupOptions(const TrialOptions& o) {
   s.stop.completion.confirm_detections = o.confirm_detections;
   s.stop.completion.seek_partly_seen = o.seek_partly_seen;
   s.stop.completion.release_left_out = o.release_left_out;
+  s.stop.completion.known_fruitlets = o.known_fruitlets;
   s.disparity_window = o.disparity_window;
   s.guided_stereo = o.guided_stereo;
   s.loop.view_overhead_s = o.view_overhead_s;
@@ -587,11 +588,9 @@ ClusterOutcome Trial::Impl::scored(host::nbv::ClusterRun run, TrialParts& cluste
     out.guidance_events = {{"sizing_views", run.sizing_views},
                            {"sizing_targets_dropped", run.sizing_targets_dropped}};
   if (run.memory)
-    out.memory = {{"views", run.memory->views},
-                  {"views_taken", run.memory->views_taken},
-                  {"fruitlets", run.memory->fruitlets},
-                  {"found", run.memory->found},
-                  {"gone", run.memory->gone}};
+    out.memory = {{"views", run.memory->views},         {"views_taken", run.memory->views_taken},
+                  {"fruitlets", run.memory->fruitlets}, {"found", run.memory->found},
+                  {"gone", run.memory->gone},           {"known", run.memory->known}};
   return out;
 }
 
@@ -610,7 +609,9 @@ nlohmann::json Trial::Impl::stopJson() const {
           {"max_iterations_without_view", c.max_iterations_without_view},
           {"confirm_detections", c.confirm_detections},
           {"seek_partly_seen", c.seek_partly_seen},
-          {"release_left_out", c.release_left_out}};
+          {"release_left_out", c.release_left_out},
+          {"known_fruitlets", c.known_fruitlets},
+          {"known_stable_views", c.known_stable_views}};
 }
 
 void Trial::Impl::describeRun(nlohmann::json& result, const TrialLog& log,

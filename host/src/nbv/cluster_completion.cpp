@@ -26,6 +26,8 @@ void ClusterCompletionConfig::validate() const {
   if (max_iterations_without_view < 1)
     throw std::invalid_argument(
         "cluster completion 'max_iterations_without_view': expected at least 1");
+  if (known_stable_views < 1)
+    throw std::invalid_argument("cluster completion 'known_stable_views': expected at least 1");
 }
 
 ClusterCompletion::ClusterCompletion(const MappingSession& session, LoopClock& clock,
@@ -99,8 +101,12 @@ void ClusterCompletion::onView(const ViewEvent& event) {
   history_.push_back(std::move(snapshot));
 }
 
+ClusterCompletionConfig ClusterCompletion::ruleNow() const {
+  return config_.known_fruitlets && known_ && known_() ? knownFruitletsRule(config_) : config_;
+}
+
 bool ClusterCompletion::done() const {
-  return sizesSettled(history_, config_, released_) && !(hold_ && hold_()) &&
+  return sizesSettled(history_, ruleNow(), released_) && !(hold_ && hold_()) &&
          !(config_.hold_while_views_disagree && recentViewsDisagree());
 }
 
@@ -116,6 +122,13 @@ bool ClusterCompletion::recentViewsDisagree() const {
 StopCondition ClusterCompletion::stopCondition() const {
   return StopCondition([this](const LoopState&) { return done(); }, "cluster_done") ||
          StopCondition::stalled(static_cast<std::size_t>(config_.max_iterations_without_view));
+}
+
+ClusterCompletionConfig knownFruitletsRule(const ClusterCompletionConfig& config) {
+  ClusterCompletionConfig rule = config;
+  rule.stable_views = config.known_stable_views;
+  rule.min_stable_span_deg = 0.0;
+  return rule;
 }
 
 bool lacksEvidence(const FruitletSnapshot& fruitlet, const ClusterCompletionConfig& config) {

@@ -190,6 +190,7 @@ ClusterRun NbvSetup::runCluster(const NbvRig& rig, ClusterWork& work, LoopObserv
       guidance->expect(work.expected, tagPoseOf(*work.session), options_.remembered_max_shift_m);
     completion->holdWhile(
         [&g = *guidance] { return g.waitingOnUnconfirmed() || g.waitingOnExpected(); });
+    completion->knownWhen([&g = *guidance] { return g.fruitletsKnown(); });
     if (spec.completion.release_left_out)
       completion->releaseWhen(
           [&g = *guidance](const FruitletSnapshot& f) { return g.leftOut(f.center_m); });
@@ -208,6 +209,7 @@ ClusterRun NbvSetup::runCluster(const NbvRig& rig, ClusterWork& work, LoopObserv
     if (guidance) {
       out.memory->found = guidance->expectedFound();
       out.memory->gone = guidance->expectedGone();
+      out.memory->known = guidance->fruitletsKnown();
     }
   }
   if (guidance) {

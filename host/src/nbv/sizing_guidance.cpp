@@ -54,9 +54,12 @@ void SizingGuidance::onPlan(const PlanEvent& event) {
   // its candidates worth more than the others', and views it prefers then only spend the cap).
   // Without release_left_out a target left out still holds the stop: counting views it was
   // not aimed at would only stop the planner aiming at it.
+  // By the rule the stop applies now (ClusterCompletion::ruleNow).
+  const ClusterCompletionConfig rule =
+      config_.known_fruitlets && fruitlets_known_ ? knownFruitletsRule(config_) : config_;
   const bool only_evidence_holds =
       config_.release_left_out &&
-      sizesSettled(history_, config_, [](const FruitletSnapshot&) { return true; });
+      sizesSettled(history_, rule, [](const FruitletSnapshot&) { return true; });
   for (std::size_t t = 0; t < targets_.size(); ++t) {
     // A remembered fruitlet is looked for by every view but the remembered ones: they come
     // first and show where the cluster was, so they cannot tell gone from not yet sized; the
@@ -85,6 +88,7 @@ void SizingGuidance::expect(std::vector<RememberedFruitlet> fruitlets_tag, TagPo
 
 void SizingGuidance::seekExpected() {
   expected_found_ = expected_gone_ = 0;
+  fruitlets_known_ = false;
   if (expected_.empty()) return;
   const std::optional<Eigen::Isometry3d>& T_world_tag = T_world_tag_();
   if (!T_world_tag) return;
@@ -104,9 +108,11 @@ void SizingGuidance::seekExpected() {
     const double d = (where[e] - sized[s]->center_m).norm();
     return d <= max_shift_m_ ? d : std::numeric_limits<double>::infinity();
   });
+  std::size_t found_kept = 0;  // sized[0, latest.fruitlets.size()) are the kept ones
   for (std::size_t e = 0; e < where.size(); ++e) {
     if (found[e] >= 0) {
       ++expected_found_;
+      found_kept += std::size_t(found[e]) < latest.fruitlets.size();
       continue;
     }
     if (const Aim* aim = findAim(where[e]); aim && aim->views >= max_aimed_views_) {
@@ -122,6 +128,8 @@ void SizingGuidance::seekExpected() {
     target_unconfirmed_.push_back(false);
     target_expected_.push_back(true);
   }
+  fruitlets_known_ =
+      found_kept + expected_gone_ == expected_.size() && found_kept == latest.fruitlets.size();
 }
 
 void SizingGuidance::onView(const ViewEvent& event) {

@@ -75,6 +75,9 @@ struct TrialOptions {
   /// With stop auto: a fruitlet the planner looked for twice in vain no longer holds the stop
   /// (host::nbv::ClusterCompletionConfig::release_left_out).
   bool release_left_out = true;
+  /// With stop auto, on a season's later visit: memory accounting for a cluster's fruitlets
+  /// shortens its stop (host::nbv::ClusterCompletionConfig::known_fruitlets).
+  bool known_fruitlets = true;
   /// Stereo's full-resolution pass over only the disparities of the Cluster Region and nearer
   /// (host::PerceptionConfig::disparity_window).
   bool disparity_window = false;

@@ -55,6 +55,7 @@ void visitTrialFields(Options& o, Visitor&& visit) {
   visit(f::kConfirmDetections, o.confirm_detections);
   visit(f::kSeekPartlySeen, o.seek_partly_seen);
   visit(f::kReleaseLeftOut, o.release_left_out);
+  visit(f::kKnownFruitlets, o.known_fruitlets);
   visit(f::kRegisterViews, o.register_views);
   visit(f::kDisparityWindow, o.disparity_window);
   visit(f::kGuidedStereo, o.guided_stereo);

@@ -121,6 +121,9 @@ struct MemoryUse {
   /// Remembered fruitlets, those the loop's last sizing found within the gate, and those looked
   /// for in vain (gone); the rest were neither (the stop ended first, or not the automatic one).
   std::size_t fruitlets = 0, found = 0, gone = 0;
+  /// Memory accounted for the cluster's fruitlets at the last sizing
+  /// (SizingGuidance::fruitletsKnown): with known_fruitlets, the stop's rule was the known one.
+  bool known = false;
 };
 
 /// What running the loop on one cluster gave.

@@ -78,6 +78,11 @@ inline constexpr RunField kReleaseLeftOut{
     "release_left_out", "--release-left-out",
     "with the automatic stop: a fruitlet the planner has looked for twice in vain no longer "
     "holds the stop (docs/nbv-loop.md)"};
+inline constexpr RunField kKnownFruitlets{
+    "known_fruitlets", "--known-fruitlets",
+    "with the automatic stop, on a visit after the first: once every fruitlet the earlier visit "
+    "sized is found or gone and nothing else was found, a cluster is done when each has the "
+    "evidence and its size agrees with the view before (docs/nbv-loop.md)"};
 inline constexpr RunField kRegisterViews{
     "register_views", "--register-views",
     "align each view to the earlier ones before fusing it (a counter-measure to pose errors; a "
@@ -157,6 +162,7 @@ void visitSetupFields(Options& o, Visitor&& visit) {
   visit(f::kConfirmDetections, o.stop.completion.confirm_detections);
   visit(f::kSeekPartlySeen, o.stop.completion.seek_partly_seen);
   visit(f::kReleaseLeftOut, o.stop.completion.release_left_out);
+  visit(f::kKnownFruitlets, o.stop.completion.known_fruitlets);
   visit(f::kRegisterViews, o.register_views);
   visit(f::kDisparityWindow, o.disparity_window);
   visit(f::kGuidedStereo, o.guided_stereo);

@@ -69,6 +69,13 @@ class SizingGuidance : public LoopObserver {
   /// After the last sizing: remembered fruitlets found, and those given up as gone.
   std::size_t expectedFound() const { return expected_found_; }
   std::size_t expectedGone() const { return expected_gone_; }
+  /// After the last sizing: memory accounts for the cluster's fruitlets. Every remembered
+  /// fruitlet is gone or stands where a kept fruitlet of the sizing does, and every kept
+  /// fruitlet is a remembered one (ClusterCompletion::knownWhen takes it). One found only as
+  /// an unconfirmed detection, or a fruitlet the earlier visit did not size, leaves the
+  /// cluster to the first visit's rule. False without remembered fruitlets or before a view
+  /// saw the tag.
+  bool fruitletsKnown() const { return fruitlets_known_; }
   /// Whether the fruitlet at center_m was left out: looked at max_aimed_views times without a
   /// new well-seen image (ClusterCompletion::releaseWhen takes it, with release_left_out).
   bool leftOut(const Eigen::Vector3d& center_m) const;
@@ -97,6 +104,7 @@ class SizingGuidance : public LoopObserver {
   TagPoseFn T_world_tag_;
   double max_shift_m_ = 0.0;
   std::size_t expected_found_ = 0, expected_gone_ = 0;
+  bool fruitlets_known_ = false;
   std::vector<Aim> aims_;
   std::size_t aimed_views_ = 0, dropped_ = 0;
 };
