@@ -128,8 +128,7 @@ void SizingGuidance::seekExpected() {
     target_unconfirmed_.push_back(false);
     target_expected_.push_back(true);
   }
-  fruitlets_known_ =
-      found_kept + expected_gone_ == expected_.size() && found_kept == latest.fruitlets.size();
+  fruitlets_known_ = found_kept == expected_.size() && found_kept == latest.fruitlets.size();
 }
 
 void SizingGuidance::onView(const ViewEvent& event) {

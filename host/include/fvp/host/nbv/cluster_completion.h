@@ -89,7 +89,7 @@ struct ClusterCompletionConfig {
   /// settled may be sized in a frame the next view corrects. The cap still ends the cluster.
   bool hold_while_views_disagree = true;
   /// On a visit after the first, once memory accounts for the cluster's fruitlets (every one
-  /// an earlier visit sized is found or gone, and nothing else was found: knownWhen), the
+  /// an earlier visit sized is found again, and nothing else was found: knownWhen), the
   /// question the window of stable_views + 1 views spanning min_stable_span_deg answers (is a
   /// fruitlet still unseen?) has been answered by the earlier visit, whose own stop asked it
   /// over the whole cluster. The cluster is then done once each fruitlet has the evidence and

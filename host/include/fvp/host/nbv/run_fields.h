@@ -81,7 +81,7 @@ inline constexpr RunField kReleaseLeftOut{
 inline constexpr RunField kKnownFruitlets{
     "known_fruitlets", "--known-fruitlets",
     "with the automatic stop, on a visit after the first: once every fruitlet the earlier visit "
-    "sized is found or gone and nothing else was found, a cluster is done when each has the "
+    "sized is found again and nothing else was found, a cluster is done when each has the "
     "evidence and its size agrees with the view before (docs/nbv-loop.md)"};
 inline constexpr RunField kRegisterViews{
     "register_views", "--register-views",

@@ -70,11 +70,13 @@ class SizingGuidance : public LoopObserver {
   std::size_t expectedFound() const { return expected_found_; }
   std::size_t expectedGone() const { return expected_gone_; }
   /// After the last sizing: memory accounts for the cluster's fruitlets. Every remembered
-  /// fruitlet is gone or stands where a kept fruitlet of the sizing does, and every kept
-  /// fruitlet is a remembered one (ClusterCompletion::knownWhen takes it). One found only as
-  /// an unconfirmed detection, or a fruitlet the earlier visit did not size, leaves the
-  /// cluster to the first visit's rule. False without remembered fruitlets or before a view
-  /// saw the tag.
+  /// fruitlet stands where a kept fruitlet of the sizing does, and every kept fruitlet is a
+  /// remembered one (ClusterCompletion::knownWhen takes it). One gone, one found only as an
+  /// unconfirmed detection, or a fruitlet the earlier visit did not size leaves the cluster
+  /// to the first visit's rule: two views without a remembered fruitlet cannot tell fallen
+  /// from hidden (on development season 1, 4 of a cluster's 6 fruitlets were given up as gone
+  /// while hanging behind leaves), and that rule's search finds a hidden one again. False
+  /// without remembered fruitlets or before a view saw the tag.
   bool fruitletsKnown() const { return fruitlets_known_; }
   /// Whether the fruitlet at center_m was left out: looked at max_aimed_views times without a
   /// new well-seen image (ClusterCompletion::releaseWhen takes it, with release_left_out).
