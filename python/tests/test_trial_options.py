@@ -84,15 +84,17 @@ def test_automatic_stop_switches_default_as_the_cli(fvp_exe):
     assert "--known-fruitlets,--no-known-fruitlets" in help_text
 
 
-@pytest.mark.parametrize("confirm,release,seek", [(False, True, True), (True, False, False)])
-def test_automatic_stop_switches_reach_the_trial(confirm, release, seek):
+@pytest.mark.parametrize("confirm,release,seek,known",
+                         [(False, True, True, False), (True, False, False, True)])
+def test_automatic_stop_switches_reach_the_trial(confirm, release, seek, known):
     result = fvp.sim.run_trial(seed=2, clock="fixed", stop="auto", max_views=1,
                                confirm_detections=confirm, release_left_out=release,
-                               seek_partly_seen=seek)
+                               seek_partly_seen=seek, known_fruitlets=known)
     assert result["stop"]["rule"] == "auto"
     assert result["stop"]["confirm_detections"] is confirm
     assert result["stop"]["release_left_out"] is release
     assert result["stop"]["seek_partly_seen"] is seek
+    assert result["stop"]["known_fruitlets"] is known
 
 
 def test_automatic_stop_switches_default_on():

@@ -110,7 +110,9 @@ ExperimentManifest manifestOf(const ExperimentOptions& o) {
   m.settings.confirm_detections = automatic && o.trial.confirm_detections;
   m.settings.seek_partly_seen = automatic && o.trial.seek_partly_seen;
   m.settings.release_left_out = automatic && o.trial.release_left_out;
-  m.settings.known_fruitlets = automatic && o.trial.known_fruitlets;
+  // No experiment's trial remembers an earlier visit, so known_fruitlets changes nothing:
+  // recorded off, so that automatic-stop experiments from before it still resume and merge.
+  m.settings.known_fruitlets = false;
   m.error_scale = o.error_scale;
   m.configs = {{"world_config", stampOf(o.trial.world_config, "world config")},
                {"planner_config", stampOf(o.trial.planner_config, "planner config")},

@@ -72,10 +72,13 @@ std::optional<nlohmann::json> finishedVisit(const TrialOptions& visit) {
   const nlohmann::json result = nlohmann::json::parse(in, nullptr, false);
   TrialOptions resolved = visit;
   resolved.register_views = registerViewsOf(visit);
+  nlohmann::json settings = trialSettingsJson(resolved);
+  // A visit remembering nothing (the first) runs the same with known_fruitlets on or off:
+  // one from before the switch is still this visit's.
+  if (visit.remembered_visit.empty()) settings.erase("known_fruitlets");
   if (result.is_discarded() || !result.is_object() ||
       !result.value("settings", nlohmann::json()).is_object() ||
-      !firstSettingDifference(result.at("settings"), nlohmann::json(trialSettingsJson(resolved)))
-           .empty() ||
+      !firstSettingDifference(result.at("settings"), settings).empty() ||
       rememberedDay(result) != visit.remembered_visit.filename() ||
       result.value("clock_charges", "") != ExperimentManifest::clockChargesFor(visit.guided_stereo))
     throw std::runtime_error(file.string() +

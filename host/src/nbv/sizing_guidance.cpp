@@ -54,9 +54,8 @@ void SizingGuidance::onPlan(const PlanEvent& event) {
   // its candidates worth more than the others', and views it prefers then only spend the cap).
   // Without release_left_out a target left out still holds the stop: counting views it was
   // not aimed at would only stop the planner aiming at it.
-  // By the rule the stop applies now (ClusterCompletion::ruleNow).
-  const ClusterCompletionConfig rule =
-      config_.known_fruitlets && fruitlets_known_ ? knownFruitletsRule(config_) : config_;
+  // By the rule the stop applies now.
+  const ClusterCompletionConfig rule = completion_ ? completion_->ruleNow() : config_;
   const bool only_evidence_holds =
       config_.release_left_out &&
       sizesSettled(history_, rule, [](const FruitletSnapshot&) { return true; });

@@ -122,7 +122,8 @@ struct MemoryUse {
   /// for in vain (gone); the rest were neither (the stop ended first, or not the automatic one).
   std::size_t fruitlets = 0, found = 0, gone = 0;
   /// Memory accounted for the cluster's fruitlets at the last sizing
-  /// (SizingGuidance::fruitletsKnown): with known_fruitlets, the stop's rule was the known one.
+  /// (SizingGuidance::fruitletsKnown), whichever stop ended the loop and whether or not
+  /// known_fruitlets was on.
   bool known = false;
 };
 

@@ -30,7 +30,9 @@ class SizingGuidance : public LoopObserver {
   SizingGuidance(const ClusterCompletion& completion, planner::ViewPlanner& planner,
                  double min_visible_fraction, int max_aimed_views = 2)
       : SizingGuidance(completion.history(), completion.config(), planner, min_visible_fraction,
-                       max_aimed_views) {}
+                       max_aimed_views) {
+    completion_ = &completion;
+  }
   /// Over any sizing history (tests): history and config must outlive this.
   SizingGuidance(const std::vector<SizingSnapshot>& history, const ClusterCompletionConfig& config,
                  planner::ViewPlanner& planner, double min_visible_fraction,
@@ -95,6 +97,9 @@ class SizingGuidance : public LoopObserver {
   void seekExpected();
 
   const std::vector<SizingSnapshot>& history_;
+  /// The stop whose rule onPlan follows (ClusterCompletion::ruleNow); none over a bare
+  /// history: the config's rule.
+  const ClusterCompletion* completion_ = nullptr;
   const ClusterCompletionConfig& config_;
   planner::ViewPlanner& planner_;
   double min_visible_fraction_;
