@@ -113,7 +113,8 @@ bool ClusterCompletion::done() const {
 bool ClusterCompletion::recentViewsDisagree() const {
   const ClusterPoseGraph* graph = session_.poseGraph();
   if (!graph) return false;
-  const std::size_t window = std::min(graph->size(), std::size_t(ruleNow().stable_views) + 1);
+  // The first visit's window under either rule: the maps' frame is not memory's to settle.
+  const std::size_t window = std::min(graph->size(), std::size_t(config_.stable_views) + 1);
   for (std::size_t k = graph->size() - window; k < graph->size(); ++k)
     if (graph->estimate(k).disagrees) return true;
   return false;

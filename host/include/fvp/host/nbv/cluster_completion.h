@@ -165,8 +165,10 @@ class ClusterCompletion : public LoopObserver {
   /// The rule done() applies now: the config's, or with known_fruitlets and knownWhen holding,
   /// the known fruitlets' (known_stable_views, no discovery span).
   ClusterCompletionConfig ruleNow() const;
-  /// Whether one of the last stable_views + 1 views (ruleNow's) disagrees in the session's
-  /// pose graph (false without one).
+  /// Whether one of the last stable_views + 1 views disagrees in the session's pose graph
+  /// (false without one). The config's stable_views under the known fruitlets' rule too:
+  /// memory says which fruitlets there are, not that the maps' frame has settled (a later
+  /// visit's clusters stopped after 3 views were the ones whose world positions were off).
   bool recentViewsDisagree() const;
   /// The cluster is not done while `pending` returns true (SizingGuidance::
   /// waitingOnUnconfirmed): `pending` must outlive this.
