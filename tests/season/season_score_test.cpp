@@ -107,6 +107,28 @@ TEST(SeasonScore, ExactSizesScorePerfectly) {
   EXPECT_GT(fallen, 0u) << "no fruitlet fell in these seasons: the gone score went untested";
 }
 
+TEST(SeasonScore, ABiasEveryVisitSharesIsNotErrorBetweenVisits) {
+  const auto spread = [](const nlohmann::json& growth) {
+    return std::sqrt(growth["size_deviation_ss_mm2"].get<double>() /
+                     growth["size_deviation_dof"].get<double>());
+  };
+  Season season(2, {0.0, 4.0, 7.0});
+  for (std::size_t v = 0; v < season.worlds.size(); ++v)
+    season.results[v] = exactResult(season.worlds[v], 0.3);
+  nlohmann::json s = season.score();
+  ASSERT_GT(s["growth"]["size_deviation_dof"].get<int>(), 0);
+  EXPECT_LT(spread(s["growth"]), 1e-9) << "0.3 mm on every visit cancels in every slope";
+  EXPECT_NEAR(s["growth"]["stated_standard_error_ss_mm2"].get<double>() /
+                  s["growth"]["stated_standard_errors"].get<double>(),
+              0.05 * 0.05, 1e-12);
+  // +0.3 mm on day 4 only: over three sizes the deviations are +0.2, -0.1, -0.1 (or +0.15,
+  // -0.15 over two), never zero.
+  season.results[1] = exactResult(season.worlds[1], 0.6);
+  s = season.score();
+  EXPECT_GT(spread(s["growth"]), 0.1);
+  EXPECT_LT(spread(s["growth"]), 0.3);
+}
+
 TEST(SeasonScore, AWrongLinkIsCounted) {
   Season season(2, {0.0, 4.0, 7.0});
   // On day 4 the result's truth says cluster 0's first two detections are each other's

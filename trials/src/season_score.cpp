@@ -166,9 +166,32 @@ nlohmann::json goneScore(const Scoring& s, const std::map<int, std::size_t>& tra
 }
 
 /// Each track of one fruitlet with a rate, against the truth's rate over the same days.
+/// A track's size errors as a rate sees them: a bias every visit shares cancels in a slope,
+/// what changes from visit to visit does not. Sums over the track's sizes of the squared
+/// deviations of each error from the track's mean error (size_deviation_ss_mm2, with
+/// size_deviation_dof = sizes - 1) and of the squared stated standard errors.
+struct SizeErrorSpread {
+  double deviation_ss_mm2 = 0.0, stated_ss_mm2 = 0.0;
+  std::size_t dof = 0, stated = 0;
+  void add(const FruitletTrack& t, const std::vector<SizeOnDay>& truth) {
+    double mean = 0.0;
+    for (std::size_t k = 0; k < truth.size(); ++k)
+      mean += t.sizes[k].sized.at.size_mm - truth[k].size_mm;
+    mean /= double(truth.size());
+    for (std::size_t k = 0; k < truth.size(); ++k) {
+      const double deviation = t.sizes[k].sized.at.size_mm - truth[k].size_mm - mean;
+      deviation_ss_mm2 += deviation * deviation;
+      const double se = t.sizes[k].sized.standard_error_mm;
+      if (std::isfinite(se)) stated_ss_mm2 += se * se, ++stated;
+    }
+    dof += truth.size() - 1;
+  }
+};
+
 nlohmann::json growthScore(const Scoring& s) {
   std::size_t scored = 0, with_error = 0, covered = 0;
   double abs_sum = 0.0, worst = 0.0;
+  SizeErrorSpread spread;
   for (const FruitletTrack& t : s.analysis.tracks) {
     if (!std::isfinite(t.rate.mm_per_day)) continue;
     const int id = s.identityOf(t, t.sizes.front());
@@ -179,6 +202,7 @@ nlohmann::json growthScore(const Scoring& s) {
       if (one_fruitlet) truth.push_back({size.day, s.truthSizeMm(id, size.day)});
     }
     if (!one_fruitlet) continue;
+    spread.add(t, truth);
     const double error = t.rate.mm_per_day - host::season::fitGrowthRate(truth).mm_per_day;
     ++scored;
     abs_sum += std::abs(error);
@@ -195,7 +219,11 @@ nlohmann::json growthScore(const Scoring& s) {
           {"worst_mm_per_day", numberOrNull(scored ? worst : std::nan(""))},
           {"with_standard_error", with_error},
           {"covered_95", covered},
-          {"covered_95_percent", numberOrNull(percent(covered, with_error))}};
+          {"covered_95_percent", numberOrNull(percent(covered, with_error))},
+          {"size_deviation_ss_mm2", spread.deviation_ss_mm2},
+          {"size_deviation_dof", spread.dof},
+          {"stated_standard_error_ss_mm2", spread.stated_ss_mm2},
+          {"stated_standard_errors", spread.stated}};
 }
 
 /// Confusion of "drops" (positive) over every fruitlet on the tree on the first visit; an

@@ -203,6 +203,11 @@ nlohmann::json ratio(double part, double whole, double scale = 100.0) {
   return whole > 0 ? nlohmann::json(scale * part / whole) : nlohmann::json(nullptr);
 }
 
+/// sqrt(sum / count): a root mean square from pooled sums; null without any.
+nlohmann::json rootOfRatio(double sum, double count) {
+  return count > 0 ? nlohmann::json(std::sqrt(sum / count)) : nlohmann::json(nullptr);
+}
+
 }  // namespace
 
 nlohmann::json summarizeSeasons(const std::vector<nlohmann::json>& seasons) {
@@ -262,6 +267,10 @@ nlohmann::json summarizeSeasons(const std::vector<nlohmann::json>& seasons) {
           {"growth_mae_mm_per_day", ratio(growth_abs, p.at("growth.tracks_scored"), 1.0)},
           {"growth_covered_95_percent",
            ratio(p.at("growth.covered_95"), p.at("growth.with_standard_error"))},
+          {"size_error_between_visits_mm",
+           rootOfRatio(p.at("growth.size_deviation_ss_mm2"), p.at("growth.size_deviation_dof"))},
+          {"stated_standard_error_rms_mm", rootOfRatio(p.at("growth.stated_standard_error_ss_mm2"),
+                                                       p.at("growth.stated_standard_errors"))},
           {"robot_fate_f1", rf1("robot")},
           {"calipers_fate_f1", rf1("calipers")},
           {"robot_undecided", p.at("robot.undecided")},

@@ -121,6 +121,7 @@ struct MemoryUse {
   /// Remembered fruitlets, those the loop's last sizing found within the gate, and those looked
   /// for in vain (gone); the rest were neither (the stop ended first, or not the automatic one).
   std::size_t fruitlets = 0, found = 0, gone = 0;
+  std::size_t gone_seen_empty = 0;  ///< of those gone, the ones whose place was seen empty
   /// Memory accounted for the cluster's fruitlets at the last sizing
   /// (SizingGuidance::fruitletsKnown), whichever stop ended the loop and whether or not
   /// known_fruitlets was on.
