@@ -416,7 +416,7 @@ TEST_F(PlaceSeenEmptyTest, AHangingFruitletsCoreStaysUnknownAFallenOnesIsSeenFre
     EXPECT_TRUE(placeSeenEmpty(*mapOf(false, views), center_m, kRadiusM, 0.0)) << views;
   }
   // Remembered 2.5 mm off and placed that well: the core (1.5 mm) still lies inside the
-  // hanging fruitlet. Asked with no placement error, the core (4 mm) reaches out of it.
+  // hanging fruitlet, and with it fallen the same core is seen free.
   const Eigen::Vector3d off_m = center_m + Eigen::Vector3d(0.0, 0.0025, 0.0);
   EXPECT_FALSE(placeSeenEmpty(*mapOf(true, 3), off_m, kRadiusM, 0.0025));
   EXPECT_TRUE(placeSeenEmpty(*mapOf(false, 3), off_m, kRadiusM, 0.0025));

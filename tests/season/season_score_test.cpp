@@ -119,7 +119,7 @@ TEST(SeasonScore, ABiasEveryVisitSharesIsNotErrorBetweenVisits) {
   ASSERT_GT(s["growth"]["size_deviation_dof"].get<int>(), 0);
   EXPECT_LT(spread(s["growth"]), 1e-9) << "0.3 mm on every visit cancels in every slope";
   EXPECT_NEAR(s["growth"]["stated_standard_error_ss_mm2"].get<double>() /
-                  s["growth"]["stated_standard_errors"].get<double>(),
+                  s["growth"]["size_deviation_dof"].get<double>(),
               0.05 * 0.05, 1e-12);
   // +0.3 mm on day 4 only: over three sizes the deviations are +0.2, -0.1, -0.1 (or +0.15,
   // -0.15 over two), never zero.

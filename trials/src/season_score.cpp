@@ -167,23 +167,28 @@ nlohmann::json goneScore(const Scoring& s, const std::map<int, std::size_t>& tra
 
 /// Each track of one fruitlet with a rate, against the truth's rate over the same days.
 /// A track's size errors as a rate sees them: a bias every visit shares cancels in a slope,
-/// what changes from visit to visit does not. Sums over the track's sizes of the squared
-/// deviations of each error from the track's mean error (size_deviation_ss_mm2, with
-/// size_deviation_dof = sizes - 1) and of the squared stated standard errors.
+/// what changes from visit to visit does not. Over tracks whose every size states a standard
+/// error: the squared deviations of each size's error from the track's mean error
+/// (size_deviation_ss_mm2, with size_deviation_dof = sizes - 1 a track, so that it estimates
+/// the sizes' mean error variance), and their squared stated standard errors weighted alike
+/// ((n - 1) / n each, over the same dof: the two are then the same quantity, measured and said).
 struct SizeErrorSpread {
   double deviation_ss_mm2 = 0.0, stated_ss_mm2 = 0.0;
-  std::size_t dof = 0, stated = 0;
+  std::size_t dof = 0;
   void add(const FruitletTrack& t, const std::vector<SizeOnDay>& truth) {
-    double mean = 0.0;
-    for (std::size_t k = 0; k < truth.size(); ++k)
-      mean += t.sizes[k].sized.at.size_mm - truth[k].size_mm;
-    mean /= double(truth.size());
+    const double n = double(truth.size());
+    double mean_error_mm = 0.0, stated_mm2 = 0.0;
     for (std::size_t k = 0; k < truth.size(); ++k) {
-      const double deviation = t.sizes[k].sized.at.size_mm - truth[k].size_mm - mean;
-      deviation_ss_mm2 += deviation * deviation;
-      const double se = t.sizes[k].sized.standard_error_mm;
-      if (std::isfinite(se)) stated_ss_mm2 += se * se, ++stated;
+      const double se_mm = t.sizes[k].sized.standard_error_mm;
+      if (!std::isfinite(se_mm)) return;
+      mean_error_mm += (t.sizes[k].sized.at.size_mm - truth[k].size_mm) / n;
+      stated_mm2 += se_mm * se_mm * (n - 1.0) / n;
     }
+    for (std::size_t k = 0; k < truth.size(); ++k) {
+      const double deviation_mm = t.sizes[k].sized.at.size_mm - truth[k].size_mm - mean_error_mm;
+      deviation_ss_mm2 += deviation_mm * deviation_mm;
+    }
+    stated_ss_mm2 += stated_mm2;
     dof += truth.size() - 1;
   }
 };
@@ -222,8 +227,7 @@ nlohmann::json growthScore(const Scoring& s) {
           {"covered_95_percent", numberOrNull(percent(covered, with_error))},
           {"size_deviation_ss_mm2", spread.deviation_ss_mm2},
           {"size_deviation_dof", spread.dof},
-          {"stated_standard_error_ss_mm2", spread.stated_ss_mm2},
-          {"stated_standard_errors", spread.stated}};
+          {"stated_standard_error_ss_mm2", spread.stated_ss_mm2}};
 }
 
 /// Confusion of "drops" (positive) over every fruitlet on the tree on the first visit; an

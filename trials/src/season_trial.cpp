@@ -270,7 +270,7 @@ nlohmann::json summarizeSeasons(const std::vector<nlohmann::json>& seasons) {
           {"size_error_between_visits_mm",
            rootOfRatio(p.at("growth.size_deviation_ss_mm2"), p.at("growth.size_deviation_dof"))},
           {"stated_standard_error_rms_mm", rootOfRatio(p.at("growth.stated_standard_error_ss_mm2"),
-                                                       p.at("growth.stated_standard_errors"))},
+                                                       p.at("growth.size_deviation_dof"))},
           {"robot_fate_f1", rf1("robot")},
           {"calipers_fate_f1", rf1("calipers")},
           {"robot_undecided", p.at("robot.undecided")},

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 
 namespace fvp::host::map {
@@ -10,7 +11,9 @@ FineVoxelCounts fineVoxelsWithin(const MapEngine& map, const Eigen::Vector3d& ce
                                  double radius_m) {
   FineVoxelCounts counts;
   const GridGeometry& grid = map.gridGeometry(MapLevel::kFine);
-  if (!(radius_m >= 0.0) || !center_m.allFinite() || !(grid.voxel_size_m > 0.0)) return counts;
+  if (!(radius_m >= 0.0) || !std::isfinite(radius_m) || !center_m.allFinite() ||
+      !(grid.voxel_size_m > 0.0))
+    return counts;
   // The ball's bounding box of voxels, clipped to the grid.
   const auto first = grid.latticeIndex(center_m.array() - radius_m);
   const auto last = grid.latticeIndex(center_m.array() + radius_m);

@@ -15,8 +15,8 @@ struct FineVoxelCounts {
 };
 
 /// Counts the fine voxels whose centres lie within radius_m of center_m (none outside the fine
-/// grid; none for a negative radius or a centre not finite). A solid body's inside stays
-/// unknown, since rays end at its surface: a ball seen mostly free holds nothing solid.
+/// grid; none for a radius negative or not finite, or a centre not finite). A solid body's inside
+/// stays unknown, since rays end at its surface: a ball seen mostly free holds nothing solid.
 FineVoxelCounts fineVoxelsWithin(const MapEngine& map, const Eigen::Vector3d& center_m,
                                  double radius_m);
 
