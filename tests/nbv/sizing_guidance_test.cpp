@@ -7,10 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <memory>
 #include <optional>
-
-#include "../map/synthetic_scan.h"
 
 namespace fvp::host::nbv {
 namespace {
@@ -338,90 +335,6 @@ TEST(SizingGuidance, ARememberedFruitletNotFoundIsSoughtThenGone) {
   // A fruitlet the earlier visit did not size: memory no longer accounts for the cluster.
   sized({fruitlet(0.0, 4, 60.0), fruitlet(0.025, 4, 60.0), fruitlet(0.06, 4, 60.0)});
   EXPECT_FALSE(guidance.fruitletsKnown());
-}
-
-TEST(SizingGuidance, ARememberedFruitletWhosePlaceIsSeenEmptyIsGoneAtOnceAndMemoryKnowsTheCluster) {
-  const ClusterCompletionConfig config;
-  std::vector<SizingSnapshot> history;
-  RecordingPlanner planner;
-  SizingGuidance guidance(history, config, planner, 0.6);
-  const std::optional<Eigen::Isometry3d> T_world_tag = Eigen::Isometry3d::Identity();
-  bool empty = false;
-  std::vector<double> asked_radius_m, asked_placement_m;
-  guidance.expect({{Eigen::Vector3d(0.0, 0.0, 0.3), 8.0}, {Eigen::Vector3d(0.02, 0.0, 0.3), 6.0}},
-                  tagPoseOf(T_world_tag), 0.008,
-                  [&](const Eigen::Vector3d& center_m, double radius_m, double placement_m) {
-                    asked_radius_m.push_back(radius_m);
-                    asked_placement_m.push_back(placement_m);
-                    return empty && center_m.x() > 0.01;
-                  });
-  // Nothing found yet: how well memory places the cluster is unknown, so nothing is asked.
-  history.push_back(snapshot(0, {}));
-  guidance.onView({.index = 0});
-  EXPECT_TRUE(asked_radius_m.empty());
-  EXPECT_EQ(guidance.expectedSeenEmpty(), 0u);
-  history.clear();
-  history.push_back(snapshot(0, {fruitlet(0.002, 4, 60.0)}));
-  guidance.onView({.index = 0});
-  EXPECT_TRUE(guidance.waitingOnExpected()) << "its place not seen: sought";
-  EXPECT_FALSE(guidance.fruitletsKnown());
-  ASSERT_EQ(asked_radius_m.size(), 1u) << "only the one not found is asked about";
-  EXPECT_DOUBLE_EQ(asked_radius_m[0], 0.003);
-  EXPECT_NEAR(asked_placement_m[0], 0.002, 1e-12) << "the one found stood 2 mm off";
-  // The first view after that shows its place empty, with no view counted against it.
-  empty = true;
-  history.push_back(snapshot(1, {fruitlet(0.0, 4, 60.0)}));
-  guidance.onView({.index = 1});
-  EXPECT_FALSE(guidance.waitingOnExpected());
-  EXPECT_TRUE(planner.targets_.empty());
-  EXPECT_EQ(guidance.expectedGone(), 1u);
-  EXPECT_EQ(guidance.expectedSeenEmpty(), 1u);
-  EXPECT_TRUE(guidance.fruitletsKnown()) << "one found, one fallen: memory accounts for both";
-  // Found after all (the map's free core was wrong): found wins, and it is not gone.
-  history.push_back(snapshot(2, {fruitlet(0.0, 4, 60.0), fruitlet(0.021, 4, 60.0)}));
-  guidance.onView({.index = 2});
-  EXPECT_EQ(guidance.expectedFound(), 2u);
-  EXPECT_EQ(guidance.expectedGone(), 0u);
-  EXPECT_EQ(guidance.expectedSeenEmpty(), 0u);
-  EXPECT_TRUE(guidance.fruitletsKnown());
-}
-
-// placeSeenEmpty on a real fine map: the synthetic scans end on the fruitlet's skin (or, with
-// it fallen, on the plane behind), with 0.3 mm of depth noise.
-class PlaceSeenEmptyTest : public ::testing::Test {
- protected:
-  static constexpr double kRadiusM = 0.005;
-  const Eigen::Vector3d center_m{0.005, 0.0, 0.3};
-
-  std::unique_ptr<map::MapEngine> mapOf(bool fruitlet_hangs, int views) const {
-    map::MapConfig config;
-    config.observation_min_m = {-0.25, -0.25, 0.0};
-    config.observation_max_m = {0.25, 0.25, 0.5};
-    auto engine =
-        map::createMapEngine("octomap", config, ClusterRegion({0.0, 0.0, 0.3}, 0.03), nullptr);
-    map::testing::SyntheticWorld world;
-    world.region_center_m = {0.0, 0.0, 0.3};
-    if (fruitlet_hangs) world.fruitlets.emplace_back(center_m.x(), 0.0, 0.3, kRadiusM);
-    const Eigen::Vector3d origins[] = {{0.0, 0.0, 0.0}, {0.1, 0.0, 0.02}, {-0.1, 0.02, 0.0}};
-    for (int v = 0; v < views; ++v)
-      engine->integrate(map::testing::renderScan(world, origins[v], 160, 160, 0.3, 7 + v).clouds());
-    return engine;
-  }
-};
-
-TEST_F(PlaceSeenEmptyTest, AHangingFruitletsCoreStaysUnknownAFallenOnesIsSeenFree) {
-  EXPECT_FALSE(placeSeenEmpty(*mapOf(false, 0), center_m, kRadiusM, 0.0)) << "not seen";
-  for (int views = 1; views <= 3; ++views) {
-    EXPECT_FALSE(placeSeenEmpty(*mapOf(true, views), center_m, kRadiusM, 0.0)) << views;
-    EXPECT_TRUE(placeSeenEmpty(*mapOf(false, views), center_m, kRadiusM, 0.0)) << views;
-  }
-  // Remembered 2.5 mm off and placed that well: the core (1.5 mm) still lies inside the
-  // hanging fruitlet, and with it fallen the same core is seen free.
-  const Eigen::Vector3d off_m = center_m + Eigen::Vector3d(0.0, 0.0025, 0.0);
-  EXPECT_FALSE(placeSeenEmpty(*mapOf(true, 3), off_m, kRadiusM, 0.0025));
-  EXPECT_TRUE(placeSeenEmpty(*mapOf(false, 3), off_m, kRadiusM, 0.0025));
-  // Placed no better than 3.5 mm, a 5 mm fruitlet cannot be told gone: undecided.
-  EXPECT_FALSE(placeSeenEmpty(*mapOf(false, 3), center_m, kRadiusM, 0.0035));
 }
 
 TEST(SizingGuidance, OneFruitletIsNotTwoRememberedOnes) {

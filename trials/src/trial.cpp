@@ -588,11 +588,9 @@ ClusterOutcome Trial::Impl::scored(host::nbv::ClusterRun run, TrialParts& cluste
     out.guidance_events = {{"sizing_views", run.sizing_views},
                            {"sizing_targets_dropped", run.sizing_targets_dropped}};
   if (run.memory)
-    out.memory = {
-        {"views", run.memory->views},         {"views_taken", run.memory->views_taken},
-        {"fruitlets", run.memory->fruitlets}, {"found", run.memory->found},
-        {"gone", run.memory->gone},           {"gone_seen_empty", run.memory->gone_seen_empty},
-        {"known", run.memory->known}};
+    out.memory = {{"views", run.memory->views},         {"views_taken", run.memory->views_taken},
+                  {"fruitlets", run.memory->fruitlets}, {"found", run.memory->found},
+                  {"gone", run.memory->gone},           {"known", run.memory->known}};
   return out;
 }
 

@@ -138,12 +138,6 @@ TagPoseFn tagPoseOf(const MappingSession& session) {
   return [&session]() -> const std::optional<Eigen::Isometry3d>& { return session.T_world_tag(); };
 }
 
-PlaceSeenEmptyFn placeSeenEmptyIn(const MappingSession& session) {
-  return [&session](const Eigen::Vector3d& center_m, double radius_m, double placement_error_m) {
-    return session.map() && placeSeenEmpty(*session.map(), center_m, radius_m, placement_error_m);
-  };
-}
-
 }  // namespace
 
 std::unique_ptr<ClusterWork> NbvSetup::makeWork(const ClusterTarget& target, std::size_t index) {
@@ -193,8 +187,7 @@ ClusterRun NbvSetup::runCluster(const NbvRig& rig, ClusterWork& work, LoopObserv
     guidance.emplace(*completion, *work.planner, options_.sizing.well_seen_fraction);
     observers.add(&*guidance);  // after completion: it reads completion's sizing
     if (work.remembered)
-      guidance->expect(work.expected, tagPoseOf(*work.session), options_.remembered_max_shift_m,
-                       placeSeenEmptyIn(*work.session));
+      guidance->expect(work.expected, tagPoseOf(*work.session), options_.remembered_max_shift_m);
     completion->holdWhile(
         [&g = *guidance] { return g.waitingOnUnconfirmed() || g.waitingOnExpected(); });
     completion->knownWhen([&g = *guidance] { return g.fruitletsKnown(); });
@@ -216,7 +209,6 @@ ClusterRun NbvSetup::runCluster(const NbvRig& rig, ClusterWork& work, LoopObserv
     if (guidance) {
       out.memory->found = guidance->expectedFound();
       out.memory->gone = guidance->expectedGone();
-      out.memory->gone_seen_empty = guidance->expectedSeenEmpty();
       out.memory->known = guidance->fruitletsKnown();
     }
   }

@@ -7,7 +7,6 @@
 #include <utility>
 
 #include "fvp/host/core/one_to_one_assignment.h"
-#include "fvp/host/map/fine_voxel_counts.h"
 
 namespace fvp::host::nbv {
 
@@ -76,28 +75,18 @@ void SizingGuidance::onPlan(const PlanEvent& event) {
   }
 }
 
-bool placeSeenEmpty(const map::MapEngine& map, const Eigen::Vector3d& center_m, double radius_m,
-                    double placement_error_m) {
-  const double voxel_m = map.gridGeometry(map::MapLevel::kFine).voxel_size_m;
-  const double core_m = radius_m - placement_error_m - voxel_m;
-  if (!(core_m >= voxel_m)) return false;
-  const map::FineVoxelCounts core = map::fineVoxelsWithin(map, center_m, core_m);
-  return 2 * core.free > core.total();
-}
-
 void SizingGuidance::expect(std::vector<RememberedFruitlet> fruitlets_tag, TagPoseFn T_world_tag,
-                            double max_shift_m, PlaceSeenEmptyFn seen_empty) {
+                            double max_shift_m) {
   if (!(max_shift_m > 0.0) || !std::isfinite(max_shift_m))
     throw std::invalid_argument("SizingGuidance::expect: max_shift_m: expected > 0");
   if (!T_world_tag) throw std::invalid_argument("SizingGuidance::expect: no tag pose");
   expected_ = std::move(fruitlets_tag);
   T_world_tag_ = std::move(T_world_tag);
   max_shift_m_ = max_shift_m;
-  seen_empty_ = std::move(seen_empty);
 }
 
 void SizingGuidance::seekExpected() {
-  expected_found_ = expected_gone_ = expected_seen_empty_ = 0;
+  expected_found_ = expected_gone_ = 0;
   fruitlets_known_ = false;
   if (expected_.empty()) return;
   const std::optional<Eigen::Isometry3d>& T_world_tag = T_world_tag_();
@@ -119,24 +108,10 @@ void SizingGuidance::seekExpected() {
     return d <= max_shift_m_ ? d : std::numeric_limits<double>::infinity();
   });
   std::size_t found_kept = 0;  // sized[0, latest.fruitlets.size()) are the kept ones
-  // How well memory places this cluster now: the farthest a found one stood from where it was.
-  double placement_error_m = -1.0;
-  for (std::size_t e = 0; e < where.size(); ++e)
-    if (found[e] >= 0)
-      placement_error_m =
-          std::max(placement_error_m, (where[e] - sized[std::size_t(found[e])]->center_m).norm());
   for (std::size_t e = 0; e < where.size(); ++e) {
     if (found[e] >= 0) {
       ++expected_found_;
       found_kept += std::size_t(found[e]) < latest.fruitlets.size();
-      continue;
-    }
-    // Any view can show its place empty, a remembered one too: a fruitlet hanging there
-    // keeps its core unknown however it is seen (placeSeenEmpty).
-    if (seen_empty_ && placement_error_m >= 0.0 &&
-        seen_empty_(where[e], 0.5e-3 * expected_[e].size_mm, placement_error_m)) {
-      ++expected_gone_;
-      ++expected_seen_empty_;
       continue;
     }
     if (const Aim* aim = findAim(where[e]); aim && aim->views >= max_aimed_views_) {
@@ -152,8 +127,7 @@ void SizingGuidance::seekExpected() {
     target_unconfirmed_.push_back(false);
     target_expected_.push_back(true);
   }
-  fruitlets_known_ = found_kept + expected_seen_empty_ == expected_.size() &&
-                     found_kept == latest.fruitlets.size();
+  fruitlets_known_ = found_kept == expected_.size() && found_kept == latest.fruitlets.size();
 }
 
 void SizingGuidance::onView(const ViewEvent& event) {

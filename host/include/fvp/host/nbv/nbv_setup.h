@@ -118,11 +118,9 @@ struct ClusterWork {
 /// What a cluster's memory did (ClusterTarget::memory).
 struct MemoryUse {
   std::size_t views = 0, views_taken = 0;  ///< remembered views, and those the arm took
-  /// Remembered fruitlets, those the loop's last sizing found within the gate, and those gone
-  /// (looked for in vain, or their place seen empty); the rest were neither (the stop ended
-  /// first, or not the automatic one).
+  /// Remembered fruitlets, those the loop's last sizing found within the gate, and those looked
+  /// for in vain (gone); the rest were neither (the stop ended first, or not the automatic one).
   std::size_t fruitlets = 0, found = 0, gone = 0;
-  std::size_t gone_seen_empty = 0;  ///< of those gone, the ones whose place was seen empty
   /// Memory accounted for the cluster's fruitlets at the last sizing
   /// (SizingGuidance::fruitletsKnown), whichever stop ended the loop and whether or not
   /// known_fruitlets was on.

@@ -15,7 +15,6 @@
 #include <optional>
 #include <vector>
 
-#include "fvp/host/map/map_engine.h"
 #include "fvp/host/nbv/cluster_completion.h"
 #include "fvp/host/nbv/nbv_loop.h"
 #include "fvp/host/nbv/remembered_views.h"
@@ -23,21 +22,6 @@
 #include "fvp/host/planner/view_planner.h"
 
 namespace fvp::host::nbv {
-
-/// Whether a remembered fruitlet's place is seen empty: its centre and radius as remembered,
-/// and how far a fruitlet still hanging may stand from that centre.
-using PlaceSeenEmptyFn =
-    std::function<bool(const Eigen::Vector3d& center_m, double radius_m, double placement_error_m)>;
-
-/// Whether the fine map shows nothing solid where a fruitlet of radius_m hung, remembered at
-/// center_m give or take placement_error_m: more than half the voxels of the core it would
-/// still fill are free. Rays end at a solid body's skin, so a hanging fruitlet's inside stays
-/// unknown; the core is the ball of radius_m - placement_error_m - one voxel (the skin's
-/// voxel, which depth error may carve) about center_m, inside the fruitlet wherever within
-/// the placement error it stands. False (undecided) where that core is under one voxel: a
-/// small fruitlet placed roughly cannot be told gone by the map.
-bool placeSeenEmpty(const map::MapEngine& map, const Eigen::Vector3d& center_m, double radius_m,
-                    double placement_error_m);
 
 class SizingGuidance : public LoopObserver {
  public:
@@ -75,15 +59,11 @@ class SizingGuidance : public LoopObserver {
   /// gives the tag's pose on this visit (empty until a view saw it) and must outlive this.
   /// After each sizing, a remembered fruitlet that no fruitlet of the sizing (kept or
   /// unconfirmed; a partly seen detection is not one) stands within max_shift_m of, one to one, is
-  /// a target the stop waits on (waitingOnExpected); one not found whose place is seen empty
-  /// (seen_empty, when given; the placement error it is asked with is the largest distance
-  /// from a remembered fruitlet found in this sizing to where it was found, this visit's own
-  /// measure of how well memory places the cluster, and none is asked before one is found)
-  /// is gone at once (expectedSeenEmpty), and one still not found after
-  /// max_aimed_views views other than remembered ones is gone too (expectedGone): looked for
-  /// where it was, and not there.
+  /// a target the stop waits on (waitingOnExpected); one still not found after max_aimed_views
+  /// views other than remembered ones is gone (expectedGone): looked for where it was, and not
+  /// there.
   void expect(std::vector<RememberedFruitlet> fruitlets_tag, TagPoseFn T_world_tag,
-              double max_shift_m, PlaceSeenEmptyFn seen_empty = {});
+              double max_shift_m);
   bool waitingOnExpected() const {
     return std::find(target_expected_.begin(), target_expected_.end(), true) !=
            target_expected_.end();
@@ -91,17 +71,14 @@ class SizingGuidance : public LoopObserver {
   /// After the last sizing: remembered fruitlets found, and those given up as gone.
   std::size_t expectedFound() const { return expected_found_; }
   std::size_t expectedGone() const { return expected_gone_; }
-  /// Of those gone, the ones whose place was seen empty.
-  std::size_t expectedSeenEmpty() const { return expected_seen_empty_; }
   /// After the last sizing: memory accounts for the cluster's fruitlets. Every remembered
-  /// fruitlet stands where a kept fruitlet of the sizing does or its place is seen empty, and
-  /// every kept fruitlet is a remembered one (ClusterCompletion::knownWhen takes it). One gone
-  /// without its place seen empty, one found only as an unconfirmed detection, or a fruitlet
-  /// the earlier visit did not size leaves the cluster to the first visit's rule: two views
-  /// without a remembered fruitlet cannot tell fallen from hidden (on development season 1, 4
-  /// of a cluster's 6 fruitlets were given up as gone while hanging behind leaves), and that
-  /// rule's search finds a hidden one again. False without remembered fruitlets or before a
-  /// view saw the tag.
+  /// fruitlet stands where a kept fruitlet of the sizing does, and every kept fruitlet is a
+  /// remembered one (ClusterCompletion::knownWhen takes it). One gone, one found only as an
+  /// unconfirmed detection, or a fruitlet the earlier visit did not size leaves the cluster
+  /// to the first visit's rule: two views without a remembered fruitlet cannot tell fallen
+  /// from hidden (on development season 1, 4 of a cluster's 6 fruitlets were given up as gone
+  /// while hanging behind leaves), and that rule's search finds a hidden one again. False
+  /// without remembered fruitlets or before a view saw the tag.
   bool fruitletsKnown() const { return fruitlets_known_; }
   /// Whether the fruitlet at center_m was left out: looked at max_aimed_views times without a
   /// new well-seen image (ClusterCompletion::releaseWhen takes it, with release_left_out).
@@ -133,8 +110,7 @@ class SizingGuidance : public LoopObserver {
   std::vector<RememberedFruitlet> expected_;
   TagPoseFn T_world_tag_;
   double max_shift_m_ = 0.0;
-  PlaceSeenEmptyFn seen_empty_;
-  std::size_t expected_found_ = 0, expected_gone_ = 0, expected_seen_empty_ = 0;
+  std::size_t expected_found_ = 0, expected_gone_ = 0;
   bool fruitlets_known_ = false;
   std::vector<Aim> aims_;
   std::size_t aimed_views_ = 0, dropped_ = 0;
