@@ -165,13 +165,10 @@ nlohmann::json goneScore(const Scoring& s, const std::map<int, std::size_t>& tra
           {"wrongly_gone", wrongly_gone}};
 }
 
-/// Each track of one fruitlet with a rate, against the truth's rate over the same days.
-/// A track's size errors as a rate sees them: a bias every visit shares cancels in a slope,
-/// what changes from visit to visit does not. Over tracks whose every size states a standard
-/// error: the squared deviations of each size's error from the track's mean error
-/// (size_deviation_ss_mm2, with size_deviation_dof = sizes - 1 a track, so that it estimates
-/// the sizes' mean error variance), and their squared stated standard errors weighted alike
-/// ((n - 1) / n each, over the same dof: the two are then the same quantity, measured and said).
+/// A track's size errors as a rate sees them (a bias every visit shares cancels in a slope),
+/// over tracks whose every size states a standard error: each error's squared deviation from
+/// the track's mean error, with sizes - 1 degrees of freedom a track, and the squared stated
+/// errors weighted (n - 1) / n each, so that both estimate the same variance.
 struct SizeErrorSpread {
   double deviation_ss_mm2 = 0.0, stated_ss_mm2 = 0.0;
   std::size_t dof = 0;
@@ -193,6 +190,7 @@ struct SizeErrorSpread {
   }
 };
 
+/// Each track of one fruitlet with a rate, against the truth's rate over the same days.
 nlohmann::json growthScore(const Scoring& s) {
   std::size_t scored = 0, with_error = 0, covered = 0;
   double abs_sum = 0.0, worst = 0.0;
