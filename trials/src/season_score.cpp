@@ -174,17 +174,17 @@ struct SizeErrorSpread {
   std::size_t dof = 0;
   void add(const FruitletTrack& t, const std::vector<SizeOnDay>& truth) {
     const double n = double(truth.size());
+    std::vector<double> errors_mm;
     double mean_error_mm = 0.0, stated_mm2 = 0.0;
     for (std::size_t k = 0; k < truth.size(); ++k) {
       const double se_mm = t.sizes[k].sized.standard_error_mm;
       if (!std::isfinite(se_mm)) return;
-      mean_error_mm += (t.sizes[k].sized.at.size_mm - truth[k].size_mm) / n;
+      errors_mm.push_back(t.sizes[k].sized.at.size_mm - truth[k].size_mm);
+      mean_error_mm += errors_mm.back() / n;
       stated_mm2 += se_mm * se_mm * (n - 1.0) / n;
     }
-    for (std::size_t k = 0; k < truth.size(); ++k) {
-      const double deviation_mm = t.sizes[k].sized.at.size_mm - truth[k].size_mm - mean_error_mm;
-      deviation_ss_mm2 += deviation_mm * deviation_mm;
-    }
+    for (const double error_mm : errors_mm)
+      deviation_ss_mm2 += (error_mm - mean_error_mm) * (error_mm - mean_error_mm);
     stated_ss_mm2 += stated_mm2;
     dof += truth.size() - 1;
   }
