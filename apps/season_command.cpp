@@ -80,6 +80,7 @@ void addSeasonCommand(CLI::App& app) {
   struct Options {
     std::vector<std::string> visits;
     std::string out;
+    double size_error_floor_mm = host::season::SeasonConfig{}.size_error_floor_mm;
   };
   auto opt = optionStorage<Options>();
   auto* cmd = app.add_subcommand(
@@ -92,6 +93,11 @@ void addSeasonCommand(CLI::App& app) {
       ->required()
       ->check(seasonVisitText());
   cmd->add_option("--out", opt->out, "output directory")->required()->check(nonEmptyPath());
+  cmd->add_option("--size-error-floor-mm", opt->size_error_floor_mm,
+                  "what a visit's images share and their spread cannot show, added in quadrature "
+                  "to each size's standard error before a rate is fitted (docs/season.md)")
+      ->check(numberFromZero(true))
+      ->capture_default_str();
   FVP_ON_RUN(cmd, [opt] {
     if (opt->visits.size() < 2)
       throw std::runtime_error("--visit: expected two or more visits, got " +
@@ -103,7 +109,8 @@ void addSeasonCommand(CLI::App& app) {
       if (!visit) throw std::runtime_error("--visit: " + error);  // the validator ran first
       visits.push_back(host::season::readSeasonVisit(visit->path, visit->day));
     }
-    const host::season::SeasonConfig config;
+    host::season::SeasonConfig config;
+    config.size_error_floor_mm = opt->size_error_floor_mm;
     const host::season::SeasonAnalysis season = host::season::analyzeSeason(visits, config);
     host::prepareOutputDirectory(opt->out, "--out");
     const host::OutputDirectoryLock lock(opt->out, "--out");

@@ -44,17 +44,20 @@ void bindPerceptionSizing(py::module_& m) {
 
   m.def(
       "season",
-      [](const std::vector<std::pair<double, std::string>>& visits) {
+      [](const std::vector<std::pair<double, std::string>>& visits, double size_error_floor_mm) {
         std::vector<host::season::SeasonVisit> read;
         for (const auto& [day, path] : visits)
           read.push_back(host::season::readSeasonVisit(path, day));
-        const host::season::SeasonConfig config;
+        host::season::SeasonConfig config;
+        config.size_error_floor_mm = size_error_floor_mm;
         return jsonToPython(
             host::season::seasonJson(host::season::analyzeSeason(read, config), config));
       },
       py::arg("visits"),
+      py::arg("size_error_floor_mm") = host::season::SeasonConfig{}.size_error_floor_mm,
       "`fvp season` as a function: visits as (day, path) pairs, each path a result.json, a "
-      "fruitlets.json or a directory holding one; returns season.json's object (docs/season.md).");
+      "fruitlets.json or a directory holding one, and the floor added in quadrature to each "
+      "size's standard error; returns season.json's object (docs/season.md).");
 }
 
 }  // namespace fvp::python

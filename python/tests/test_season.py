@@ -24,6 +24,19 @@ def test_two_visits_of_a_tree_match_the_command(fvp_exe, tmp_path):
     assert json.loads((tmp_path / "season.json").read_text()) == season
 
 
+def test_the_size_error_floor_widens_the_rates_errors():
+    """size_error_floor_mm adds to every size's standard error in quadrature (docs/season.md):
+    tag 3's third fruitlet states 0.25 and 0.2 mm on days 0 and 4."""
+    visits = [(0.0, os.path.join(DATA, "tree_day0.json")), (4.0, os.path.join(DATA, "tree_day4.json"))]
+    wide = fvp.season(visits, size_error_floor_mm=0.3)
+    assert wide["config"]["size_error_floor_mm"] == 0.3
+    rate = wide["clusters"][0]["fruitlets"][2]
+    assert rate["growth_rate_standard_error_mm_per_day"] == pytest.approx(
+        (0.0625 + 0.04 + 2 * 0.09) ** 0.5 / 4, abs=1e-12)
+    with pytest.raises(ValueError, match="size_error_floor_mm"):
+        fvp.season(visits, size_error_floor_mm=-0.1)
+
+
 def test_a_missing_visit_is_an_error_naming_it():
     with pytest.raises(RuntimeError, match="no_such_visit.json: no such file or directory"):
         fvp.season([(0.0, os.path.join(DATA, "tree_day0.json")), (4.0, "/nonexistent/no_such_visit.json")])

@@ -77,6 +77,14 @@ TEST(SeasonVisit, BadVisitsNameTheFileAndTheField) {
   EXPECT_EQ(errorOf(R"({"T_world_tag": {}, "sized_fruitlets": [{"center_tag_m": [0, 0, 0],
                         "size_mm": 7, "support": 3}]})"),
             "visit.json: sized_fruitlets[0].support: expected an object");
+  EXPECT_EQ(errorOf(R"({"T_world_tag": {}, "sized_fruitlets": [{"center_tag_m": [0, 0, 0],
+                        "size_mm": 7, "support": {"well_seen_images": 2.5}}]})"),
+            "visit.json: sized_fruitlets[0].support.well_seen_images: expected a count of images "
+            "(an integer >= 0)");
+  EXPECT_EQ(errorOf(R"({"T_world_tag": {}, "sized_fruitlets": [{"center_tag_m": [0, 0, 0],
+                        "size_mm": 7, "support": {"well_seen_images": -1}}]})"),
+            "visit.json: sized_fruitlets[0].support.well_seen_images: expected a count of images "
+            "(an integer >= 0)");
   std::string crowded = R"({"T_world_tag": {}, "sized_fruitlets": [)";
   for (int i = 0; i < 65; ++i)
     crowded += std::string(i ? "," : "") + R"({"center_tag_m": [0, 0, 0], "size_mm": 7})";
@@ -87,8 +95,11 @@ TEST(SeasonVisit, BadVisitsNameTheFileAndTheField) {
 // Tag 3: fruitlets grew 3.6 and 3.2 mm and one 0.4 mm in 4 days; tag 5: one grew 3.0 mm, one
 // fell off. Reference: the fastest fifth of 4 rates, the fastest alone, 0.9 mm/day.
 TEST(SeasonAnalysis, TwoVisitsOfATreeByHand) {
+  SeasonConfig stated_errors_alone;
+  stated_errors_alone.size_error_floor_mm = 0.0;
   const SeasonAnalysis s = analyzeSeason({readSeasonVisit(kData + "tree_day4.json", 4.0),
-                                          readSeasonVisit(kData + "tree_day0.json", 0.0)});
+                                          readSeasonVisit(kData + "tree_day0.json", 0.0)},
+                                         stated_errors_alone);
   EXPECT_EQ(s.days, (std::vector<double>{0.0, 4.0}));  // in day order
   ASSERT_EQ(s.clusters.size(), 2u);
   ASSERT_EQ(s.tracks.size(), 5u);
@@ -120,6 +131,38 @@ TEST(SeasonAnalysis, TwoVisitsOfATreeByHand) {
   EXPECT_TRUE(j["clusters"][0]["fruitlets"][2]["growth_rate_degrees_of_freedom"].is_null());
   EXPECT_EQ(j["clusters"][0]["fruitlets"][0]["sizes"].size(), 2u);
   EXPECT_TRUE(j["clusters"][0]["fruitlets"][0]["sizes"][0]["association_confidence"].is_null());
+}
+
+TEST(SeasonVisit, TheImageCountIsReadWhereTheResultGivesIt) {
+  const SeasonVisit v = parseSeasonVisit(
+      R"({"T_world_tag": {}, "sized_fruitlets": [
+            {"center_tag_m": [0, 0, 0], "size_mm": 7,
+             "support": {"well_seen_images": 5, "size_stderr_mm": 0.2}},
+            {"center_tag_m": [0, 0.02, 0], "size_mm": 6}]})",
+      "result.json", 0.0);
+  ASSERT_EQ(v.clusters.at(0).fruitlets.size(), 2u);
+  EXPECT_EQ(v.clusters[0].fruitlets[0].well_seen_images, 5);
+  EXPECT_EQ(v.clusters[0].fruitlets[1].well_seen_images, -1);
+}
+
+// The floor adds to each stated error in quadrature: track 2's sizes state 0.25 and 0.2 mm.
+TEST(SeasonAnalysis, TheSizeErrorFloorWidensEveryStatedError) {
+  const std::vector<SeasonVisit> visits = {readSeasonVisit(kData + "tree_day0.json", 0.0),
+                                           readSeasonVisit(kData + "tree_day4.json", 4.0)};
+  SeasonConfig config;
+  config.size_error_floor_mm = 0.0;
+  const double bare = analyzeSeason(visits, config).tracks[2].rate.standard_error_mm_per_day;
+  EXPECT_NEAR(bare, std::sqrt(0.0625 + 0.04) / 4, 1e-12);
+  config.size_error_floor_mm = 0.3;
+  const SeasonAnalysis s = analyzeSeason(visits, config);
+  EXPECT_NEAR(s.tracks[2].rate.standard_error_mm_per_day, std::sqrt(0.0625 + 0.04 + 2 * 0.09) / 4,
+              1e-12);
+  EXPECT_NEAR(s.tracks[2].rate.mm_per_day, 0.1, 1e-12);
+  EXPECT_EQ(seasonJson(s, config)["config"]["size_error_floor_mm"], 0.3);
+  for (const double bad : {-0.1, double(NAN), double(INFINITY)}) {
+    config.size_error_floor_mm = bad;
+    EXPECT_THROW(analyzeSeason(visits, config), std::invalid_argument) << bad;
+  }
 }
 
 TEST(SeasonAnalysis, AVisitWithoutTheTagLeavesTheFruitletsAndTwoOnOneDayAreRefused) {

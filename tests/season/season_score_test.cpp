@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "fvp/host/season/season_visit.h"
 
@@ -127,6 +128,62 @@ TEST(SeasonScore, ABiasEveryVisitSharesIsNotErrorBetweenVisits) {
   s = season.score();
   EXPECT_GT(spread(s["growth"]), 0.1);
   EXPECT_LT(spread(s["growth"]), 0.3);
+}
+
+/// Tracks of three sizes whose errors are a track's bias plus N(0, se^2 + floor^2), with
+/// stated errors se of 0.05-0.4 mm.
+std::vector<std::vector<SizeError>> simulatedTracks(double floor_mm, std::size_t count) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> stated(0.05, 0.4), bias(-1.0, 1.0);
+  std::normal_distribution<double> normal;
+  std::vector<std::vector<SizeError>> tracks(count);
+  for (auto& track : tracks) {
+    const double b = bias(rng);
+    for (int k = 0; k < 3; ++k) {
+      const double se = stated(rng);
+      track.push_back({b + std::hypot(se, floor_mm) * normal(rng), se});
+    }
+  }
+  return tracks;
+}
+
+TEST(SeasonScore, TheFloorFitFindsWhatTheStatedErrorsLack) {
+  for (const double floor_mm : {0.1, 0.2, 0.4}) {
+    const double fit = sizeErrorFloorFit(simulatedTracks(floor_mm, 4000));
+    EXPECT_NEAR(fit, floor_mm, 0.1 * floor_mm) << "floor " << floor_mm;
+  }
+  // Stated errors that are right: the spread is what they say, the floor (near) none.
+  EXPECT_LT(sizeErrorFloorFit(simulatedTracks(0.0, 4000)), 0.03);
+  // A bias a track's sizes share cancels.
+  auto tracks = simulatedTracks(0.2, 2000);
+  const double before = sizeErrorFloorFit(tracks);
+  for (auto& t : tracks)
+    for (auto& e : t) e.error_mm += 5.0;
+  EXPECT_NEAR(sizeErrorFloorFit(tracks), before, 1e-6);
+}
+
+TEST(SeasonScore, TheFloorFitNeedsTracksOfTwoSizes) {
+  EXPECT_TRUE(std::isnan(sizeErrorFloorFit({})));
+  EXPECT_TRUE(std::isnan(sizeErrorFloorFit({{{0.1, 0.1}}, {{0.3, 0.2}}})));
+  EXPECT_EQ(sizeErrorFloorFit({{{0.0, 0.1}, {0.0, 0.1}}}), 0.0);
+  EXPECT_THROW(sizeErrorFloorFit({{{0.0, 0.0}, {0.1, 0.1}}}), std::invalid_argument);
+  EXPECT_THROW(sizeErrorFloorFit({{{NAN, 0.1}, {0.1, 0.1}}}), std::invalid_argument);
+}
+
+TEST(SeasonScore, EachSizeIsRecordedWithItsTruth) {
+  Season season(2, {0.0, 4.0, 7.0});
+  season.results[1] = exactResult(season.worlds[1], 0.3);
+  const nlohmann::json s = season.score();
+  const nlohmann::json& sizes = s["growth"]["sizes"];
+  ASSERT_FALSE(sizes.empty());
+  for (const nlohmann::json& r : sizes) {
+    const double error = r["size_mm"].get<double>() - r["truth_mm"].get<double>();
+    EXPECT_NEAR(error, r["day"] == 4.0 ? 0.3 : 0.0, 1e-9) << r.dump();
+    EXPECT_EQ(r["standard_error_mm"], 0.05);
+    EXPECT_EQ(r["well_seen_images"], -1) << "the results here do not say";
+  }
+  // Deviations of +-0.2/0.1 mm against a stated 0.05: the floor makes up the difference.
+  EXPECT_GT(s["growth"]["size_error_floor_fit_mm"].get<double>(), 0.05);
 }
 
 TEST(SeasonScore, AWrongLinkIsCounted) {

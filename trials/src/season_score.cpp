@@ -1,5 +1,6 @@
 #include "fvp/trials/season_score.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -165,6 +166,20 @@ nlohmann::json goneScore(const Scoring& s, const std::map<int, std::size_t>& tra
           {"wrongly_gone", wrongly_gone}};
 }
 
+/// A track's sizes for the summary's pooled floor fit: one entry each, with the track's
+/// place in the analysis, both sizes (robot's, truth's), the stated error and its images.
+void addSizeRecords(const FruitletTrack& t, std::size_t track, int identity,
+                    const std::vector<SizeOnDay>& truth, nlohmann::json& records) {
+  for (std::size_t k = 0; k < truth.size(); ++k)
+    records.push_back({{"track", track},
+                       {"identity", identity},
+                       {"day", truth[k].day},
+                       {"size_mm", t.sizes[k].sized.at.size_mm},
+                       {"truth_mm", truth[k].size_mm},
+                       {"standard_error_mm", numberOrNull(t.sizes[k].sized.standard_error_mm)},
+                       {"well_seen_images", t.sizes[k].sized.well_seen_images}});
+}
+
 /// A track's size errors as a rate sees them (a bias every visit shares cancels in a slope),
 /// over tracks whose every size states a standard error: each error's squared deviation from
 /// the track's mean error, with sizes - 1 degrees of freedom a track, and the squared stated
@@ -172,21 +187,23 @@ nlohmann::json goneScore(const Scoring& s, const std::map<int, std::size_t>& tra
 struct SizeErrorSpread {
   double deviation_ss_mm2 = 0.0, stated_ss_mm2 = 0.0;
   std::size_t dof = 0;
+  std::vector<std::vector<SizeError>> tracks;  ///< for the floor's fit
   void add(const FruitletTrack& t, const std::vector<SizeOnDay>& truth) {
     const double n = double(truth.size());
-    std::vector<double> errors_mm;
+    std::vector<SizeError> errors;
     double mean_error_mm = 0.0, stated_mm2 = 0.0;
     for (std::size_t k = 0; k < truth.size(); ++k) {
       const double se_mm = t.sizes[k].sized.standard_error_mm;
       if (!std::isfinite(se_mm)) return;
-      errors_mm.push_back(t.sizes[k].sized.at.size_mm - truth[k].size_mm);
-      mean_error_mm += errors_mm.back() / n;
+      errors.push_back({t.sizes[k].sized.at.size_mm - truth[k].size_mm, se_mm});
+      mean_error_mm += errors.back().error_mm / n;
       stated_mm2 += se_mm * se_mm * (n - 1.0) / n;
     }
-    for (const double error_mm : errors_mm)
-      deviation_ss_mm2 += (error_mm - mean_error_mm) * (error_mm - mean_error_mm);
+    for (const SizeError& e : errors)
+      deviation_ss_mm2 += (e.error_mm - mean_error_mm) * (e.error_mm - mean_error_mm);
     stated_ss_mm2 += stated_mm2;
     dof += truth.size() - 1;
+    tracks.push_back(std::move(errors));
   }
 };
 
@@ -195,7 +212,9 @@ nlohmann::json growthScore(const Scoring& s) {
   std::size_t scored = 0, with_error = 0, covered = 0;
   double abs_sum = 0.0, worst = 0.0;
   SizeErrorSpread spread;
-  for (const FruitletTrack& t : s.analysis.tracks) {
+  nlohmann::json records = nlohmann::json::array();
+  for (std::size_t index = 0; index < s.analysis.tracks.size(); ++index) {
+    const FruitletTrack& t = s.analysis.tracks[index];
     if (!std::isfinite(t.rate.mm_per_day)) continue;
     const int id = s.identityOf(t, t.sizes.front());
     bool one_fruitlet = id >= 0;
@@ -206,6 +225,7 @@ nlohmann::json growthScore(const Scoring& s) {
     }
     if (!one_fruitlet) continue;
     spread.add(t, truth);
+    addSizeRecords(t, index, id, truth, records);
     const double error = t.rate.mm_per_day - host::season::fitGrowthRate(truth).mm_per_day;
     ++scored;
     abs_sum += std::abs(error);
@@ -225,7 +245,9 @@ nlohmann::json growthScore(const Scoring& s) {
           {"covered_95_percent", numberOrNull(percent(covered, with_error))},
           {"size_deviation_ss_mm2", spread.deviation_ss_mm2},
           {"size_deviation_dof", spread.dof},
-          {"stated_standard_error_ss_mm2", spread.stated_ss_mm2}};
+          {"stated_standard_error_ss_mm2", spread.stated_ss_mm2},
+          {"size_error_floor_fit_mm", numberOrNull(sizeErrorFloorFit(spread.tracks))},
+          {"sizes", records}};
 }
 
 /// Confusion of "drops" (positive) over every fruitlet on the tree on the first visit; an
@@ -307,6 +329,55 @@ CaliperOutcome caliperBaseline(const Scoring& s, const std::vector<int>& identit
 }
 
 }  // namespace
+
+namespace {
+
+/// Sum over tracks of sum w (e - e_w)^2 with w = 1 / (se^2 + f^2).
+double weightedSpread(const std::vector<std::vector<SizeError>>& tracks, double floor_mm) {
+  double q = 0.0;
+  for (const auto& track : tracks) {
+    double w_sum = 0.0, we_sum = 0.0;
+    for (const SizeError& e : track) {
+      const double w = 1.0 / (e.standard_error_mm * e.standard_error_mm + floor_mm * floor_mm);
+      w_sum += w;
+      we_sum += w * e.error_mm;
+    }
+    const double mean_mm = we_sum / w_sum;
+    for (const SizeError& e : track) {
+      const double w = 1.0 / (e.standard_error_mm * e.standard_error_mm + floor_mm * floor_mm);
+      q += w * (e.error_mm - mean_mm) * (e.error_mm - mean_mm);
+    }
+  }
+  return q;
+}
+
+}  // namespace
+
+double sizeErrorFloorFit(const std::vector<std::vector<SizeError>>& tracks) {
+  double dof = 0.0, largest_deviation_mm = 0.0;
+  for (const auto& track : tracks) {
+    for (const SizeError& e : track)
+      if (!(e.standard_error_mm > 0.0 && std::isfinite(e.standard_error_mm)) ||
+          !std::isfinite(e.error_mm))
+        throw std::invalid_argument(
+            "sizeErrorFloorFit: every size needs a finite error and a standard error > 0");
+    if (track.size() < 2) continue;
+    dof += double(track.size() - 1);
+    for (const SizeError& a : track)
+      for (const SizeError& b : track)
+        largest_deviation_mm = std::max(largest_deviation_mm, std::abs(a.error_mm - b.error_mm));
+  }
+  if (dof == 0.0) return std::nan("");
+  if (weightedSpread(tracks, 0.0) <= dof) return 0.0;
+  // The spread falls as f grows; at twice the largest deviation D a track's is below
+  // n D^2 / (2 D)^2 = n / 4 <= n - 1, so the root lies between 0 and that.
+  double low = 0.0, high = 2.0 * std::max(largest_deviation_mm, 1e-6);
+  for (int i = 0; i < 200 && high - low > 1e-9; ++i) {
+    const double mid = 0.5 * (low + high);
+    (weightedSpread(tracks, mid) > dof ? low : high) = mid;
+  }
+  return 0.5 * (low + high);
+}
 
 double dropsF1(double true_drops, double false_drops, double missed_drops) {
   const double denominator = 2.0 * true_drops + false_drops + missed_drops;

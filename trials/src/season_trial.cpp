@@ -5,6 +5,7 @@
 #include <iomanip>
 #include <map>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -203,9 +204,36 @@ nlohmann::json ratio(double part, double whole, double scale = 100.0) {
   return whole > 0 ? nlohmann::json(scale * part / whole) : nlohmann::json(nullptr);
 }
 
+nlohmann::json numberOrNull(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+
 /// sqrt(sum / count): a root mean square from pooled sums; null without any.
 nlohmann::json rootOfRatio(double sum, double count) {
   return count > 0 ? nlohmann::json(std::sqrt(sum / count)) : nlohmann::json(nullptr);
+}
+
+/// Every season's tracks whose every size states a standard error, as the floor's fit takes
+/// them (the score's growth.sizes, grouped by track).
+std::vector<std::vector<SizeError>> pooledSizeErrors(const std::vector<nlohmann::json>& seasons) {
+  std::vector<std::vector<SizeError>> tracks;
+  for (const nlohmann::json& s : seasons) {
+    const nlohmann::json& growth = s.at("score").at("growth");
+    std::map<std::size_t, std::vector<SizeError>> by_track;
+    std::set<std::size_t> incomplete;
+    for (const nlohmann::json& r : growth.value("sizes", nlohmann::json::array())) {
+      const std::size_t track = r.at("track").get<std::size_t>();
+      if (!r.at("standard_error_mm").is_number()) {
+        incomplete.insert(track);
+        continue;
+      }
+      by_track[track].push_back({r.at("size_mm").get<double>() - r.at("truth_mm").get<double>(),
+                                 r.at("standard_error_mm").get<double>()});
+    }
+    for (auto& [track, errors] : by_track)
+      if (!incomplete.count(track)) tracks.push_back(std::move(errors));
+  }
+  return tracks;
 }
 
 }  // namespace
@@ -271,6 +299,7 @@ nlohmann::json summarizeSeasons(const std::vector<nlohmann::json>& seasons) {
            rootOfRatio(p.at("growth.size_deviation_ss_mm2"), p.at("growth.size_deviation_dof"))},
           {"stated_standard_error_rms_mm", rootOfRatio(p.at("growth.stated_standard_error_ss_mm2"),
                                                        p.at("growth.size_deviation_dof"))},
+          {"size_error_floor_fit_mm", numberOrNull(sizeErrorFloorFit(pooledSizeErrors(seasons)))},
           {"robot_fate_f1", rf1("robot")},
           {"calipers_fate_f1", rf1("calipers")},
           {"robot_undecided", p.at("robot.undecided")},
@@ -375,6 +404,12 @@ std::string seasonTable(const nlohmann::json& summary) {
      << " | " << fmt(summary["calipers_fate_f1"], 2) << " | "
      << fmt(summary["fruit_set_error_pp_robot"], 1) << " | "
      << fmt(summary["fruit_set_error_pp_calipers"], 1) << " |\n\n"
+     << "Growth rates' 95 % intervals hold the true rate for "
+     << fmt(summary["growth_covered_95_percent"], 1)
+     << " %. Sizes' errors between visits: " << fmt(summary["size_error_between_visits_mm"], 2)
+     << " mm RMS against stated " << fmt(summary["stated_standard_error_rms_mm"], 2)
+     << " mm; the floor that would account for them: " << fmt(summary["size_error_floor_fit_mm"], 2)
+     << " mm.\n\n"
      << "| visit | mean simulated s | MP % | MAE mm | precision % |\n|---|---|---|---|---|\n";
   for (const auto& v : summary.at("visits"))
     md << "| " << v.at("visit") << " | " << fmt(v["mean_sim_s"], 1) << " | "

@@ -12,6 +12,9 @@ namespace fvp::host::season {
 void SeasonConfig::validate() const {
   association.validate();
   fate.validate();
+  if (!(size_error_floor_mm >= 0.0 && std::isfinite(size_error_floor_mm)))
+    throw std::invalid_argument("SeasonConfig: size_error_floor_mm must be finite and >= 0, got " +
+                                std::to_string(size_error_floor_mm));
 }
 
 namespace {
@@ -114,16 +117,17 @@ FruitSet fruitSetOf(const std::vector<FruitletTrack>& tracks,
 
 /// Every track's rate, and every fate against the whole sample's reference (gone tracks
 /// neither set the reference nor get a fate).
-void predictFates(SeasonAnalysis& out, const FateConfig& config) {
+void predictFates(SeasonAnalysis& out, const SeasonConfig& config) {
   std::vector<GrowthRate> rates;
   for (FruitletTrack& t : out.tracks) {
     std::vector<SizeOnDay> sizes;
-    for (const TrackedSize& s : t.sizes)
-      sizes.push_back({s.day, s.sized.at.size_mm, s.sized.standard_error_mm});
+    for (const TrackedSize& s : t.sizes)  // NaN (unknown) stays NaN
+      sizes.push_back({s.day, s.sized.at.size_mm,
+                       std::hypot(s.sized.standard_error_mm, config.size_error_floor_mm)});
     t.rate = fitGrowthRate(sizes);
     rates.push_back(t.gone ? GrowthRate{} : t.rate);
   }
-  const FruitSetPrediction prediction = predictFruitSet(rates, config);
+  const FruitSetPrediction prediction = predictFruitSet(rates, config.fate);
   out.reference_mm_per_day = prediction.reference_mm_per_day;
   out.threshold_mm_per_day = prediction.threshold_mm_per_day;
   std::vector<std::size_t> all;
@@ -156,7 +160,7 @@ SeasonAnalysis analyzeSeason(std::vector<SeasonVisit> visits, const SeasonConfig
     for (const VisitCluster& c : visits[v].clusters) tags.insert(c.tag_id);
   }
   for (const int tag : tags) followCluster(tag, visits, config.association, out);
-  predictFates(out, config.fate);
+  predictFates(out, config);
   return out;
 }
 

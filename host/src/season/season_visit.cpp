@@ -1,6 +1,8 @@
 #include "fvp/host/season/season_visit.h"
 
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -34,6 +36,12 @@ SizedFruitlet sizedFruitlet(const json& f, const std::string& source, const std:
   const auto support = f.find("support");
   if (support == f.end()) return out;
   if (!support->is_object()) fail(source, field + ".support", "an object");
+  if (const auto images = support->find("well_seen_images"); images != support->end()) {
+    if (!images->is_number_integer() || images->get<std::int64_t>() < 0 ||
+        images->get<std::int64_t>() > std::numeric_limits<int>::max())
+      fail(source, field + ".support.well_seen_images", "a count of images (an integer >= 0)");
+    out.well_seen_images = images->get<int>();
+  }
   const auto se = support->find("size_stderr_mm");
   if (se == support->end() || se->is_null()) return out;
   const double v = finiteNumber(*se, source, field + ".support.size_stderr_mm");

@@ -34,6 +34,20 @@ struct SeasonScoreInput {
 /// found): one season's and the pooled seasons'.
 double dropsF1(double true_drops, double false_drops, double missed_drops);
 
+/// One size of a track as the floor's fit sees it: its error against the truth and its stated
+/// standard error.
+struct SizeError {
+  double error_mm = 0.0;
+  double standard_error_mm = 0.0;
+};
+
+/// The floor f (mm) that, added in quadrature to every stated standard error, makes the
+/// tracks' weighted spread about their own mean errors what those errors say
+/// (sum over tracks of sum w (e - e_w)^2 = sum (n - 1), w = 1 / (se^2 + f^2): the Paule-Mandel
+/// moment equation, one shared excess variance); 0 when the stated errors already account for
+/// the spread, NaN without any track of two sizes. A bias a track's sizes share cancels.
+double sizeErrorFloorFit(const std::vector<std::vector<SizeError>>& tracks);
+
 /// The score object (docs/season.md "season_score.json"): association (links made, correct,
 /// truth links), gone (fallen fruitlets reported gone, tracks wrongly gone), growth (rate MAE
 /// against the truth's rate over the same days, and how often the stated uncertainty covers

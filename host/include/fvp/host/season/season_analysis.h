@@ -20,6 +20,11 @@ namespace fvp::host::season {
 struct SeasonConfig {
   AssociationConfig association;
   FateConfig fate;
+  /// What the images of one visit share and their spread cannot show (segmentation and
+  /// occlusion alike in every view of a visit): added in quadrature to each size's stated
+  /// standard error before a rate is fitted. Measured on development seasons
+  /// (docs/season.md "The sizes' errors"); 0 takes the stated errors as they are.
+  double size_error_floor_mm = 0.0;
   void validate() const;
 };
 

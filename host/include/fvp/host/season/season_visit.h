@@ -14,11 +14,13 @@
 
 namespace fvp::host::season {
 
-/// A fruitlet one visit sized: where (tag frame) and how large, and the sizing's own standard
-/// error (NaN where the result has none).
+/// A fruitlet one visit sized: where (tag frame) and how large, the sizing's own standard
+/// error (NaN where the result has none) and how many well-seen images it came from (-1
+/// where the result does not say).
 struct SizedFruitlet {
   VisitFruitlet at;
   double standard_error_mm = std::numeric_limits<double>::quiet_NaN();
+  int well_seen_images = -1;
 };
 
 /// A cluster on one visit, by its tag's id (0 for a result of one cluster without one).
