@@ -1,12 +1,14 @@
 // parseSeasonVisit (host/src/season/season_visit.cpp) and parseVisitMemory
 // (remembered_visit.cpp) on the input as a visit's result.json or fruitlets.json text. What they
 // accept must be usable by the season's association and growth rates and by a later visit:
-// finite centres, finite positive sizes, standard errors positive or unknown, rigid poses.
+// finite centres, finite positive sizes, standard errors positive (at most kMaxStandardErrorMm)
+// or unknown, image counts from 0 or unknown (-1), rigid poses.
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
 #include "fuzz_support.h"
+#include "fvp/host/season/growth_rate.h"
 #include "fvp/host/season/remembered_visit.h"
 #include "fvp/host/season/season_visit.h"
 
@@ -18,9 +20,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (const auto& cluster : visit.clusters)
       for (const auto& f : cluster.fruitlets) {
         const bool se_ok = std::isnan(f.standard_error_mm) ||
-                           (f.standard_error_mm > 0.0 && std::isfinite(f.standard_error_mm));
+                           (f.standard_error_mm > 0.0 &&
+                            f.standard_error_mm <= fvp::host::season::kMaxStandardErrorMm);
         if (!f.at.center_tag_m.allFinite() || !(f.at.size_mm > 0.0) ||
-            !std::isfinite(f.at.size_mm) || !se_ok || cluster.tag_id < 0) {
+            !std::isfinite(f.at.size_mm) || !se_ok || cluster.tag_id < 0 ||
+            f.well_seen_images < -1) {
           std::fprintf(stderr, "fvp fuzz: accepted a fruitlet of %g mm (error %g) in tag %d\n",
                        f.at.size_mm, f.standard_error_mm, cluster.tag_id);
           std::abort();

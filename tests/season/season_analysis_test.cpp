@@ -73,18 +73,22 @@ TEST(SeasonVisit, BadVisitsNameTheFileAndTheField) {
   EXPECT_EQ(errorOf(R"({"T_world_tag": {}, "sized_fruitlets": [{"center_tag_m": [0, 0, 0],
                         "size_mm": 7, "support": {"size_stderr_mm": -0.2}}]})"),
             "visit.json: sized_fruitlets[0].support.size_stderr_mm: expected -1 or 0 (unknown) "
-            "or a standard error of at least 1e-6 mm");
+            "or a standard error from 1e-6 to 1000 mm");
   EXPECT_EQ(errorOf(R"({"T_world_tag": {}, "sized_fruitlets": [{"center_tag_m": [0, 0, 0],
                         "size_mm": 7, "support": 3}]})"),
             "visit.json: sized_fruitlets[0].support: expected an object");
   EXPECT_EQ(errorOf(R"({"T_world_tag": {}, "sized_fruitlets": [{"center_tag_m": [0, 0, 0],
                         "size_mm": 7, "support": {"well_seen_images": 2.5}}]})"),
             "visit.json: sized_fruitlets[0].support.well_seen_images: expected a count of images "
-            "(an integer >= 0)");
+            "(an integer from 0 to 2147483647)");
   EXPECT_EQ(errorOf(R"({"T_world_tag": {}, "sized_fruitlets": [{"center_tag_m": [0, 0, 0],
                         "size_mm": 7, "support": {"well_seen_images": -1}}]})"),
             "visit.json: sized_fruitlets[0].support.well_seen_images: expected a count of images "
-            "(an integer >= 0)");
+            "(an integer from 0 to 2147483647)");
+  EXPECT_EQ(errorOf(R"({"T_world_tag": {}, "sized_fruitlets": [{"center_tag_m": [0, 0, 0],
+                        "size_mm": 7, "support": {"size_stderr_mm": 1e200}}]})"),
+            "visit.json: sized_fruitlets[0].support.size_stderr_mm: expected -1 or 0 (unknown) "
+            "or a standard error from 1e-6 to 1000 mm");
   std::string crowded = R"({"T_world_tag": {}, "sized_fruitlets": [)";
   for (int i = 0; i < 65; ++i)
     crowded += std::string(i ? "," : "") + R"({"center_tag_m": [0, 0, 0], "size_mm": 7})";
@@ -159,7 +163,7 @@ TEST(SeasonAnalysis, TheSizeErrorFloorWidensEveryStatedError) {
               1e-12);
   EXPECT_NEAR(s.tracks[2].rate.mm_per_day, 0.1, 1e-12);
   EXPECT_EQ(seasonJson(s, config)["config"]["size_error_floor_mm"], 0.3);
-  for (const double bad : {-0.1, double(NAN), double(INFINITY)}) {
+  for (const double bad : {-0.1, 1001.0, double(NAN), double(INFINITY)}) {
     config.size_error_floor_mm = bad;
     EXPECT_THROW(analyzeSeason(visits, config), std::invalid_argument) << bad;
   }

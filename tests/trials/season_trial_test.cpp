@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -114,6 +115,56 @@ TEST_F(SeasonTrial, RepeatsExactlyAndResumesOnlyWhatItWouldRun) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("days"), std::string::npos) << e.what();
   }
+}
+
+/// A season's line as summarizeSeasons reads it: one visit, and a score whose growth holds
+/// the given sizes (each {track, size_mm, truth_mm, standard_error_mm}).
+nlohmann::json seasonLine(const nlohmann::json& sizes) {
+  const nlohmann::json confusion = {
+      {"true_drops", 1}, {"false_drops", 0}, {"missed_drops", 0}, {"true_stays", 3}};
+  return {{"visits",
+           {{{"sim_time_s", 100.0},
+             {"gt_fruitlets", 4},
+             {"matched", 4},
+             {"detections", 4},
+             {"mae_mm", 0.2}}}},
+          {"score",
+           {{"association", {{"links_made", 2}, {"links_correct", 2}}},
+            {"gone", {{"fallen_sized", 1}, {"reported_gone", 1}}},
+            {"growth",
+             {{"tracks_scored", 2},
+              {"mae_mm_per_day", 0.05},
+              {"size_error_floor_fit_mm", 0.5},
+              {"sizes", sizes}}},
+            {"fate", {{"robot", confusion}, {"calipers", confusion}}},
+            {"fruit_set_percent", {{"truth", 75.0}, {"robot", 70.0}, {"calipers", 75.0}}}}}};
+}
+
+nlohmann::json sizeRecord(std::size_t track, double error_mm, nlohmann::json se_mm) {
+  return {{"track", track},
+          {"size_mm", 6.0 + error_mm},
+          {"truth_mm", 6.0},
+          {"standard_error_mm", std::move(se_mm)}};
+}
+
+TEST(SeasonSummary, FitsTheFloorOverEverySeasonsSizes) {
+  // Season A: track 0 deviates by 0.2 mm (stated 0.1); track 1 lacks a standard error and is
+  // left out. Season B: the same deviation, and a line scored before sizes were recorded.
+  const nlohmann::json a = seasonLine({sizeRecord(0, 0.2, 0.1), sizeRecord(0, -0.2, 0.1),
+                                       sizeRecord(1, 0.3, nullptr), sizeRecord(1, 0.0, 0.1)});
+  const nlohmann::json b = seasonLine({sizeRecord(0, 0.2, 0.1), sizeRecord(0, -0.2, 0.1)});
+  nlohmann::json old = seasonLine({});
+  old["score"]["growth"].erase("sizes");
+  const nlohmann::json summary = summarizeSeasons({a, b, old});
+  EXPECT_EQ(summary["size_error_floor_fit_tracks"], 2);
+  // Two tracks of deviation +-0.2 about their means, one dof each: 2 * 0.08 / (0.01 + f^2) = 2.
+  EXPECT_NEAR(summary["size_error_floor_fit_mm"].get<double>(), std::sqrt(0.07), 1e-6);
+  EXPECT_NEAR(summarizeSeasons({a})["size_error_floor_fit_mm"].get<double>(), std::sqrt(0.07),
+              1e-6);
+  EXPECT_TRUE(summarizeSeasons({old})["size_error_floor_fit_mm"].is_null());
+  EXPECT_NE(seasonTable(summary).find("the floor that would account for them: 0.26 mm"),
+            std::string::npos)
+      << seasonTable(summary);
 }
 
 TEST(SeasonDays, AreCheckedNamingTheDay) {

@@ -357,10 +357,12 @@ double sizeErrorFloorFit(const std::vector<std::vector<SizeError>>& tracks) {
   double dof = 0.0, largest_deviation_mm = 0.0;
   for (const auto& track : tracks) {
     for (const SizeError& e : track)
-      if (!(e.standard_error_mm > 0.0 && std::isfinite(e.standard_error_mm)) ||
-          !std::isfinite(e.error_mm))
+      if (!(e.standard_error_mm >= host::season::kMinStandardErrorMm &&
+            e.standard_error_mm <= host::season::kMaxStandardErrorMm) ||
+          !(std::abs(e.error_mm) <= host::season::kMaxStandardErrorMm))
         throw std::invalid_argument(
-            "sizeErrorFloorFit: every size needs a finite error and a standard error > 0");
+            "sizeErrorFloorFit: every size needs an error within 1000 mm and a standard error "
+            "from 1e-6 to 1000 mm");
     if (track.size() < 2) continue;
     dof += double(track.size() - 1);
     for (const SizeError& a : track)

@@ -191,7 +191,7 @@ struct Pooled {
     for (const auto& [key, value] : object.items())
       if (value.is_number() && (key.find("percent") == std::string::npos) &&
           key.find("mae") == std::string::npos && key.find("f1") == std::string::npos &&
-          key.find("worst") == std::string::npos)
+          key.find("worst") == std::string::npos && key.find("floor") == std::string::npos)
         sums[prefix + key] += value.get<double>();
   }
   double at(const std::string& key) const {
@@ -280,6 +280,8 @@ nlohmann::json summarizeSeasons(const std::vector<nlohmann::json>& seasons) {
                       {"mae_mm", ratio(abs, matched, 1.0)},
                       {"precision_percent", ratio(matched, detections)}});
   }
+  // Seasons scored before the score recorded its sizes add none: the fit says how many.
+  const std::vector<std::vector<SizeError>> size_errors = pooledSizeErrors(seasons);
   const auto rf1 = [&](const std::string& who) {
     return dropsF1(p.at(who + ".true_drops"), p.at(who + ".false_drops"),
                    p.at(who + ".missed_drops"));
@@ -299,7 +301,8 @@ nlohmann::json summarizeSeasons(const std::vector<nlohmann::json>& seasons) {
            rootOfRatio(p.at("growth.size_deviation_ss_mm2"), p.at("growth.size_deviation_dof"))},
           {"stated_standard_error_rms_mm", rootOfRatio(p.at("growth.stated_standard_error_ss_mm2"),
                                                        p.at("growth.size_deviation_dof"))},
-          {"size_error_floor_fit_mm", numberOrNull(sizeErrorFloorFit(pooledSizeErrors(seasons)))},
+          {"size_error_floor_fit_mm", numberOrNull(sizeErrorFloorFit(size_errors))},
+          {"size_error_floor_fit_tracks", size_errors.size()},
           {"robot_fate_f1", rf1("robot")},
           {"calipers_fate_f1", rf1("calipers")},
           {"robot_undecided", p.at("robot.undecided")},

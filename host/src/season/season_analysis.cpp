@@ -12,8 +12,8 @@ namespace fvp::host::season {
 void SeasonConfig::validate() const {
   association.validate();
   fate.validate();
-  if (!(size_error_floor_mm >= 0.0 && std::isfinite(size_error_floor_mm)))
-    throw std::invalid_argument("SeasonConfig: size_error_floor_mm must be finite and >= 0, got " +
+  if (!(size_error_floor_mm >= 0.0 && size_error_floor_mm <= kMaxStandardErrorMm))
+    throw std::invalid_argument("SeasonConfig: size_error_floor_mm must lie in [0, 1000] mm, got " +
                                 std::to_string(size_error_floor_mm));
 }
 

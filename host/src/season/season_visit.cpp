@@ -39,16 +39,18 @@ SizedFruitlet sizedFruitlet(const json& f, const std::string& source, const std:
   if (const auto images = support->find("well_seen_images"); images != support->end()) {
     if (!images->is_number_integer() || images->get<std::int64_t>() < 0 ||
         images->get<std::int64_t>() > std::numeric_limits<int>::max())
-      fail(source, field + ".support.well_seen_images", "a count of images (an integer >= 0)");
+      fail(source, field + ".support.well_seen_images",
+           "a count of images (an integer from 0 to " +
+               std::to_string(std::numeric_limits<int>::max()) + ")");
     out.well_seen_images = images->get<int>();
   }
   const auto se = support->find("size_stderr_mm");
   if (se == support->end() || se->is_null()) return out;
   const double v = finiteNumber(*se, source, field + ".support.size_stderr_mm");
   // -1: fewer than two well-seen images (the sizer's "unknown"); 0: no spread measured.
-  if (v != -1.0 && v != 0.0 && !(v >= kMinStandardErrorMm))
+  if (v != -1.0 && v != 0.0 && !(v >= kMinStandardErrorMm && v <= kMaxStandardErrorMm))
     fail(source, field + ".support.size_stderr_mm",
-         "-1 or 0 (unknown) or a standard error of at least 1e-6 mm");
+         "-1 or 0 (unknown) or a standard error from 1e-6 to 1000 mm");
   if (v > 0.0) out.standard_error_mm = v;
   return out;
 }

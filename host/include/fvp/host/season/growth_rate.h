@@ -33,6 +33,10 @@ struct GrowthRate {
 /// fit overflow.
 inline constexpr double kMinStandardErrorMm = 1e-6;
 
+/// The largest a visit's reader takes (a metre: a fruitlet is a few centimetres; far beyond
+/// it the weights underflow).
+inline constexpr double kMaxStandardErrorMm = 1000.0;
+
 /// The least-squares slope of size against day: weighted by 1 / standard error^2 when every
 /// size has one (the slope's standard error then follows from them), else unweighted (its
 /// standard error from the residuals, with three or more sizes). A fruitlet sized on one day
