@@ -24,7 +24,7 @@ struct SeasonConfig {
   /// occlusion alike in every view of a visit): added in quadrature to each size's stated
   /// standard error before a rate is fitted. Measured on development seasons
   /// (docs/season.md "The sizes' errors"); 0 takes the stated errors as they are.
-  double size_error_floor_mm = 0.0;
+  double size_error_floor_mm = 0.14;
   void validate() const;
 };
 
