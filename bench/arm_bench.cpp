@@ -162,6 +162,20 @@ struct Query {
   Eigen::Isometry3d T_world_camera;
 };
 
+// The worlds of BM_MotionPlan: one cluster (range 0 = 0, the default world) or a four-cluster
+// tree (1: world_tree.yaml's geometry), each mapped at the coarse map's 1 cm from the truth.
+robot::sim::WorldConfig planningWorldConfig(std::int64_t tree) {
+  robot::sim::WorldConfig config;
+  if (tree != 0) {
+    config.cluster_count = 4;
+    config.min_cluster_spacing_m = 0.2;
+    config.cluster_height_spread_m = 0.3;
+  }
+  return config;
+}
+
+// moveToPose over feasible queries on four worlds. range(0): one cluster (0) or a tree (1);
+// range(1): the collision checker's distance field on (1) or FCL alone (0), the same plans.
 void BM_MotionPlan(benchmark::State& state) {
   const ArmModel arm{ArmConfig{}};
   constexpr int kWorlds = 4, kQueriesPerWorld = 25;
@@ -170,18 +184,23 @@ void BM_MotionPlan(benchmark::State& state) {
   std::mt19937_64 rng(77);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   for (int w = 0; w < kWorlds; ++w) {
-    const auto world = robot::sim::World::generate(robot::sim::WorldConfig{}, 500 + w);
-    const Eigen::Vector3d c = world.clusterCenter_m();
-    const auto tree = robot::sim::worldOccupancy(
-        world, 0.01, Eigen::AlignedBox3d(c.array() - 0.6, c.array() + 0.6));
+    const auto world = robot::sim::World::generate(planningWorldConfig(state.range(0)), 500 + w);
+    Eigen::AlignedBox3d box;
+    for (const auto& cluster : world.clusters())
+      box.extend(
+          Eigen::AlignedBox3d(cluster.center_m.array() - 0.6, cluster.center_m.array() + 0.6));
+    const auto tree = robot::sim::worldOccupancy(world, 0.01, box);
     checkers.push_back(std::make_unique<robot::ArmCollisionChecker>(arm));
     checkers.back()->setMap(*tree);
+    checkers.back()->setUseDistanceField(state.range(1) != 0);
     const auto start = robot::sim::ArmController::startConfiguration(arm, world.startCameraPose());
     if (!start) {
       state.SkipWithError("motion plan: a start view is unreachable");
       return;
     }
     for (int found = 0; found < kQueriesPerWorld;) {
+      const Eigen::Vector3d c =
+          world.clusters()[static_cast<std::size_t>(found) % world.clusters().size()].center_m;
       const Eigen::Vector3d target = c + 0.04 * Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
       const Eigen::Vector3d dir =
           Eigen::Vector3d(unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5).normalized();
@@ -243,6 +262,11 @@ BENCHMARK(BM_WorkspaceLoad)
     ->UseRealTime();
 BENCHMARK(BM_MotionPlan)
     ->Name("BM_MotionPlan/rrtconnect/cpu")
+    ->ArgNames({"tree", "field"})
+    ->Args({0, 1})
+    ->Args({0, 0})
+    ->Args({1, 1})
+    ->Args({1, 0})
     ->Iterations(100)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

@@ -6,7 +6,10 @@
 #include <random>
 
 #include "fvp/robot/arm_collision_checker.h"
+#include "fvp/robot/occupancy_distance_field.h"
+#include "fvp/robot/sim/camera_views.h"
 #include "fvp/robot/sim/world.h"
+#include "fvp/robot/sim/world_config.h"
 #include "fvp/robot/sim/world_occupancy.h"
 
 namespace fvp::robot {
@@ -228,6 +231,128 @@ TEST(ArmCollisionChecker, StartViewOfAWorldIsFreeInItsFullMap) {
   for (const JointVector& q : arm.inverse(world.startCameraPose(), arm.homeConfiguration()))
     free_start += checker.isValid(q) ? 1 : 0;
   EXPECT_GT(free_start, 0);
+}
+
+// The field's squared distances are the brute-force minimum over the occupied voxels, cell by
+// cell, on random sets (one voxel, a few, many; a grid flat along one axis).
+TEST(OccupancyDistanceField, SquaredDistancesAreTheBruteForceMinimum) {
+  std::mt19937_64 rng(11);
+  for (const int count : {1, 3, 40, 400}) {
+    std::uniform_int_distribution<int> x(-7, 12), y(3, 17), z(count == 40 ? 5 : -4, 5);
+    std::vector<Eigen::Vector3i> occupied;
+    for (int i = 0; i < count; ++i) occupied.emplace_back(x(rng), y(rng), z(rng));
+    const OccupancyDistanceField field(0.01, occupied);
+    ASSERT_FALSE(field.empty());
+    const Eigen::Vector3i low = field.gridMin(), size = field.gridSize();
+    for (int i = 0; i < size.x(); ++i)
+      for (int j = 0; j < size.y(); ++j)
+        for (int k = 0; k < size.z(); ++k) {
+          const Eigen::Vector3i cell = low + Eigen::Vector3i(i, j, k);
+          int best = std::numeric_limits<int>::max();
+          for (const Eigen::Vector3i& v : occupied) best = std::min(best, (v - cell).squaredNorm());
+          ASSERT_EQ(field.squaredDistanceVox(cell), static_cast<float>(best))
+              << count << " voxels, cell " << cell.transpose();
+        }
+    EXPECT_EQ(field.squaredDistanceVoxChecked(low - Eigen::Vector3i::UnitX()), -1.0f);
+    EXPECT_EQ(field.squaredDistanceVoxChecked(low + size), -1.0f);
+  }
+}
+
+// lowerBoundDistance_m never exceeds the distance to the nearest occupied box, inside and
+// outside the grid, and inside it is within a voxel's diagonal of it; upperBoundDistance_m never
+// falls below it; capsuleVerdict's kClear and kTouching hold by a brute-force check.
+TEST(OccupancyDistanceField, LowerBoundsHoldAgainstBruteForce) {
+  std::mt19937_64 rng(12);
+  constexpr double kVoxelM = 0.02;
+  std::uniform_int_distribution<int> cell(-10, 10);
+  std::vector<Eigen::Vector3i> occupied;
+  for (int i = 0; i < 60; ++i) occupied.emplace_back(cell(rng), cell(rng), cell(rng));
+  const OccupancyDistanceField field(kVoxelM, occupied);
+  const auto boxOf = [&](const Eigen::Vector3i& v) {
+    return Eigen::AlignedBox3d(v.cast<double>() * kVoxelM,
+                               (v + Eigen::Vector3i::Ones()).cast<double>() * kVoxelM);
+  };
+  const auto pointDistance = [&](const Eigen::Vector3d& p) {
+    double best = std::numeric_limits<double>::infinity();
+    for (const Eigen::Vector3i& v : occupied) best = std::min(best, pointBoxDistance(p, boxOf(v)));
+    return best;
+  };
+  std::uniform_real_distribution<double> coordinate(-0.4, 0.4), radius(0.0, 0.1);
+  int shown_clear = 0, clear = 0, shown_touching = 0, touching = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const Eigen::Vector3d p(coordinate(rng), coordinate(rng), coordinate(rng));
+    const double truth = pointDistance(p), bound = field.lowerBoundDistance_m(p);
+    ASSERT_LE(bound, truth + 1e-12) << "point " << p.transpose();
+    // Within the grid, a voxel's diagonal at most below (outside it, the grid's faces).
+    const Eigen::Vector3i in_cell = (p / kVoxelM).array().floor().cast<int>().matrix();
+    if (field.squaredDistanceVoxChecked(in_cell) >= 0.0f)
+      ASSERT_GE(bound, truth - std::sqrt(3.0) * kVoxelM - 1e-12) << "point " << p.transpose();
+    const Eigen::Vector3d q(coordinate(rng), coordinate(rng), coordinate(rng));
+    const double r = radius(rng);
+    double clearance = std::numeric_limits<double>::infinity();
+    for (const Eigen::Vector3i& v : occupied)
+      clearance = std::min(clearance, segmentBoxDistance(p, q, boxOf(v)) - r);
+    clear += clearance > 1e-3 ? 1 : 0;
+    touching += clearance < -1e-3 ? 1 : 0;
+    const auto verdict = field.capsuleVerdict(p, q, r, 1e-3);
+    if (verdict == OccupancyDistanceField::CapsuleVerdict::kClear) {
+      ++shown_clear;
+      ASSERT_GT(clearance, 1e-3 - 1e-9) << "capsule " << p.transpose() << " to " << q.transpose();
+    } else if (verdict == OccupancyDistanceField::CapsuleVerdict::kTouching) {
+      ++shown_touching;
+      ASSERT_LT(clearance, -1e-3 + 1e-9) << "capsule " << p.transpose() << " to " << q.transpose();
+    }
+    const double upper = field.upperBoundDistance_m(p);
+    ASSERT_GE(upper, truth - 1e-12) << "point " << p.transpose();
+  }
+  std::cout << "capsules: " << clear << " clear, " << shown_clear << " shown clear; " << touching
+            << " touching, " << shown_touching << " shown touching\n";
+  EXPECT_GT(shown_clear, clear / 4);
+  EXPECT_GT(shown_touching, touching / 4);
+  EXPECT_TRUE(OccupancyDistanceField().capsuleClear(Eigen::Vector3d::Zero(),
+                                                    Eigen::Vector3d::Ones(), 1.0, 0.0));
+  EXPECT_THROW(OccupancyDistanceField(
+                   0.01, {Eigen::Vector3i(0, 0, 0), Eigen::Vector3i(999, 999, 999)}, 1000),
+               std::invalid_argument);
+}
+
+// The checker's answers with the distance field are FCL's alone, on a tree world's 1 cm map:
+// random configurations, and configurations viewing the clusters from 15-40 cm (the links
+// among the leaves).
+TEST(ArmCollisionChecker, DistanceFieldKeepsFclsAnswersOnATreeWorld) {
+  const ArmModel arm{ArmConfig{}};
+  const auto world = sim::World::generate(
+      sim::WorldConfig::fromYamlFile(FVP_SOURCE_DIR "/robot/sim/config/world_season.yaml"), 3);
+  const Eigen::AlignedBox3d bounds(Eigen::Vector3d(-1.0, -1.0, 0.0),
+                                   Eigen::Vector3d(1.0, 1.0, 2.0));
+  const auto tree = sim::worldOccupancy(world, 0.01, bounds);
+  ArmCollisionChecker checker(arm);
+  checker.setMap(*tree);
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<JointVector> configurations;
+  for (int i = 0; i < 400; ++i) configurations.push_back(randomConfiguration(arm, rng));
+  for (int i = 0; i < 300; ++i) {
+    const Eigen::Vector3d target =
+        world.clusters()[static_cast<std::size_t>(i) % world.clusters().size()].center_m;
+    const Eigen::Vector3d dir =
+        Eigen::Vector3d(unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5).normalized();
+    const Eigen::Isometry3d T = sim::lookAt(target - (0.15 + 0.25 * unit(rng)) * dir, target);
+    for (const JointVector& q : arm.inverse(T, arm.homeConfiguration()))
+      configurations.push_back(q);
+  }
+  int colliding = 0, disagreements = 0;
+  for (const JointVector& q : configurations) {
+    const LinkCapsules links = arm.linkCapsules(q);
+    const bool fcl = checker.mapCollisionFclOnly(links);
+    disagreements += checker.mapCollision(links) != fcl ? 1 : 0;
+    colliding += fcl ? 1 : 0;
+  }
+  std::cout << configurations.size() << " configurations, " << colliding << " colliding, "
+            << disagreements << " disagreements\n";
+  EXPECT_EQ(disagreements, 0);
+  EXPECT_GT(colliding, 50);
+  EXPECT_GT(static_cast<int>(configurations.size()) - colliding, 50);
 }
 
 }  // namespace

@@ -1,7 +1,9 @@
 // Whether an arm configuration is valid: within joint limits, free of self collision, the
 // ground and the slider rail, and with no link capsule (padded by collision_padding_m)
 // touching an occupied voxel of the coarse map. The map check is FCL's capsule-against-
-// fcl::OcTree test over a copy of the octomap::OcTree, as MoveIt does.
+// fcl::OcTree test over a copy of the octomap::OcTree, as MoveIt does, for the capsules that a
+// distance field over the occupied voxels (OccupancyDistanceField) does not show clear: the
+// same answers, without FCL's traversal for links far from every obstacle.
 #pragma once
 
 #include <atomic>
@@ -43,6 +45,12 @@ class ArmCollisionChecker {
   bool isValid(const JointVector& q) const;
   /// Only the map part of isValid, for given capsules (padding is added here).
   bool mapCollision(const LinkCapsules& links) const;
+  /// mapCollision by FCL alone, every capsule near the occupied voxels traversed: the oracle
+  /// the distance field's shortcut is tested and measured against.
+  bool mapCollisionFclOnly(const LinkCapsules& links) const;
+  /// Whether isValid and mapCollision use the distance field (default true; false: FCL alone,
+  /// the same answers more slowly, for benchmarks).
+  void setUseDistanceField(bool use) { use_distance_field_ = use; }
   const ArmModel& arm() const { return arm_; }
   /// isValid calls so far (planning statistics).
   std::uint64_t checks() const { return checks_.load(std::memory_order_relaxed); }
@@ -50,9 +58,11 @@ class ArmCollisionChecker {
  private:
   struct Fcl;
   void setMapOwned(std::shared_ptr<octomap::OcTree> map);
+  bool mapCollision_(const LinkCapsules& links, bool use_field) const;
   const ArmModel& arm_;
   std::unique_ptr<Fcl> fcl_;
   mutable std::atomic<std::uint64_t> checks_{0};
+  bool use_distance_field_ = true;
 };
 
 }  // namespace fvp::robot

@@ -1,0 +1,76 @@
+// Distances to the nearest occupied voxel of a map, as lower bounds that a collision check can
+// trust: exact squared Euclidean distances between voxel centres (the separable transform of
+// Felzenszwalb and Huttenlocher, "Distance Transforms of Sampled Functions", 2012) over the
+// occupied voxels' bounding grid. The arm's collision check decides a capsule with it when every
+// obstacle is clearly beyond the capsule's radius, or one clearly within it, and leaves the rest
+// to FCL's exact test.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace fvp::robot {
+
+class OccupancyDistanceField {
+ public:
+  /// No occupied voxel: every point is clear.
+  OccupancyDistanceField() = default;
+  /// Voxels of edge `voxel_size_m`; voxel index i spans [i, i + 1) * voxel_size_m on each axis
+  /// (OctoMap's key minus its centre key). Throws std::invalid_argument when the voxels'
+  /// bounding grid would hold more than `max_cells` cells.
+  OccupancyDistanceField(double voxel_size_m, const std::vector<Eigen::Vector3i>& occupied,
+                         std::size_t max_cells = kDefaultMaxCells);
+
+  /// At most this many cells by default (4 bytes each): a 2 m cube at 1 cm is 8 M.
+  static constexpr std::size_t kDefaultMaxCells = std::size_t{64} << 20;
+
+  bool empty() const { return squared_distance_vox_.empty(); }
+  double voxel_size_m() const { return voxel_size_m_; }
+  Eigen::Vector3i gridMin() const { return min_; }
+  Eigen::Vector3i gridSize() const { return size_; }
+
+  /// Squared distance, in voxels, from voxel `index`'s centre to the nearest occupied voxel's
+  /// centre; `index` must lie in the grid (checked twin: squaredDistanceVoxChecked).
+  float squaredDistanceVox(const Eigen::Vector3i& index) const {
+    const Eigen::Vector3i local = index - min_;
+    return squared_distance_vox_[static_cast<std::size_t>(local.x()) +
+                                 static_cast<std::size_t>(size_.x()) *
+                                     (static_cast<std::size_t>(local.y()) +
+                                      static_cast<std::size_t>(size_.y()) * local.z())];
+  }
+  /// squaredDistanceVox, or -1 when `index` lies outside the grid.
+  float squaredDistanceVoxChecked(const Eigen::Vector3i& index) const;
+
+  /// A lower bound on the distance from `point_m` to every occupied voxel's box (infinite
+  /// when there is none; may be negative near one).
+  double lowerBoundDistance_m(const Eigen::Vector3d& point_m) const;
+  /// An upper bound on the distance from `point_m` to the nearest occupied voxel's box (its
+  /// centre's distance); infinite outside the grid or with no occupied voxel.
+  double upperBoundDistance_m(const Eigen::Vector3d& point_m) const;
+
+  enum class CapsuleVerdict {
+    kClear,      ///< more than the margin from every occupied voxel's box
+    kTouching,   ///< more than the margin into an occupied voxel's box
+    kUndecided,  ///< the bounds cannot tell: an exact test must
+  };
+  /// The capsule of segment a-b and `radius_m` against the occupied voxels, by the bounds.
+  CapsuleVerdict capsuleVerdict(const Eigen::Vector3d& a_m, const Eigen::Vector3d& b_m,
+                                double radius_m, double margin_m) const;
+  bool capsuleClear(const Eigen::Vector3d& a_m, const Eigen::Vector3d& b_m, double radius_m,
+                    double margin_m) const {
+    return capsuleVerdict(a_m, b_m, radius_m, margin_m) == CapsuleVerdict::kClear;
+  }
+
+ private:
+  /// The grid cell holding `point_m`, false outside the grid.
+  bool cellOf(const Eigen::Vector3d& point_m, Eigen::Vector3i& index) const;
+  double voxel_size_m_ = 0.0;
+  Eigen::Vector3i min_ = Eigen::Vector3i::Zero();
+  Eigen::Vector3i size_ = Eigen::Vector3i::Zero();
+  std::vector<float> squared_distance_vox_;
+};
+
+}  // namespace fvp::robot

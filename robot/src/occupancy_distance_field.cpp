@@ -1,0 +1,166 @@
+#include "fvp/robot/occupancy_distance_field.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace fvp::robot {
+namespace {
+
+// "No occupied voxel on this line yet": finite, so that the lower envelope's intersections stay
+// finite, and larger than any squared distance in a grid of at most 2^16 cells an axis.
+constexpr float kFarSquaredVox = 1e12f;
+
+/// One line of the separable transform: out[q] = min over p of f[p] + (q - p)^2, by the lower
+/// envelope of the parabolas rooted at each p (Felzenszwalb and Huttenlocher, section 3).
+void transformLine(std::vector<double>& f, std::vector<double>& out, std::vector<int>& roots,
+                   std::vector<double>& bounds) {
+  const int n = static_cast<int>(f.size());
+  int k = 0;
+  roots[0] = 0;
+  bounds[0] = -std::numeric_limits<double>::infinity();
+  bounds[1] = std::numeric_limits<double>::infinity();
+  const auto meet = [&](int q, int r) {
+    return ((f[q] + double(q) * q) - (f[r] + double(r) * r)) / (2.0 * q - 2.0 * r);
+  };
+  for (int q = 1; q < n; ++q) {
+    double s = meet(q, roots[k]);
+    while (s <= bounds[k]) s = meet(q, roots[--k]);
+    ++k;
+    roots[k] = q;
+    bounds[k] = s;
+    bounds[k + 1] = std::numeric_limits<double>::infinity();
+  }
+  k = 0;
+  for (int q = 0; q < n; ++q) {
+    while (bounds[k + 1] < q) ++k;
+    const double d = q - roots[k];
+    out[q] = d * d + f[roots[k]];
+  }
+}
+
+/// The transform along `axis` of every line of the grid, in place.
+void transformAxis(std::vector<float>& grid, const Eigen::Vector3i& size, int axis) {
+  const int n = size[axis];
+  const std::size_t stride = axis == 0   ? 1
+                             : axis == 1 ? static_cast<std::size_t>(size.x())
+                                         : static_cast<std::size_t>(size.x()) * size.y();
+  const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+  const std::size_t stride_a = a == 0   ? 1
+                               : a == 1 ? static_cast<std::size_t>(size.x())
+                                        : static_cast<std::size_t>(size.x()) * size.y();
+  const std::size_t stride_b = b == 0   ? 1
+                               : b == 1 ? static_cast<std::size_t>(size.x())
+                                        : static_cast<std::size_t>(size.x()) * size.y();
+  std::vector<double> f(static_cast<std::size_t>(n)), out(f.size());
+  std::vector<int> roots(f.size());
+  std::vector<double> bounds(f.size() + 1);
+  for (int j = 0; j < size[b]; ++j)
+    for (int i = 0; i < size[a]; ++i) {
+      const std::size_t first = i * stride_a + j * stride_b;
+      for (int q = 0; q < n; ++q) f[q] = grid[first + q * stride];
+      transformLine(f, out, roots, bounds);
+      for (int q = 0; q < n; ++q) grid[first + q * stride] = static_cast<float>(out[q]);
+    }
+}
+
+}  // namespace
+
+OccupancyDistanceField::OccupancyDistanceField(double voxel_size_m,
+                                               const std::vector<Eigen::Vector3i>& occupied,
+                                               std::size_t max_cells)
+    : voxel_size_m_(voxel_size_m) {
+  if (!(voxel_size_m > 0.0) || !std::isfinite(voxel_size_m))
+    throw std::invalid_argument("occupancy distance field: voxel size must be positive");
+  if (occupied.empty()) return;
+  Eigen::Vector3i low = occupied.front(), high = occupied.front();
+  for (const Eigen::Vector3i& v : occupied) low = low.cwiseMin(v), high = high.cwiseMax(v);
+  const Eigen::Array3d cells = (high - low).cast<double>().array() + 1.0;
+  if (cells.prod() > static_cast<double>(max_cells))
+    throw std::invalid_argument("occupancy distance field: the occupied voxels span " +
+                                std::to_string(cells.prod()) + " cells, more than " +
+                                std::to_string(max_cells));
+  min_ = low;
+  size_ = (high - low).array() + 1;
+  squared_distance_vox_.assign(static_cast<std::size_t>(cells.prod()), kFarSquaredVox);
+  for (const Eigen::Vector3i& v : occupied) {
+    const Eigen::Vector3i local = v - min_;
+    squared_distance_vox_[static_cast<std::size_t>(local.x()) +
+                          static_cast<std::size_t>(size_.x()) *
+                              (static_cast<std::size_t>(local.y()) +
+                               static_cast<std::size_t>(size_.y()) * local.z())] = 0.0f;
+  }
+  for (int axis = 0; axis < 3; ++axis) transformAxis(squared_distance_vox_, size_, axis);
+}
+
+float OccupancyDistanceField::squaredDistanceVoxChecked(const Eigen::Vector3i& index) const {
+  const Eigen::Vector3i local = index - min_;
+  if (empty() || (local.array() < 0).any() || (local.array() >= size_.array()).any()) return -1.0f;
+  return squaredDistanceVox(index);
+}
+
+bool OccupancyDistanceField::cellOf(const Eigen::Vector3d& point_m, Eigen::Vector3i& index) const {
+  const Eigen::Vector3d cell = (point_m / voxel_size_m_).array().floor();
+  if ((cell.array() < min_.cast<double>().array()).any() ||
+      (cell.array() >= (min_ + size_).cast<double>().array()).any())
+    return false;
+  index = cell.cast<int>();
+  return true;
+}
+
+double OccupancyDistanceField::lowerBoundDistance_m(const Eigen::Vector3d& point_m) const {
+  if (empty()) return std::numeric_limits<double>::infinity();
+  if (!point_m.allFinite()) return -std::numeric_limits<double>::infinity();
+  Eigen::Vector3i index;
+  if (!cellOf(point_m, index)) {
+    // Outside the grid every occupied box is beyond the grid's faces.
+    const Eigen::Vector3d grid_low = min_.cast<double>() * voxel_size_m_;
+    const Eigen::Vector3d grid_high = (min_ + size_).cast<double>() * voxel_size_m_;
+    return (point_m - point_m.cwiseMax(grid_low).cwiseMin(grid_high)).norm();
+  }
+  const Eigen::Vector3d centre_m = (index.cast<double>().array() + 0.5) * voxel_size_m_;
+  // To the nearest occupied centre at least the centres' distance less the point's offset
+  // from its own centre; to that voxel's box, half a voxel's diagonal less again.
+  return std::sqrt(static_cast<double>(squaredDistanceVox(index))) * voxel_size_m_ -
+         (point_m - centre_m).norm() - 0.5 * std::sqrt(3.0) * voxel_size_m_;
+}
+
+double OccupancyDistanceField::upperBoundDistance_m(const Eigen::Vector3d& point_m) const {
+  Eigen::Vector3i index;
+  if (empty() || !point_m.allFinite() || !cellOf(point_m, index))
+    return std::numeric_limits<double>::infinity();
+  const Eigen::Vector3d centre_m = (index.cast<double>().array() + 0.5) * voxel_size_m_;
+  // The nearest occupied centre lies in its box; it is at most that far from the point.
+  return std::sqrt(static_cast<double>(squaredDistanceVox(index))) * voxel_size_m_ +
+         (point_m - centre_m).norm();
+}
+
+OccupancyDistanceField::CapsuleVerdict OccupancyDistanceField::capsuleVerdict(
+    const Eigen::Vector3d& a_m, const Eigen::Vector3d& b_m, double radius_m,
+    double margin_m) const {
+  if (empty()) return CapsuleVerdict::kClear;
+  const double length_m = (b_m - a_m).norm();
+  if (!std::isfinite(length_m) || !a_m.allFinite()) return CapsuleVerdict::kUndecided;
+  const Eigen::Vector3d direction =
+      length_m > 0.0 ? Eigen::Vector3d((b_m - a_m) / length_m) : Eigen::Vector3d::Zero();
+  // Sphere tracing along the axis: a point whose bound exceeds the radius and margin by s
+  // clears every axis point within s of it. Where the bound is too near to step a quarter
+  // voxel, look on, a voxel at a time, for an axis point certainly inside an obstacle.
+  const double min_step_m = 0.25 * voxel_size_m_;
+  double t_m = 0.0;
+  for (;;) {
+    const double step_m = lowerBoundDistance_m(a_m + t_m * direction) - radius_m - margin_m;
+    if (step_m < min_step_m) break;
+    t_m += step_m;
+    if (t_m >= length_m) return CapsuleVerdict::kClear;
+  }
+  for (; t_m <= length_m + voxel_size_m_; t_m += voxel_size_m_) {
+    if (upperBoundDistance_m(a_m + std::min(t_m, length_m) * direction) < radius_m - margin_m)
+      return CapsuleVerdict::kTouching;
+  }
+  return CapsuleVerdict::kUndecided;
+}
+
+}  // namespace fvp::robot
