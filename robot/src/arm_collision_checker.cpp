@@ -3,6 +3,7 @@
 #include <octomap/OcTree.h>
 
 #include <cmath>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -72,6 +73,34 @@ bool capsuleTouchesBox(const fcl::Capsuled& capsule, const fcl::Transform3d& tf,
   return result.isCollision();
 }
 
+/// The distance field of the map's occupied voxels (pruned leaves larger than a voxel split into
+/// voxels); empty when there are none, or when their bounds span more cells than the field
+/// takes (the span is checked before any leaf is split).
+OccupancyDistanceField distanceFieldOf(const octomap::OcTree& map,
+                                       const Eigen::AlignedBox3d& occupied_bounds) {
+  if (occupied_bounds.isEmpty()) return {};
+  const double resolution = map.getResolution();
+  const Eigen::Array3d span = (occupied_bounds.sizes() / resolution).array().round();
+  if (span.prod() > static_cast<double>(OccupancyDistanceField::kDefaultMaxCells)) return {};
+  std::vector<Eigen::Vector3i> voxels;
+  for (auto it = map.begin_leafs(), end = map.end_leafs(); it != end; ++it) {
+    if (!map.isNodeOccupied(*it)) continue;
+    const double half = 0.5 * it.getSize();
+    const Eigen::Vector3d c(it.getX(), it.getY(), it.getZ());
+    const int cells = static_cast<int>(std::lround(it.getSize() / resolution));
+    const Eigen::Vector3i first =
+        ((c.array() - half) / resolution + 0.5).floor().cast<int>().matrix();
+    for (int i = 0; i < cells; ++i)
+      for (int j = 0; j < cells; ++j)
+        for (int k = 0; k < cells; ++k) voxels.push_back(first + Eigen::Vector3i(i, j, k));
+  }
+  try {
+    return OccupancyDistanceField(resolution, voxels);
+  } catch (const std::invalid_argument&) {
+    return {};  // too large a grid: FCL decides every capsule near the occupied bounds
+  }
+}
+
 }  // namespace
 
 void ArmCollisionChecker::setMap(const octomap::OcTree& coarse_map) {
@@ -127,29 +156,16 @@ std::size_t ArmCollisionChecker::setMapFreeAt(const octomap::OcTree& coarse_map,
 void ArmCollisionChecker::setMapOwned(std::shared_ptr<octomap::OcTree> copy) {
   auto fcl = std::make_unique<Fcl>();
   fcl->occupied_bounds.setEmpty();
-  // The bounds' and the field's voxels: FCL's occupied test (occupancy at or above the
-  // threshold, OctoMap's is above it), so that both judge the voxels FCL would test.
-  std::vector<Eigen::Vector3i> field_voxels;
-  const double resolution = copy->getResolution();
+  // The bounds' and the field's voxels: OctoMap's occupied test, FCL's too (log-odds at or
+  // above the threshold), so that both judge exactly the voxels FCL would test.
   for (auto it = copy->begin_leafs(), end = copy->end_leafs(); it != end; ++it) {
-    if (it->getOccupancy() < copy->getOccupancyThres()) continue;
-    const double half = 0.5 * it.getSize();
+    if (!copy->isNodeOccupied(*it)) continue;
     const Eigen::Vector3d c(it.getX(), it.getY(), it.getZ());
-    fcl->occupied_bounds.extend(c - Eigen::Vector3d::Constant(half));
-    fcl->occupied_bounds.extend(c + Eigen::Vector3d::Constant(half));
-    const int cells = static_cast<int>(std::lround(it.getSize() / resolution));
-    const Eigen::Vector3i first =
-        ((c.array() - half) / resolution + 0.5).floor().cast<int>().matrix();
-    for (int i = 0; i < cells; ++i)
-      for (int j = 0; j < cells; ++j)
-        for (int k = 0; k < cells; ++k) field_voxels.push_back(first + Eigen::Vector3i(i, j, k));
+    fcl->occupied_bounds.extend(c - Eigen::Vector3d::Constant(0.5 * it.getSize()));
+    fcl->occupied_bounds.extend(c + Eigen::Vector3d::Constant(0.5 * it.getSize()));
   }
-  try {
-    fcl->distance = OccupancyDistanceField(resolution, field_voxels);
-  } catch (const std::invalid_argument&) {
-    // Too large a grid: every capsule near the occupied bounds goes to FCL.
-    fcl->distance_disabled = true;
-  }
+  fcl->distance = distanceFieldOf(*copy, fcl->occupied_bounds);
+  fcl->distance_disabled = fcl->distance.empty() && !fcl->occupied_bounds.isEmpty();
   fcl->tree = std::make_shared<fcl::OcTreed>(std::shared_ptr<const octomap::OcTree>(copy));
   // Subtrees whose largest log-odds is below the occupancy threshold hold no obstacle:
   // let FCL prune them (inner nodes carry their children's maximum).

@@ -78,6 +78,12 @@ OccupancyDistanceField::OccupancyDistanceField(double voxel_size_m,
   Eigen::Vector3i low = occupied.front(), high = occupied.front();
   for (const Eigen::Vector3i& v : occupied) low = low.cwiseMin(v), high = high.cwiseMax(v);
   const Eigen::Array3d cells = (high - low).cast<double>().array() + 1.0;
+  // The far value stays above every squared distance while an axis spans at most 2^16 cells
+  // (OctoMap's keys do).
+  if (cells.maxCoeff() > 65536.0)
+    throw std::invalid_argument("occupancy distance field: the occupied voxels span " +
+                                std::to_string(cells.maxCoeff()) +
+                                " cells along an axis, more than 65536");
   if (cells.prod() > static_cast<double>(max_cells))
     throw std::invalid_argument("occupancy distance field: the occupied voxels span " +
                                 std::to_string(cells.prod()) + " cells, more than " +
@@ -142,7 +148,12 @@ OccupancyDistanceField::CapsuleVerdict OccupancyDistanceField::capsuleVerdict(
     double margin_m) const {
   if (empty()) return CapsuleVerdict::kClear;
   const double length_m = (b_m - a_m).norm();
-  if (!std::isfinite(length_m) || !a_m.allFinite()) return CapsuleVerdict::kUndecided;
+  // Far beyond any map (or not numbers): the steps would lose their precision; FCL decides.
+  constexpr double kMaxCoordinateM = 1e6;
+  if (!(radius_m >= 0.0) || !(margin_m >= 0.0) || !std::isfinite(radius_m + margin_m) ||
+      !(a_m.cwiseAbs().maxCoeff() < kMaxCoordinateM) ||
+      !(b_m.cwiseAbs().maxCoeff() < kMaxCoordinateM))
+    return CapsuleVerdict::kUndecided;
   const Eigen::Vector3d direction =
       length_m > 0.0 ? Eigen::Vector3d((b_m - a_m) / length_m) : Eigen::Vector3d::Zero();
   // Sphere tracing along the axis: a point whose bound exceeds the radius and margin by s

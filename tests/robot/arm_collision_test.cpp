@@ -285,8 +285,9 @@ TEST(OccupancyDistanceField, LowerBoundsHoldAgainstBruteForce) {
     ASSERT_LE(bound, truth + 1e-12) << "point " << p.transpose();
     // Within the grid, a voxel's diagonal at most below (outside it, the grid's faces).
     const Eigen::Vector3i in_cell = (p / kVoxelM).array().floor().cast<int>().matrix();
-    if (field.squaredDistanceVoxChecked(in_cell) >= 0.0f)
+    if (field.squaredDistanceVoxChecked(in_cell) >= 0.0f) {
       ASSERT_GE(bound, truth - std::sqrt(3.0) * kVoxelM - 1e-12) << "point " << p.transpose();
+    }
     const Eigen::Vector3d q(coordinate(rng), coordinate(rng), coordinate(rng));
     const double r = radius(rng);
     double clearance = std::numeric_limits<double>::infinity();
@@ -309,11 +310,22 @@ TEST(OccupancyDistanceField, LowerBoundsHoldAgainstBruteForce) {
             << " touching, " << shown_touching << " shown touching\n";
   EXPECT_GT(shown_clear, clear / 4);
   EXPECT_GT(shown_touching, touching / 4);
+  // Not numbers, or too far out for the steps' precision: undecided, never an answer.
+  using Verdict = OccupancyDistanceField::CapsuleVerdict;
+  const Eigen::Vector3d inside = occupied.front().cast<double>() * kVoxelM;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(field.capsuleVerdict(inside, inside, nan, 1e-3), Verdict::kUndecided);
+  EXPECT_EQ(field.capsuleVerdict(inside, inside, 0.01, nan), Verdict::kUndecided);
+  EXPECT_EQ(field.capsuleVerdict(Eigen::Vector3d(1e17, 0.0, 0.0), inside, 0.01, 1e-3),
+            Verdict::kUndecided);
   EXPECT_TRUE(OccupancyDistanceField().capsuleClear(Eigen::Vector3d::Zero(),
                                                     Eigen::Vector3d::Ones(), 1.0, 0.0));
   EXPECT_THROW(OccupancyDistanceField(
                    0.01, {Eigen::Vector3i(0, 0, 0), Eigen::Vector3i(999, 999, 999)}, 1000),
                std::invalid_argument);
+  EXPECT_THROW(
+      OccupancyDistanceField(0.01, {Eigen::Vector3i(0, 0, 0), Eigen::Vector3i(70000, 0, 0)}),
+      std::invalid_argument);
 }
 
 // The checker's answers with the distance field are FCL's alone, on a tree world's 1 cm map:
