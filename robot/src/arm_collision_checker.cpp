@@ -22,12 +22,11 @@ struct ArmCollisionChecker::Fcl {
   std::shared_ptr<fcl::OcTreed> tree;
   // Occupied voxels' bounds: capsules whose box misses them skip the FCL traversal.
   Eigen::AlignedBox3d occupied_bounds;
-  // Capsules it shows clear skip the traversal too. On a tree's map most of a plan's checks
-  // hold links far from the canopy, and FCL's traversal of a dense 1 cm map costs each of
-  // them up to milliseconds (measured: a visit's plans 9 times slower on the season tree
-  // than BM_MotionPlan's lone cluster, the rate the fixed clock charges).
+  // Capsules it shows clear or touching skip the traversal too: FCL's traversal of a dense
+  // 1 cm tree map costs a link near the canopy up to milliseconds (development season 1's
+  // first visit planned for 9 times what the fixed clock charged). Empty with occupied
+  // voxels only when the grid would be too large: then FCL decides every capsule.
   OccupancyDistanceField distance;
-  bool distance_disabled = false;
 };
 
 // Beyond FCL's GJK tolerance: a capsule the field shows this clear FCL finds free, and one
@@ -165,7 +164,6 @@ void ArmCollisionChecker::setMapOwned(std::shared_ptr<octomap::OcTree> copy) {
     fcl->occupied_bounds.extend(c + Eigen::Vector3d::Constant(0.5 * it.getSize()));
   }
   fcl->distance = distanceFieldOf(*copy, fcl->occupied_bounds);
-  fcl->distance_disabled = fcl->distance.empty() && !fcl->occupied_bounds.isEmpty();
   fcl->tree = std::make_shared<fcl::OcTreed>(std::shared_ptr<const octomap::OcTree>(copy));
   // Subtrees whose largest log-odds is below the occupancy threshold hold no obstacle:
   // let FCL prune them (inner nodes carry their children's maximum).
@@ -192,7 +190,7 @@ bool ArmCollisionChecker::mapCollisionFclOnly(const LinkCapsules& links) const {
 bool ArmCollisionChecker::mapCollision_(const LinkCapsules& links, bool use_field) const {
   if (!fcl_ || fcl_->occupied_bounds.isEmpty()) return false;
   const double pad = arm_.config().collision_padding_m;
-  use_field = use_field && !fcl_->distance_disabled;
+  use_field = use_field && !fcl_->distance.empty();
   for (const Capsule& link : links) {
     if (!paddedBounds(link, pad).intersects(fcl_->occupied_bounds)) continue;
     if (use_field) {

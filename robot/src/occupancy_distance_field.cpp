@@ -43,17 +43,13 @@ void transformLine(std::vector<double>& f, std::vector<double>& out, std::vector
 
 /// The transform along `axis` of every line of the grid, in place.
 void transformAxis(std::vector<float>& grid, const Eigen::Vector3i& size, int axis) {
-  const int n = size[axis];
-  const std::size_t stride = axis == 0   ? 1
-                             : axis == 1 ? static_cast<std::size_t>(size.x())
-                                         : static_cast<std::size_t>(size.x()) * size.y();
-  const int a = (axis + 1) % 3, b = (axis + 2) % 3;
-  const std::size_t stride_a = a == 0   ? 1
-                               : a == 1 ? static_cast<std::size_t>(size.x())
-                                        : static_cast<std::size_t>(size.x()) * size.y();
-  const std::size_t stride_b = b == 0   ? 1
-                               : b == 1 ? static_cast<std::size_t>(size.x())
-                                        : static_cast<std::size_t>(size.x()) * size.y();
+  const auto strideOf = [&size](int along) {
+    return along == 0   ? std::size_t{1}
+           : along == 1 ? static_cast<std::size_t>(size.x())
+                        : static_cast<std::size_t>(size.x()) * static_cast<std::size_t>(size.y());
+  };
+  const int n = size[axis], a = (axis + 1) % 3, b = (axis + 2) % 3;
+  const std::size_t stride = strideOf(axis), stride_a = strideOf(a), stride_b = strideOf(b);
   std::vector<double> f(static_cast<std::size_t>(n)), out(f.size());
   std::vector<int> roots(f.size());
   std::vector<double> bounds(f.size() + 1);
@@ -91,13 +87,7 @@ OccupancyDistanceField::OccupancyDistanceField(double voxel_size_m,
   min_ = low;
   size_ = (high - low).array() + 1;
   squared_distance_vox_.assign(static_cast<std::size_t>(cells.prod()), kFarSquaredVox);
-  for (const Eigen::Vector3i& v : occupied) {
-    const Eigen::Vector3i local = v - min_;
-    squared_distance_vox_[static_cast<std::size_t>(local.x()) +
-                          static_cast<std::size_t>(size_.x()) *
-                              (static_cast<std::size_t>(local.y()) +
-                               static_cast<std::size_t>(size_.y()) * local.z())] = 0.0f;
-  }
+  for (const Eigen::Vector3i& v : occupied) squared_distance_vox_[offsetOf(v - min_)] = 0.0f;
   for (int axis = 0; axis < 3; ++axis) transformAxis(squared_distance_vox_, size_, axis);
 }
 

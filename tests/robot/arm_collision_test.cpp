@@ -318,8 +318,9 @@ TEST(OccupancyDistanceField, LowerBoundsHoldAgainstBruteForce) {
   EXPECT_EQ(field.capsuleVerdict(inside, inside, 0.01, nan), Verdict::kUndecided);
   EXPECT_EQ(field.capsuleVerdict(Eigen::Vector3d(1e17, 0.0, 0.0), inside, 0.01, 1e-3),
             Verdict::kUndecided);
-  EXPECT_TRUE(OccupancyDistanceField().capsuleClear(Eigen::Vector3d::Zero(),
-                                                    Eigen::Vector3d::Ones(), 1.0, 0.0));
+  EXPECT_EQ(OccupancyDistanceField().capsuleVerdict(Eigen::Vector3d::Zero(),
+                                                    Eigen::Vector3d::Ones(), 1.0, 0.0),
+            Verdict::kClear);
   EXPECT_THROW(OccupancyDistanceField(
                    0.01, {Eigen::Vector3i(0, 0, 0), Eigen::Vector3i(999, 999, 999)}, 1000),
                std::invalid_argument);

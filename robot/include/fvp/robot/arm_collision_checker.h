@@ -2,8 +2,8 @@
 // ground and the slider rail, and with no link capsule (padded by collision_padding_m)
 // touching an occupied voxel of the coarse map. The map check is FCL's capsule-against-
 // fcl::OcTree test over a copy of the octomap::OcTree, as MoveIt does, for the capsules that a
-// distance field over the occupied voxels (OccupancyDistanceField) does not show clear: the
-// same answers, without FCL's traversal for links far from every obstacle.
+// distance field over the occupied voxels (OccupancyDistanceField) cannot show clear or
+// touching: the same answers, without FCL's traversal for the links it decides.
 #pragma once
 
 #include <atomic>

@@ -35,11 +35,7 @@ class OccupancyDistanceField {
   /// Squared distance, in voxels, from voxel `index`'s centre to the nearest occupied voxel's
   /// centre; `index` must lie in the grid (checked twin: squaredDistanceVoxChecked).
   float squaredDistanceVox(const Eigen::Vector3i& index) const {
-    const Eigen::Vector3i local = index - min_;
-    return squared_distance_vox_[static_cast<std::size_t>(local.x()) +
-                                 static_cast<std::size_t>(size_.x()) *
-                                     (static_cast<std::size_t>(local.y()) +
-                                      static_cast<std::size_t>(size_.y()) * local.z())];
+    return squared_distance_vox_[offsetOf(index - min_)];
   }
   /// squaredDistanceVox, or -1 when `index` lies outside the grid.
   float squaredDistanceVoxChecked(const Eigen::Vector3i& index) const;
@@ -59,12 +55,15 @@ class OccupancyDistanceField {
   /// The capsule of segment a-b and `radius_m` against the occupied voxels, by the bounds.
   CapsuleVerdict capsuleVerdict(const Eigen::Vector3d& a_m, const Eigen::Vector3d& b_m,
                                 double radius_m, double margin_m) const;
-  bool capsuleClear(const Eigen::Vector3d& a_m, const Eigen::Vector3d& b_m, double radius_m,
-                    double margin_m) const {
-    return capsuleVerdict(a_m, b_m, radius_m, margin_m) == CapsuleVerdict::kClear;
-  }
 
  private:
+  /// The storage offset of a cell at `local` from the grid's first cell (x fastest).
+  std::size_t offsetOf(const Eigen::Vector3i& local) const {
+    return static_cast<std::size_t>(local.x()) +
+           static_cast<std::size_t>(size_.x()) *
+               (static_cast<std::size_t>(local.y()) +
+                static_cast<std::size_t>(size_.y()) * static_cast<std::size_t>(local.z()));
+  }
   /// The grid cell holding `point_m`, false outside the grid.
   bool cellOf(const Eigen::Vector3d& point_m, Eigen::Vector3i& index) const;
   double voxel_size_m_ = 0.0;
