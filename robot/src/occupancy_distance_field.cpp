@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "fvp/host/core/segment_distance.h"
+
 namespace fvp::robot {
 namespace {
 
@@ -89,6 +91,25 @@ OccupancyDistanceField::OccupancyDistanceField(double voxel_size_m,
   squared_distance_vox_.assign(static_cast<std::size_t>(cells.prod()), kFarSquaredVox);
   for (const Eigen::Vector3i& v : occupied) squared_distance_vox_[offsetOf(v - min_)] = 0.0f;
   for (int axis = 0; axis < 3; ++axis) transformAxis(squared_distance_vox_, size_, axis);
+  bucketByBrick(occupied);
+}
+
+void OccupancyDistanceField::bucketByBrick(const std::vector<Eigen::Vector3i>& occupied) {
+  bricks_ = (size_.array() + kBrickCells - 1) / kBrickCells;
+  const auto brickOf = [this](const Eigen::Vector3i& v) {
+    const Eigen::Vector3i brick = (v - min_) / kBrickCells;
+    return static_cast<std::size_t>(brick.x()) +
+           static_cast<std::size_t>(bricks_.x()) *
+               (static_cast<std::size_t>(brick.y()) +
+                static_cast<std::size_t>(bricks_.y()) * static_cast<std::size_t>(brick.z()));
+  };
+  // Counting sort: counts, their prefix sums, then each voxel into its brick's range.
+  brick_first_.assign(static_cast<std::size_t>(bricks_.prod()) + 1, 0);
+  for (const Eigen::Vector3i& v : occupied) ++brick_first_[brickOf(v) + 1];
+  for (std::size_t b = 1; b < brick_first_.size(); ++b) brick_first_[b] += brick_first_[b - 1];
+  std::vector<std::uint32_t> next(brick_first_.begin(), brick_first_.end() - 1);
+  brick_voxels_.resize(occupied.size());
+  for (const Eigen::Vector3i& v : occupied) brick_voxels_[next[brickOf(v)]++] = v;
 }
 
 float OccupancyDistanceField::squaredDistanceVoxChecked(const Eigen::Vector3i& index) const {
@@ -162,6 +183,60 @@ OccupancyDistanceField::CapsuleVerdict OccupancyDistanceField::capsuleVerdict(
       return CapsuleVerdict::kTouching;
   }
   return CapsuleVerdict::kUndecided;
+}
+
+bool OccupancyDistanceField::capsuleTouches(const Eigen::Vector3d& a_m, const Eigen::Vector3d& b_m,
+                                            double radius_m) const {
+  if (!a_m.allFinite() || !b_m.allFinite() || !std::isfinite(radius_m)) return true;
+  if (empty() || radius_m < 0.0) return false;
+  return touchesAlong(a_m, b_m, radius_m);
+}
+
+bool OccupancyDistanceField::touchesAlong(const Eigen::Vector3d& a_m, const Eigen::Vector3d& b_m,
+                                          double radius_m) const {
+  // Every axis point lies within half the length of the middle: a bound beyond the radius by
+  // that clears the whole part. Otherwise halve it, down to a brick's length, whose nearby
+  // bricks are few enough to test voxel by voxel.
+  const Eigen::Vector3d middle_m = 0.5 * (a_m + b_m);
+  const double half_length_m = 0.5 * (b_m - a_m).norm();
+  if (lowerBoundDistance_m(middle_m) > radius_m + half_length_m) return false;
+  if (half_length_m > 0.5 * kBrickCells * voxel_size_m_)
+    return touchesAlong(a_m, middle_m, radius_m) || touchesAlong(middle_m, b_m, radius_m);
+  return touchesInBricks(a_m, b_m, radius_m);
+}
+
+bool OccupancyDistanceField::touchesInBricks(const Eigen::Vector3d& a_m, const Eigen::Vector3d& b_m,
+                                             double radius_m) const {
+  const double brick_m = kBrickCells * voxel_size_m_, radius2 = radius_m * radius_m;
+  const Eigen::Vector3d grid_low_m = min_.cast<double>() * voxel_size_m_;
+  // The bricks the capsule's box overlaps, clamped to the grid.
+  const auto brickRange = [&](const Eigen::Vector3d& corner_m) {
+    const Eigen::Array3d brick = ((corner_m - grid_low_m) / brick_m).array().floor();
+    return brick.max(0.0).min((bricks_.array() - 1).cast<double>()).cast<int>().matrix().eval();
+  };
+  const Eigen::Vector3i first = brickRange(a_m.cwiseMin(b_m).array() - radius_m);
+  const Eigen::Vector3i last = brickRange(a_m.cwiseMax(b_m).array() + radius_m);
+  for (int z = first.z(); z <= last.z(); ++z)
+    for (int y = first.y(); y <= last.y(); ++y)
+      for (int x = first.x(); x <= last.x(); ++x) {
+        const std::size_t brick = static_cast<std::size_t>(x) +
+                                  static_cast<std::size_t>(bricks_.x()) *
+                                      (static_cast<std::size_t>(y) +
+                                       static_cast<std::size_t>(bricks_.y()) * std::size_t(z));
+        const std::uint32_t begin = brick_first_[brick], end = brick_first_[brick + 1];
+        if (begin == end) continue;
+        const Eigen::Vector3d brick_low_m = grid_low_m + Eigen::Vector3d(x, y, z) * brick_m;
+        if (host::squaredSegmentBoxDistance(a_m, b_m, brick_low_m, brick_low_m.array() + brick_m) >
+            radius2)
+          continue;
+        for (std::uint32_t i = begin; i < end; ++i) {
+          const Eigen::Vector3d low_m = brick_voxels_[i].cast<double>() * voxel_size_m_;
+          if (host::squaredSegmentBoxDistance(a_m, b_m, low_m, low_m.array() + voxel_size_m_) <=
+              radius2)
+            return true;
+        }
+      }
+  return false;
 }
 
 }  // namespace fvp::robot

@@ -5,6 +5,7 @@
 
 #include <random>
 
+#include "fvp/host/core/segment_distance.h"
 #include "fvp/robot/arm_collision_checker.h"
 #include "fvp/robot/occupancy_distance_field.h"
 #include "fvp/robot/sim/camera_views.h"
@@ -329,7 +330,69 @@ TEST(OccupancyDistanceField, LowerBoundsHoldAgainstBruteForce) {
       std::invalid_argument);
 }
 
-// The checker's answers with the distance field are FCL's alone, on a tree world's 1 cm map:
+// The exact segment-to-box distance is the ternary search's minimum: random segments and boxes,
+// segments along an axis, through the box, inside it, and of zero length.
+TEST(SegmentBoxDistance, IsTheSearchedMinimum) {
+  std::mt19937_64 rng(14);
+  std::uniform_real_distribution<double> coordinate(-1.0, 1.0), size(0.0, 0.8);
+  for (int i = 0; i < 20000; ++i) {
+    const Eigen::Vector3d low(coordinate(rng), coordinate(rng), coordinate(rng));
+    const Eigen::Vector3d high = low + Eigen::Vector3d(size(rng), size(rng), size(rng));
+    Eigen::Vector3d a(coordinate(rng), coordinate(rng), coordinate(rng));
+    Eigen::Vector3d b(coordinate(rng), coordinate(rng), coordinate(rng));
+    if (i % 5 == 1) b = a + Eigen::Vector3d::Unit(i % 3) * coordinate(rng);
+    if (i % 5 == 2) b = a;
+    if (i % 5 == 3) a = 0.5 * (low + high);
+    const double exact = std::sqrt(host::squaredSegmentBoxDistance(a, b, low, high));
+    ASSERT_NEAR(exact, segmentBoxDistance(a, b, Eigen::AlignedBox3d(low, high)), 1e-9)
+        << "segment " << a.transpose() << " to " << b.transpose() << ", box " << low.transpose()
+        << " to " << high.transpose();
+  }
+}
+
+// capsuleTouches is the brute-force answer over every occupied voxel, for capsules from far
+// off to deep inside, long and short, near the grid's edges and outside it.
+TEST(OccupancyDistanceField, CapsuleTouchesIsTheBruteForceAnswer) {
+  std::mt19937_64 rng(15);
+  constexpr double kVoxelM = 0.01;
+  std::uniform_int_distribution<int> cell(-20, 20);
+  std::vector<Eigen::Vector3i> occupied;
+  for (int i = 0; i < 300; ++i) occupied.emplace_back(cell(rng), cell(rng), cell(rng) / 4);
+  const OccupancyDistanceField field(kVoxelM, occupied);
+  std::uniform_real_distribution<double> coordinate(-0.3, 0.3), radius(0.0, 0.06), unit(0, 1);
+  int touching = 0, near_misses = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Eigen::Vector3d a(coordinate(rng), coordinate(rng), coordinate(rng));
+    const Eigen::Vector3d b =
+        a + (i % 2 == 0 ? 0.5 : 0.05) *
+                Eigen::Vector3d(coordinate(rng), coordinate(rng), coordinate(rng));
+    double nearest2 = std::numeric_limits<double>::infinity();
+    for (const Eigen::Vector3i& v : occupied) {
+      const Eigen::Vector3d low = v.cast<double>() * kVoxelM;
+      nearest2 =
+          std::min(nearest2, host::squaredSegmentBoxDistance(a, b, low, low.array() + kVoxelM));
+    }
+    // Half the capsules graze: their radius within 2 mm of the nearest voxel's distance.
+    const double r =
+        i % 4 < 2 ? radius(rng) : std::max(0.0, std::sqrt(nearest2) + 0.002 * (unit(rng) - 0.5));
+    const bool truth = nearest2 <= r * r;
+    touching += truth ? 1 : 0;
+    near_misses += !truth && std::sqrt(nearest2) - r < 1e-3 ? 1 : 0;
+    ASSERT_EQ(field.capsuleTouches(a, b, r), truth)
+        << "capsule " << a.transpose() << " to " << b.transpose() << ", radius " << r;
+  }
+  std::cout << touching << " of 20000 capsules touching, " << near_misses << " missing by < 1 mm\n";
+  EXPECT_GT(touching, 2000);
+  EXPECT_GT(near_misses, 1000);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_TRUE(field.capsuleTouches(Eigen::Vector3d(nan, 0, 0), Eigen::Vector3d::Zero(), 0.01));
+  EXPECT_TRUE(field.capsuleTouches(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), nan));
+  EXPECT_FALSE(OccupancyDistanceField().capsuleTouches(Eigen::Vector3d::Zero(),
+                                                       Eigen::Vector3d::Ones(), 1.0));
+}
+
+// The checker's answers with the distance field (its bounds and its exact test) are FCL's, on
+// a tree world's 1 cm map:
 // random configurations, and configurations viewing the clusters from 15-40 cm (the links
 // among the leaves).
 TEST(ArmCollisionChecker, DistanceFieldKeepsFclsAnswersOnATreeWorld) {
@@ -366,6 +429,38 @@ TEST(ArmCollisionChecker, DistanceFieldKeepsFclsAnswersOnATreeWorld) {
   EXPECT_EQ(disagreements, 0);
   EXPECT_GT(colliding, 50);
   EXPECT_GT(static_cast<int>(configurations.size()) - colliding, 50);
+
+  // At contact itself (FCL's free-to-touching boundary on random short motions from the viewing
+  // configurations, bisected to 1e-15): the answers may differ only within FCL's GJK tolerance,
+  // a micrometre, and there the field's is the brute-force one.
+  int boundaries = 0, boundary_disagreements = 0;
+  std::uniform_real_distribution<double> step(-0.05, 0.05);
+  for (std::size_t i = 400; i < configurations.size() && boundaries < 150; ++i) {
+    const JointVector q0 = configurations[i];
+    JointVector q1 = q0;
+    for (int j = 0; j < kArmJoints; ++j) q1[j] += step(rng);
+    if (checker.mapCollisionFclOnly(arm.linkCapsules(q0)) ||
+        !checker.mapCollisionFclOnly(arm.linkCapsules(q1)))
+      continue;
+    ++boundaries;
+    double free_t = 0.0, touching_t = 1.0;
+    for (int k = 0; k < 50; ++k) {
+      const double t = 0.5 * (free_t + touching_t);
+      (checker.mapCollisionFclOnly(arm.linkCapsules(q0 + t * (q1 - q0))) ? touching_t : free_t) = t;
+    }
+    for (const double t : {free_t, touching_t}) {
+      const LinkCapsules links = arm.linkCapsules(q0 + t * (q1 - q0));
+      const bool field = checker.mapCollision(links);
+      if (field == checker.mapCollisionFclOnly(links)) continue;
+      ++boundary_disagreements;
+      const double clearance = bruteForceClearance(*tree, links, arm.config().collision_padding_m);
+      EXPECT_LT(std::abs(clearance), 2e-6) << "configuration " << (q0 + t * (q1 - q0)).transpose();
+      EXPECT_EQ(field, clearance <= 0.0) << "clearance " << clearance;
+    }
+  }
+  std::cout << boundaries << " contact boundaries, " << boundary_disagreements
+            << " answers within FCL's tolerance that differ\n";
+  EXPECT_EQ(boundaries, 150);
 }
 
 }  // namespace

@@ -1,9 +1,11 @@
 // Whether an arm configuration is valid: within joint limits, free of self collision, the
 // ground and the slider rail, and with no link capsule (padded by collision_padding_m)
-// touching an occupied voxel of the coarse map. The map check is FCL's capsule-against-
-// fcl::OcTree test over a copy of the octomap::OcTree, as MoveIt does, for the capsules that a
-// distance field over the occupied voxels (OccupancyDistanceField) cannot show clear or
-// touching: the same answers, without FCL's traversal for the links it decides.
+// touching an occupied voxel of the coarse map. The map check is a distance field over the
+// occupied voxels (OccupancyDistanceField): its bounds, and an exact capsule-against-voxel test
+// where they cannot tell. FCL's capsule-against-fcl::OcTree test over a copy of the
+// octomap::OcTree, as MoveIt does it, is the oracle it is tested against (the same answers but
+// within a micrometre of contact, FCL's GJK tolerance, where the exact test's is right), the
+// benchmarks' peer, and the check when the occupied voxels span too large a grid for a field.
 #pragma once
 
 #include <atomic>
@@ -46,10 +48,10 @@ class ArmCollisionChecker {
   /// Only the map part of isValid, for given capsules (padding is added here).
   bool mapCollision(const LinkCapsules& links) const;
   /// mapCollision by FCL alone, every capsule near the occupied voxels traversed: the oracle
-  /// the distance field's shortcut is tested and measured against.
+  /// the distance field's checks are tested and measured against.
   bool mapCollisionFclOnly(const LinkCapsules& links) const;
   /// Whether isValid and mapCollision use the distance field (default true; false: FCL alone,
-  /// the same answers more slowly, for benchmarks).
+  /// the same answers but within a micrometre of contact, more slowly, for benchmarks).
   void setUseDistanceField(bool use) { use_distance_field_ = use; }
   const ArmModel& arm() const { return arm_; }
   /// isValid calls so far (planning statistics).

@@ -2,8 +2,9 @@
 // trust: exact squared Euclidean distances between voxel centres (the separable transform of
 // Felzenszwalb and Huttenlocher, "Distance Transforms of Sampled Functions", 2012) over the
 // occupied voxels' bounding grid. The arm's collision check decides a capsule with it when every
-// obstacle is clearly beyond the capsule's radius, or one clearly within it, and leaves the rest
-// to FCL's exact test.
+// obstacle is clearly beyond the capsule's radius, or one clearly within it, and the rest by an
+// exact capsule-against-voxel test over the occupied voxels near the capsule (bucketed in
+// bricks), not FCL's octree traversal.
 #pragma once
 
 #include <cstddef>
@@ -55,6 +56,13 @@ class OccupancyDistanceField {
   /// The capsule of segment a-b and `radius_m` against the occupied voxels, by the bounds.
   CapsuleVerdict capsuleVerdict(const Eigen::Vector3d& a_m, const Eigen::Vector3d& b_m,
                                 double radius_m, double margin_m) const;
+  /// Exactly whether the capsule of segment a-b and `radius_m` meets an occupied voxel's box
+  /// (their distance at most the radius); true for inputs that are not finite numbers.
+  bool capsuleTouches(const Eigen::Vector3d& a_m, const Eigen::Vector3d& b_m,
+                      double radius_m) const;
+
+  /// Cells a brick spans along each axis: the exact test's buckets of occupied voxels.
+  static constexpr int kBrickCells = 4;
 
  private:
   /// The storage offset of a cell at `local` from the grid's first cell (x fastest).
@@ -66,10 +74,21 @@ class OccupancyDistanceField {
   }
   /// The grid cell holding `point_m`, false outside the grid.
   bool cellOf(const Eigen::Vector3d& point_m, Eigen::Vector3i& index) const;
+  /// Buckets the occupied voxels by brick (brick_first_, brick_voxels_).
+  void bucketByBrick(const std::vector<Eigen::Vector3i>& occupied);
+  /// capsuleTouches over the part a-b of the axis (segments of at most a brick's length).
+  bool touchesAlong(const Eigen::Vector3d& a_m, const Eigen::Vector3d& b_m, double radius_m) const;
+  /// capsuleTouches by testing every occupied voxel of the bricks near the segment a-b.
+  bool touchesInBricks(const Eigen::Vector3d& a_m, const Eigen::Vector3d& b_m,
+                       double radius_m) const;
   double voxel_size_m_ = 0.0;
   Eigen::Vector3i min_ = Eigen::Vector3i::Zero();
   Eigen::Vector3i size_ = Eigen::Vector3i::Zero();
   std::vector<float> squared_distance_vox_;
+  Eigen::Vector3i bricks_ = Eigen::Vector3i::Zero();  ///< bricks along each axis
+  /// Brick b's occupied voxels are brick_voxels_[brick_first_[b] .. brick_first_[b + 1]).
+  std::vector<std::uint32_t> brick_first_;
+  std::vector<Eigen::Vector3i> brick_voxels_;
 };
 
 }  // namespace fvp::robot
