@@ -193,6 +193,9 @@ bool ArmCollisionChecker::mapCollision_(const LinkCapsules& links, bool use_fiel
   const double pad = arm_.config().collision_padding_m;
   use_field = use_field && !fcl_->distance.empty();
   for (const Capsule& link : links) {
+    // A link that is not numbers is nowhere a plan may put it (the bounds would skip it).
+    if (!link.a_m.allFinite() || !link.b_m.allFinite() || !std::isfinite(link.radius_m))
+      return true;
     if (!paddedBounds(link, pad).intersects(fcl_->occupied_bounds)) continue;
     if (use_field) {
       using Verdict = OccupancyDistanceField::CapsuleVerdict;

@@ -73,6 +73,8 @@ OccupancyDistanceField::OccupancyDistanceField(double voxel_size_m,
   if (!(voxel_size_m > 0.0) || !std::isfinite(voxel_size_m))
     throw std::invalid_argument("occupancy distance field: voxel size must be positive");
   if (occupied.empty()) return;
+  if (occupied.size() > std::numeric_limits<std::uint32_t>::max())
+    throw std::invalid_argument("occupancy distance field: more than 2^32 occupied voxels");
   Eigen::Vector3i low = occupied.front(), high = occupied.front();
   for (const Eigen::Vector3i& v : occupied) low = low.cwiseMin(v), high = high.cwiseMax(v);
   const Eigen::Array3d cells = (high - low).cast<double>().array() + 1.0;
@@ -104,7 +106,11 @@ void OccupancyDistanceField::bucketByBrick(const std::vector<Eigen::Vector3i>& o
                 static_cast<std::size_t>(bricks_.y()) * static_cast<std::size_t>(brick.z()));
   };
   // Counting sort: counts, their prefix sums, then each voxel into its brick's range.
-  brick_first_.assign(static_cast<std::size_t>(bricks_.prod()) + 1, 0);
+  brick_first_.assign(static_cast<std::size_t>(bricks_.x()) *
+                              static_cast<std::size_t>(bricks_.y()) *
+                              static_cast<std::size_t>(bricks_.z()) +
+                          1,
+                      0);
   for (const Eigen::Vector3i& v : occupied) ++brick_first_[brickOf(v) + 1];
   for (std::size_t b = 1; b < brick_first_.size(); ++b) brick_first_[b] += brick_first_[b - 1];
   std::vector<std::uint32_t> next(brick_first_.begin(), brick_first_.end() - 1);
@@ -159,8 +165,8 @@ OccupancyDistanceField::CapsuleVerdict OccupancyDistanceField::capsuleVerdict(
     double margin_m) const {
   if (empty()) return CapsuleVerdict::kClear;
   const double length_m = (b_m - a_m).norm();
-  // Far beyond any map (or not numbers): the steps would lose their precision; FCL decides.
-  constexpr double kMaxCoordinateM = 1e6;
+  // Far beyond any map (or not numbers): the steps would lose their precision; the exact test
+  // decides.
   if (!(radius_m >= 0.0) || !(margin_m >= 0.0) || !std::isfinite(radius_m + margin_m) ||
       !(a_m.cwiseAbs().maxCoeff() < kMaxCoordinateM) ||
       !(b_m.cwiseAbs().maxCoeff() < kMaxCoordinateM))
@@ -187,20 +193,43 @@ OccupancyDistanceField::CapsuleVerdict OccupancyDistanceField::capsuleVerdict(
 
 bool OccupancyDistanceField::capsuleTouches(const Eigen::Vector3d& a_m, const Eigen::Vector3d& b_m,
                                             double radius_m) const {
-  if (!a_m.allFinite() || !b_m.allFinite() || !std::isfinite(radius_m)) return true;
+  // Not numbers, or no arm's: touching, the answer that moves nothing there.
+  if (!(a_m.cwiseAbs().maxCoeff() < kMaxCoordinateM) ||
+      !(b_m.cwiseAbs().maxCoeff() < kMaxCoordinateM) || !(std::abs(radius_m) < kMaxCoordinateM))
+    return true;
   if (empty() || radius_m < 0.0) return false;
-  return touchesAlong(a_m, b_m, radius_m);
+  // Only the part of the axis within the radius (and a voxel, against rounding) of the grid's
+  // box can touch: clipped to it (Liang-Barsky), the halving's depth stays that of the grid.
+  const Eigen::Vector3d reach = Eigen::Vector3d::Constant(radius_m + voxel_size_m_);
+  const Eigen::Vector3d low_m = min_.cast<double>() * voxel_size_m_ - reach;
+  const Eigen::Vector3d high_m = (min_ + size_).cast<double>() * voxel_size_m_ + reach;
+  const Eigen::Vector3d d = b_m - a_m;
+  double t0 = 0.0, t1 = 1.0;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (d[axis] == 0.0) {
+      if (a_m[axis] < low_m[axis] || a_m[axis] > high_m[axis]) return false;
+      continue;
+    }
+    const double enter = (low_m[axis] - a_m[axis]) / d[axis];
+    const double leave = (high_m[axis] - a_m[axis]) / d[axis];
+    t0 = std::max(t0, std::min(enter, leave));
+    t1 = std::min(t1, std::max(enter, leave));
+  }
+  if (t0 > t1) return false;
+  return touchesAlong(t0 == 0.0 ? a_m : Eigen::Vector3d(a_m + t0 * d),
+                      t1 == 1.0 ? b_m : Eigen::Vector3d(a_m + t1 * d), radius_m);
 }
 
 bool OccupancyDistanceField::touchesAlong(const Eigen::Vector3d& a_m, const Eigen::Vector3d& b_m,
                                           double radius_m) const {
   // Every axis point lies within half the length of the middle: a bound beyond the radius by
-  // that clears the whole part. Otherwise halve it, down to a brick's length, whose nearby
-  // bricks are few enough to test voxel by voxel.
+  // that clears the whole part. Otherwise halve it, down to a brick's length or the radius
+  // (halving parts shorter than the radius saves few voxels and re-tests the same bricks).
   const Eigen::Vector3d middle_m = 0.5 * (a_m + b_m);
   const double half_length_m = 0.5 * (b_m - a_m).norm();
   if (lowerBoundDistance_m(middle_m) > radius_m + half_length_m) return false;
-  if (half_length_m > 0.5 * kBrickCells * voxel_size_m_)
+  if (half_length_m > std::max(0.5 * kBrickCells * voxel_size_m_, radius_m) && middle_m != a_m &&
+      middle_m != b_m)
     return touchesAlong(a_m, middle_m, radius_m) || touchesAlong(middle_m, b_m, radius_m);
   return touchesInBricks(a_m, b_m, radius_m);
 }
@@ -209,13 +238,20 @@ bool OccupancyDistanceField::touchesInBricks(const Eigen::Vector3d& a_m, const E
                                              double radius_m) const {
   const double brick_m = kBrickCells * voxel_size_m_, radius2 = radius_m * radius_m;
   const Eigen::Vector3d grid_low_m = min_.cast<double>() * voxel_size_m_;
-  // The bricks the capsule's box overlaps, clamped to the grid.
-  const auto brickRange = [&](const Eigen::Vector3d& corner_m) {
-    const Eigen::Array3d brick = ((corner_m - grid_low_m) / brick_m).array().floor();
-    return brick.max(0.0).min((bricks_.array() - 1).cast<double>()).cast<int>().matrix().eval();
+  // The bricks the capsule's box overlaps, clamped to the grid; a corner on a brick's face (or
+  // a rounding away from it) takes the bricks on both sides.
+  constexpr double kFaceSlackBricks = 1e-9;
+  const auto brickRange = [&](const Eigen::Vector3d& corner_m, double slack) {
+    const Eigen::Array3d brick = ((corner_m - grid_low_m) / brick_m).array() + slack;
+    return brick.floor()
+        .max(0.0)
+        .min((bricks_.array() - 1).cast<double>())
+        .cast<int>()
+        .matrix()
+        .eval();
   };
-  const Eigen::Vector3i first = brickRange(a_m.cwiseMin(b_m).array() - radius_m);
-  const Eigen::Vector3i last = brickRange(a_m.cwiseMax(b_m).array() + radius_m);
+  const Eigen::Vector3i first = brickRange(a_m.cwiseMin(b_m).array() - radius_m, -kFaceSlackBricks);
+  const Eigen::Vector3i last = brickRange(a_m.cwiseMax(b_m).array() + radius_m, kFaceSlackBricks);
   for (int z = first.z(); z <= last.z(); ++z)
     for (int y = first.y(); y <= last.y(); ++y)
       for (int x = first.x(); x <= last.x(); ++x) {
@@ -225,9 +261,13 @@ bool OccupancyDistanceField::touchesInBricks(const Eigen::Vector3d& a_m, const E
                                        static_cast<std::size_t>(bricks_.y()) * std::size_t(z));
         const std::uint32_t begin = brick_first_[brick], end = brick_first_[brick + 1];
         if (begin == end) continue;
-        const Eigen::Vector3d brick_low_m = grid_low_m + Eigen::Vector3d(x, y, z) * brick_m;
-        if (host::squaredSegmentBoxDistance(a_m, b_m, brick_low_m, brick_low_m.array() + brick_m) >
-            radius2)
+        // The brick's box by the same arithmetic as its voxels' boxes, so that it holds them.
+        const Eigen::Vector3i first_voxel = min_ + kBrickCells * Eigen::Vector3i(x, y, z);
+        const Eigen::Vector3d brick_low_m = first_voxel.cast<double>() * voxel_size_m_;
+        const Eigen::Vector3d brick_high_m =
+            (first_voxel.array() + (kBrickCells - 1)).cast<double>() * voxel_size_m_ +
+            voxel_size_m_;
+        if (host::squaredSegmentBoxDistance(a_m, b_m, brick_low_m, brick_high_m) > radius2)
           continue;
         for (std::uint32_t i = begin; i < end; ++i) {
           const Eigen::Vector3d low_m = brick_voxels_[i].cast<double>() * voxel_size_m_;

@@ -215,6 +215,11 @@ TEST(ArmCollisionChecker, NoMapMeansOnlySelfAndStatic) {
   tree.updateNode(camera.x(), camera.y(), camera.z(), true);
   checker.setMap(tree);
   EXPECT_FALSE(checker.isValid(home));
+  // A link that is not numbers collides, with the field and with FCL alone.
+  LinkCapsules links = arm.linkCapsules(home);
+  links[0].a_m.x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_TRUE(checker.mapCollision(links));
+  EXPECT_TRUE(checker.mapCollisionFclOnly(links));
   checker.clearMap();
   EXPECT_TRUE(checker.isValid(home));
 }
@@ -372,7 +377,7 @@ TEST(OccupancyDistanceField, CapsuleTouchesIsTheBruteForceAnswer) {
       nearest2 =
           std::min(nearest2, host::squaredSegmentBoxDistance(a, b, low, low.array() + kVoxelM));
     }
-    // Half the capsules graze: their radius within 2 mm of the nearest voxel's distance.
+    // Half the capsules graze: their radius within 1 mm of the nearest voxel's distance.
     const double r =
         i % 4 < 2 ? radius(rng) : std::max(0.0, std::sqrt(nearest2) + 0.002 * (unit(rng) - 0.5));
     const bool truth = nearest2 <= r * r;
@@ -384,6 +389,41 @@ TEST(OccupancyDistanceField, CapsuleTouchesIsTheBruteForceAnswer) {
   std::cout << touching << " of 20000 capsules touching, " << near_misses << " missing by < 1 mm\n";
   EXPECT_GT(touching, 2000);
   EXPECT_GT(near_misses, 1000);
+  // Exact ties: a segment lying in the plane of an occupied voxel's face, across it, radius 0
+  // (the face's coordinate by the voxels' own arithmetic), on brick faces and inside bricks.
+  for (int i = 0; i < 3000; ++i) {
+    const Eigen::Vector3i v = occupied[static_cast<std::size_t>(i) % occupied.size()];
+    const int axis = i % 3, along = (i / 3) % 3 == axis ? (axis + 1) % 3 : (i / 3) % 3;
+    Eigen::Vector3d a = (v.cast<double>().array() + unit(rng)).matrix() * kVoxelM;
+    a[axis] = (i / 9) % 2 == 0 ? v[axis] * kVoxelM : v[axis] * kVoxelM + kVoxelM;
+    Eigen::Vector3d b = a;
+    a[along] -= 0.05 * unit(rng);
+    b[along] += 0.05 * unit(rng);
+    ASSERT_TRUE(field.capsuleTouches(a, b, 0.0))
+        << "segment " << a.transpose() << " to " << b.transpose() << " on voxel " << v.transpose();
+  }
+  // Long segments through the grid, clipped to it: the brute-force answer; no arm's
+  // coordinates (1e200 m out): touching, at once.
+  for (int i = 0; i < 200; ++i) {
+    const Eigen::Vector3d through(coordinate(rng), coordinate(rng), coordinate(rng));
+    const Eigen::Vector3d direction =
+        Eigen::Vector3d(coordinate(rng), coordinate(rng), coordinate(rng)).normalized();
+    const Eigen::Vector3d a = through - 1e5 * direction, b = through + 2e5 * direction;
+    const double r = radius(rng);
+    double nearest2 = std::numeric_limits<double>::infinity();
+    for (const Eigen::Vector3i& v : occupied) {
+      const Eigen::Vector3d low = v.cast<double>() * kVoxelM;
+      nearest2 =
+          std::min(nearest2, host::squaredSegmentBoxDistance(a, b, low, low.array() + kVoxelM));
+    }
+    if (std::abs(std::sqrt(nearest2) - r) < 1e-6) continue;  // too near a tie for 1e5 m
+    ASSERT_EQ(field.capsuleTouches(a, b, r), nearest2 <= r * r)
+        << "segment " << a.transpose() << " to " << b.transpose() << ", radius " << r;
+  }
+  EXPECT_TRUE(
+      field.capsuleTouches(Eigen::Vector3d(-1e200, 0, 0), Eigen::Vector3d(1e200, 0, 0), 0.01));
+  EXPECT_FALSE(field.capsuleTouches(Eigen::Vector3d(0.3, 0.3, 0.3),
+                                    Eigen::Vector3d(-0.3, -0.3, -0.3), -1.0));
   const double nan = std::numeric_limits<double>::quiet_NaN();
   EXPECT_TRUE(field.capsuleTouches(Eigen::Vector3d(nan, 0, 0), Eigen::Vector3d::Zero(), 0.01));
   EXPECT_TRUE(field.capsuleTouches(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), nan));

@@ -86,7 +86,9 @@ double squaredSegmentBoxDistance(const Eigen::Vector3d& a, const Eigen::Vector3d
       linear += d[axis] * (a[axis] - face[axis]);
     }
     const double t = quadratic > 0.0 ? std::clamp(-linear / quadratic, t0, t1) : t0;
-    best = std::min(best, ((a + t * d - face).cwiseProduct(outside)).squaredNorm());
+    // At t = 1 the point is b itself, not a + d rounded.
+    const Eigen::Vector3d point = t == 1.0 ? b : Eigen::Vector3d(a + t * d);
+    best = std::min(best, ((point - face).cwiseProduct(outside)).squaredNorm());
   }
   return best;
 }

@@ -57,12 +57,16 @@ class OccupancyDistanceField {
   CapsuleVerdict capsuleVerdict(const Eigen::Vector3d& a_m, const Eigen::Vector3d& b_m,
                                 double radius_m, double margin_m) const;
   /// Exactly whether the capsule of segment a-b and `radius_m` meets an occupied voxel's box
-  /// (their distance at most the radius); true for inputs that are not finite numbers.
+  /// (their distance at most the radius); true for inputs that are not numbers or lie
+  /// kMaxCoordinateM or farther out (no arm's link).
   bool capsuleTouches(const Eigen::Vector3d& a_m, const Eigen::Vector3d& b_m,
                       double radius_m) const;
 
   /// Cells a brick spans along each axis: the exact test's buckets of occupied voxels.
   static constexpr int kBrickCells = 4;
+  /// Coordinates and radii at or beyond this are no arm's: capsuleVerdict leaves them
+  /// undecided, capsuleTouches answers touching.
+  static constexpr double kMaxCoordinateM = 1e6;
 
  private:
   /// The storage offset of a cell at `local` from the grid's first cell (x fastest).
@@ -76,7 +80,8 @@ class OccupancyDistanceField {
   bool cellOf(const Eigen::Vector3d& point_m, Eigen::Vector3i& index) const;
   /// Buckets the occupied voxels by brick (brick_first_, brick_voxels_).
   void bucketByBrick(const std::vector<Eigen::Vector3i>& occupied);
-  /// capsuleTouches over the part a-b of the axis (segments of at most a brick's length).
+  /// capsuleTouches over the part a-b of the axis, clipped to near the grid: halved while the
+  /// bounds cannot clear a part longer than a brick and the radius.
   bool touchesAlong(const Eigen::Vector3d& a_m, const Eigen::Vector3d& b_m, double radius_m) const;
   /// capsuleTouches by testing every occupied voxel of the bricks near the segment a-b.
   bool touchesInBricks(const Eigen::Vector3d& a_m, const Eigen::Vector3d& b_m,
