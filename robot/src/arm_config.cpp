@@ -52,6 +52,7 @@ const std::vector<KeySpec>& keySpecs() {
       {"reproducible_planning_checks", &ArmConfig::reproducible_planning_checks, 100, 1e9},
       {"reproducible_simplify_checks", &ArmConfig::reproducible_simplify_checks, 0, 1e9},
       {"validity_step_rad", &ArmConfig::validity_step_rad, 1e-4, 0.5},
+      {"retreat_share", &ArmConfig::retreat_share, 0.0, 0.5},
       {"trajectory_timing", &ArmConfig::trajectory_timing},
       {"workspace_samples", &ArmConfig::workspace_samples, 1000, 1e10},
       {"workspace_resolution_m", &ArmConfig::workspace_resolution_m, 0.005, 0.5},

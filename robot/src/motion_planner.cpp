@@ -34,6 +34,9 @@ using Clock = std::chrono::steady_clock;
 // Distinct IK goals: at most this many, at least this far apart in joint space.
 constexpr int kMaxGoals = 8;
 constexpr double kDistinctGoalRad = 0.5;
+// A way in ends where the arm stands when its last waypoint is this near (the driver's
+// tolerance is far larger; this only tells a stale way in from the current one).
+constexpr double kSameConfigurationRad = 1e-3;
 // The nearest goal's share of planning_time_s, planned in the local box, before all
 // distinct goals are tried in the whole joint space.
 constexpr double kNearestShare = 0.25;
@@ -326,6 +329,12 @@ MotionPlanner::MotionPlanner(const ArmCollisionChecker& checker) : checker_(chec
 
 MotionPlan MotionPlanner::moveToPose(const JointVector& current,
                                      const Eigen::Isometry3d& T_world_camera) const {
+  return moveToPose(current, T_world_camera, {});
+}
+
+MotionPlan MotionPlanner::moveToPose(const JointVector& current,
+                                     const Eigen::Isometry3d& T_world_camera,
+                                     const std::vector<JointVector>& way_in) const {
   const auto start = Clock::now();
   const std::uint64_t checks_before = checker_.checks();
   MotionPlan plan;
@@ -359,9 +368,18 @@ MotionPlan MotionPlanner::moveToPose(const JointVector& current,
   // few tens of ms. A goal in a pocket of the map cannot be reached at all, so then every
   // distinct solution becomes a goal state of one more query, in the whole joint space, for
   // the rest of the time.
+  // Going back the way in takes its share from the whole-space query, only when there is one.
+  const double retreat_share =
+      way_in.size() >= 2 && jointDistance(way_in.back(), current) < kSameConfigurationRad
+          ? checker_.arm().config().retreat_share
+          : 0.0;
   plan = plan_(current, {goals.front()}, kNearestShare, /*local=*/true);
   if (!plan.ok() && plan.status != MotionStatus::kStartInvalid) {
-    plan = plan_(current, goals, 1.0 - kNearestShare, /*local=*/false);
+    plan = plan_(current, goals, 1.0 - kNearestShare - retreat_share, /*local=*/false);
+    if (!plan.ok() && plan.status != MotionStatus::kStartInvalid && retreat_share > 0.0) {
+      MotionPlan back = retreatAndPlan_(current, goals, way_in, retreat_share);
+      if (back.ok()) plan = std::move(back);
+    }
   }
   plan.ik_solutions = static_cast<int>(solutions.size());
   return finish(plan);
@@ -379,6 +397,27 @@ MotionStatus MotionPlanner::goalStatus(const JointVector& current,
   if (first_valid == solutions.end()) return MotionStatus::kNoCollisionFreeIk;
   if (goal) *goal = *first_valid;
   return MotionStatus::kSuccess;
+}
+
+MotionPlan MotionPlanner::retreatAndPlan_(const JointVector& current,
+                                          const std::vector<JointVector>& goals,
+                                          const std::vector<JointVector>& way_in,
+                                          double share) const {
+  MotionPlan plan;
+  // The way back on the map as it is now: leaves seen since the arm came in may close it.
+  std::vector<JointVector> waypoints(way_in.rbegin(), way_in.rend());
+  waypoints.front() = current;
+  for (std::size_t i = 1; i < waypoints.size(); ++i) {
+    if (!segmentValid(checker_, waypoints[i - 1], waypoints[i])) return plan;
+  }
+  plan = plan_(way_in.front(), goals, share, /*local=*/false);
+  if (!plan.ok()) return plan;
+  const std::vector<JointVector>& onward = plan.trajectory.waypoints();
+  waypoints.insert(waypoints.end(), onward.begin() + 1, onward.end());
+  plan.trajectory = timedTrajectory(checker_, std::move(waypoints));
+  plan.straight = false;
+  plan.retreated = true;
+  return plan;
 }
 
 MotionPlan MotionPlanner::planToJoints(const JointVector& current, const JointVector& goal) const {

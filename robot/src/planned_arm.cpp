@@ -95,10 +95,11 @@ host::nbv::MoveResult PlannedArm::moveTo(const Eigen::Isometry3d& T_world_camera
 
 PlannedMove PlannedArm::moveToPose(const Eigen::Isometry3d& T_world_camera) {
   PlannedMove move;
-  move.plan = planner_.moveToPose(joints(), T_world_camera);
+  move.plan = planner_.moveToPose(joints(), T_world_camera, way_in_);
   if (observer_) observer_(move.plan);
   move.status = toMoveStatus(move.plan.status);
   if (!move.plan.ok()) return move;
+  way_in_.clear();  // until this move is done, the arm is not where a way in would end
   move.execution = executor_.execute(move.plan.trajectory);
   switch (move.execution.status) {
     case ExecutionStatus::kRefused:
@@ -118,7 +119,9 @@ PlannedMove PlannedArm::moveToPose(const Eigen::Isometry3d& T_world_camera) {
     move.execution.detail = "the executor reported done, but a joint is " +
                             std::to_string(error.cwiseAbs().maxCoeff()) +
                             " (rad or m) from the trajectory's end";
+    return move;
   }
+  way_in_ = move.plan.trajectory.waypoints();
   return move;
 }
 

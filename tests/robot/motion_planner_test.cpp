@@ -88,6 +88,72 @@ TEST(MotionPlanner, ReportsStatusesWithoutThrowing) {
   EXPECT_STREQ(toString(MotionStatus::kTimeout), "timeout");
 }
 
+// Going back the way in (ArmConfig retreat_share): where the straight motion from the arm's
+// configuration to every goal is blocked and a small budget leaves OMPL without a path, but the
+// goal is straight from where the arm came from, the arm goes back and on, collision-free;
+// with the way back closed, or retreat_share 0, it does not, and retreat_share 0 plans as
+// before.
+TEST(MotionPlanner, GoesBackTheWayInWhenPlansFail) {
+  ArmConfig config;
+  config.reproducible_planning_checks = 400;
+  config.reproducible_simplify_checks = 0;
+  ArmConfig off_config = config;
+  config.retreat_share = 0.3;
+  const ArmModel arm{config}, arm_off{off_config};
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> offset(-0.5, 0.5);
+  int cases = 0;
+  for (int attempt = 0; attempt < 300 && cases < 3; ++attempt) {
+    const JointVector came_from = arm.homeConfiguration();
+    JointVector current = came_from, goal_q = came_from;
+    for (int j = 1; j < kArmJoints; ++j) current[j] += offset(rng), goal_q[j] += offset(rng);
+    const Eigen::Isometry3d goal = arm.T_world_camera(goal_q);
+    // Voxels where the camera is halfway along the straight motion to each goal.
+    octomap::OcTree tree(0.02);
+    for (const JointVector& g : arm.inverse(goal, current)) {
+      const Eigen::Vector3d p = arm.T_world_camera(0.5 * (current + g)).translation();
+      tree.updateNode(p.x(), p.y(), p.z(), true);
+    }
+    ArmCollisionChecker checker(arm), checker_off(arm_off);
+    checker.setMap(tree);
+    checker_off.setMap(tree);
+    const std::vector<JointVector> way_in{came_from, current};
+    const Trajectory way_back({current, came_from}, arm.maxVelocity(), arm.maxAcceleration());
+    if (!checker.isValid(current) || !testing::pathValid(checker, way_back, 0.004)) continue;
+    MotionPlanner off(checker_off), on(checker);
+    off.setReproducible(7);
+    on.setReproducible(7);
+    const MotionPlan without = off.moveToPose(current, goal, way_in);
+    if (without.ok() || without.status == MotionStatus::kNoCollisionFreeIk) continue;
+    // retreat_share 0: the way in changes nothing.
+    MotionPlanner off_again(checker_off);
+    off_again.setReproducible(7);
+    const MotionPlan plain = off_again.moveToPose(current, goal);
+    EXPECT_EQ(plain.status, without.status);
+    EXPECT_EQ(plain.validity_checks, without.validity_checks);
+    const MotionPlan with = on.moveToPose(current, goal, way_in);
+    if (!with.ok()) continue;  // the goal not straight from where the arm came from either
+    ++cases;
+    EXPECT_TRUE(with.retreated);
+    const std::vector<JointVector>& w = with.trajectory.waypoints();
+    EXPECT_EQ(w.front(), current);
+    EXPECT_LT(jointDistance(w[1], came_from), 1e-12);
+    EXPECT_LT((arm.T_world_camera(w.back()).translation() - goal.translation()).norm(), 1e-6);
+    EXPECT_TRUE(testing::pathValid(checker, with.trajectory, 0.004) || with.trajectory.isBlended());
+    EXPECT_TRUE(testing::timedPathValid(checker, with.trajectory));
+    // The way back closed (a voxel where the camera is halfway back): no retreat.
+    octomap::OcTree closed = tree;
+    const Eigen::Vector3d back = arm.T_world_camera(0.5 * (current + came_from)).translation();
+    closed.updateNode(back.x(), back.y(), back.z(), true);
+    checker.setMap(closed);
+    if (!checker.isValid(current)) continue;
+    MotionPlanner blocked(checker);
+    blocked.setReproducible(7);
+    EXPECT_FALSE(blocked.moveToPose(current, goal, way_in).retreated);
+  }
+  EXPECT_EQ(cases, 3);
+}
+
 TEST(MotionPlanner, GoalStatusIsMoveToPosesFirstStepWithoutPlanning) {
   // Views of a generated world's cluster from the sensor range, on the world's full coarse
   // map: a pose the goal check turns down fails moveToPose with the same status, and one it

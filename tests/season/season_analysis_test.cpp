@@ -181,6 +181,53 @@ TEST(SeasonAnalysis, AVisitWithoutTheTagLeavesTheFruitletsAndTwoOnOneDayAreRefus
   EXPECT_THROW(analyzeSeason({day0, day0}), std::invalid_argument);
 }
 
+// A fruitlet the later visit did not find is gone only when that visit looked at the cluster
+// until its own stop held: not when the automatic stop's budget, no reachable view or a view
+// cap cut it short (season 1's second visit reached two of its clusters for two views).
+TEST(SeasonAnalysis, AVisitCutShortDoesNotMakeFruitletsGone) {
+  const auto visit = [](double day, const std::string& rule, const std::string& reason,
+                        const std::string& fruitlets) {
+    return parseSeasonVisit(
+        R"({"stop": {"rule": ")" + rule +
+            R"("}, "clusters": [{"tag_id": 1, "T_world_tag": {}, "stop_reason": )" + reason +
+            R"(, "sized_fruitlets": [)" + fruitlets + "]}]}",
+        "day" + std::to_string(int(day)), day);
+  };
+  const std::string a0 = R"({"center_tag_m": [0, 0, 0.05], "size_mm": 7})";
+  const std::string b0 = R"({"center_tag_m": [-0.02, 0, 0.05], "size_mm": 6})";
+  const std::string a4 = R"({"center_tag_m": [0, 0, 0.05], "size_mm": 9})";
+  const SeasonVisit first = visit(0, "auto", R"("cluster_done")", a0 + "," + b0);
+  EXPECT_TRUE(first.clusters[0].searched);
+  const auto goneOf = [&](const SeasonVisit& later) {
+    const SeasonAnalysis s = analyzeSeason({first, later});
+    int gone = 0;
+    for (const FruitletTrack& t : s.tracks) gone += t.gone;
+    return gone;
+  };
+  EXPECT_EQ(goneOf(visit(4, "auto", R"("cluster_done")", a4)), 1);
+  EXPECT_EQ(goneOf(visit(4, "budget", R"("budget")", a4)), 1);  // the paper's whole budget
+  EXPECT_EQ(goneOf(visit(4, "auto", R"(null)", a4)), 1);        // not said: as before
+  for (const std::string reason : {R"("budget")", R"("no_reachable_view")", R"("max_views")"}) {
+    const SeasonVisit cut = visit(4, "auto", reason, a4);
+    EXPECT_FALSE(cut.clusters[0].searched) << reason;
+    EXPECT_EQ(goneOf(cut), 0) << reason;
+  }
+  // Cut short after a search that did not find it: still gone.
+  const SeasonAnalysis s = analyzeSeason(
+      {first, visit(4, "auto", R"("cluster_done")", a4), visit(7, "auto", R"("budget")", "")});
+  int gone = 0;
+  for (const FruitletTrack& t : s.tracks) gone += t.gone;
+  EXPECT_EQ(gone, 1);
+  EXPECT_NE(
+      errorOf(
+          R"({"clusters": [{"tag_id": 1, "T_world_tag": {}, "stop_reason": 3, "sized_fruitlets": []}]})")
+          .find("clusters[0].stop_reason"),
+      std::string::npos);
+  EXPECT_NE(errorOf(R"({"stop": {"rule": 1}, "T_world_tag": {}, "sized_fruitlets": []})")
+                .find("stop.rule"),
+            std::string::npos);
+}
+
 TEST(SeasonAnalysis, OneSightingBetweenTheFirstAndLastVisitIsUnconfirmedNotGone) {
   // Fruitlet A on every visit; B only on day 4 (a false blob, most likely: no fruitlet appears
   // after bloom); C only on day 0 (fell off, or hidden since: gone).

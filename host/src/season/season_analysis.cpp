@@ -39,7 +39,8 @@ void markUnconfirmed(const ClusterSeason& cluster, const std::vector<SeasonVisit
 
 /// Follows one cluster's fruitlets over the visits: each visit that saw the tag is associated
 /// with the last size of every track so far (tracks missed once stay, to be found again); the
-/// unpaired fruitlets start tracks; a track not found on the cluster's latest visit is gone.
+/// unpaired fruitlets start tracks; a track not found on the cluster's latest visit that searched
+/// it (VisitCluster::searched) is gone.
 void followCluster(int tag_id, const std::vector<SeasonVisit>& visits,
                    const AssociationConfig& config, SeasonAnalysis& out) {
   ClusterSeason cluster;
@@ -65,7 +66,8 @@ void followCluster(int tag_id, const std::vector<SeasonVisit>& visits,
       for (std::size_t e = 0; e < before.size(); ++e) {
         FruitletTrack& track = out.tracks[before[e]];
         const int l = a.later_of_earlier[e];
-        track.gone = l < 0;
+        // Not found by a visit cut short: missed there, as the visit before left it.
+        if (l >= 0 || c.searched) track.gone = l < 0;
         if (l >= 0)
           track.sizes.push_back(
               {v, visits[v].day, c.fruitlets[std::size_t(l)], a.confidence[e], std::size_t(l)});

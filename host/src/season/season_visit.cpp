@@ -55,12 +55,35 @@ SizedFruitlet sizedFruitlet(const json& f, const std::string& source, const std:
   return out;
 }
 
+/// Whether the cluster's "stop_reason" (absent: yes) says the visit looked until its own stop
+/// held; `stop_rule` is the run's "stop"."rule" ("budget": the paper's protocol, every cluster
+/// given its whole budget).
+bool searchedOf(const json& sizing, const std::string& stop_rule, const std::string& source,
+                const std::string& field) {
+  const auto reason = sizing.find("stop_reason");
+  if (reason == sizing.end() || reason->is_null()) return true;
+  if (!reason->is_string()) fail(source, field + "stop_reason", "a string (the cluster's stop)");
+  const std::string& why = reason->get_ref<const std::string&>();
+  return why == "cluster_done" || (why == "budget" && stop_rule == "budget");
+}
+
+/// The run's stop rule ("stop": {"rule": ...}), "" when the file does not say.
+std::string stopRuleOf(const json& root, const std::string& source) {
+  const auto stop = root.find("stop");
+  if (stop == root.end() || !stop->is_object()) return "";
+  const auto rule = stop->find("rule");
+  if (rule == stop->end()) return "";
+  if (!rule->is_string()) fail(source, "stop.rule", "a string (budget or auto)");
+  return rule->get<std::string>();
+}
+
 /// A cluster's sizing: "sized_fruitlets" with the tag frame ("T_world_tag" present), or no
 /// tag seen (no "T_world_tag": nothing to place).
-VisitCluster clusterOf(const json& sizing, int tag_id, const std::string& source,
-                       const std::string& field) {
+VisitCluster clusterOf(const json& sizing, int tag_id, const std::string& stop_rule,
+                       const std::string& source, const std::string& field) {
   VisitCluster cluster;
   cluster.tag_id = tag_id;
+  cluster.searched = searchedOf(sizing, stop_rule, source, field);
   cluster.tag_seen = sizing.contains("T_world_tag");
   if (!cluster.tag_seen) return cluster;
   if (const json& pose = sizing["T_world_tag"]; pose.is_object() && pose.contains("translation_m"))
@@ -91,9 +114,10 @@ SeasonVisit json_fields::seasonVisitOf(const json& root, const std::string& sour
   SeasonVisit visit;
   visit.day = day;
   visit.source = source;
+  const std::string stop_rule = stopRuleOf(root, source);
   const auto clusters = root.find("clusters");
   if (clusters == root.end()) {
-    visit.clusters.push_back(clusterOf(root, tagIdOf(root, source, ""), source, ""));
+    visit.clusters.push_back(clusterOf(root, tagIdOf(root, source, ""), stop_rule, source, ""));
     return visit;
   }
   if (!clusters->is_array()) fail(source, "clusters", "an array (a tree's clusters)");
@@ -108,7 +132,7 @@ SeasonVisit json_fields::seasonVisitOf(const json& root, const std::string& sour
       fail(source, field + "tag_id",
            "a tag of its own (clusters[" + std::to_string(it->second) + "] has tag " +
                std::to_string(tag) + " too)");
-    visit.clusters.push_back(clusterOf(c, tag, source, field));
+    visit.clusters.push_back(clusterOf(c, tag, stop_rule, source, field));
   }
   return visit;
 }

@@ -48,6 +48,8 @@ inline constexpr std::int64_t kDefaultReproducibleSimplifyChecks = 66000;
 // ~1.2 m over seven joints), so a state between two checked ones is within ~0.85 cm of one:
 // inside the 1 cm padding, the real (unpadded) arm never touches an occupied voxel.
 inline constexpr double kDefaultValidityStepRad = 0.01;
+/// Off until measured on more worlds (docs/robot.md "Going back the way in").
+inline constexpr double kDefaultRetreatShare = 0.0;
 inline constexpr std::int64_t kDefaultWorkspaceSamples = 10'000'000;  // the paper's
 inline constexpr double kDefaultWorkspaceResolutionM = 0.04;
 inline constexpr int kDefaultWorkspaceDirectionBins = 3;
@@ -92,6 +94,9 @@ struct ArmConfig {
   std::int64_t reproducible_planning_checks = kDefaultReproduciblePlanningChecks;
   std::int64_t reproducible_simplify_checks = kDefaultReproducibleSimplifyChecks;
   double validity_step_rad = kDefaultValidityStepRad;  ///< joint-space step of motion checks
+  /// The share of the planning budget for going back the way the arm came in and planning
+  /// from there, when the plans from where it stands fail (0: never; MotionPlanner).
+  double retreat_share = kDefaultRetreatShare;
   /// How a planned path is timed (trajectory.h): "rest_to_rest" stops at every waypoint;
   /// "blended" moves through the via points with parabolic blends, where the blended path is
   /// collision-free (else rest to rest).

@@ -36,7 +36,8 @@ struct MotionPlan {
   Trajectory trajectory;                   ///< empty unless kSuccess
   double planning_wall_s = 0.0;            ///< IK + planning + simplification + timing
   int ik_solutions = 0;                    ///< within limits, before collision checks
-  bool straight = false;  ///< the straight joint-space motion, without a sampling planner
+  bool straight = false;   ///< the straight joint-space motion, without a sampling planner
+  bool retreated = false;  ///< back the way the arm came in first (ArmConfig retreat_share)
   /// Every state and motion check of the query (moveToPose: the goals' and every planning
   /// attempt's): the work a fixed clock charges (SimClock::chargeMotionPlanning).
   std::uint64_t validity_checks = 0;
@@ -50,6 +51,14 @@ class MotionPlanner {
   explicit MotionPlanner(const ArmCollisionChecker& checker);
 
   MotionPlan moveToPose(const JointVector& current, const Eigen::Isometry3d& T_world_camera) const;
+  /// moveToPose, knowing `way_in`: the waypoints by which the arm came to `current` (the last
+  /// one `current`). When ArmConfig retreat_share is positive and both queries from `current`
+  /// fail, the arm may go back that way, checked again on the map it has now, and plan from
+  /// where it came from with that share of the budget (taken from the whole-space query's).
+  /// Among leaves the arm can stand in a pocket of free space that RRTConnect's long
+  /// extensions rarely leave, while the way it came in is open.
+  MotionPlan moveToPose(const JointVector& current, const Eigen::Isometry3d& T_world_camera,
+                        const std::vector<JointVector>& way_in) const;
   /// moveToPose's first step alone, without motion planning: kNoIk or kNoCollisionFreeIk
   /// exactly when moveToPose from `current` on the same map would fail with that status,
   /// else kSuccess (a collision-free goal exists; the motion may still fail). IK along the
@@ -75,6 +84,9 @@ class MotionPlanner {
   /// the start and the goals.
   MotionPlan plan_(const JointVector& current, const std::vector<JointVector>& goals, double share,
                    bool local) const;
+  /// Back along `way_in` (if it is still free) to its first waypoint, then plan_ from there.
+  MotionPlan retreatAndPlan_(const JointVector& current, const std::vector<JointVector>& goals,
+                             const std::vector<JointVector>& way_in, double share) const;
 
   const ArmCollisionChecker& checker_;
   bool reproducible_ = false;

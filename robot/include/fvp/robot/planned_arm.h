@@ -89,6 +89,9 @@ class PlannedArm : public host::nbv::Arm {
   ArmCollisionChecker checker_;
   MotionPlanner planner_;
   PlanningObserver observer_;
+  /// The waypoints of the last move done (empty after a failed one): the way back that the
+  /// planner may take (MotionPlanner::moveToPose's way_in).
+  std::vector<JointVector> way_in_;
 };
 
 /// MotionStatus -> the loop's MoveStatus (the planning failures keep their names).

@@ -29,6 +29,11 @@ struct SizedFruitlet {
 struct VisitCluster {
   int tag_id = 0;
   bool tag_seen = true;
+  /// The visit looked at the cluster until its own stop held ("stop_reason" "cluster_done", or
+  /// "budget" under the paper's budget rule, or none given): a fruitlet it did not find is
+  /// gone. False when the visit was cut short (the budget under the automatic stop, no
+  /// reachable view, a view cap, no region): not found there is not evidence of gone.
+  bool searched = true;
   /// The tag's pose in the visit's world ("T_world_tag" with "translation_m" and
   /// "quaternion_wxyz", as fvp's results write it); none when the file gives no pose.
   std::optional<Eigen::Isometry3d> T_world_tag;
