@@ -277,6 +277,21 @@ ob::RealVectorBounds planningBounds(const ArmModel& arm, const JointVector& curr
 /// only at the corners whose blends collide; then the whole path at half and a quarter of the
 /// joints' speed limits (a blend cuts its corner by |dv|^2 / (8 a): four and sixteen times
 /// less, as a smaller blend radius does on a UR), where that is quicker still.
+/// The way in backwards from `current` (its first waypoint `current` itself), when the way in
+/// ends where the arm stands and every segment of it is free on the map as it is now (leaves
+/// seen since the arm came in may close it); else empty.
+std::vector<JointVector> openWayBack(const ArmCollisionChecker& checker, const JointVector& current,
+                                     const std::vector<JointVector>& way_in) {
+  if (way_in.size() < 2 || !(jointDistance(way_in.back(), current) < kSameConfigurationRad))
+    return {};
+  std::vector<JointVector> way_back(way_in.rbegin(), way_in.rend());
+  way_back.front() = current;
+  for (std::size_t i = 1; i < way_back.size(); ++i) {
+    if (!segmentValid(checker, way_back[i - 1], way_back[i])) return {};
+  }
+  return way_back;
+}
+
 Trajectory timedTrajectory(const ArmCollisionChecker& checker, std::vector<JointVector> waypoints) {
   const ArmModel& arm = checker.arm();
   // Zero-length segments have no corner to blend or rest at.
@@ -368,16 +383,16 @@ MotionPlan MotionPlanner::moveToPose(const JointVector& current,
   // few tens of ms. A goal in a pocket of the map cannot be reached at all, so then every
   // distinct solution becomes a goal state of one more query, in the whole joint space, for
   // the rest of the time.
-  // Going back the way in takes its share from the whole-space query, only when there is one.
-  const double retreat_share =
-      way_in.size() >= 2 && jointDistance(way_in.back(), current) < kSameConfigurationRad
-          ? checker_.arm().config().retreat_share
-          : 0.0;
   plan = plan_(current, {goals.front()}, kNearestShare, /*local=*/true);
   if (!plan.ok() && plan.status != MotionStatus::kStartInvalid) {
+    // Going back the way in takes its share from the whole-space query, only when it is open.
+    const double share = checker_.arm().config().retreat_share;
+    const std::vector<JointVector> way_back =
+        share > 0.0 ? openWayBack(checker_, current, way_in) : std::vector<JointVector>{};
+    const double retreat_share = way_back.empty() ? 0.0 : share;
     plan = plan_(current, goals, 1.0 - kNearestShare - retreat_share, /*local=*/false);
     if (!plan.ok() && plan.status != MotionStatus::kStartInvalid && retreat_share > 0.0) {
-      MotionPlan back = retreatAndPlan_(current, goals, way_in, retreat_share);
+      MotionPlan back = retreatAndPlan_(way_back, goals, retreat_share);
       if (back.ok()) plan = std::move(back);
     }
   }
@@ -399,24 +414,17 @@ MotionStatus MotionPlanner::goalStatus(const JointVector& current,
   return MotionStatus::kSuccess;
 }
 
-MotionPlan MotionPlanner::retreatAndPlan_(const JointVector& current,
+MotionPlan MotionPlanner::retreatAndPlan_(const std::vector<JointVector>& way_back,
                                           const std::vector<JointVector>& goals,
-                                          const std::vector<JointVector>& way_in,
                                           double share) const {
-  MotionPlan plan;
-  // The way back on the map as it is now: leaves seen since the arm came in may close it.
-  std::vector<JointVector> waypoints(way_in.rbegin(), way_in.rend());
-  waypoints.front() = current;
-  for (std::size_t i = 1; i < waypoints.size(); ++i) {
-    if (!segmentValid(checker_, waypoints[i - 1], waypoints[i])) return plan;
-  }
-  plan = plan_(way_in.front(), goals, share, /*local=*/false);
+  MotionPlan plan = plan_(way_back.back(), goals, share, /*local=*/false);
   if (!plan.ok()) return plan;
+  std::vector<JointVector> waypoints = way_back;
   const std::vector<JointVector>& onward = plan.trajectory.waypoints();
   waypoints.insert(waypoints.end(), onward.begin() + 1, onward.end());
   plan.trajectory = timedTrajectory(checker_, std::move(waypoints));
   plan.straight = false;
-  plan.retreated = true;
+  plan.retreat_turn = way_back.size() - 1;
   return plan;
 }
 

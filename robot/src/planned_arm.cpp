@@ -99,10 +99,13 @@ PlannedMove PlannedArm::moveToPose(const Eigen::Isometry3d& T_world_camera) {
   if (observer_) observer_(move.plan);
   move.status = toMoveStatus(move.plan.status);
   if (!move.plan.ok()) return move;
-  way_in_.clear();  // until this move is done, the arm is not where a way in would end
+  // Until this move is done the arm is not where a way in would end (a refused one: it is).
+  std::vector<JointVector> way_in = std::move(way_in_);
+  way_in_.clear();
   move.execution = executor_.execute(move.plan.trajectory);
   switch (move.execution.status) {
     case ExecutionStatus::kRefused:
+      way_in_ = std::move(way_in);
       move.status = host::nbv::MoveStatus::kRefused;
       return move;
     case ExecutionStatus::kFailed:
@@ -121,7 +124,11 @@ PlannedMove PlannedArm::moveToPose(const Eigen::Isometry3d& T_world_camera) {
                             " (rad or m) from the trajectory's end";
     return move;
   }
-  way_in_ = move.plan.trajectory.waypoints();
+  // The way in of the next move: from where this one turned onward (going back into a pocket
+  // it left is no way out), ending where the arm stands (within the driver's tolerance).
+  const std::vector<JointVector>& w = move.plan.trajectory.waypoints();
+  way_in_.assign(w.begin() + static_cast<std::ptrdiff_t>(move.plan.retreat_turn), w.end());
+  way_in_.back() = joints();
   return move;
 }
 

@@ -134,9 +134,10 @@ TEST(MotionPlanner, GoesBackTheWayInWhenPlansFail) {
     const MotionPlan with = on.moveToPose(current, goal, way_in);
     if (!with.ok()) continue;  // the goal not straight from where the arm came from either
     ++cases;
-    EXPECT_TRUE(with.retreated);
+    EXPECT_TRUE(with.retreated());
     const std::vector<JointVector>& w = with.trajectory.waypoints();
     EXPECT_EQ(w.front(), current);
+    ASSERT_EQ(with.retreat_turn, 1u);  // the next move's way in starts where it turned
     EXPECT_LT(jointDistance(w[1], came_from), 1e-12);
     EXPECT_LT((arm.T_world_camera(w.back()).translation() - goal.translation()).norm(), 1e-6);
     EXPECT_TRUE(testing::pathValid(checker, with.trajectory, 0.004) || with.trajectory.isBlended());
@@ -147,9 +148,14 @@ TEST(MotionPlanner, GoesBackTheWayInWhenPlansFail) {
     closed.updateNode(back.x(), back.y(), back.z(), true);
     checker.setMap(closed);
     if (!checker.isValid(current)) continue;
-    MotionPlanner blocked(checker);
+    MotionPlanner blocked(checker), blocked_off(checker_off);
     blocked.setReproducible(7);
-    EXPECT_FALSE(blocked.moveToPose(current, goal, way_in).retreated);
+    blocked_off.setReproducible(7);
+    checker_off.setMap(closed);
+    // No retreat, and the whole-space query keeps its whole share: the plan without one.
+    const MotionPlan closed_plan = blocked.moveToPose(current, goal, way_in);
+    EXPECT_FALSE(closed_plan.retreated());
+    EXPECT_EQ(closed_plan.status, blocked_off.moveToPose(current, goal, way_in).status);
   }
   EXPECT_EQ(cases, 3);
 }

@@ -218,6 +218,16 @@ TEST(SeasonAnalysis, AVisitCutShortDoesNotMakeFruitletsGone) {
   int gone = 0;
   for (const FruitletTrack& t : s.tracks) gone += t.gone;
   EXPECT_EQ(gone, 1);
+  // A fruitlet first found on the second visit is not made unconfirmed by a third cut short.
+  const std::string b4 = R"({"center_tag_m": [0.02, 0, 0.05], "size_mm": 7})";
+  const SeasonAnalysis later = analyzeSeason({visit(0, "auto", R"("cluster_done")", a0),
+                                              visit(4, "auto", R"("cluster_done")", a4 + "," + b4),
+                                              visit(7, "auto", R"("budget")", a4)});
+  int unconfirmed = 0;
+  for (const FruitletTrack& t : later.tracks) unconfirmed += t.unconfirmed;
+  EXPECT_EQ(unconfirmed, 0);
+  EXPECT_NE(errorOf(R"({"stop": "budget", "T_world_tag": {}, "sized_fruitlets": []})").find("stop"),
+            std::string::npos);
   EXPECT_NE(
       errorOf(
           R"({"clusters": [{"tag_id": 1, "T_world_tag": {}, "stop_reason": 3, "sized_fruitlets": []}]})")

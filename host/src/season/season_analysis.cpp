@@ -19,18 +19,19 @@ void SeasonConfig::validate() const {
 
 namespace {
 
-/// Tracks sized on one visit between the cluster's first and last that saw its tag: a
-/// fruitlet that appeared after the first visit and was gone by the last.
+/// Tracks sized on one visit after the cluster's first that searched it, and gone since (a
+/// later visit searched and did not find them): a fruitlet that appeared after the first visit
+/// and was gone by the last. Visits cut short judge neither.
 void markUnconfirmed(const ClusterSeason& cluster, const std::vector<SeasonVisit>& visits,
                      std::vector<FruitletTrack>& tracks) {
-  std::vector<std::size_t> seen;  // the visits that saw the cluster's tag
+  std::vector<std::size_t> searched;  // the visits that saw the cluster's tag and searched it
   for (std::size_t v = 0; v < visits.size(); ++v)
     for (const VisitCluster& c : visits[v].clusters)
-      if (c.tag_id == cluster.tag_id && c.tag_seen) seen.push_back(v);
+      if (c.tag_id == cluster.tag_id && c.tag_seen && c.searched) searched.push_back(v);
   for (const std::size_t t : cluster.tracks) {
     FruitletTrack& track = tracks[t];
     const std::size_t v = track.sizes.front().visit;
-    if (track.sizes.size() == 1 && !seen.empty() && v != seen.front() && v != seen.back()) {
+    if (track.sizes.size() == 1 && !searched.empty() && v > searched.front() && track.gone) {
       track.unconfirmed = true;
       track.gone = false;
     }

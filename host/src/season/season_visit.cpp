@@ -70,9 +70,10 @@ bool searchedOf(const json& sizing, const std::string& stop_rule, const std::str
 /// The run's stop rule ("stop": {"rule": ...}), "" when the file does not say.
 std::string stopRuleOf(const json& root, const std::string& source) {
   const auto stop = root.find("stop");
-  if (stop == root.end() || !stop->is_object()) return "";
+  if (stop == root.end() || stop->is_null()) return "";
+  if (!stop->is_object()) fail(source, "stop", "an object (the run's stop rule)");
   const auto rule = stop->find("rule");
-  if (rule == stop->end()) return "";
+  if (rule == stop->end() || rule->is_null()) return "";
   if (!rule->is_string()) fail(source, "stop.rule", "a string (budget or auto)");
   return rule->get<std::string>();
 }

@@ -36,8 +36,11 @@ struct MotionPlan {
   Trajectory trajectory;                   ///< empty unless kSuccess
   double planning_wall_s = 0.0;            ///< IK + planning + simplification + timing
   int ik_solutions = 0;                    ///< within limits, before collision checks
-  bool straight = false;   ///< the straight joint-space motion, without a sampling planner
-  bool retreated = false;  ///< back the way the arm came in first (ArmConfig retreat_share)
+  bool straight = false;  ///< the straight joint-space motion, without a sampling planner
+  /// 0, or the waypoint where a move that went back the way the arm came in (ArmConfig
+  /// retreat_share) turns onward: the onward path is the way in of the next move.
+  std::size_t retreat_turn = 0;
+  bool retreated() const { return retreat_turn > 0; }
   /// Every state and motion check of the query (moveToPose: the goals' and every planning
   /// attempt's): the work a fixed clock charges (SimClock::chargeMotionPlanning).
   std::uint64_t validity_checks = 0;
@@ -84,9 +87,9 @@ class MotionPlanner {
   /// the start and the goals.
   MotionPlan plan_(const JointVector& current, const std::vector<JointVector>& goals, double share,
                    bool local) const;
-  /// Back along `way_in` (if it is still free) to its first waypoint, then plan_ from there.
-  MotionPlan retreatAndPlan_(const JointVector& current, const std::vector<JointVector>& goals,
-                             const std::vector<JointVector>& way_in, double share) const;
+  /// Along `way_back` (checked free) to its last waypoint, then plan_ from there.
+  MotionPlan retreatAndPlan_(const std::vector<JointVector>& way_back,
+                             const std::vector<JointVector>& goals, double share) const;
 
   const ArmCollisionChecker& checker_;
   bool reproducible_ = false;

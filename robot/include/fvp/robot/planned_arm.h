@@ -89,8 +89,9 @@ class PlannedArm : public host::nbv::Arm {
   ArmCollisionChecker checker_;
   MotionPlanner planner_;
   PlanningObserver observer_;
-  /// The waypoints of the last move done (empty after a failed one): the way back that the
-  /// planner may take (MotionPlanner::moveToPose's way_in).
+  /// The waypoints of the last move done, from where it turned onward, ending where the arm
+  /// stood after it (empty after a move that failed): the way back that the planner may take
+  /// (MotionPlanner::moveToPose's way_in).
   std::vector<JointVector> way_in_;
 };
 
