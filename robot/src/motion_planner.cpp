@@ -272,11 +272,6 @@ ob::RealVectorBounds planningBounds(const ArmModel& arm, const JointVector& curr
   return bounds;
 }
 
-/// The waypoints timed rest to rest, or blended through the via points (ArmConfig
-/// trajectory_timing) where that is faster and collision-free. First at full speed, resting
-/// only at the corners whose blends collide; then the whole path at half and a quarter of the
-/// joints' speed limits (a blend cuts its corner by |dv|^2 / (8 a): four and sixteen times
-/// less, as a smaller blend radius does on a UR), where that is quicker still.
 /// The way in backwards from `current` (its first waypoint `current` itself), when the way in
 /// ends where the arm stands and every segment of it is free on the map as it is now (leaves
 /// seen since the arm came in may close it); else empty.
@@ -292,6 +287,11 @@ std::vector<JointVector> openWayBack(const ArmCollisionChecker& checker, const J
   return way_back;
 }
 
+/// The waypoints timed rest to rest, or blended through the via points (ArmConfig
+/// trajectory_timing) where that is faster and collision-free. First at full speed, resting
+/// only at the corners whose blends collide; then the whole path at half and a quarter of the
+/// joints' speed limits (a blend cuts its corner by |dv|^2 / (8 a): four and sixteen times
+/// less, as a smaller blend radius does on a UR), where that is quicker still.
 Trajectory timedTrajectory(const ArmCollisionChecker& checker, std::vector<JointVector> waypoints) {
   const ArmModel& arm = checker.arm();
   // Zero-length segments have no corner to blend or rest at.
