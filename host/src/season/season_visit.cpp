@@ -5,8 +5,10 @@
 #include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
 
+#include "fvp/host/nbv/stop_rule.h"
 #include "fvp/host/season/growth_rate.h"
 #include "json_fields.h"
 
@@ -56,31 +58,36 @@ SizedFruitlet sizedFruitlet(const json& f, const std::string& source, const std:
 }
 
 /// Whether the cluster's "stop_reason" (absent: yes) says the visit looked until its own stop
-/// held; `stop_rule` is the run's "stop"."rule" ("budget": the paper's protocol, every cluster
-/// given its whole budget).
-bool searchedOf(const json& sizing, const std::string& stop_rule, const std::string& source,
-                const std::string& field) {
+/// held; `stop_rule` is the run's "stop"."rule" (the budget rule: the paper's protocol, every
+/// cluster given its whole budget).
+bool searchedOf(const json& sizing, std::optional<nbv::StopRule> stop_rule,
+                const std::string& source, const std::string& field) {
   const auto reason = sizing.find("stop_reason");
   if (reason == sizing.end() || reason->is_null()) return true;
   if (!reason->is_string()) fail(source, field + "stop_reason", "a string (the cluster's stop)");
   const std::string& why = reason->get_ref<const std::string&>();
-  return why == "cluster_done" || (why == "budget" && stop_rule == "budget");
+  // The budget's stop condition (nbv::budget) is named as the budget rule.
+  return why == "cluster_done" ||
+         (stop_rule == nbv::StopRule::kBudget && why == nbv::toString(nbv::StopRule::kBudget));
 }
 
-/// The run's stop rule ("stop": {"rule": ...}), "" when the file does not say.
-std::string stopRuleOf(const json& root, const std::string& source) {
+/// The run's stop rule ("stop": {"rule": ...}), none when the file does not say.
+std::optional<nbv::StopRule> stopRuleOf(const json& root, const std::string& source) {
   const auto stop = root.find("stop");
-  if (stop == root.end() || stop->is_null()) return "";
+  if (stop == root.end() || stop->is_null()) return std::nullopt;
   if (!stop->is_object()) fail(source, "stop", "an object (the run's stop rule)");
   const auto rule = stop->find("rule");
-  if (rule == stop->end() || rule->is_null()) return "";
-  if (!rule->is_string()) fail(source, "stop.rule", "a string (budget or auto)");
-  return rule->get<std::string>();
+  if (rule == stop->end() || rule->is_null()) return std::nullopt;
+  const std::optional<nbv::StopRule> parsed =
+      rule->is_string() ? nbv::stopRuleFromString(rule->get_ref<const std::string&>())
+                        : std::nullopt;
+  if (!parsed) fail(source, "stop.rule", "one of " + nbv::stopRuleNames());
+  return parsed;
 }
 
 /// A cluster's sizing: "sized_fruitlets" with the tag frame ("T_world_tag" present), or no
 /// tag seen (no "T_world_tag": nothing to place).
-VisitCluster clusterOf(const json& sizing, int tag_id, const std::string& stop_rule,
+VisitCluster clusterOf(const json& sizing, int tag_id, std::optional<nbv::StopRule> stop_rule,
                        const std::string& source, const std::string& field) {
   VisitCluster cluster;
   cluster.tag_id = tag_id;
@@ -115,7 +122,7 @@ SeasonVisit json_fields::seasonVisitOf(const json& root, const std::string& sour
   SeasonVisit visit;
   visit.day = day;
   visit.source = source;
-  const std::string stop_rule = stopRuleOf(root, source);
+  const std::optional<nbv::StopRule> stop_rule = stopRuleOf(root, source);
   const auto clusters = root.find("clusters");
   if (clusters == root.end()) {
     visit.clusters.push_back(clusterOf(root, tagIdOf(root, source, ""), stop_rule, source, ""));
