@@ -99,18 +99,10 @@ OccupancyDistanceField::OccupancyDistanceField(double voxel_size_m,
 void OccupancyDistanceField::bucketByBrick(const std::vector<Eigen::Vector3i>& occupied) {
   bricks_ = (size_.array() + kBrickCells - 1) / kBrickCells;
   const auto brickOf = [this](const Eigen::Vector3i& v) {
-    const Eigen::Vector3i brick = (v - min_) / kBrickCells;
-    return static_cast<std::size_t>(brick.x()) +
-           static_cast<std::size_t>(bricks_.x()) *
-               (static_cast<std::size_t>(brick.y()) +
-                static_cast<std::size_t>(bricks_.y()) * static_cast<std::size_t>(brick.z()));
+    return brickOffsetOf((v - min_) / kBrickCells);
   };
   // Counting sort: counts, their prefix sums, then each voxel into its brick's range.
-  brick_first_.assign(static_cast<std::size_t>(bricks_.x()) *
-                              static_cast<std::size_t>(bricks_.y()) *
-                              static_cast<std::size_t>(bricks_.z()) +
-                          1,
-                      0);
+  brick_first_.assign(brickOffsetOf(bricks_ - Eigen::Vector3i::Ones()) + 2, 0);
   for (const Eigen::Vector3i& v : occupied) ++brick_first_[brickOf(v) + 1];
   for (std::size_t b = 1; b < brick_first_.size(); ++b) brick_first_[b] += brick_first_[b - 1];
   std::vector<std::uint32_t> next(brick_first_.begin(), brick_first_.end() - 1);
@@ -255,10 +247,7 @@ bool OccupancyDistanceField::touchesInBricks(const Eigen::Vector3d& a_m, const E
   for (int z = first.z(); z <= last.z(); ++z)
     for (int y = first.y(); y <= last.y(); ++y)
       for (int x = first.x(); x <= last.x(); ++x) {
-        const std::size_t brick = static_cast<std::size_t>(x) +
-                                  static_cast<std::size_t>(bricks_.x()) *
-                                      (static_cast<std::size_t>(y) +
-                                       static_cast<std::size_t>(bricks_.y()) * std::size_t(z));
+        const std::size_t brick = brickOffsetOf(Eigen::Vector3i(x, y, z));
         const std::uint32_t begin = brick_first_[brick], end = brick_first_[brick + 1];
         if (begin == end) continue;
         // The brick's box by the same arithmetic as its voxels' boxes, so that it holds them.

@@ -76,6 +76,14 @@ class OccupancyDistanceField {
                (static_cast<std::size_t>(local.y()) +
                 static_cast<std::size_t>(size_.y()) * static_cast<std::size_t>(local.z()));
   }
+  /// The offset of brick `brick` (bricks of kBrickCells cells from the grid's first) in the
+  /// brick table (x fastest).
+  std::size_t brickOffsetOf(const Eigen::Vector3i& brick) const {
+    return static_cast<std::size_t>(brick.x()) +
+           static_cast<std::size_t>(bricks_.x()) *
+               (static_cast<std::size_t>(brick.y()) +
+                static_cast<std::size_t>(bricks_.y()) * static_cast<std::size_t>(brick.z()));
+  }
   /// The grid cell holding `point_m`, false outside the grid.
   bool cellOf(const Eigen::Vector3d& point_m, Eigen::Vector3i& index) const;
   /// Buckets the occupied voxels by brick (brick_first_, brick_voxels_).
