@@ -1,7 +1,8 @@
 // NbvLoop's contract, driven by fakes: it captures at the arm's pose, plans again without a
 // capture after a failed move, counts refusals and dropped frames, stops when the stop
-// condition holds (also between a capture and the planning that would follow it), and stops
-// without planning when no view showed the tag.
+// condition holds (also between a capture and the planning that would follow it), stops
+// without planning when no view showed the tag, and ends an iteration after
+// max_failed_plans motion plans failed.
 #include "fvp/host/nbv/nbv_loop.h"
 
 #include <gtest/gtest.h>
@@ -74,6 +75,11 @@ class FakeArm : public Arm {
   bool reachable(const Eigen::Isometry3d&) const override { return true; }
   MoveResult moveTo(const Eigen::Isometry3d& T) override {
     ++moves;
+    if (fail_with) return {*fail_with, 0.0, 0.0};
+    if (retreat_every && moves % retreat_every == 0) {
+      pose_ = T;
+      return {MoveStatus::kSuccess, 0.0, 0.0, /*retreated=*/true};
+    }
     if (refuse_every && moves % refuse_every == 0) return {MoveStatus::kRefused, 0.0, 0.0};
     pose_ = T;
     return {MoveStatus::kSuccess, 0.0, 0.0};
@@ -90,14 +96,16 @@ class FakeArm : public Arm {
   int reject_every = 0;
   mutable int goal_checks = 0;
   int refuse_every = 0, moves = 0;
+  std::optional<MoveStatus> fail_with;  ///< every move fails so
+  int retreat_every = 0;                ///< every n-th move goes back the way in first
   std::size_t obstacle_updates = 0;
 
  private:
   Eigen::Isometry3d pose_ = renderedFrame(1).T_world_camera;
 };
 
-/// Offers one candidate per iteration, 1 cm along x from the current pose, ranked when
-/// reachable.
+/// Offers `per_round` candidates per iteration, 1 cm apart along x from the current pose,
+/// ranked when reachable.
 class FakePlanner : public planner::ViewPlanner {
  public:
   std::string_view name() const override { return "fake"; }
@@ -107,16 +115,19 @@ class FakePlanner : public planner::ViewPlanner {
                                        planner::PlanStep&) override {
     if (round > 0) return std::nullopt;
     planner::Ranking ranking;
-    planner::Candidate c;
-    c.T_world_camera = T_now;
-    c.T_world_camera.translation().x() += 0.01;
-    c.reachable = reachable(c.T_world_camera);
-    ranking.candidates.push_back(c);
-    if (c.reachable) ranking.order.push_back(0);
+    for (std::size_t k = 0; k < per_round; ++k) {
+      planner::Candidate c;
+      c.T_world_camera = T_now;
+      c.T_world_camera.translation().x() += 0.01 * static_cast<double>(k + 1);
+      c.reachable = reachable(c.T_world_camera);
+      ranking.candidates.push_back(c);
+      if (c.reachable) ranking.order.push_back(k);
+    }
     ++calls;
     return ranking;
   }
   int calls = 0;
+  std::size_t per_round = 1;
 };
 
 struct Rig {
@@ -179,6 +190,14 @@ TEST(NbvLoop, NoGoalChecksWhenTheArmHasNoneOrTheyAreOff) {
   EXPECT_EQ(off.arm.goal_checks, 0);
   EXPECT_EQ(r.events.goal_checks, 0u);
   EXPECT_EQ(off.clock.goal_check_charges, 0);
+}
+
+TEST(NbvLoop, MovesThatWentBackTheWayInAreCounted) {
+  Rig rig;
+  rig.arm.retreat_every = 2;
+  const NbvResult r = rig.run(StopCondition::views(5));  // four moves
+  EXPECT_EQ(r.events.retreats, 2u);
+  EXPECT_EQ(r.events.motion_status.at("success"), 4u);
 }
 
 TEST(NbvLoop, ARefusedMoveIsCountedAndPlannedAgainWithoutACapture) {
@@ -260,6 +279,39 @@ TEST(NbvLoop, AMoveStartsTheStallCountAfresh) {
   const NbvResult r = rig.run(StopCondition::stalled(2) || StopCondition::views(4));
   EXPECT_EQ(r.stop_reason, "max_views");
   EXPECT_EQ(r.events.iterations_without_move, 2u);
+}
+
+TEST(NbvLoop, FailedPlansEndAnIterationAndTheStallRuleEndsTheLoop) {
+  Rig rig;
+  rig.planner.per_round = 10;
+  rig.arm.fail_with = MoveStatus::kTimeout;
+  rig.options.max_failed_plans = 3;
+  const NbvResult r = rig.run(StopCondition::stalled(2) || StopCondition::views(5));
+  EXPECT_EQ(r.stop_reason, "no_reachable_view");
+  EXPECT_EQ(r.events.planning_iterations, 2u);
+  EXPECT_EQ(r.events.move_attempts, 6u);  // 3 of each iteration's 10 views
+  EXPECT_EQ(r.events.motion_status.at("timeout"), 6u);
+  EXPECT_EQ(r.events.iterations_ended_by_failed_plans, 2u);
+}
+
+TEST(NbvLoop, FailuresThatCostNoPlanningDoNotEndAnIteration) {
+  for (const MoveStatus status :
+       {MoveStatus::kNoIk, MoveStatus::kNoCollisionFreeIk, MoveStatus::kRefused}) {
+    Rig rig;
+    rig.planner.per_round = 10;
+    rig.arm.fail_with = status;
+    rig.options.max_failed_plans = 3;
+    const NbvResult r = rig.run(StopCondition::stalled(1) || StopCondition::views(5));
+    EXPECT_EQ(r.events.move_attempts, 10u) << toString(status);
+    EXPECT_EQ(r.events.iterations_ended_by_failed_plans, 0u) << toString(status);
+  }
+  Rig unlimited;
+  unlimited.planner.per_round = 10;
+  unlimited.arm.fail_with = MoveStatus::kNoPath;
+  unlimited.options.max_failed_plans = 0;
+  const NbvResult r = unlimited.run(StopCondition::stalled(1) || StopCondition::views(5));
+  EXPECT_EQ(r.events.move_attempts, 10u);
+  EXPECT_EQ(r.events.iterations_ended_by_failed_plans, 0u);
 }
 
 TEST(StopCondition, RefusesNonsenseAndReportsTheFirstThatHolds) {

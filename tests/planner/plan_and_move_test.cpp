@@ -68,6 +68,28 @@ TEST(PlanAndMove, TriesRankedViewsInOrderAndStopsAtTheFirstMove) {
   EXPECT_EQ(step.sampling_rounds, 2u);
 }
 
+TEST(PlanAndMove, GiveUpEndsTheIterationAfterAFailedMove) {
+  ScriptedPlanner planner(3, 3);
+  std::vector<double> tried;
+  std::size_t asked = 0;
+  const PlanStep step = planAndMove(
+      planner, someMap(), Eigen::Isometry3d::Identity(), {},
+      [&](const Eigen::Isometry3d& T) {
+        tried.push_back(T.translation().x());
+        return T.translation().x() == 10.0;  // round 1's last: never reached
+      },
+      {}, kDefaultGoalCheckBatch, 0.0, [&] { return ++asked == 4; });
+  EXPECT_EQ(tried, (std::vector<double>{2, 1, 0, 12}));  // into round 1, then no more
+  EXPECT_EQ(asked, 4u);                                  // once after each failed move
+  EXPECT_TRUE(step.gave_up);
+  EXPECT_FALSE(step.moved());
+  EXPECT_EQ(step.move_attempts, 4u);
+  EXPECT_EQ(step.failed_moves, 4u);
+  // The cut round is told it moved nowhere, and no round follows it.
+  EXPECT_EQ(planner.outcomes, (std::vector<bool>{false, false}));
+  EXPECT_EQ(step.sampling_rounds, 2u);
+}
+
 TEST(PlanAndMove, GivesUpWhenThePlannerHasNoRoundLeft) {
   ScriptedPlanner planner(2, 2);
   const PlanStep step = planAndMove(planner, someMap(), Eigen::Isometry3d::Identity(), {},
@@ -77,6 +99,7 @@ TEST(PlanAndMove, GivesUpWhenThePlannerHasNoRoundLeft) {
   EXPECT_EQ(step.failed_moves, 4u);
   EXPECT_EQ(planner.outcomes, (std::vector<bool>{false, false}));
   EXPECT_EQ(step.candidates.size(), 2u);  // the last round's
+  EXPECT_FALSE(step.gave_up);             // no give_up given
 }
 
 /// A goal check by the view's x: 1 has no IK, 2 only IK solutions in collision, the rest pass.

@@ -325,6 +325,16 @@ TEST(PlannedArm, TheMapIsFreedWhereTheArmStands) {
   EXPECT_EQ(robot.arm.moveTo(robot.reachableGoal()).status, MoveStatus::kSuccess);
 }
 
+TEST(PlannedArm, AMoveThatWentBackTheWayInSaysSo) {
+  PlannedMove move;
+  move.status = host::nbv::MoveStatus::kSuccess;
+  EXPECT_FALSE(move.result().retreated);
+  move.plan.retreat_turn = 2;  // the way back's last waypoint, where the onward path began
+  EXPECT_TRUE(move.result().retreated);
+  move.status = host::nbv::MoveStatus::kRefused;  // a plan that did not move the arm
+  EXPECT_FALSE(move.result().retreated);
+}
+
 TEST(PlannedArm, MisconfigurationThrows) {
   FakeRobot robot(RecordingExecutor::Mode::kMove);
   EXPECT_THROW(PlannedArm(robot.model, robot.reachability, robot.joints, robot.executor, 0.0),

@@ -197,6 +197,7 @@ class TrialLog : public host::nbv::LoopObserver {
          {"moved", step.moved()},
          {"move_attempts", step.move_attempts},
          {"failed_moves", step.failed_moves},
+         {"ended_by_failed_plans", step.gave_up},
          {"sampling_rounds", step.sampling_rounds},
          {"chosen_utility",
           step.chosen ? nlohmann::json(step.candidates[*step.chosen].utility) : nlohmann::json()},
@@ -349,6 +350,8 @@ nlohmann::json eventsJson(const host::nbv::NbvEvents& events) {
           {"dropped_disparities", events.dropped_disparities},
           {"saturated_disparities", events.saturated_disparities},
           {"collision_voxels_freed_at_arm", events.obstacle_update_count},
+          {"iterations_ended_by_failed_plans", events.iterations_ended_by_failed_plans},
+          {"retreats", events.retreats},
           {"dropped_frames", events.dropped_frames},
           {"motion_status", events.motion_status}};
 }

@@ -50,6 +50,7 @@ planner::PlanStep NbvLoop::planAndMove_(map::MapEngine& map, NbvResult& out, dou
   // the arm's to account for: a simulated arm charges the simulated clock itself) and the
   // goal checks, each batch of which is a compute stage of its own.
   double move_wall_s = 0.0, goal_check_wall_s = 0.0;
+  std::size_t failed_plans = 0;
   const planner::ReachabilityFn reachable = [&](const Eigen::Isometry3d& T) {
     return arm_.reachable(T);
   };
@@ -59,7 +60,12 @@ planner::PlanStep NbvLoop::planAndMove_(map::MapEngine& map, NbvResult& out, dou
     move_wall_s += secondsSince(t_move);
     out.wall_s.motion_planning += moved.planning_wall_s;
     ++events.motion_status[toString(moved.status)];
+    events.retreats += moved.retreated ? 1 : 0;
+    if (moved.status == MoveStatus::kTimeout || moved.status == MoveStatus::kNoPath) ++failed_plans;
     return moved.ok();
+  };
+  const planner::GiveUpFn give_up = [&] {
+    return options_.max_failed_plans > 0 && failed_plans >= options_.max_failed_plans;
   };
   planner::GoalCheckFn check_goals;
   if (arm_.checksGoals() && options_.goal_check_batch > 0) {
@@ -77,7 +83,7 @@ planner::PlanStep NbvLoop::planAndMove_(map::MapEngine& map, NbvResult& out, dou
   const auto t_plan = Clock::now();
   planner::PlanStep step =
       planner::planAndMove(planner_, map, arm_.cameraPose(), reachable, move, check_goals,
-                           options_.goal_check_batch, options_.view_overhead_s);
+                           options_.goal_check_batch, options_.view_overhead_s, give_up);
   plan_s = std::max(0.0, secondsSince(t_plan) - move_wall_s - goal_check_wall_s);
   out.wall_s.planning += plan_s;
   out.wall_s.goal_check += goal_check_wall_s;
@@ -86,6 +92,7 @@ planner::PlanStep NbvLoop::planAndMove_(map::MapEngine& map, NbvResult& out, dou
   ++events.planning_iterations;
   events.move_attempts += step.move_attempts;
   events.failed_moves += step.failed_moves;
+  events.iterations_ended_by_failed_plans += step.gave_up ? 1 : 0;
   events.rejected_clearance += step.rejected_clearance;
   events.goal_checks += step.goal_checks;
   events.goal_check_batches += step.goal_check_batches;

@@ -82,7 +82,8 @@ void rankBatchByInformationRate(const std::vector<Candidate>& candidates,
 PlanStep planAndMove(ViewPlanner& planner, map::MapEngine& map,
                      const Eigen::Isometry3d& T_world_camera_now, const ReachabilityFn& reachable,
                      const MoveToPoseFn& move, const GoalCheckFn& check_goals,
-                     std::size_t goal_check_batch, double view_overhead_s) {
+                     std::size_t goal_check_batch, double view_overhead_s,
+                     const GiveUpFn& give_up) {
   PlanStep step;
   for (std::size_t round = 0;; ++round) {
     std::optional<Ranking> ranking = planner.rank(map, T_world_camera_now, reachable, round, step);
@@ -109,9 +110,13 @@ PlanStep planAndMove(ViewPlanner& planner, map::MapEngine& map,
         break;
       }
       ++step.failed_moves;
+      if (give_up && give_up()) {
+        step.gave_up = true;
+        break;
+      }
     }
     planner.roundDone(step.moved());
-    if (step.moved()) break;
+    if (step.moved() || step.gave_up) break;
   }
   return step;
 }

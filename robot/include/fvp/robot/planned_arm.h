@@ -32,7 +32,8 @@ struct PlannedMove {
   ExecutionResult execution;  ///< kFailed with no detail when nothing was executed
   host::nbv::MoveResult result() const {
     const bool moved = status == host::nbv::MoveStatus::kSuccess;
-    return {status, plan.planning_wall_s, moved ? plan.trajectory.duration_s() : 0.0};
+    return {status, plan.planning_wall_s, moved ? plan.trajectory.duration_s() : 0.0,
+            moved && plan.retreated()};
   }
 };
 

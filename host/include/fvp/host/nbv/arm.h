@@ -35,6 +35,8 @@ struct MoveResult {
   /// The arm's time in motion: the executed trajectory's duration (0 when it did not move,
   /// or for an arm that does not say).
   double motion_s = 0.0;
+  /// The move first went back the way the arm came in (robot::ArmConfig::retreat_share).
+  bool retreated = false;
   bool ok() const { return status == MoveStatus::kSuccess; }
 };
 

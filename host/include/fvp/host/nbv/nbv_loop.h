@@ -46,6 +46,8 @@ class LoopObserver {
   virtual void onDroppedFrame(const std::string& detail) { (void)detail; }
 };
 
+inline constexpr std::size_t kDefaultMaxFailedPlans = 6;
+
 struct NbvLoopOptions {
   /// Frames dropped in a row after which the loop stops ("camera_failed"): a camera that
   /// never delivers must not spin the loop forever.
@@ -56,6 +58,11 @@ struct NbvLoopOptions {
   /// A view's cost besides its move, for trying each checked batch by information per
   /// second (planAndMove); 0: the planner's own order.
   double view_overhead_s = planner::kDefaultViewOverheadS;
+  /// Motion plans that failed (timed out or found no path: the failures that cost the arm's
+  /// planning time) after which a planning iteration ends without a move; the stall rule
+  /// (StopCondition::stalled) then counts it. 0: no limit. Why 6: docs/nbv-loop.md,
+  /// "Failed plans end an iteration".
+  std::size_t max_failed_plans = kDefaultMaxFailedPlans;
 };
 
 /// Counted expected events of a run (never errors).
@@ -63,6 +70,10 @@ struct NbvEvents {
   std::size_t planning_iterations = 0, iterations_without_move = 0, move_attempts = 0,
               failed_moves = 0, rejected_clearance = 0, culled_rays = 0, views_without_tag = 0,
               dropped_frames = 0, obstacle_update_count = 0;
+  /// Planning iterations ended by NbvLoopOptions::max_failed_plans.
+  std::size_t iterations_ended_by_failed_plans = 0;
+  /// Moves that first went back the way the arm came in (MoveResult::retreated).
+  std::size_t retreats = 0;
   /// The arm's goal checks (PlanStep): poses checked, calls, and ranked views turned down.
   std::size_t goal_checks = 0, goal_check_batches = 0, rejected_no_ik = 0,
               rejected_no_collision_free_ik = 0;

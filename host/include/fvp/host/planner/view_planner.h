@@ -49,6 +49,10 @@ struct Candidate {
 using ReachabilityFn = std::function<bool(const Eigen::Isometry3d& T_world_camera)>;
 /// Plans and executes a move; false when it failed (no IK, no path, timeout: counted).
 using MoveToPoseFn = std::function<bool(const Eigen::Isometry3d& T_world_camera)>;
+/// Asked after each failed move of a planning iteration; true ends the iteration without a
+/// move (as OMPL's PlannerTerminationCondition ends a query): the caller knows what the
+/// failures cost and whether more are worth trying.
+using GiveUpFn = std::function<bool()>;
 
 /// Named wall-time parts of one planning iteration (e.g. "snapshot", "sample", "cull",
 /// "info_gain", "select"), in seconds, in the order they ran.
@@ -62,6 +66,7 @@ struct PlanStep {
   std::optional<std::size_t> chosen;
   std::size_t move_attempts = 0;  ///< moveToPose calls this iteration
   std::size_t failed_moves = 0;   ///< of which failed
+  bool gave_up = false;           ///< ended by planAndMove's give_up after a failed move
   /// Ranked views the arm's goal check (goal_check.h) was asked about, in how many calls, and
   /// those it turned down before a move was tried (not counted as move attempts).
   std::size_t goal_checks = 0, goal_check_batches = 0;
@@ -122,11 +127,12 @@ class ViewPlanner {
 /// With view_overhead_s > 0 and the check's travel times, each checked batch is tried by
 /// information per second of the robot's time, ig / (travel_s + view_overhead_s): the
 /// planner's rule picks the views worth a move, the arm's time orders them
-/// (docs/nbv-loop.md, "Views ranked by time").
+/// (docs/nbv-loop.md, "Views ranked by time"). give_up (optional) is asked after each failed
+/// move; when it says so the round ends as one without a move and the iteration ends there.
 PlanStep planAndMove(ViewPlanner& planner, map::MapEngine& map,
                      const Eigen::Isometry3d& T_world_camera_now, const ReachabilityFn& reachable,
                      const MoveToPoseFn& move, const GoalCheckFn& check_goals = {},
                      std::size_t goal_check_batch = kDefaultGoalCheckBatch,
-                     double view_overhead_s = kDefaultViewOverheadS);
+                     double view_overhead_s = kDefaultViewOverheadS, const GiveUpFn& give_up = {});
 
 }  // namespace fvp::host::planner
