@@ -31,6 +31,7 @@ void PyObserver::onPlan(const host::nbv::PlanEvent& e) {
   d["candidates"] = e.step->candidates.size();
   d["moved"] = e.step->moved();
   d["move_attempts"] = e.step->move_attempts;
+  d["ended_by_failed_plans"] = e.step->gave_up;
   d["planning_s"] = e.planning_s;
   d["now_s"] = e.now_s;
   target_.attr("on_plan")(d);
@@ -53,6 +54,8 @@ py::dict nbvResultToDict(const host::nbv::NbvResult& r) {
   events["iterations_without_move"] = e.iterations_without_move;
   events["move_attempts"] = e.move_attempts;
   events["failed_moves"] = e.failed_moves;
+  events["iterations_ended_by_failed_plans"] = e.iterations_ended_by_failed_plans;
+  events["retreats"] = e.retreats;
   events["goal_checks"] = e.goal_checks;
   events["candidates_rejected_no_ik"] = e.rejected_no_ik;
   events["candidates_rejected_no_collision_free_ik"] = e.rejected_no_collision_free_ik;
@@ -109,10 +112,11 @@ void bindLoop(py::module_& m) {
       "run_nbv",
       [](Session& session, Planner& planner, host::nbv::Camera& camera, host::nbv::Arm& arm,
          const host::nbv::StopCondition& stop, const py::object& observer,
-         int max_consecutive_dropped_frames) {
+         int max_consecutive_dropped_frames, std::size_t max_failed_plans) {
         host::nbv::SteadyLoopClock clock;
         host::nbv::NbvLoopOptions options;
         options.max_consecutive_dropped_frames = max_consecutive_dropped_frames;
+        options.max_failed_plans = max_failed_plans;
         host::nbv::NbvLoop loop(*session.session, *planner.planner, camera, arm, clock, options);
         std::optional<PyObserver> hooks;
         if (!observer.is_none()) hooks.emplace(observer);
@@ -126,8 +130,11 @@ void bindLoop(py::module_& m) {
       },
       py::arg("session"), py::arg("planner"), py::arg("camera"), py::arg("arm"), py::arg("stop"),
       py::arg("observer") = py::none(), py::arg("max_consecutive_dropped_frames") = 10,
+      py::arg("max_failed_plans") = host::nbv::kDefaultMaxFailedPlans,
       "The next-best-view loop on the wall clock: capture at the arm's pose, perceive and map, "
-      "plan, move, until stop holds. Returns views, stop_reason, camera_poses, events, wall_s.");
+      "plan, move, until stop holds; a planning iteration ends after max_failed_plans timed-out "
+      "or pathless motion plans (0: no limit). Returns views, stop_reason, camera_poses, events, "
+      "wall_s.");
 }
 
 }  // namespace fvp::python

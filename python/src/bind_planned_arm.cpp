@@ -141,6 +141,7 @@ py::dict moveToDict(const robot::PlannedMove& move) {
   out["planning_wall_s"] = move.plan.planning_wall_s;
   out["motion_status"] = robot::toString(move.plan.status);
   out["duration_s"] = move.plan.ok() ? move.plan.trajectory.duration_s() : 0.0;
+  out["retreated"] = move.result().retreated;
   out["execution"] = move.plan.ok() ? py::cast(move.execution.status) : py::none();
   out["detail"] = move.execution.detail;
   return out;

@@ -125,15 +125,17 @@ void bindMoveResult(py::module_& m) {
   py::class_<MoveResult>(m, "MoveResult",
                          "How a move ended, the planning time it took and the arm's time in "
                          "motion.")
-      .def(py::init([](MoveStatus s, double planning_wall_s, double motion_s) {
+      .def(py::init([](MoveStatus s, double planning_wall_s, double motion_s, bool retreated) {
              if (!(motion_s >= 0.0) || !std::isfinite(motion_s))
                throw py::value_error("fvp.MoveResult: motion_s: expected seconds >= 0");
-             return MoveResult{s, planning_wall_s, motion_s};
+             return MoveResult{s, planning_wall_s, motion_s, retreated};
            }),
-           py::arg("status"), py::arg("planning_wall_s") = 0.0, py::arg("motion_s") = 0.0)
+           py::arg("status"), py::arg("planning_wall_s") = 0.0, py::arg("motion_s") = 0.0,
+           py::arg("retreated") = false)
       .def_readonly("status", &MoveResult::status)
       .def_readonly("planning_wall_s", &MoveResult::planning_wall_s)
       .def_readonly("motion_s", &MoveResult::motion_s)
+      .def_readonly("retreated", &MoveResult::retreated)
       .def_property_readonly("ok", &MoveResult::ok);
 }
 

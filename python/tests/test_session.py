@@ -184,6 +184,34 @@ def test_run_nbv_with_a_python_stop_predicate_and_dropped_frames():
     assert len(result["camera_poses"]) == 3
 
 
+class TimingOutArm(SimArm):
+    """Every plan times out; a move reports how it ended."""
+
+    def move_to(self, T):
+        return fvp.MoveResult(fvp.MoveStatus.timeout, planning_wall_s=1.0)
+
+
+def test_run_nbv_ends_an_iteration_after_max_failed_plans():
+    trial = fvp.sim.Trial(seed=2, clock="fixed", backend="cpu")
+    session = fvp.MappingSession(backend="cpu")
+    planner = fvp.Planner("fvp", seed=2, backend="cpu")
+    plans = []
+
+    class Log:
+        def on_plan(self, plan):
+            plans.append(plan)
+
+    stop = fvp.StopCondition(lambda s: s.iterations >= 2, "two_iterations")
+    result = fvp.run_nbv(session, planner, trial.camera, TimingOutArm(trial.arm), stop,
+                         observer=Log(), max_failed_plans=2)
+    assert result["events"]["move_attempts"] == 4  # two per iteration, then it gives up
+    assert result["events"]["iterations_ended_by_failed_plans"] == 2
+    assert result["events"]["retreats"] == 0
+    assert [p["ended_by_failed_plans"] for p in plans] == [True, True]
+    assert fvp.MoveResult(fvp.MoveStatus.success, retreated=True).retreated
+    assert not fvp.MoveResult(fvp.MoveStatus.success).retreated
+
+
 def test_size_captures_is_fvp_size_as_a_function(capture_set, tmp_path):
     result = fvp.size_captures(str(capture_set), out_dir=str(tmp_path / "sized"), backend="cpu")
     assert result["cluster_region_found"]

@@ -68,7 +68,9 @@ class FakeCamera : public Camera {
   std::size_t frame_;
 };
 
-/// An arm that refuses every `refuse_every`-th move (1-based), else moves instantly.
+/// An arm that fails every move with `fail_with` when set; else refuses every
+/// `refuse_every`-th move (1-based), reports every `retreat_every`-th as having gone back the
+/// way in, and moves instantly.
 class FakeArm : public Arm {
  public:
   Eigen::Isometry3d cameraPose() const override { return pose_; }
@@ -282,21 +284,25 @@ TEST(NbvLoop, AMoveStartsTheStallCountAfresh) {
 }
 
 TEST(NbvLoop, FailedPlansEndAnIterationAndTheStallRuleEndsTheLoop) {
-  Rig rig;
-  rig.planner.per_round = 10;
-  rig.arm.fail_with = MoveStatus::kTimeout;
-  rig.options.max_failed_plans = 3;
-  const NbvResult r = rig.run(StopCondition::stalled(2) || StopCondition::views(5));
-  EXPECT_EQ(r.stop_reason, "no_reachable_view");
-  EXPECT_EQ(r.events.planning_iterations, 2u);
-  EXPECT_EQ(r.events.move_attempts, 6u);  // 3 of each iteration's 10 views
-  EXPECT_EQ(r.events.motion_status.at("timeout"), 6u);
-  EXPECT_EQ(r.events.iterations_ended_by_failed_plans, 2u);
+  for (const MoveStatus status : {MoveStatus::kTimeout, MoveStatus::kNoPath}) {
+    Rig rig;
+    rig.planner.per_round = 10;
+    rig.arm.fail_with = status;
+    rig.options.max_failed_plans = 3;
+    const NbvResult r = rig.run(StopCondition::stalled(2) || StopCondition::views(5));
+    EXPECT_EQ(r.stop_reason, "no_reachable_view") << toString(status);
+    EXPECT_EQ(r.events.planning_iterations, 2u) << toString(status);
+    EXPECT_EQ(r.events.move_attempts, 6u) << toString(status);  // 3 of each iteration's 10
+    EXPECT_EQ(r.events.motion_status.at(toString(status)), 6u);
+    EXPECT_EQ(r.events.iterations_ended_by_failed_plans, 2u) << toString(status);
+  }
 }
 
-TEST(NbvLoop, FailuresThatCostNoPlanningDoNotEndAnIteration) {
+TEST(NbvLoop, OnlyFailedPlansEndAnIteration) {
+  // Failures before any planning, and after a plan was found, do not count.
   for (const MoveStatus status :
-       {MoveStatus::kNoIk, MoveStatus::kNoCollisionFreeIk, MoveStatus::kRefused}) {
+       {MoveStatus::kNoIk, MoveStatus::kNoCollisionFreeIk, MoveStatus::kStartInvalid,
+        MoveStatus::kRefused, MoveStatus::kExecutionFailed}) {
     Rig rig;
     rig.planner.per_round = 10;
     rig.arm.fail_with = status;

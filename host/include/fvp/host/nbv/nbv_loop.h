@@ -46,6 +46,7 @@ class LoopObserver {
   virtual void onDroppedFrame(const std::string& detail) { (void)detail; }
 };
 
+/// NbvLoopOptions::max_failed_plans' default (docs/nbv-loop.md, "Failed plans end an iteration").
 inline constexpr std::size_t kDefaultMaxFailedPlans = 6;
 
 struct NbvLoopOptions {
@@ -58,10 +59,9 @@ struct NbvLoopOptions {
   /// A view's cost besides its move, for trying each checked batch by information per
   /// second (planAndMove); 0: the planner's own order.
   double view_overhead_s = planner::kDefaultViewOverheadS;
-  /// Motion plans that failed (timed out or found no path: the failures that cost the arm's
-  /// planning time) after which a planning iteration ends without a move; the stall rule
-  /// (StopCondition::stalled) then counts it. 0: no limit. Why 6: docs/nbv-loop.md,
-  /// "Failed plans end an iteration".
+  /// Motion plans that failed (timed out, which costs the arm its whole planning time, or
+  /// found no path) after which a planning iteration ends without a move; the stall rule
+  /// (StopCondition::stalled), where there is one, then counts it. 0: no limit.
   std::size_t max_failed_plans = kDefaultMaxFailedPlans;
 };
 
