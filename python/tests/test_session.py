@@ -165,10 +165,14 @@ class SimArm(fvp.Arm):
         return self.inner.move_to(T)
 
 
+def loop_parts(seed):
+    """A simulated world (its camera and arm), an empty session and FVP, for run_nbv."""
+    trial = fvp.sim.Trial(seed=seed, clock="fixed", backend="cpu")
+    return trial, fvp.MappingSession(backend="cpu"), fvp.Planner("fvp", seed=seed, backend="cpu")
+
+
 def test_run_nbv_with_a_python_stop_predicate_and_dropped_frames():
-    trial = fvp.sim.Trial(seed=2, clock="fixed", backend="cpu")
-    session = fvp.MappingSession(backend="cpu")
-    planner = fvp.Planner("fvp", seed=2, backend="cpu")
+    trial, session, planner = loop_parts(seed=2)
     seen = []
 
     class Log:
@@ -192,9 +196,7 @@ class TimingOutArm(SimArm):
 
 
 def test_run_nbv_ends_an_iteration_after_max_failed_plans():
-    trial = fvp.sim.Trial(seed=2, clock="fixed", backend="cpu")
-    session = fvp.MappingSession(backend="cpu")
-    planner = fvp.Planner("fvp", seed=2, backend="cpu")
+    trial, session, planner = loop_parts(seed=2)
     plans = []
 
     class Log:
